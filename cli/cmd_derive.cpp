@@ -1,0 +1,87 @@
+// plant derive / plant check
+#include "commands.hpp"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <sys/resource.h>
+#include <unistd.h>
+
+namespace plant::cli {
+
+namespace {
+
+struct DeriveCmd {
+    GrammarOptions g;
+    bool ids = false;
+    bool stats = false;
+};
+
+long peak_rss_kb() {
+    rusage ru{};
+    getrusage(RUSAGE_SELF, &ru);
+    return ru.ru_maxrss;
+}
+
+int derive_main(const DeriveCmd& c) {
+    int exit_code = kOk;
+    SourceManager sources;
+    auto program = load_program(c.g, sources, exit_code);
+    if (!program) return exit_code;
+    DeriveOptions opt = derive_options(c.g);
+    const bool progress = !c.stats && isatty(2);
+    double total_ms = 0;
+    std::string stats_out;
+    opt.on_step = [&](const StepStats& s) {
+        total_ms += s.ms;
+        if (c.stats) stats_out += fmt::format("step {} modules={} bytes={} ms={:.3f}\n", s.step, s.modules, s.bytes, s.ms);
+        if (progress) std::cerr << fmt::format("\rstep {}: {} modules   ", s.step, s.modules) << std::flush;
+    };
+    opt.on_print = [](const std::string& text) { std::cerr << text; };
+    Derivation d(*program, opt);
+    bool ok = run_derivation(d, sources, c.g.color);
+    if (progress) std::cerr << "\r\x1b[K" << std::flush;
+    if (!ok) return kRuntime;
+    if (c.stats) {
+        stats_out += fmt::format("total steps={} modules={} bytes={} ms={:.3f} peak_rss_kb={}\n", d.steps_done(),
+                                 d.string().size(), d.string().bytes(), total_ms, peak_rss_kb());
+        std::fwrite(stats_out.data(), 1, stats_out.size(), stdout);
+        return kOk;
+    }
+    std::string text = format_string(*program, d.string(), c.ids);
+    text += '\n';
+    std::fwrite(text.data(), 1, text.size(), stdout);
+    if (std::fflush(stdout) != 0) {
+        std::cerr << "plant: cannot write the string to standard output\n";
+        return kFailed;
+    }
+    return kOk;
+}
+
+} // namespace
+
+void setup_derive(CLI::App& app, int& exit_code) {
+    auto c = std::make_shared<DeriveCmd>();
+    CLI::App* cmd = app.add_subcommand("derive", "Derive a grammar and print the string in ABOP notation");
+    add_grammar_options(*cmd, c->g, true);
+    cmd->add_flag("--ids", c->ids, "Show each module's identity after it, as F(1)#7");
+    cmd->add_flag("--stats", c->stats, "Print counts and timings per step instead of the string");
+    cmd->callback([c, &exit_code] { exit_code = derive_main(*c); });
+}
+
+void setup_check(CLI::App& app, int& exit_code) {
+    auto c = std::make_shared<GrammarOptions>();
+    CLI::App* cmd = app.add_subcommand("check", "Parse and check a grammar; print its diagnostics only");
+    add_grammar_options(*cmd, *c, false);
+    cmd->callback([c, &exit_code] {
+        SourceManager sources;
+        int code = kOk;
+        auto program = load_program(*c, sources, code);
+        exit_code = program ? kOk : code;
+    });
+}
+
+} // namespace plant::cli

@@ -1,0 +1,294 @@
+// plant test: golden files and script tests.
+//
+// A .plant file with `# expect...` comments is a script test: it is derived (or checked) by a
+// child `plant` process and its standard output, diagnostics and exit code are compared with
+// the comments:
+//   # args: -n 3 --seed 7           extra command-line arguments
+//   # command: check                run `plant check` instead of `plant derive`
+//   # expect: LINE                  one line of standard output, in order
+//   # expect error: 3:14: message   an error at line 3, column 14 (or without position)
+//   # expect warning: 3:14: message a warning
+//   # expect exit: 70               the exit code (default 65 with errors, else 0)
+// A file without such comments is a golden test: its derived string is compared with the
+// sidecar NAME.txt beside it, which `--bless` rewrites.
+#include "commands.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <regex>
+#include <fcntl.h>
+#include <spawn.h>
+#include <sstream>
+#include <sys/wait.h>
+#include <unistd.h>
+
+extern char** environ;
+
+namespace plant::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Outcome {
+    int exit_code = -1;
+    std::string out, err;
+};
+
+std::string slurp(const std::string& path) {
+    std::string s;
+    read_file(path, s);
+    return s;
+}
+
+// Runs this program with `args`, capturing standard output and error through temporary files.
+Outcome run_self(const std::vector<std::string>& args) {
+    Outcome o;
+    char out_name[] = "/tmp/plant-test-out-XXXXXX";
+    char err_name[] = "/tmp/plant-test-err-XXXXXX";
+    int out_fd = mkstemp(out_name);
+    int err_fd = mkstemp(err_name);
+    if (out_fd < 0 || err_fd < 0) {
+        o.err = "cannot create temporary files";
+        return o;
+    }
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_adddup2(&fa, out_fd, 1);
+    posix_spawn_file_actions_adddup2(&fa, err_fd, 2);
+    posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+    std::vector<char*> argv;
+    std::string self = fs::read_symlink("/proc/self/exe").string();
+    argv.push_back(self.data());
+    std::vector<std::string> copy = args;
+    for (auto& a : copy) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    // children print without colour and see the same environment
+    setenv("NO_COLOR", "1", 1);
+    pid_t pid = 0;
+    if (posix_spawn(&pid, self.c_str(), &fa, nullptr, argv.data(), environ) == 0) {
+        int status = 0;
+        waitpid(pid, &status, 0);
+        o.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    }
+    posix_spawn_file_actions_destroy(&fa);
+    close(out_fd);
+    close(err_fd);
+    o.out = slurp(out_name);
+    o.err = slurp(err_name);
+    unlink(out_name);
+    unlink(err_name);
+    return o;
+}
+
+std::vector<std::string> split_words(const std::string& s) {
+    std::vector<std::string> out;
+    std::istringstream in(s);
+    std::string w;
+    while (in >> w) out.push_back(w);
+    return out;
+}
+
+std::vector<std::string> lines_of(const std::string& s) {
+    std::vector<std::string> out;
+    std::string line;
+    std::istringstream in(s);
+    while (std::getline(in, line)) out.push_back(line);
+    return out;
+}
+
+struct Expectations {
+    bool script = false;
+    std::string command = "derive";
+    std::vector<std::string> args, out, errors, warnings;
+    std::optional<int> exit_code;
+};
+
+Expectations read_expectations(const std::string& text) {
+    Expectations e;
+    for (const auto& raw : lines_of(text)) {
+        auto hash = raw.find('#');
+        if (hash == std::string::npos) continue;
+        std::string c = raw.substr(hash + 1);
+        auto take = [&](const char* key, std::string& rest) {
+            std::string k = std::string(" ") + key;
+            if (c.rfind(k, 0) != 0) return false;
+            rest = c.substr(k.size());
+            if (!rest.empty() && rest[0] == ' ') rest.erase(0, 1);
+            return true;
+        };
+        std::string rest;
+        if (take("args:", rest)) {
+            e.args = split_words(rest);
+        } else if (take("command:", rest)) {
+            e.command = split_words(rest).empty() ? "derive" : split_words(rest)[0];
+            e.script = true;
+        } else if (take("expect error:", rest)) {
+            e.errors.push_back(rest);
+            e.script = true;
+        } else if (take("expect warning:", rest)) {
+            e.warnings.push_back(rest);
+            e.script = true;
+        } else if (take("expect exit:", rest)) {
+            e.exit_code = std::atoi(rest.c_str());
+            e.script = true;
+        } else if (take("expect:", rest)) {
+            e.out.push_back(rest);
+            e.script = true;
+        }
+    }
+    return e;
+}
+
+// Diagnostics from stderr as "LINE:COL: message" (or the bare message when it has no place).
+void parse_diagnostics(const std::string& err, std::vector<std::string>& errors, std::vector<std::string>& warnings) {
+    static const std::regex placed(R"(^.*?:(\d+):(\d+): (error|warning): (.*)$)");
+    static const std::regex bare(R"(^plant: (error|warning): (.*)$)");
+    for (const auto& line : lines_of(err)) {
+        std::smatch m;
+        if (std::regex_match(line, m, placed)) {
+            (m[3] == "error" ? errors : warnings).push_back(fmt::format("{}:{}: {}", m[1].str(), m[2].str(), m[4].str()));
+        } else if (std::regex_match(line, m, bare)) {
+            (m[1] == "error" ? errors : warnings).push_back(m[2].str());
+        }
+    }
+}
+
+std::string compare_lists(const char* what, const std::vector<std::string>& want, const std::vector<std::string>& got) {
+    std::string msg;
+    for (std::size_t i = 0; i < std::max(want.size(), got.size()); ++i) {
+        if (i < want.size() && i < got.size() && want[i] == got[i]) continue;
+        msg += fmt::format("  {} {}:\n    expected: {}\n    got:      {}\n", what, i + 1,
+                           i < want.size() ? want[i] : "(nothing)", i < got.size() ? got[i] : "(nothing)");
+    }
+    return msg;
+}
+
+std::string first_difference(const std::string& want, const std::string& got) {
+    std::size_t i = 0;
+    while (i < want.size() && i < got.size() && want[i] == got[i]) ++i;
+    auto excerpt = [&](const std::string& s) {
+        std::size_t b = i > 30 ? i - 30 : 0;
+        std::string e = s.substr(b, 70);
+        std::replace(e.begin(), e.end(), '\n', ' ');
+        return e;
+    };
+    return fmt::format("  differs at byte {} (expected {} bytes, got {})\n    expected: ...{}\n    got:      ...{}\n", i,
+                       want.size(), got.size(), excerpt(want), excerpt(got));
+}
+
+bool write_atomically(const fs::path& path, const std::string& text) {
+    fs::path tmp = path;
+    tmp += ".tmp";
+    {
+        std::ofstream f(tmp, std::ios::binary);
+        if (!f.write(text.data(), static_cast<std::streamsize>(text.size()))) return false;
+    }
+    std::error_code ec;
+    fs::rename(tmp, path, ec);
+    return !ec;
+}
+
+// Returns an empty string when the test passed, else what went wrong.
+std::string run_one(const fs::path& file, bool bless, bool& blessed) {
+    std::string text;
+    if (!read_file(file.string(), text)) return "  cannot read the file\n";
+    Expectations e = read_expectations(text);
+    std::vector<std::string> args{e.command, file.string()};
+    args.insert(args.end(), e.args.begin(), e.args.end());
+    Outcome o = run_self(args);
+    if (e.script) {
+        std::vector<std::string> errors, warnings;
+        parse_diagnostics(o.err, errors, warnings);
+        std::string msg;
+        int want_exit = e.exit_code ? *e.exit_code : (e.errors.empty() ? 0 : 65);
+        if (o.exit_code != want_exit) msg += fmt::format("  exit code: expected {}, got {}\n", want_exit, o.exit_code);
+        msg += compare_lists("error", e.errors, errors);
+        msg += compare_lists("warning", e.warnings, warnings);
+        if (!e.out.empty() || o.exit_code == 0) {
+            if (!e.out.empty() || (!o.out.empty() && e.command != "check"))
+                msg += compare_lists("output line", e.out, lines_of(o.out));
+        }
+        if (!msg.empty() && !o.err.empty() && errors.empty() && warnings.empty())
+            msg += "  stderr:\n" + o.err;
+        return msg;
+    }
+    fs::path sidecar = file;
+    sidecar.replace_extension(".txt");
+    if (o.exit_code != 0)
+        return fmt::format("  exit code {} (a golden grammar must derive cleanly)\n{}", o.exit_code, o.err);
+    if (bless) {
+        std::string old;
+        if (!read_file(sidecar.string(), old) || old != o.out) {
+            if (!write_atomically(sidecar, o.out)) return "  cannot write " + sidecar.string() + "\n";
+            blessed = true;
+        }
+        return {};
+    }
+    std::string want;
+    if (!read_file(sidecar.string(), want))
+        return fmt::format("  no expectations: add '# expect' comments or create {} with --bless\n", sidecar.string());
+    if (want != o.out) return first_difference(want, o.out);
+    return {};
+}
+
+struct TestCmd {
+    std::vector<std::string> paths;
+    bool bless = false;
+    bool verbose = false;
+};
+
+int test_main(const TestCmd& c) {
+    std::vector<fs::path> files;
+    std::vector<std::string> paths = c.paths.empty() ? std::vector<std::string>{"grammars"} : c.paths;
+    for (const auto& p : paths) {
+        std::error_code ec;
+        if (fs::is_directory(p, ec)) {
+            for (const auto& entry : fs::recursive_directory_iterator(p, ec))
+                if (entry.is_regular_file() && entry.path().extension() == ".plant") files.push_back(entry.path());
+        } else if (fs::exists(p, ec)) {
+            files.emplace_back(p);
+        } else {
+            std::cerr << fmt::format("plant: cannot read '{}': no such file or directory\n", p);
+            return kNoInput;
+        }
+    }
+    std::sort(files.begin(), files.end());
+    int passed = 0, failed = 0, blessed_count = 0;
+    for (const auto& f : files) {
+        bool blessed = false;
+        std::string msg = run_one(f, c.bless, blessed);
+        if (msg.empty()) {
+            ++passed;
+            if (blessed) {
+                ++blessed_count;
+                std::cout << "blessed " << f.string() << "\n";
+            } else if (c.verbose) {
+                std::cout << "ok " << f.string() << "\n";
+            }
+        } else {
+            ++failed;
+            std::cout << "FAIL " << f.string() << "\n" << msg;
+        }
+    }
+    if (c.bless) std::cout << fmt::format("{} sidecar{} rewritten\n", blessed_count, blessed_count == 1 ? "" : "s");
+    std::cout << fmt::format("{} passed, {} failed\n", passed, failed);
+    return failed == 0 && !files.empty() ? kOk : kFailed;
+}
+
+} // namespace
+
+void setup_test(CLI::App& app, int& exit_code) {
+    auto c = std::make_shared<TestCmd>();
+    CLI::App* cmd = app.add_subcommand("test", "Run golden-file and script tests of grammars");
+    cmd->add_option("PATH", c->paths, "Grammar files or directories (default: grammars)");
+    cmd->add_flag("--bless", c->bless, "Rewrite the golden sidecars from the current output (review the diff!)");
+    cmd->add_flag("-v,--verbose", c->verbose, "List passing tests too");
+    cmd->callback([c, &exit_code] { exit_code = test_main(*c); });
+}
+
+} // namespace plant::cli

@@ -1,0 +1,43 @@
+// The `plant` commands. Only this front end prints to the terminal or picks exit codes.
+#pragma once
+
+#include "plant/compiler.hpp"
+#include "plant/derive.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <string>
+#include <vector>
+
+namespace plant::cli {
+
+// Exit codes (sysexits.h): usage 64, unreadable input 66, grammar error 65, runtime error 70.
+enum Exit { kOk = 0, kFailed = 1, kUsage = 64, kGrammar = 65, kNoInput = 66, kRuntime = 70 };
+
+// Options shared by the commands that compile and derive a grammar.
+struct GrammarOptions {
+    std::string file;
+    std::vector<std::string> defines; // name=value
+    std::vector<std::string> include_dirs;
+    std::optional<int> steps;
+    std::optional<std::uint64_t> seed;
+    int threads = 0; // 0: one per core
+    std::size_t max_modules = 50'000'000;
+    bool color = false;
+};
+
+void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation);
+
+// Compiles the grammar, printing diagnostics to stderr. On failure sets `exit_code`.
+std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& sources, int& exit_code);
+
+// Runs a derivation, printing a runtime error as a diagnostic. Returns false on error.
+bool run_derivation(Derivation& d, const SourceManager& sources, bool color);
+
+DeriveOptions derive_options(const GrammarOptions& o);
+
+void setup_derive(CLI::App& app, int& exit_code);
+void setup_check(CLI::App& app, int& exit_code);
+void setup_test(CLI::App& app, int& exit_code);
+
+} // namespace plant::cli

@@ -1,0 +1,38 @@
+// plant: grow plants from parametric L-system grammars.
+#include "commands.hpp"
+
+#include <fmt/format.h>
+
+#include <cstdio>
+#include <iostream>
+
+int main(int argc, char** argv) {
+    using namespace plant::cli;
+    CLI::App app{"plant: an interpreter for the .plant L-system language.\n"
+                 "Grammars are parametric, context-sensitive and stochastic L-systems (see docs/language.md).",
+                 "plant"};
+    app.require_subcommand(1);
+    app.set_help_all_flag("--help-all", "Show help for every command");
+    int exit_code = kOk;
+    setup_derive(app, exit_code);
+    setup_check(app, exit_code);
+    setup_test(app, exit_code);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp&) {
+        std::cout << app.help();
+        return kOk;
+    } catch (const CLI::CallForAllHelp&) {
+        std::cout << app.help("", CLI::AppFormatMode::All);
+        return kOk;
+    } catch (const CLI::ParseError& e) {
+        // CLI11 reports --help of a subcommand as CallForHelp too, caught above; everything else
+        // is a usage error.
+        std::string which;
+        for (const CLI::App* sub : app.get_subcommands()) which = sub->get_name();
+        std::cerr << "plant: " << e.what() << "\n"
+                  << "Run 'plant " << (which.empty() ? "" : which + " ") << "--help' for usage.\n";
+        return kUsage;
+    }
+    return exit_code;
+}

@@ -1,0 +1,103 @@
+// The derivation engine: hooks, parallel rewriting with tree-aware context, stochastic choice,
+// decomposition and cut (LANGUAGE.md sections 4, 6, 7). The result depends only on the program,
+// its parameters and the seed: never on the thread count.
+#pragma once
+
+#include "plant/diagnostics.hpp"
+#include "plant/module_string.hpp"
+#include "plant/program.hpp"
+
+#include <atomic>
+#include <functional>
+#include <optional>
+#include <string>
+
+namespace plant {
+
+// Implemented by the runtime: interprets the string with the turtle and writes the position,
+// heading, up or left vector into every query module (?P ?H ?U ?L). Called before a step whose
+// productions read query modules.
+class QueryPass {
+public:
+    virtual ~QueryPass() = default;
+    virtual void fill_queries(const Program& program, const double* globals, ModuleString& string) = 0;
+};
+
+struct StepStats {
+    int step = 0;
+    std::size_t modules = 0;
+    std::size_t bytes = 0;
+    double ms = 0;
+};
+
+struct DeriveOptions {
+    std::optional<int> steps;          // overrides the grammar's `derive N;`
+    std::optional<std::uint64_t> seed; // overrides the grammar's `seed S;`
+    int threads = 1;
+    std::size_t max_modules = 50'000'000;
+    std::size_t max_bytes = std::size_t{8} << 30; // estimate of the string's memory
+    QueryPass* queries = nullptr;
+    std::function<void(const StepStats&)> on_step;
+    std::function<void(const std::string&)> on_print; // output of print(...) in hooks
+    const std::atomic<bool>* interrupt = nullptr;     // set asynchronously to abandon a step
+};
+
+class Derivation {
+public:
+    Derivation(const Program& program, DeriveOptions options);
+
+    // Evaluates settings, builds the axiom (with decomposition) and runs `on start`.
+    void start();
+    // Runs one step with its hooks. Returns false when the derivation is over (the target step
+    // count was reached or a hook said `stop;`).
+    bool step();
+    // Runs `on end`. Called once, after the last step.
+    void finish();
+    // start(), all steps, finish().
+    void run();
+
+    const ModuleString& string() const { return current_; }
+    ModuleString& mutable_string() { return current_; }
+    int steps_done() const { return step_; }
+    int target_steps() const { return target_; }
+    bool stopped() const { return stopped_; }
+    std::uint64_t seed() const { return seed_; }
+    double default_angle() const { return angle_; }
+    double default_step() const { return step_length_; }
+    double default_width() const { return width_; }
+    std::vector<double>& globals() { return globals_; }
+    int active_group() const { return group_; }
+    ModuleId next_id() const { return next_id_; }
+
+    // The string as the turtle sees it: interpretation rules applied (max_depth passes).
+    ModuleString interpreted(const ModuleString& s) const;
+
+private:
+    void run_hook(HookKind kind);
+    void rewrite(const ModuleString& in, ModuleString& out, const std::vector<const RuleSet*>& sets,
+                 std::uint64_t phase, int step_for_env) const;
+    void decompose(ModuleString& s, int step_for_env);
+    void apply_cut(ModuleString& s) const;
+    void check_limits(const ModuleString& s) const;
+
+    const Program& prog_;
+    DeriveOptions opt_;
+    ModuleString current_;
+    std::vector<double> globals_;
+    int step_ = 0;
+    int target_ = 0;
+    int group_ = -1;
+    bool stopped_ = false;
+    bool started_ = false;
+    std::uint64_t seed_ = 0;
+    double angle_ = 90, step_length_ = 1, width_ = 1;
+    mutable ModuleId next_id_ = 1;
+    mutable double growth_ = 2.0, param_growth_ = 2.0; // last step's growth, for reserving memory
+};
+
+// Formats a string in ABOP notation (LANGUAGE.md section 11).
+std::string format_string(const Program& program, const ModuleString& s, bool with_ids = false);
+// Shortest text that reads back to the same double.
+std::string format_double(double v);
+
+} // namespace plant

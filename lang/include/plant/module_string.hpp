@@ -1,0 +1,60 @@
+// The module string: flat arrays, no per-module heap objects (ARCHITECTURE.md, "Data that
+// matters for speed"). Module i has symbol sym[i], parameters params[poff[i] .. poff[i+1]) and
+// the identity ids[i] (LANGUAGE.md section 6). Vec3 parameters occupy three consecutive doubles.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace plant {
+
+using SymbolId = std::uint32_t;
+using ModuleId = std::uint64_t;
+
+struct ModuleString {
+    std::vector<SymbolId> sym;
+    std::vector<std::uint32_t> poff{0}; // size() + 1 entries
+    std::vector<double> params;
+    std::vector<ModuleId> ids;
+
+    std::size_t size() const { return sym.size(); }
+    bool empty() const { return sym.empty(); }
+    std::uint32_t arity(std::size_t i) const { return poff[i + 1] - poff[i]; }
+    const double* args(std::size_t i) const { return params.data() + poff[i]; }
+    std::span<const double> arg_span(std::size_t i) const { return {params.data() + poff[i], arity(i)}; }
+
+    void clear() {
+        sym.clear();
+        poff.assign(1, 0);
+        params.clear();
+        ids.clear();
+    }
+    void push(SymbolId s, const double* p, std::uint32_t k, ModuleId id) {
+        sym.push_back(s);
+        params.insert(params.end(), p, p + k);
+        poff.push_back(static_cast<std::uint32_t>(params.size()));
+        ids.push_back(id);
+    }
+    // Appends modules [b, e) of another string.
+    void append_range(const ModuleString& o, std::size_t b, std::size_t e);
+    void append(const ModuleString& o) { append_range(o, 0, o.size()); }
+    // Bytes held by the arrays (capacity, not size: what the process really pays).
+    std::size_t bytes() const {
+        return sym.capacity() * sizeof(SymbolId) + poff.capacity() * sizeof(std::uint32_t) +
+               params.capacity() * sizeof(double) + ids.capacity() * sizeof(ModuleId);
+    }
+    void swap(ModuleString& o) noexcept {
+        sym.swap(o.sym);
+        poff.swap(o.poff);
+        params.swap(o.params);
+        ids.swap(o.ids);
+    }
+};
+
+// For each '[' the index of its ']' and for each ']' the index of its '['; other entries are
+// unused. Unbalanced brackets map to size() (no partner). Built once per step, only when some
+// production has context.
+std::vector<std::uint32_t> bracket_table(const ModuleString& s, SymbolId open, SymbolId close);
+
+} // namespace plant

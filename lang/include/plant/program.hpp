@@ -1,0 +1,192 @@
+// The compiled program: what the derivation engine runs. Names are resolved to slots and symbol
+// ids once, here; nothing is looked up by name while rewriting.
+#pragma once
+
+#include "plant/ast.hpp"
+#include "plant/diagnostics.hpp"
+#include "plant/module_string.hpp"
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace plant {
+
+enum class ValueType : std::uint8_t { Number, Bool, Vec3, String, Void };
+inline int value_width(ValueType t) { return t == ValueType::Vec3 ? 3 : (t == ValueType::Void ? 0 : 1); }
+const char* value_type_name(ValueType t);
+
+struct SymbolInfo {
+    std::string name;
+    bool declared = false;  // by `module`, or a built-in turtle or query symbol
+    bool turtle = false;    // has a meaning for the turtle (LANGUAGE.md section 10)
+    bool query = false;     // ?P ?H ?U ?L ?E
+    int arity = -1;         // declared parameter count; -1 when any count is accepted
+    int max_arity = -1;     // for built-ins: the most parameters accepted
+    std::vector<ValueType> param_types;
+    std::vector<std::string> param_names;
+    std::string bound_to;   // climber environment for physics-bound segments
+    Span decl_span;
+};
+
+class SymbolTable {
+public:
+    SymbolTable();
+    SymbolId intern(std::string_view name);
+    std::optional<SymbolId> find(std::string_view name) const;
+    const SymbolInfo& operator[](SymbolId id) const { return infos_[id]; }
+    SymbolInfo& operator[](SymbolId id) { return infos_[id]; }
+    std::size_t size() const { return infos_.size(); }
+    const std::vector<SymbolInfo>& all() const { return infos_; }
+
+    SymbolId open_bracket = 0, close_bracket = 0, cut = 0;
+
+private:
+    std::vector<SymbolInfo> infos_;
+    std::unordered_map<std::string, SymbolId> index_;
+};
+
+// ---- compiled expressions and statements: a small stack machine over doubles -----------------
+
+enum class Op : std::uint8_t {
+    Const,      // push consts[a]
+    Const3,     // push consts[a..a+3)
+    LoadLocal,  // push frame[a .. a+n)
+    StoreLocal, // pop n into frame[a ..)
+    LoadGlobal, // push globals[a .. a+n)
+    StoreGlobal,
+    Pop,        // drop n
+    Add, Sub, Mul, Div, Mod, Neg, Not,
+    Lt, Le, Gt, Ge, Eq, Ne,
+    VAdd, VSub, VMulS, VSMul, VDivS, VNeg, VEq, VNe, // vec3 arithmetic (S: scalar operand)
+    Member,     // pop vec3, push component a
+    Jump,       // pc = a
+    JumpIfZero, // pop; if 0 pc = a
+    JumpIfZeroKeep, JumpIfNonZeroKeep, // for && and ||: inspect top, jump keeping it, else pop
+    Builtin,    // call builtin a with its known argument types (b: variant)
+    Call,       // call user function a
+    Return,     // end a function with the value on top (or nothing)
+    Emit,       // pop the parameters of module a (n doubles) and append it to the output
+    ProduceEnd, // produce: the body has applied and ends
+    NProduceMark, // marks that something was produced
+    Use,        // select rule group a (-1: none)
+    Stop,       // stop the derivation after the current hook
+    Print,      // pop n values described by print_formats[a] and print them
+    ForCheck,   // loop guard: frame[a] < frame[a+1] else jump to b-th label (uses `jump`)
+    Halt,
+};
+
+struct Instr {
+    Op op;
+    std::uint8_t n = 0;   // widths, argument counts
+    std::uint16_t b = 0;  // secondary operand
+    std::int32_t a = 0;   // primary operand
+};
+
+struct Code {
+    std::vector<Instr> instrs;
+    std::vector<Span> spans; // one per instruction, for runtime errors
+    std::vector<double> consts;
+    bool empty() const { return instrs.empty(); }
+};
+
+// One argument of a predecessor or context module: bind it to frame slots or require a value.
+struct PatternArg {
+    bool bind = true;
+    std::uint16_t slot = 0;  // frame slot of the first double when binding
+    std::uint8_t width = 1;  // 1 or 3
+    double value = 0;        // required value when !bind
+};
+
+struct PatternModule {
+    SymbolId sym = 0;
+    std::uint32_t width = 0; // total doubles the module must carry
+    std::vector<PatternArg> args;
+    Span span;
+};
+
+struct Production {
+    Span span;
+    std::vector<PatternModule> strict, left, left_new, right, right_new;
+    Code condition; // empty: always true
+    Code weight;    // empty: not stochastic
+    Code body;      // emits the successor; for the arrow form ends with ProduceEnd
+    std::uint16_t frame_size = 0;
+    bool body_form = false;
+    bool has_context() const { return !left.empty() || !right.empty(); }
+    bool has_new_context() const { return !left_new.empty() || !right_new.empty(); }
+};
+
+struct RuleSet {
+    std::string name;
+    Span span;
+    std::vector<Production> productions;
+    std::vector<std::vector<std::uint32_t>> by_symbol; // strict predecessor's first symbol -> productions
+    int max_depth = 1;
+    bool needs_brackets = false;
+    bool uses_left_new = false, uses_right_new = false;
+    void index(std::size_t symbols);
+    bool empty() const { return productions.empty(); }
+};
+
+enum class GlobalKind { Param, Var };
+
+struct Global {
+    std::string name;
+    GlobalKind kind = GlobalKind::Param;
+    ValueType type = ValueType::Number;
+    std::uint32_t slot = 0;
+    Span span;
+};
+
+struct Function {
+    std::string name;
+    Span span;
+    std::vector<ValueType> param_types;
+    ValueType result = ValueType::Number;
+    std::uint16_t frame_size = 0;
+    std::uint16_t param_width = 0;
+    Code code;
+};
+
+enum class HookKind { Start = 0, BeforeStep = 1, AfterStep = 2, End = 3 };
+
+// Declarations parsed now and given meaning by the runtime issues (surfaces, curves,
+// environments, instances); kept with their syntax so later passes can compile them.
+struct Deferred {
+    std::vector<const ast::ShapeDecl*> curves, surfaces, envs;
+    std::vector<const ast::InstanceDecl*> instances;
+};
+
+struct Program {
+    SymbolTable symbols;
+    std::vector<Global> globals;
+    std::vector<double> global_values; // current values, param defaults (after overrides) at start
+    std::unordered_map<std::string, std::uint32_t> global_index;
+    std::vector<Function> functions;
+    std::vector<std::string> print_formats;
+
+    Code axiom;                   // emits the axiom's modules
+    Code setting_derive, setting_angle, setting_step, setting_width, setting_seed;
+    double default_angle = 90, default_step = 1, default_width = 1;
+    std::vector<std::uint8_t> ignored; // per symbol: skipped when matching context
+
+    RuleSet rules;                // the unnamed, always-active group
+    std::vector<RuleSet> groups;  // named groups, selected by `use`
+    RuleSet decompose;
+    RuleSet interpret;
+    std::array<Code, 4> hooks;
+    std::array<bool, 4> has_hook{};
+    std::array<std::uint16_t, 4> hook_frame{};
+
+    Deferred deferred;
+    std::vector<std::unique_ptr<ast::File>> files; // the syntax trees the program was built from
+
+    int group_index(std::string_view name) const;
+};
+
+} // namespace plant

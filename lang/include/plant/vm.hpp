@@ -1,0 +1,60 @@
+// The stack machine that runs compiled expressions, production bodies, functions and hooks.
+#pragma once
+
+#include "plant/program.hpp"
+
+#include <string>
+#include <vector>
+
+namespace plant {
+
+// What a hook asked for while it ran.
+struct HookEffects {
+    int use_group = -2; // -2: unchanged, -1: none, else group index
+    bool stop = false;
+    std::string printed;
+};
+
+// Marks an identity as "new in this step"; the engine replaces it with a real identity after
+// the step so identities do not depend on how the string was split between threads.
+inline constexpr ModuleId kNewIdBit = ModuleId{1} << 63;
+
+struct EvalEnv {
+    const Program* prog = nullptr;
+    double* globals = nullptr;
+    std::uint64_t seed = 0;
+    std::uint64_t phase = 0;    // derivation step and pass
+    std::uint64_t position = 0; // index of the module in the string being rewritten
+    std::uint32_t draw = 0;     // random draws made so far for this module
+    int step = 0;
+    ModuleId id = 0;
+    std::size_t max_output = ~std::size_t{0};
+
+    // Output of production bodies.
+    ModuleString* out = nullptr;
+    const SymbolId* keep_syms = nullptr; // predecessor modules whose identities may be kept
+    const ModuleId* keep_ids = nullptr;
+    std::uint32_t keep_count = 0;
+    std::uint32_t keep_used = 0; // bit mask
+    ModuleId new_count = 0;      // new modules emitted by this chunk so far
+    bool produced = false;
+
+    HookEffects* effects = nullptr; // non-null only while a hook runs
+    int call_depth = 0;
+    std::vector<double> arena; // operand stacks and frames of nested calls
+    std::size_t arena_top = 0;
+
+    EvalEnv() : arena(1 << 16) {}
+};
+
+enum class RunStatus { Finished, Produced };
+
+// Runs `code` with `frame` as locals. The value of an expression (up to three doubles) is copied
+// to `result` when non-null. Throws RuntimeError on division by zero, NaN or infinity reaching a
+// module parameter, runaway recursion and the like.
+RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result = nullptr);
+
+// Convenience for code that yields one number.
+double eval_number(const Code& code, double* frame, EvalEnv& env);
+
+} // namespace plant

@@ -1,0 +1,140 @@
+// The compiler's private state, shared by compiler.cpp (expressions, statements, patterns)
+// and compiler_program.cpp (imports, declarations, rule sets, checks).
+#pragma once
+
+#include "plant/ast.hpp"
+#include "plant/compiler.hpp"
+#include "plant/program.hpp"
+
+#include <array>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace plant {
+
+enum class CtxKind { Global, Axiom, Production, Hook, Function };
+enum class PatternRole { Strict, Left, LeftNew, Right, RightNew };
+
+struct LocalVar {
+    std::string name;
+    ValueType type = ValueType::Number;
+    std::uint16_t slot = 0;
+    bool bound = false; // bound by a predecessor pattern: read-only
+};
+
+// Where code is being compiled to and which names are in scope.
+struct Ctx {
+    Code* code = nullptr;
+    CtxKind kind = CtxKind::Global;
+    std::vector<LocalVar> locals;
+    std::uint16_t next_slot = 0;
+    ValueType* fn_result = nullptr;
+    bool fn_result_known = false;
+};
+
+struct ConstVal {
+    ValueType type = ValueType::Number;
+    double v[3] = {0, 0, 0};
+    Span span;
+};
+
+// A letter run split into several modules, remembered for the undeclared-run warning.
+struct RawRun {
+    std::string text;
+    Span span;
+    std::vector<std::string> letters;
+};
+
+struct LoadedFile {
+    ast::File* file = nullptr;
+    std::map<std::string, std::pair<const ast::Expr*, Span>> overrides; // from `import ... with { }`
+};
+
+std::size_t edit_distance(std::string_view a, std::string_view b);
+std::string nearest_name(std::string_view name, const std::vector<std::string>& candidates);
+
+class Compiler {
+public:
+    Compiler(SourceManager& sm, const CompileOptions& opts, Diagnostics& diags) : sm_(sm), opts_(opts), diags_(diags) {}
+    std::unique_ptr<Program> compile(std::uint32_t main_file);
+
+    // expressions (compiler.cpp)
+    ValueType compile_expr(Ctx& c, const ast::Expr& e);
+    ValueType compile_binary(Ctx& c, const ast::Expr& e);
+    ValueType compile_call(Ctx& c, const ast::Expr& e);
+    std::optional<ConstVal> eval_const(const ast::Expr& e, const char* what);
+    std::optional<double> fold_number(const ast::Expr& e);
+    void compile_block(Ctx& c, const std::vector<ast::Stmt>& body);
+    void compile_stmt(Ctx& c, const ast::Stmt& s);
+    void compile_assign(Ctx& c, const ast::Stmt& s);
+    void compile_print(Ctx& c, const ast::Expr& e);
+    void compile_successor(Ctx& c, const ast::ModuleList& list, Span span);
+    std::vector<PatternModule> compile_pattern(Ctx& c, const ast::ModuleList& list, PatternRole role);
+    std::vector<std::pair<std::string, Span>> split_run(const ast::ModuleRef& m);
+    SymbolId module_symbol(const std::string& name, Span span);
+    void declare_function(const ast::FnDecl& fd);
+    void ensure_function_compiled(std::uint32_t index);
+    ValueType param_type(const ast::ParamName& p);
+
+private:
+    // program structure (compiler_program.cpp)
+    void load(std::uint32_t file_id, std::map<std::string, std::pair<const ast::Expr*, Span>> overrides,
+              std::vector<std::string>& stack);
+    std::string resolve_import(const ast::Import& im, std::uint32_t from_file, std::vector<std::string>& searched);
+    void declare_modules(const ast::File& f);
+    void declare_values(const LoadedFile& lf);
+    void compile_rules(const ast::File& f);
+    void compile_production(const ast::Production& p, RuleSet& set, bool is_decompose);
+    void compile_hooks(const ast::File& f);
+    void compile_settings(const ast::File& f);
+    void check_never_applying();
+    void check_raw_runs();
+    void finish_rule_set(RuleSet& set);
+
+    // helpers (compiler.cpp)
+    void emit(Ctx& c, Op op, std::int32_t a, int n, Span span, std::uint16_t b = 0);
+    void emit_const(Ctx& c, double v, Span span);
+    std::size_t here(Ctx& c) const;
+    void patch(Ctx& c, std::size_t at);
+    const LocalVar* find_local(Ctx& c, const std::string& name) const;
+    std::uint16_t add_local(Ctx& c, const std::string& name, ValueType t);
+    std::vector<std::string> visible_names(Ctx& c) const;
+    void unknown_name(Ctx& c, const std::string& name, Span span, const char* what);
+    void type_error(Span span, const std::string& op, ValueType a, ValueType b);
+    void duplicate(const std::string& what, const std::string& name, Span here, Span first);
+    std::string where(Span s) const;
+
+    SourceManager& sm_;
+    const CompileOptions& opts_;
+    Diagnostics& diags_;
+    std::unique_ptr<Program> program_ = std::make_unique<Program>();
+    Program& P_ = *program_;
+    std::uint32_t current_file_ = 0;
+
+    std::vector<LoadedFile> order_;
+    std::set<std::string> loaded_paths_;
+    std::unordered_map<std::string, ConstVal> consts_;
+    std::unordered_map<std::string, Span> value_spans_;
+    std::unordered_map<std::string, std::uint32_t> fn_index_;
+    std::vector<const ast::FnDecl*> fn_decls_;
+    std::vector<int> fn_state_; // 0 pending, 1 compiling, 2 done
+    std::map<std::string, std::string> env_names_; // env name -> kind
+    std::set<std::string> curve_names_;
+    std::set<std::string> used_groups_;
+    std::set<SymbolId> produced_;
+    std::vector<RawRun> raw_runs_;
+    std::size_t max_declared_len_ = 1;
+    std::map<std::string, std::pair<ast::ExprPtr, std::uint32_t>> defines_; // -D name -> expr, source
+    std::set<std::string> defines_used_;
+    std::unordered_map<std::string, Span> shape_spans_;
+    std::set<SymbolId> ignore_syms_, consider_syms_;
+    bool has_ignore_ = false, has_consider_ = false, has_axiom_ = false;
+    std::vector<std::tuple<std::string, Span, bool>> group_decls_;
+    std::array<std::vector<const ast::Hook*>, 4> hook_bodies_;
+};
+
+} // namespace plant

@@ -1,0 +1,783 @@
+// The derivation engine. One step: hooks, then (if some production reads query modules) a
+// turtle pass, then the parallel rewrite, decomposition and cut, then hooks again.
+//
+// Parallel rewriting splits the old string into chunks, each rewritten by one thread into its
+// own buffer; the buffers are joined with prefix sums. Random draws are keyed by the module's
+// position in the old string and identities of new modules are numbered after the join, so the
+// result is the same for any number of threads.
+#include "plant/derive.hpp"
+
+#include "plant/random.hpp"
+#include "plant/vm.hpp"
+
+#include <fmt/format.h>
+
+#include <charconv>
+#include <chrono>
+#include <unordered_set>
+#include <cmath>
+#include <thread>
+
+namespace plant {
+
+void ModuleString::append_range(const ModuleString& o, std::size_t b, std::size_t e) {
+    if (b >= e) return;
+    sym.insert(sym.end(), o.sym.begin() + static_cast<std::ptrdiff_t>(b), o.sym.begin() + static_cast<std::ptrdiff_t>(e));
+    ids.insert(ids.end(), o.ids.begin() + static_cast<std::ptrdiff_t>(b), o.ids.begin() + static_cast<std::ptrdiff_t>(e));
+    const std::uint32_t pb = o.poff[b];
+    const auto shift = static_cast<std::int64_t>(params.size()) - pb;
+    params.insert(params.end(), o.params.begin() + pb, o.params.begin() + o.poff[e]);
+    for (std::size_t i = b + 1; i <= e; ++i) poff.push_back(static_cast<std::uint32_t>(o.poff[i] + shift));
+}
+
+std::vector<std::uint32_t> bracket_table(const ModuleString& s, SymbolId open, SymbolId close) {
+    const auto n = static_cast<std::uint32_t>(s.size());
+    std::vector<std::uint32_t> match(s.size(), n);
+    std::vector<std::uint32_t> stack;
+    for (std::uint32_t i = 0; i < n; ++i) {
+        if (s.sym[i] == open) {
+            stack.push_back(i);
+        } else if (s.sym[i] == close && !stack.empty()) {
+            match[i] = stack.back();
+            match[stack.back()] = i;
+            stack.pop_back();
+        }
+    }
+    return match;
+}
+
+namespace {
+
+constexpr std::uint64_t kChoiceDraw = 0xffffffffULL; // draw index of the stochastic choice
+
+double now_ms() {
+    using namespace std::chrono;
+    return duration<double, std::milli>(steady_clock::now().time_since_epoch()).count();
+}
+
+// Everything one thread needs to rewrite a stretch of the string.
+struct Worker {
+    EvalEnv env;
+    std::vector<double> frame;
+    ModuleString out;
+    std::optional<RuntimeError> error;
+};
+
+class Rewriter {
+public:
+    Rewriter(const Program& p, const ModuleString& in, const std::vector<const RuleSet*>& sets)
+        : P(p), in(in), sets(sets), n(in.size()) {
+        bool brackets = false;
+        std::size_t frame = 1;
+        has_prod.assign(P.symbols.size(), 0);
+        for (const RuleSet* rs : sets) {
+            brackets = brackets || rs->needs_brackets || rs->uses_left_new || rs->uses_right_new;
+            for (const auto& pr : rs->productions) {
+                frame = std::max<std::size_t>(frame, pr.frame_size);
+                has_prod[pr.strict[0].sym] = 1;
+                if (pr.strict.size() > 1) multi = true;
+            }
+            left_new = left_new || rs->uses_left_new;
+            right_new = right_new || rs->uses_right_new;
+        }
+        frame_size = frame;
+        if (brackets) match = bracket_table(in, P.symbols.open_bracket, P.symbols.close_bracket);
+    }
+
+    bool sequential() const { return multi || left_new || right_new; }
+
+    // Rewrites modules [b, e) into w.out.
+    void run_range(Worker& w, std::size_t b, std::size_t e) {
+        w.frame.assign(frame_size, 0.0);
+        std::size_t i = b;
+        while (i < e) {
+            if (!has_prod[in.sym[i]]) {
+                std::size_t j = i + 1;
+                while (j < e && !has_prod[in.sym[j]]) ++j;
+                w.out.append_range(in, i, j);
+                i = j;
+                if (w.out.size() > w.env.max_output) limit_error(w);
+                continue;
+            }
+            std::size_t used = apply(w, i);
+            if (used == 0) {
+                w.out.append_range(in, i, i + 1);
+                used = 1;
+            }
+            i += used;
+        }
+    }
+
+    // Backward processing for `>>`: modules right to left; each successor becomes a piece and
+    // the new string to the right is the pieces made so far, newest first.
+    void run_backward(Worker& w) {
+        w.frame.assign(frame_size, 0.0);
+        piece_starts.clear();
+        for (std::size_t k = n; k-- > 0;) {
+            piece_starts.push_back(w.out.size());
+            std::size_t used = has_prod[in.sym[k]] ? apply(w, k) : 0;
+            if (used == 0) w.out.append_range(in, k, k + 1);
+            if (used > 1) {
+                // multi-module predecessors end at k; not supported backwards
+                throw RuntimeError{Span{}, "a predecessor of several modules cannot be used with '>>' context"};
+            }
+        }
+        piece_starts.push_back(w.out.size());
+    }
+
+    ModuleString assemble_backward(const ModuleString& pieces) const {
+        ModuleString out;
+        for (std::size_t p = piece_starts.size() - 1; p-- > 0;) out.append_range(pieces, piece_starts[p], piece_starts[p + 1]);
+        return out;
+    }
+
+private:
+    [[noreturn]] void limit_error(Worker& w) const {
+        (void)w;
+        throw RuntimeError{Span{}, "module limit"};
+    }
+
+    bool match_module(std::size_t j, const PatternModule& pm, double* frame) const {
+        if (in.sym[j] != pm.sym || in.arity(j) != pm.width) return false;
+        const double* a = in.args(j);
+        for (const auto& pa : pm.args) {
+            if (pa.bind) {
+                for (int k = 0; k < pa.width; ++k) frame[pa.slot + k] = a[k];
+            } else if (!std::isnan(pa.value) && a[0] != pa.value) {
+                return false;
+            }
+            a += pa.width;
+        }
+        return true;
+    }
+
+    bool match_left(std::size_t i, const std::vector<PatternModule>& pats, double* frame) const {
+        auto j = static_cast<std::int64_t>(i) - 1;
+        for (std::size_t k = pats.size(); k-- > 0;) {
+            for (;;) {
+                if (j < 0) return false;
+                SymbolId s = in.sym[static_cast<std::size_t>(j)];
+                if (s == P.symbols.close_bracket) {
+                    std::uint32_t m = match[static_cast<std::size_t>(j)];
+                    if (m >= n) return false;
+                    j = static_cast<std::int64_t>(m) - 1;
+                } else if (s == P.symbols.open_bracket || P.ignored[s]) {
+                    --j;
+                } else {
+                    break;
+                }
+            }
+            if (!match_module(static_cast<std::size_t>(j), pats[k], frame)) return false;
+            --j;
+        }
+        return true;
+    }
+
+    bool match_right(std::size_t e, const std::vector<PatternModule>& pats, double* frame) const {
+        std::size_t j = e;
+        const SymbolId open = P.symbols.open_bracket, close = P.symbols.close_bracket;
+        for (const auto& p : pats) {
+            if (p.sym == open) {
+                while (j < n && P.ignored[in.sym[j]]) ++j;
+                if (j >= n || in.sym[j] != open) return false;
+                ++j;
+                continue;
+            }
+            if (p.sym == close) { // skip the rest of the current branch
+                while (j < n && in.sym[j] != close) {
+                    if (in.sym[j] == open) {
+                        if (match[j] >= n) return false;
+                        j = match[j] + 1;
+                    } else {
+                        ++j;
+                    }
+                }
+                if (j >= n) return false;
+                ++j;
+                continue;
+            }
+            for (;;) {
+                if (j >= n) return false;
+                SymbolId s = in.sym[j];
+                if (s == open) {
+                    if (match[j] >= n) return false;
+                    j = match[j] + 1;
+                } else if (s == close) {
+                    return false;
+                } else if (P.ignored[s]) {
+                    ++j;
+                } else {
+                    break;
+                }
+            }
+            if (!match_module(j, p, frame)) return false;
+            ++j;
+        }
+        return true;
+    }
+
+    // Left context in the new string (forward processing): the output made so far.
+    bool match_left_new(const ModuleString& out, const std::vector<PatternModule>& pats, double* frame) const {
+        const SymbolId open = P.symbols.open_bracket, close = P.symbols.close_bracket;
+        auto j = static_cast<std::int64_t>(out.size()) - 1;
+        for (std::size_t k = pats.size(); k-- > 0;) {
+            for (;;) {
+                if (j < 0) return false;
+                SymbolId s = out.sym[static_cast<std::size_t>(j)];
+                if (s == close) { // skip the whole preceding branch
+                    int depth = 0;
+                    for (; j >= 0; --j) {
+                        SymbolId t = out.sym[static_cast<std::size_t>(j)];
+                        if (t == close) ++depth;
+                        else if (t == open && --depth == 0) break;
+                    }
+                    if (j < 0) return false;
+                    --j;
+                } else if (s == open || P.ignored[s]) {
+                    --j;
+                } else {
+                    break;
+                }
+            }
+            if (!match_in(out, static_cast<std::size_t>(j), pats[k], frame)) return false;
+            --j;
+        }
+        return true;
+    }
+
+    // Walks the new string to the right of the module being rewritten in backward processing:
+    // the pieces made so far, the newest (the right neighbour's successor) first.
+    struct PieceIter {
+        const std::vector<std::size_t>& ps;
+        std::size_t p = 0, i = 0;
+        bool valid = false;
+        explicit PieceIter(const std::vector<std::size_t>& starts) : ps(starts) {
+            if (ps.size() >= 2) {
+                p = ps.size() - 2;
+                i = ps[p];
+                valid = true;
+                normalize();
+            }
+        }
+        void normalize() {
+            while (valid && i >= ps[p + 1]) {
+                if (p == 0) {
+                    valid = false;
+                    break;
+                }
+                --p;
+                i = ps[p];
+            }
+        }
+        void next() {
+            ++i;
+            normalize();
+        }
+    };
+
+    bool match_right_new(const ModuleString& out, const std::vector<PatternModule>& pats, double* frame) const {
+        const SymbolId open = P.symbols.open_bracket, close = P.symbols.close_bracket;
+        PieceIter it(piece_starts);
+        for (const auto& pat : pats) {
+            for (;;) {
+                if (!it.valid) return false;
+                SymbolId s = out.sym[it.i];
+                if (s == open && pat.sym != open) { // skip the lateral branch
+                    int depth = 0;
+                    for (; it.valid; it.next()) {
+                        SymbolId t = out.sym[it.i];
+                        if (t == open) ++depth;
+                        else if (t == close && --depth == 0) break;
+                    }
+                    if (!it.valid) return false;
+                    it.next();
+                } else if (s == close && pat.sym != close) {
+                    return false;
+                } else if (s != open && s != close && P.ignored[s]) {
+                    it.next();
+                } else {
+                    break;
+                }
+            }
+            if (!match_in(out, it.i, pat, frame)) return false;
+            it.next();
+        }
+        return true;
+    }
+
+    bool match_in(const ModuleString& s, std::size_t j, const PatternModule& pm, double* frame) const {
+        if (s.sym[j] != pm.sym || s.arity(j) != pm.width) return false;
+        const double* a = s.args(j);
+        for (const auto& pa : pm.args) {
+            if (pa.bind) {
+                for (int k = 0; k < pa.width; ++k) frame[pa.slot + k] = a[k];
+            } else if (!std::isnan(pa.value) && a[0] != pa.value) {
+                return false;
+            }
+            a += pa.width;
+        }
+        return true;
+    }
+
+    // Pattern, context and condition. Binds the frame.
+    bool matches(Worker& w, std::size_t i, const Production& pr) {
+        double* frame = w.frame.data();
+        for (std::size_t k = 0; k < pr.strict.size(); ++k)
+            if (i + k >= n || !match_module(i + k, pr.strict[k], frame)) return false;
+        if (!pr.left.empty() && !match_left(i, pr.left, frame)) return false;
+        if (!pr.right.empty() && !match_right(i + pr.strict.size(), pr.right, frame)) return false;
+        if (!pr.left_new.empty() && !match_left_new(w.out, pr.left_new, frame)) return false;
+        if (!pr.right_new.empty() && !match_right_new(w.out, pr.right_new, frame)) return false;
+        if (!pr.condition.empty() && eval_number(pr.condition, frame, w.env) == 0) return false;
+        return true;
+    }
+
+    // Tries the productions for module i; returns the number of modules consumed (0: none applied).
+    std::size_t apply(Worker& w, std::size_t i) {
+        EvalEnv& env = w.env;
+        env.position = i;
+        env.draw = 0;
+        env.id = in.ids[i];
+        const SymbolId sym = in.sym[i];
+        for (std::size_t si = 0; si < sets.size(); ++si) {
+            const RuleSet& rs = *sets[si];
+            const auto& cands = rs.by_symbol[sym];
+            for (std::size_t ci = 0; ci < cands.size(); ++ci) {
+                const Production& pr = rs.productions[cands[ci]];
+                if (!matches(w, i, pr)) continue;
+                if (!pr.weight.empty()) return choose(w, i, si, ci);
+                if (std::size_t used = run_body(w, i, pr)) return used;
+            }
+        }
+        return 0;
+    }
+
+    std::size_t run_body(Worker& w, std::size_t i, const Production& pr) {
+        EvalEnv& env = w.env;
+        SymbolId keep_syms[32];
+        ModuleId keep_ids[32];
+        const std::size_t k = std::min<std::size_t>(pr.strict.size(), 32);
+        for (std::size_t m = 0; m < k; ++m) {
+            keep_syms[m] = in.sym[i + m];
+            keep_ids[m] = in.ids[i + m];
+        }
+        env.keep_syms = keep_syms;
+        env.keep_ids = keep_ids;
+        env.keep_count = static_cast<std::uint32_t>(k);
+        env.keep_used = 0;
+        env.produced = false;
+        env.out = &w.out;
+        const std::size_t mark = w.out.size();
+        RunStatus st = run(pr.body, w.frame.data(), env);
+        env.keep_count = 0;
+        if (st == RunStatus::Produced || env.produced) return pr.strict.size();
+        // not applied: drop anything a partial body emitted
+        w.out.sym.resize(mark);
+        w.out.ids.resize(mark);
+        w.out.params.resize(w.out.poff[mark]);
+        w.out.poff.resize(mark + 1);
+        return 0;
+    }
+
+    // cpfg semantics: all applicable weighted productions of the module, one drawn by weight.
+    std::size_t choose(Worker& w, std::size_t i, std::size_t set0, std::size_t cand0) {
+        struct Option {
+            const Production* pr;
+            double weight;
+        };
+        Option options[64];
+        std::size_t count = 0;
+        double total = 0;
+        const SymbolId sym = in.sym[i];
+        for (std::size_t si = set0; si < sets.size(); ++si) {
+            const auto& cands = sets[si]->by_symbol[sym];
+            for (std::size_t ci = si == set0 ? cand0 : 0; ci < cands.size(); ++ci) {
+                const Production& pr = sets[si]->productions[cands[ci]];
+                if (pr.weight.empty() || !matches(w, i, pr)) continue;
+                double wt = eval_number(pr.weight, w.frame.data(), w.env);
+                if (!(wt >= 0) || !std::isfinite(wt))
+                    throw RuntimeError{pr.weight.spans.empty() ? pr.span : pr.weight.spans.back(),
+                                       fmt::format("a production weight must be a finite number >= 0, found {}", wt)};
+                if (wt == 0 || count == 64) continue;
+                options[count++] = {&pr, wt};
+                total += wt;
+            }
+        }
+        if (count == 0) return 0;
+        double u = random_unit(random_bits(w.env.seed, w.env.phase, i, kChoiceDraw)) * total;
+        std::size_t pick = count - 1;
+        for (std::size_t k = 0; k < count; ++k) {
+            if (u < options[k].weight) {
+                pick = k;
+                break;
+            }
+            u -= options[k].weight;
+        }
+        const Production& pr = *options[pick].pr;
+        w.env.draw = 0;
+        matches(w, i, pr); // bind the chosen production's names again
+        return run_body(w, i, pr);
+    }
+
+    const Program& P;
+    const ModuleString& in;
+    const std::vector<const RuleSet*>& sets;
+    const std::size_t n;
+    std::vector<std::uint8_t> has_prod;
+    std::vector<std::uint32_t> match;
+    std::vector<std::size_t> piece_starts;
+    std::size_t frame_size = 1;
+    bool multi = false, left_new = false, right_new = false;
+};
+
+} // namespace
+
+// ---- Derivation ------------------------------------------------------------------------------
+
+Derivation::Derivation(const Program& program, DeriveOptions options) : prog_(program), opt_(std::move(options)) {
+    globals_ = prog_.global_values;
+}
+
+void Derivation::check_limits(const ModuleString& s) const {
+    if (s.size() > opt_.max_modules)
+        throw RuntimeError{Span{}, fmt::format("step {}: the string grew to {} modules, more than the limit of {} "
+                                               "(raise it with --max-modules)",
+                                               step_, s.size(), opt_.max_modules)};
+    std::size_t estimate = s.size() * (sizeof(SymbolId) + sizeof(std::uint32_t) + sizeof(ModuleId)) +
+                           s.params.size() * sizeof(double);
+    if (estimate > opt_.max_bytes)
+        throw RuntimeError{Span{}, fmt::format("step {}: the string needs about {:.1f} GiB, more than the limit of "
+                                               "{:.1f} GiB",
+                                               step_, estimate / double(1 << 30), opt_.max_bytes / double(1 << 30))};
+}
+
+void Derivation::rewrite(const ModuleString& in, ModuleString& out, const std::vector<const RuleSet*>& sets,
+                         std::uint64_t phase, int step_for_env) const {
+    Rewriter rw(prog_, in, sets);
+    auto setup = [&](Worker& w) {
+        w.env.prog = &prog_;
+        w.env.globals = const_cast<double*>(globals_.data()); // read-only during rewriting
+        w.env.seed = seed_;
+        w.env.phase = phase;
+        w.env.step = step_for_env;
+        w.env.max_output = opt_.max_modules;
+    };
+    const std::size_t n = in.size();
+    int threads = std::max(1, opt_.threads);
+    if (rw.sequential() || n < 20000) threads = 1;
+    out.clear();
+    if (threads == 1) {
+        Worker w;
+        setup(w);
+        w.out.sym.reserve(static_cast<std::size_t>(n * growth_ * 1.02) + 16);
+        w.out.ids.reserve(w.out.sym.capacity());
+        w.out.poff.reserve(w.out.sym.capacity() + 1);
+        w.out.params.reserve(static_cast<std::size_t>(in.params.size() * param_growth_ * 1.02) + 16);
+        try {
+            bool backward = false;
+            for (const RuleSet* rs : sets) backward = backward || rs->uses_right_new;
+            if (backward) {
+                rw.run_backward(w);
+                w.out = rw.assemble_backward(w.out);
+            } else {
+                rw.run_range(w, 0, n);
+            }
+        } catch (const RuntimeError& e) {
+            if (e.message == "module limit" || e.message == "the string outgrew the module limit")
+                check_limits(w.out);
+            throw;
+        }
+        out.swap(w.out);
+        for (auto& id : out.ids)
+            if (id & kNewIdBit) id = next_id_ + (id & ~kNewIdBit);
+        next_id_ += w.env.new_count;
+    } else {
+        std::vector<Worker> workers(static_cast<std::size_t>(threads));
+        {
+            std::vector<std::jthread> pool;
+            for (int t = 0; t < threads; ++t) {
+                pool.emplace_back([&, t] {
+                    Worker& w = workers[static_cast<std::size_t>(t)];
+                    setup(w);
+                    std::size_t b = n * static_cast<std::size_t>(t) / static_cast<std::size_t>(threads);
+                    std::size_t e = n * static_cast<std::size_t>(t + 1) / static_cast<std::size_t>(threads);
+                    w.out.sym.reserve(static_cast<std::size_t>((e - b) * growth_ * 1.02) + 16);
+                    w.out.ids.reserve(w.out.sym.capacity());
+                    w.out.poff.reserve(w.out.sym.capacity() + 1);
+                    try {
+                        rw.run_range(w, b, e);
+                    } catch (const RuntimeError& err) {
+                        w.error = err;
+                    }
+                });
+            }
+        }
+        std::size_t total = 0, total_params = 0;
+        for (auto& w : workers) {
+            if (w.error) {
+                if (w.error->message == "module limit" || w.error->message == "the string outgrew the module limit")
+                    check_limits(w.out);
+                throw *w.error;
+            }
+            total += w.out.size();
+            total_params += w.out.params.size();
+        }
+        if (total > opt_.max_modules) {
+            ModuleString probe;
+            probe.sym.resize(total);
+            check_limits(probe);
+        }
+        // join by prefix sums, each worker copying its own part
+        out.sym.resize(total);
+        out.ids.resize(total);
+        out.poff.resize(total + 1);
+        out.params.resize(total_params);
+        std::vector<std::size_t> mod_at(workers.size()), par_at(workers.size());
+        std::vector<ModuleId> id_at(workers.size());
+        std::size_t m = 0, p = 0;
+        ModuleId ids = next_id_;
+        for (std::size_t t = 0; t < workers.size(); ++t) {
+            mod_at[t] = m;
+            par_at[t] = p;
+            id_at[t] = ids;
+            m += workers[t].out.size();
+            p += workers[t].out.params.size();
+            ids += workers[t].env.new_count;
+        }
+        {
+            std::vector<std::jthread> pool;
+            for (std::size_t t = 0; t < workers.size(); ++t) {
+                pool.emplace_back([&, t] {
+                    ModuleString& src = workers[t].out;
+                    std::copy(src.sym.begin(), src.sym.end(), out.sym.begin() + static_cast<std::ptrdiff_t>(mod_at[t]));
+                    std::copy(src.params.begin(), src.params.end(),
+                              out.params.begin() + static_cast<std::ptrdiff_t>(par_at[t]));
+                    for (std::size_t i = 0; i < src.size(); ++i) {
+                        out.poff[mod_at[t] + i] = static_cast<std::uint32_t>(par_at[t] + src.poff[i]);
+                        ModuleId id = src.ids[i];
+                        out.ids[mod_at[t] + i] = (id & kNewIdBit) ? id_at[t] + (id & ~kNewIdBit) : id;
+                    }
+                    ModuleString().swap(src);
+                });
+            }
+        }
+        out.poff[total] = static_cast<std::uint32_t>(total_params);
+        next_id_ = ids;
+    }
+    if (n > 0) {
+        growth_ = std::max(0.5, std::min(16.0, double(out.size()) / double(n)));
+        param_growth_ = in.params.empty() ? growth_ : std::max(0.5, std::min(16.0, double(out.params.size()) / double(in.params.size())));
+    }
+    check_limits(out);
+}
+
+void Derivation::decompose(ModuleString& s, int step_for_env) {
+    if (prog_.decompose.empty()) return;
+    std::vector<const RuleSet*> sets{&prog_.decompose};
+    for (int pass = 0; pass < prog_.decompose.max_depth; ++pass) {
+        ModuleString next;
+        ModuleId before = next_id_;
+        rewrite(s, next, sets, (static_cast<std::uint64_t>(step_for_env) << 16) | static_cast<std::uint64_t>(pass + 1),
+                step_for_env);
+        bool changed = next_id_ != before || next.size() != s.size() || next.sym != s.sym || next.params != s.params;
+        s.swap(next);
+        if (!changed) break;
+    }
+}
+
+void Derivation::apply_cut(ModuleString& s) const {
+    const SymbolId cut = prog_.symbols.cut, open = prog_.symbols.open_bracket, close = prog_.symbols.close_bracket;
+    bool any = false;
+    for (SymbolId x : s.sym)
+        if (x == cut) {
+            any = true;
+            break;
+        }
+    if (!any) return;
+    ModuleString out;
+    const std::size_t n = s.size();
+    std::size_t i = 0;
+    while (i < n) {
+        if (s.sym[i] != cut) {
+            out.append_range(s, i, i + 1);
+            ++i;
+            continue;
+        }
+        // skip to the ']' closing the current branch (kept) or to the end
+        int depth = 0;
+        ++i;
+        while (i < n) {
+            if (s.sym[i] == open) ++depth;
+            else if (s.sym[i] == close) {
+                if (depth == 0) break;
+                --depth;
+            }
+            ++i;
+        }
+    }
+    s.swap(out);
+}
+
+ModuleString Derivation::interpreted(const ModuleString& s) const {
+    ModuleString cur = s;
+    if (prog_.interpret.empty()) return cur;
+    std::vector<const RuleSet*> sets{&prog_.interpret};
+    ModuleId saved = next_id_;
+    for (int pass = 0; pass < prog_.interpret.max_depth; ++pass) {
+        ModuleString next;
+        rewrite(cur, next, sets, (static_cast<std::uint64_t>(step_) << 16) | 0x8000u | static_cast<std::uint64_t>(pass),
+                step_);
+        bool changed = next.sym != cur.sym || next.params != cur.params;
+        cur.swap(next);
+        if (!changed) break;
+    }
+    next_id_ = saved; // interpretation never creates modules that live on
+    return cur;
+}
+
+void Derivation::run_hook(HookKind kind) {
+    const auto k = static_cast<std::size_t>(kind);
+    if (!prog_.has_hook[k]) return;
+    EvalEnv env;
+    HookEffects effects;
+    env.prog = &prog_;
+    env.globals = globals_.data();
+    env.seed = seed_;
+    env.phase = (static_cast<std::uint64_t>(step_) << 16) | (0xF000u + k);
+    env.position = ~std::uint64_t{0};
+    env.step = step_;
+    env.effects = &effects;
+    std::vector<double> frame(std::max<std::size_t>(prog_.hook_frame[k], 1));
+    plant::run(prog_.hooks[k], frame.data(), env);
+    if (!effects.printed.empty() && opt_.on_print) opt_.on_print(effects.printed);
+    if (effects.use_group != -2) group_ = effects.use_group;
+    if (effects.stop) stopped_ = true;
+}
+
+void Derivation::start() {
+    EvalEnv env;
+    env.prog = &prog_;
+    env.globals = globals_.data();
+    auto setting = [&](const Code& c, double fallback) { return c.empty() ? fallback : eval_number(c, nullptr, env); };
+    double steps = opt_.steps ? *opt_.steps : setting(prog_.setting_derive, 0);
+    if (steps < 0 || steps > 1e6 || steps != std::floor(steps))
+        throw RuntimeError{prog_.setting_derive.spans.empty() ? Span{} : prog_.setting_derive.spans.back(),
+                           fmt::format("the number of steps must be a whole number from 0 to 1000000, found {}", steps)};
+    target_ = static_cast<int>(steps);
+    double seed = setting(prog_.setting_seed, 0);
+    seed_ = opt_.seed ? *opt_.seed : static_cast<std::uint64_t>(std::llround(std::fabs(seed)));
+    angle_ = setting(prog_.setting_angle, 90);
+    step_length_ = setting(prog_.setting_step, 1);
+    width_ = setting(prog_.setting_width, 1);
+    step_ = 0;
+    stopped_ = false;
+    group_ = -1;
+    next_id_ = 1;
+    // the axiom: emitted like a successor, then decomposed
+    env.seed = seed_;
+    env.phase = 0xFFFF0000ULL;
+    ModuleString axiom;
+    env.out = &axiom;
+    env.max_output = opt_.max_modules;
+    plant::run(prog_.axiom, nullptr, env);
+    for (auto& id : axiom.ids)
+        if (id & kNewIdBit) id = next_id_ + (id & ~kNewIdBit);
+    next_id_ += env.new_count;
+    current_.swap(axiom);
+    decompose(current_, 0);
+    apply_cut(current_);
+    started_ = true;
+    run_hook(HookKind::Start);
+}
+
+bool Derivation::step() {
+    if (!started_) start();
+    if (stopped_ || step_ >= target_) return false;
+    if (opt_.interrupt && opt_.interrupt->load()) throw RuntimeError{Span{}, "interrupted"};
+    double t0 = now_ms();
+    run_hook(HookKind::BeforeStep);
+    if (stopped_) return false;
+    std::vector<const RuleSet*> sets;
+    if (group_ >= 0 && group_ < static_cast<int>(prog_.groups.size())) sets.push_back(&prog_.groups[group_]);
+    sets.push_back(&prog_.rules);
+    bool queries = false;
+    for (const RuleSet* rs : sets)
+        for (const auto& pr : rs->productions) {
+            auto is_query = [&](const std::vector<PatternModule>& v) {
+                for (const auto& m : v)
+                    if (prog_.symbols[m.sym].query) return true;
+                return false;
+            };
+            queries = queries || is_query(pr.strict) || is_query(pr.left) || is_query(pr.right);
+        }
+    if (queries && opt_.queries) opt_.queries->fill_queries(prog_, globals_.data(), current_);
+    ModuleString next;
+    ++step_;
+    try {
+        rewrite(current_, next, sets, static_cast<std::uint64_t>(step_) << 16, step_);
+        current_.swap(next);
+        { ModuleString().swap(next); }
+        decompose(current_, step_);
+        apply_cut(current_);
+    } catch (RuntimeError& e) {
+        if (e.message.rfind("step ", 0) != 0) e.message = fmt::format("step {}: {}", step_, e.message);
+        throw;
+    }
+    run_hook(HookKind::AfterStep);
+    if (opt_.on_step) opt_.on_step(StepStats{step_, current_.size(), current_.bytes(), now_ms() - t0});
+    return !stopped_ && step_ < target_;
+}
+
+void Derivation::finish() { run_hook(HookKind::End); }
+
+void Derivation::run() {
+    start();
+    while (step()) {
+    }
+    finish();
+}
+
+// ---- printing --------------------------------------------------------------------------------
+
+std::string format_double(double v) {
+    if (v == 0) return "0"; // also for -0
+    char buf[64];
+    auto r = std::to_chars(buf, buf + sizeof buf, v);
+    return std::string(buf, r.ptr);
+}
+
+std::string format_string(const Program& program, const ModuleString& s, bool with_ids) {
+    std::string out;
+    out.reserve(s.size() * 2);
+    // Prefixes of declared multi-letter names: "F" then "b" must be spaced when "Fb..." is declared.
+    std::unordered_set<std::string> prefixes;
+    for (const auto& info : program.symbols.all())
+        if (info.declared && info.name.size() > 1 && std::isalpha(static_cast<unsigned char>(info.name[0])))
+            for (std::size_t l = 2; l <= info.name.size(); ++l) prefixes.insert(info.name.substr(0, l));
+    const std::string* prev = nullptr; // name of the previous module when it ends in a letter run
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        const std::string& name = program.symbols[s.sym[i]].name;
+        bool letter_start = !name.empty() && (std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_');
+        // a space only where reading back would merge two names
+        if (prev && letter_start) {
+            if (prev->size() > 1 || prefixes.count(*prev + name[0])) out += ' ';
+        }
+        out += name;
+        std::uint32_t k = s.arity(i);
+        if (k > 0) {
+            out += '(';
+            const double* a = s.args(i);
+            for (std::uint32_t j = 0; j < k; ++j) {
+                if (j) out += ',';
+                out += format_double(a[j]);
+            }
+            out += ')';
+        }
+        if (with_ids) out += fmt::format("#{}", s.ids[i]);
+        bool ends_letters = !name.empty() && (std::isalnum(static_cast<unsigned char>(name.back())) || name.back() == '_');
+        prev = (k == 0 && !with_ids && ends_letters) ? &name : nullptr;
+    }
+    return out;
+}
+
+} // namespace plant

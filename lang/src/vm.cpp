@@ -1,0 +1,320 @@
+#include "plant/vm.hpp"
+
+#include "plant/builtins.hpp"
+#include "plant/random.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <algorithm>
+#include <numbers>
+
+namespace plant {
+
+namespace {
+
+constexpr int kMaxCallDepth = 256;
+constexpr std::size_t kStackSize = 1024;
+constexpr double kPi = std::numbers::pi;
+
+[[noreturn]] void fail(const Code& code, std::size_t pc, std::string msg) {
+    throw RuntimeError{pc < code.spans.size() ? code.spans[pc] : Span{}, std::move(msg)};
+}
+
+double next_unit(EvalEnv& env) {
+    return random_unit(random_bits(env.seed, env.phase, env.position, env.draw++));
+}
+
+// Applies builtin `id` to the arguments at `a` (already popped); writes the result to `r`.
+// Returns the width of the result.
+int apply_builtin(BuiltinId id, const double* a, double* r, EvalEnv& env) {
+    switch (id) {
+    case BuiltinId::Sin: r[0] = std::sin(a[0]); return 1;
+    case BuiltinId::Cos: r[0] = std::cos(a[0]); return 1;
+    case BuiltinId::Tan: r[0] = std::tan(a[0]); return 1;
+    case BuiltinId::Asin: r[0] = std::asin(a[0]); return 1;
+    case BuiltinId::Acos: r[0] = std::acos(a[0]); return 1;
+    case BuiltinId::Atan: r[0] = std::atan(a[0]); return 1;
+    case BuiltinId::Atan2: r[0] = std::atan2(a[0], a[1]); return 1;
+    case BuiltinId::Sqrt: r[0] = std::sqrt(a[0]); return 1;
+    case BuiltinId::Exp: r[0] = std::exp(a[0]); return 1;
+    case BuiltinId::Log: r[0] = std::log(a[0]); return 1;
+    case BuiltinId::Pow: r[0] = std::pow(a[0], a[1]); return 1;
+    case BuiltinId::Abs: r[0] = std::fabs(a[0]); return 1;
+    case BuiltinId::Min: r[0] = std::min(a[0], a[1]); return 1;
+    case BuiltinId::Max: r[0] = std::max(a[0], a[1]); return 1;
+    case BuiltinId::Clamp: r[0] = std::min(std::max(a[0], a[1]), a[2]); return 1;
+    case BuiltinId::Floor: r[0] = std::floor(a[0]); return 1;
+    case BuiltinId::Ceil: r[0] = std::ceil(a[0]); return 1;
+    case BuiltinId::Round: r[0] = std::round(a[0]); return 1;
+    case BuiltinId::Sign: r[0] = a[0] > 0 ? 1.0 : a[0] < 0 ? -1.0 : 0.0; return 1;
+    case BuiltinId::Mix: r[0] = a[0] + (a[1] - a[0]) * a[2]; return 1;
+    case BuiltinId::MixV:
+        for (int k = 0; k < 3; ++k) r[k] = a[k] + (a[3 + k] - a[k]) * a[6];
+        return 3;
+    case BuiltinId::Smoothstep: {
+        double t = a[1] == a[0] ? (a[2] < a[0] ? 0.0 : 1.0) : std::clamp((a[2] - a[0]) / (a[1] - a[0]), 0.0, 1.0);
+        r[0] = t * t * (3 - 2 * t);
+        return 1;
+    }
+    case BuiltinId::Rad: r[0] = a[0] * kPi / 180.0; return 1;
+    case BuiltinId::Deg: r[0] = a[0] * 180.0 / kPi; return 1;
+    case BuiltinId::Pi: r[0] = kPi; return 1;
+    case BuiltinId::Vec3: r[0] = a[0]; r[1] = a[1]; r[2] = a[2]; return 3;
+    case BuiltinId::Vec3S: r[0] = r[1] = r[2] = a[0]; return 3;
+    case BuiltinId::Dot: r[0] = a[0] * a[3] + a[1] * a[4] + a[2] * a[5]; return 1;
+    case BuiltinId::Cross: {
+        double x = a[1] * a[5] - a[2] * a[4], y = a[2] * a[3] - a[0] * a[5], z = a[0] * a[4] - a[1] * a[3];
+        r[0] = x; r[1] = y; r[2] = z;
+        return 3;
+    }
+    case BuiltinId::Length: r[0] = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]); return 1;
+    case BuiltinId::Normalize: {
+        double l = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+        double inv = l > 0 ? 1.0 / l : 0.0;
+        r[0] = a[0] * inv; r[1] = a[1] * inv; r[2] = a[2] * inv;
+        return 3;
+    }
+    case BuiltinId::Distance: {
+        double dx = a[0] - a[3], dy = a[1] - a[4], dz = a[2] - a[5];
+        r[0] = std::sqrt(dx * dx + dy * dy + dz * dz);
+        return 1;
+    }
+    case BuiltinId::Uniform: r[0] = a[0] + (a[1] - a[0]) * next_unit(env); return 1;
+    case BuiltinId::Normal: {
+        // Box-Muller from two counter-based draws
+        double u1 = next_unit(env), u2 = next_unit(env);
+        r[0] = a[0] + a[1] * std::sqrt(-2.0 * std::log(1.0 - u1)) * std::cos(2 * kPi * u2);
+        return 1;
+    }
+    case BuiltinId::Chance: r[0] = next_unit(env) < a[0] ? 1.0 : 0.0; return 1;
+    case BuiltinId::Step: r[0] = env.step; return 1;
+    case BuiltinId::Id: r[0] = static_cast<double>(env.id & ~kNewIdBit); return 1;
+    case BuiltinId::Lod: r[0] = a[2] == 0 ? a[0] : std::round(a[0] * (1 - a[1] / a[2])); return 1;
+    }
+    return 0;
+}
+
+std::string format_number(double v) {
+    if (v == std::floor(v) && std::fabs(v) < 1e15) return fmt::format("{}", static_cast<long long>(v));
+    return fmt::format("{}", v);
+}
+
+struct ArenaScope {
+    EvalEnv& env;
+    std::size_t saved;
+    ArenaScope(EvalEnv& e, std::size_t need) : env(e), saved(e.arena_top) {
+        if (env.arena_top + need > env.arena.size()) env.arena.resize((env.arena_top + need) * 2);
+        env.arena_top += need;
+    }
+    ~ArenaScope() { env.arena_top = saved; }
+};
+
+} // namespace
+
+RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
+    ArenaScope scope(env, kStackSize);
+    // The arena may grow (and move) inside nested calls, so address the stack by offset.
+    const std::size_t base = scope.saved;
+    auto S = [&env, base]() { return env.arena.data() + base; };
+    double* st = S();
+    int sp = 0;
+    const Instr* ins = code.instrs.data();
+    const std::size_t n = code.instrs.size();
+    for (std::size_t pc = 0; pc < n; ++pc) {
+        const Instr& I = ins[pc];
+        switch (I.op) {
+        case Op::Const: st[sp++] = code.consts[I.a]; break;
+        case Op::Const3:
+            st[sp] = code.consts[I.a]; st[sp + 1] = code.consts[I.a + 1]; st[sp + 2] = code.consts[I.a + 2];
+            sp += 3;
+            break;
+        case Op::LoadLocal:
+            for (int k = 0; k < I.n; ++k) st[sp++] = frame[I.a + k];
+            break;
+        case Op::StoreLocal:
+            sp -= I.n;
+            for (int k = 0; k < I.n; ++k) frame[I.a + k] = st[sp + k];
+            break;
+        case Op::LoadGlobal:
+            for (int k = 0; k < I.n; ++k) st[sp++] = env.globals[I.a + k];
+            break;
+        case Op::StoreGlobal:
+            sp -= I.n;
+            for (int k = 0; k < I.n; ++k) env.globals[I.a + k] = st[sp + k];
+            break;
+        case Op::Pop: sp -= I.n; break;
+        case Op::Add: --sp; st[sp - 1] += st[sp]; break;
+        case Op::Sub: --sp; st[sp - 1] -= st[sp]; break;
+        case Op::Mul: --sp; st[sp - 1] *= st[sp]; break;
+        case Op::Div:
+            --sp;
+            if (st[sp] == 0) fail(code, pc, "division by zero");
+            st[sp - 1] /= st[sp];
+            break;
+        case Op::Mod:
+            --sp;
+            if (st[sp] == 0) fail(code, pc, "remainder of a division by zero");
+            st[sp - 1] = std::fmod(st[sp - 1], st[sp]);
+            break;
+        case Op::Neg: st[sp - 1] = -st[sp - 1]; break;
+        case Op::Not: st[sp - 1] = st[sp - 1] == 0 ? 1.0 : 0.0; break;
+        case Op::Lt: --sp; st[sp - 1] = st[sp - 1] < st[sp]; break;
+        case Op::Le: --sp; st[sp - 1] = st[sp - 1] <= st[sp]; break;
+        case Op::Gt: --sp; st[sp - 1] = st[sp - 1] > st[sp]; break;
+        case Op::Ge: --sp; st[sp - 1] = st[sp - 1] >= st[sp]; break;
+        case Op::Eq: --sp; st[sp - 1] = st[sp - 1] == st[sp]; break;
+        case Op::Ne: --sp; st[sp - 1] = st[sp - 1] != st[sp]; break;
+        case Op::VAdd: sp -= 3; for (int k = 0; k < 3; ++k) st[sp - 3 + k] += st[sp + k]; break;
+        case Op::VSub: sp -= 3; for (int k = 0; k < 3; ++k) st[sp - 3 + k] -= st[sp + k]; break;
+        case Op::VMulS: { // vec * s
+            double s = st[--sp];
+            for (int k = 0; k < 3; ++k) st[sp - 3 + k] *= s;
+            break;
+        }
+        case Op::VSMul: { // s * vec
+            double s = st[sp - 4];
+            for (int k = 0; k < 3; ++k) st[sp - 4 + k] = s * st[sp - 3 + k];
+            --sp;
+            break;
+        }
+        case Op::VDivS: {
+            double s = st[--sp];
+            if (s == 0) fail(code, pc, "division by zero");
+            for (int k = 0; k < 3; ++k) st[sp - 3 + k] /= s;
+            break;
+        }
+        case Op::VNeg: for (int k = 1; k <= 3; ++k) st[sp - k] = -st[sp - k]; break;
+        case Op::VEq:
+        case Op::VNe: {
+            sp -= 6;
+            bool eq = st[sp] == st[sp + 3] && st[sp + 1] == st[sp + 4] && st[sp + 2] == st[sp + 5];
+            st[sp++] = (I.op == Op::VEq) == eq ? 1.0 : 0.0;
+            break;
+        }
+        case Op::Member: {
+            double v = st[sp - 3 + I.a];
+            sp -= 3;
+            st[sp++] = v;
+            break;
+        }
+        case Op::Jump: pc = static_cast<std::size_t>(I.a) - 1; break;
+        case Op::JumpIfZero:
+            if (st[--sp] == 0) pc = static_cast<std::size_t>(I.a) - 1;
+            break;
+        case Op::JumpIfZeroKeep:
+            if (st[sp - 1] == 0) pc = static_cast<std::size_t>(I.a) - 1;
+            else --sp;
+            break;
+        case Op::JumpIfNonZeroKeep:
+            if (st[sp - 1] != 0) pc = static_cast<std::size_t>(I.a) - 1;
+            else --sp;
+            break;
+        case Op::Builtin: {
+            sp -= I.n;
+            double r[3];
+            int w = apply_builtin(static_cast<BuiltinId>(I.a), st + sp, r, env);
+            for (int k = 0; k < w; ++k) st[sp++] = r[k];
+            break;
+        }
+        case Op::Call: {
+            const Function& fn = env.prog->functions[I.a];
+            if (env.call_depth >= kMaxCallDepth)
+                fail(code, pc, fmt::format("recursion deeper than {} calls in '{}'", kMaxCallDepth, fn.name));
+            sp -= fn.param_width;
+            std::vector<double> callee(std::max<std::size_t>(fn.frame_size, 1));
+            for (int k = 0; k < fn.param_width; ++k) callee[k] = st[sp + k];
+            double r[3] = {0, 0, 0};
+            ++env.call_depth;
+            ModuleString* saved_out = env.out;
+            env.out = nullptr;
+            run(fn.code, callee.data(), env, r);
+            env.out = saved_out;
+            --env.call_depth;
+            st = S();
+            int w = value_width(fn.result);
+            for (int k = 0; k < w; ++k) st[sp++] = r[k];
+            break;
+        }
+        case Op::Return:
+            if (result)
+                for (int k = 0; k < I.n; ++k) result[k] = st[sp - I.n + k];
+            return RunStatus::Finished;
+        case Op::Emit: {
+            sp -= I.n;
+            const double* p = st + sp;
+            for (int k = 0; k < I.n; ++k)
+                if (!std::isfinite(p[k]))
+                    fail(code, pc,
+                         fmt::format("parameter {} of '{}' is {}", k + 1, env.prog->symbols[I.a].name,
+                                     std::isnan(p[k]) ? "NaN" : "infinite"));
+            auto sym = static_cast<SymbolId>(I.a);
+            ModuleId id = 0;
+            bool kept = false;
+            for (std::uint32_t k = 0; k < env.keep_count; ++k) {
+                if (!(env.keep_used & (1u << k)) && env.keep_syms[k] == sym) {
+                    env.keep_used |= 1u << k;
+                    id = env.keep_ids[k];
+                    kept = true;
+                    break;
+                }
+            }
+            if (!kept) id = kNewIdBit | env.new_count++;
+            env.out->push(sym, p, I.n, id);
+            env.produced = true;
+            if (env.out->size() > env.max_output) fail(code, pc, "the string outgrew the module limit");
+            break;
+        }
+        case Op::ProduceEnd: env.produced = true; return RunStatus::Produced;
+        case Op::NProduceMark: env.produced = true; break;
+        case Op::Use:
+            if (env.effects) env.effects->use_group = I.a;
+            break;
+        case Op::Stop:
+            if (env.effects) env.effects->stop = true;
+            break;
+        case Op::Print: {
+            sp -= I.n;
+            const std::string& fmtstr = env.prog->print_formats[I.a];
+            std::string line;
+            int k = 0;
+            // the format is a sequence of n (number), v (vec3), b (bool) and s<text>\x1f pieces
+            for (std::size_t c = 0; c < fmtstr.size(); ++c) {
+                if (!line.empty()) line += ' ';
+                char t = fmtstr[c];
+                if (t == 'n') line += format_number(st[sp + k++]);
+                else if (t == 'b') line += st[sp + k++] != 0 ? "true" : "false";
+                else if (t == 'v') {
+                    line += fmt::format("vec3({}, {}, {})", format_number(st[sp + k]), format_number(st[sp + k + 1]),
+                                        format_number(st[sp + k + 2]));
+                    k += 3;
+                } else if (t == 's') {
+                    auto e = fmtstr.find('\x1f', c + 1);
+                    line += fmtstr.substr(c + 1, e - c - 1);
+                    c = e;
+                }
+            }
+            if (env.effects) env.effects->printed += line + "\n";
+            break;
+        }
+        case Op::ForCheck:
+            if (++frame[I.a] > 1e7) fail(code, pc, "loop ran more than 10 million times");
+            break;
+        case Op::Halt:
+            if (result)
+                for (int k = 0; k < I.n; ++k) result[k] = st[sp - I.n + k];
+            return RunStatus::Finished;
+        }
+    }
+    if (result && sp > 0)
+        for (int k = 0; k < std::min(sp, 3); ++k) result[k] = st[sp - std::min(sp, 3) + k];
+    return RunStatus::Finished;
+}
+
+double eval_number(const Code& code, double* frame, EvalEnv& env) {
+    double r[3] = {0, 0, 0};
+    run(code, frame, env, r);
+    return r[0];
+}
+
+} // namespace plant
