@@ -440,9 +440,9 @@ Derivation::Derivation(const Program& program, DeriveOptions options) : prog_(pr
 
 void Derivation::check_limits(const ModuleString& s) const {
     if (s.size() > opt_.max_modules)
-        throw RuntimeError{Span{}, fmt::format("step {}: the string grew to {} modules, more than the limit of {} "
-                                               "(raise it with --max-modules)",
-                                               step_, s.size(), opt_.max_modules)};
+        throw RuntimeError{Span{}, fmt::format("step {}: the string grew past the limit of {} modules (raise it "
+                                               "with --max-modules)",
+                                               step_, opt_.max_modules)};
     std::size_t estimate = s.size() * (sizeof(SymbolId) + sizeof(std::uint32_t) + sizeof(ModuleId)) +
                            s.params.size() * sizeof(double);
     if (estimate > opt_.max_bytes)

@@ -116,9 +116,11 @@ struct or_x : seq<and_x, star<pad<or_op>, must<and_x>>> {};
 struct ternary_then;
 struct ternary_else;
 struct ternary : seq<or_x, opt<if_must<pad<one<'?'>>, ternary_then, colon, ternary_else>>> {};
-struct expr : ternary {};
-struct ternary_then : expr {};
-struct ternary_else : expr {};
+// (expr wraps ternary in seq<> so that ternary is matched as a rule of its own and can be a
+// parse-tree node; `struct expr : ternary {}` would only reuse ternary's implementation)
+struct expr : seq<ternary> {};
+struct ternary_then : seq<expr> {};
+struct ternary_else : seq<expr> {};
 
 // ---- modules, successors and patterns (sections 2, 4) --------------------------------------
 

@@ -21,7 +21,7 @@ template <typename Rule>
 using selector = pt::selector<
     Rule,
     pt::store_content::on<g::identifier, g::number, g::string_lit, g::true_lit, g::false_lit, g::call, g::call_args,
-                          g::name_ref, g::member, g::unary_expr, g::unary_op, g::mul_op, g::add_op, g::rel_op,
+                          g::name_ref, g::paren_expr, g::member, g::unary_expr, g::unary_op, g::mul_op, g::add_op, g::rel_op,
                           g::eq_op, g::and_op, g::or_op, g::module_ref, g::module_name, g::module_args,
                           g::bracket_open, g::bracket_close, g::wildcard, g::successor, g::pattern,
                           g::production, g::ctx_part, g::ctx_op, g::condition, g::arrow_form, g::weight, g::block,
@@ -77,6 +77,14 @@ public:
             e->kind = ast::ExprKind::Unary;
             e->text = n.children.at(0)->string();
             e->args.push_back(expr(*n.children.at(1)));
+        } else if (n.is_type<g::paren_expr>()) {
+            // the value is the inner expression; the span covers the parentheses
+            ast::ExprPtr inner = expr(*n.children.at(0));
+            std::string_view text = n.string_view();
+            auto close = text.rfind(')');
+            inner->span = {file_, static_cast<std::uint32_t>(n.begin().byte),
+                           static_cast<std::uint32_t>(n.begin().byte + (close == text.npos ? text.size() : close + 1))};
+            return inner;
         } else if (n.is_type<g::ternary>()) {
             e->kind = ast::ExprKind::Ternary;
             for (const auto& c : n.children) e->args.push_back(expr(*c));

@@ -5,6 +5,7 @@
 
 #include "plant/source.hpp"
 
+#include <exception>
 #include <string>
 #include <vector>
 
@@ -41,7 +42,9 @@ std::string render(const Diagnostic& d, const SourceManager& sources, bool color
 std::string render_all(const Diagnostics& ds, const SourceManager& sources, bool color = false);
 
 // Thrown by the runtime for errors that end a derivation (runtime errors exit 70).
-struct RuntimeError {
+struct RuntimeError : std::exception {
+    RuntimeError(Span s, std::string m) : span(s), message(std::move(m)) {}
+    const char* what() const noexcept override { return message.c_str(); }
     Span span;
     std::string message;
 };

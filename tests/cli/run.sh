@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# Command-line behaviour that script tests cannot reach: help on every command, usage errors,
+# unreadable input, and exit codes.
+set -u
+plant=${1:?usage: run.sh PLANT}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+pass=0
+fail=0
+
+check() { # check NAME EXPECTED_EXIT COMMAND... ; stderr/stdout saved in $tmp/out, $tmp/err
+  local name=$1 want=$2
+  shift 2
+  "$@" >"$tmp/out" 2>"$tmp/err"
+  local got=$?
+  if [ "$got" -eq "$want" ]; then pass=$((pass + 1)); else
+    fail=$((fail + 1))
+    echo "FAIL $name: exit $got, expected $want"
+    sed 's/^/  /' "$tmp/err" | head -5
+  fi
+}
+contains() { # contains NAME FILE TEXT
+  if grep -qF -- "$3" "$2"; then pass=$((pass + 1)); else
+    fail=$((fail + 1))
+    echo "FAIL $1: '$3' not in output"
+    sed 's/^/  /' "$2" | head -5
+  fi
+}
+
+printf 'axiom: F;\nderive 2;\nrules { F -> F+F; }\n' >"$tmp/ok.plant"
+
+check "top-level help" 0 "$plant" --help
+contains "top-level help lists derive" "$tmp/out" "derive"
+for cmd in derive check test; do
+  check "$cmd --help" 0 "$plant" "$cmd" --help
+  contains "$cmd --help shows usage" "$tmp/out" "Usage"
+done
+check "no command" 64 "$plant"
+check "unknown command" 64 "$plant" grow
+check "unknown option" 64 "$plant" derive "$tmp/ok.plant" --frobnicate
+check "bad -n" 64 "$plant" derive "$tmp/ok.plant" -n minus
+check "bad -D" 64 "$plant" derive "$tmp/ok.plant" -D nothing
+check "missing file" 66 "$plant" derive "$tmp/none.plant"
+contains "missing file message" "$tmp/err" "cannot read '$tmp/none.plant': no such file"
+check "directory as file" 66 "$plant" check "$tmp"
+check "derive ok" 0 "$plant" derive "$tmp/ok.plant"
+contains "derive output" "$tmp/out" "F+F+F+F"
+check "derive -n" 0 "$plant" derive "$tmp/ok.plant" -n 1
+contains "derive -n output" "$tmp/out" "F+F"
+check "derive --stats" 0 "$plant" derive "$tmp/ok.plant" --stats
+contains "stats total line" "$tmp/out" "total steps=2 modules=7"
+check "check ok" 0 "$plant" check "$tmp/ok.plant"
+head -c 4096 /dev/urandom >"$tmp/garbage.plant"
+printf '\x00\x01binary' >>"$tmp/garbage.plant"
+check "binary garbage" 65 "$plant" derive "$tmp/garbage.plant"
+contains "binary garbage is positioned" "$tmp/err" "garbage.plant:1:"
+: >"$tmp/empty.plant"
+check "empty file" 65 "$plant" derive "$tmp/empty.plant"
+contains "empty file message" "$tmp/err" "the grammar has no axiom"
+printf 'axiom: F;\nderive 40;\nrules { F -> FF; }\n' >"$tmp/boom.plant"
+check "explosion" 70 "$plant" derive "$tmp/boom.plant" --max-modules 1000
+contains "explosion names the step" "$tmp/err" "step 10: the string grew past the limit of 1000 modules"
+check "threads agree" 0 "$plant" derive "$tmp/ok.plant" --threads 2
+check "test of missing path" 66 "$plant" test "$tmp/none"
+
+echo "$pass passed, $fail failed"
+[ "$fail" -eq 0 ]

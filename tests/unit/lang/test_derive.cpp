@@ -1,0 +1,145 @@
+#include "helpers.hpp"
+
+#include <catch2/catch.hpp>
+
+using namespace plant;
+using plant::test::derive;
+
+TEST_CASE("parallel rewriting of a bracketed OL-system (ABOP Fig. 1.24d)", "[derive]") {
+    const char* g = "axiom: X; rules { X -> F[+X]F[-X]+X; F -> FF; }";
+    DeriveOptions o;
+    o.steps = 2;
+    CHECK(derive(g, o) == "FF[+F[+X]F[-X]+X]FF[-F[+X]F[-X]+X]+F[+X]F[-X]+X");
+    o.steps = 10;
+    auto c = test::compile(g);
+    Derivation d(*c->program, o);
+    d.run();
+    CHECK(d.string().size() == 381767); // ABOP Fig. 1.24d at n = 10
+}
+
+TEST_CASE("parametric rewriting with conditions (ABOP section 1.10)", "[derive]") {
+    // ABOP p. 43: A(x, y) with conditions, the example derivation
+    const char* g = R"(
+        module A(x, y); module B(x); module C;
+        axiom: B(2) A(4, 4);
+        derive 3;
+        rules {
+          A(x, y) : y <= 3 -> A(x * 2, x + y);
+          A(x, y) : y > 3 -> B(x) A(x / y, 0);
+          B(x) : x < 1 -> C;
+          B(x) : x >= 1 -> B(x - 1);
+        })";
+    // B(2)A(4,4) => B(1)B(4)A(1,0) => B(0)B(3)A(2,1) => C B(2)A(4,3)
+    CHECK(derive(g) == "CB(2)A(4,3)");
+}
+
+TEST_CASE("identities stay with the first successor module of the same name", "[derive]") {
+    DeriveOptions o;
+    o.steps = 1;
+    CHECK(derive("axiom: A B; rules { A -> B A A; }", o, true) == "B#3A#1A#4B#2");
+}
+
+TEST_CASE("the body form: let, if, for, nproduce, produce and falling through", "[derive]") {
+    const char* g = R"(
+        module A(n);
+        axiom: A(3) A(0) A(-1);
+        derive 1;
+        rules {
+          A(n) {
+            if (n > 0) {
+              for i in 0..n { nproduce F(i); }
+              produce B;
+            }
+            if (n == 0) { produce; }
+          }
+          A(n) -> C;
+        })";
+    CHECK(derive(g) == "F(0)F(1)F(2)BC");
+}
+
+TEST_CASE("decomposition applies after the axiom and after every step, up to max_depth", "[derive]") {
+    const char* g = R"(
+        module A(n); module I(k);
+        axiom: A(5);
+        derive 0;
+        decompose max_depth 10 { A(n) : n > 0 -> I(n) A(n - 1); A(0) -> ; }
+    )";
+    CHECK(derive(g) == "I(5)I(4)I(3)I(2)I(1)");
+    const char* shallow = R"(
+        module A(n); module I(k);
+        axiom: A(5);
+        decompose max_depth 2 { A(n) : n > 0 -> I(n) A(n - 1); }
+    )";
+    CHECK(derive(shallow) == "I(5)I(4)A(3)");
+}
+
+TEST_CASE("cut removes the rest of the branch", "[derive]") {
+    DeriveOptions o;
+    o.steps = 1;
+    CHECK(derive("axiom: F[A F F[G]F]F A B; rules { A -> %; }", o) == "F[]F");
+}
+
+TEST_CASE("hooks: vars, groups and stop", "[derive]") {
+    const char* g = R"(
+        var count = 0;
+        axiom: A;
+        derive 10;
+        rules { A -> A B; }
+        rules pinch { A -> C; }
+        on after_step { count += 1; if (count == 2) { use pinch; } if (count == 4) { stop; } }
+    )";
+    // steps 1-2 grow, steps 3-4 pinch, then stop
+    auto c = test::compile(g);
+    Derivation d(*c->program, {});
+    d.run();
+    CHECK(d.steps_done() == 4);
+    CHECK(format_string(*c->program, d.string()) == "CBB");
+}
+
+TEST_CASE("the module limit stops an explosion with an error naming the step", "[derive][limits]") {
+    auto c = test::compile("axiom: F; derive 30; rules { F -> FFFFFFFFFF; }");
+    DeriveOptions o;
+    o.max_modules = 100000;
+    o.threads = 2;
+    Derivation d(*c->program, o);
+    try {
+        d.run();
+        FAIL("expected an error");
+    } catch (const RuntimeError& e) {
+        CHECK(e.message == "step 6: the string grew past the limit of 100000 modules (raise it with --max-modules)");
+    }
+}
+
+TEST_CASE("NaN and infinity never reach a module parameter", "[derive][limits]") {
+    auto c = test::compile("axiom: A(1); derive 1; rules { A(x) -> A(sqrt(-x)); }");
+    Derivation d(*c->program, {});
+    CHECK_THROWS_WITH(d.run(), "step 1: parameter 1 of 'A' is NaN");
+    auto c2 = test::compile("axiom: A(1); derive 1; rules { A(x) -> A(x / (x - 1)); }");
+    Derivation d2(*c2->program, {});
+    try {
+        d2.run();
+        FAIL("expected an error");
+    } catch (const RuntimeError& e) {
+        CHECK(e.message == "step 1: division by zero");
+        const std::string& text = c2->sources.file(e.span.file).text();
+        CHECK(text.substr(e.span.begin, e.span.end - e.span.begin) == "x / (x - 1)");
+    }
+}
+
+TEST_CASE("recursion in functions is bounded", "[derive][limits]") {
+    auto c = test::compile("fn f(x) = f(x + 1); axiom: A(1); derive 1; rules { A(x) -> A(f(x)); }");
+    Derivation d(*c->program, {});
+    CHECK_THROWS_WITH(d.run(), "step 1: recursion deeper than 256 calls in 'f'");
+}
+
+TEST_CASE("numbers print in the shortest form that reads back", "[derive]") {
+    CHECK(format_double(0.1 + 0.2) == "0.30000000000000004");
+    CHECK(format_double(-0.0) == "0");
+    CHECK(format_double(1e21) == "1e+21");
+    CHECK(format_double(137.5) == "137.5");
+    CHECK(format_double(0.707) == "0.707");
+}
+
+TEST_CASE("string output: modules back to back, parameters in parentheses", "[derive]") {
+    CHECK(derive("module B(l, w); axiom: !(10)F(1)[&(45)B(0.6, 7.07)];") == "!(10)F(1)[&(45)B(0.6,7.07)]");
+}
