@@ -763,8 +763,10 @@ void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list, Span span)
                 emit(c, Op::Emit, static_cast<std::int32_t>(sym), 0, m.span);
                 continue;
             }
+            std::vector<Span> arg_spans;
             for (std::size_t i = 0; i < nargs; ++i) {
                 ValueType t = compile_expr(c, *m.args[i]);
+                for (int w = 0; w < std::max(1, value_width(t)); ++w) arg_spans.push_back(m.args[i]->span);
                 if (t == ValueType::String) t = ValueType::Number;
                 if (info.arity >= 0 && i < info.param_types.size() &&
                     value_width(t) != value_width(info.param_types[i])) {
@@ -778,7 +780,12 @@ void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list, Span span)
                 diags_.error(m.span, "a module can carry at most 255 numbers");
                 width = 0;
             }
-            emit(c, Op::Emit, static_cast<std::int32_t>(sym), width, last ? m.span : parts[k].second);
+            std::uint16_t spans_index = 0;
+            if (!arg_spans.empty() && c.code->arg_spans.size() < 65535) {
+                c.code->arg_spans.push_back(std::move(arg_spans));
+                spans_index = static_cast<std::uint16_t>(c.code->arg_spans.size());
+            }
+            emit(c, Op::Emit, static_cast<std::int32_t>(sym), width, last ? m.span : parts[k].second, spans_index);
         }
     }
 }

@@ -199,7 +199,7 @@ void Compiler::declare_values(const LoadedFile& lf) {
             }
         }
         auto cv = eval_const(*value, v.kind == ast::DeclKind::Const ? "a const" : "the initial value");
-        if (!cv) continue;
+        if (!cv) cv = ConstVal{}; // declared all the same, so later uses are not "unknown" too
         if (v.kind == ast::DeclKind::Const) {
             consts_[v.name] = *cv;
             consts_[v.name].span = v.name_span;

@@ -743,7 +743,16 @@ std::string format_double(double v) {
     if (v == 0) return "0"; // also for -0
     char buf[64];
     auto r = std::to_chars(buf, buf + sizeof buf, v);
-    return std::string(buf, r.ptr);
+    std::string s(buf, r.ptr);
+    // to_chars writes exponents as e+21 and e-07; the shortest reading-back form is e21 and e-7
+    if (auto e = s.find('e'); e != std::string::npos) {
+        std::string mant = s.substr(0, e), exp = s.substr(e + 1);
+        bool neg = !exp.empty() && exp[0] == '-';
+        if (!exp.empty() && (exp[0] == '+' || exp[0] == '-')) exp.erase(0, 1);
+        while (exp.size() > 1 && exp[0] == '0') exp.erase(0, 1);
+        s = mant + "e" + (neg ? "-" : "") + exp;
+    }
+    return s;
 }
 
 std::string format_string(const Program& program, const ModuleString& s, bool with_ids) {

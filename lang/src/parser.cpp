@@ -481,20 +481,25 @@ std::string describe_found(const std::string& text, std::size_t byte) {
     return fmt::format("'{}'", static_cast<char>(c));
 }
 
-// After an error, skip to the next line that starts with a top-level keyword.
-std::size_t resync(const std::string& text, std::size_t from) {
+// After an error, restart at the first line that starts with a top-level keyword at or after the
+// error (the error may be the keyword itself, as when a ';' is missing at the end of the line
+// before), but always after `item_start` so that parsing makes progress.
+std::size_t resync(const std::string& text, std::size_t from, std::size_t item_start) {
     static const char* keywords[] = {"param ",   "const ",     "var ",       "module ", "fn ",      "curve ",
                                      "surface ", "env ",       "instance ",  "derive ", "angle ",   "step ",
                                      "width ",   "seed ",      "axiom",      "ignore",  "consider", "rules",
                                      "decompose", "interpret", "on ",        "import ", "/*"};
-    std::size_t pos = text.find('\n', from);
-    while (pos != std::string::npos) {
-        std::size_t b = pos + 1;
+    std::size_t b = from;
+    while (b > 0 && text[b - 1] != '\n') --b; // start of the error's line
+    while (b < text.size()) {
         std::size_t s = b;
         while (s < text.size() && (text[s] == ' ' || text[s] == '\t')) ++s;
-        for (const char* kw : keywords)
-            if (text.compare(s, std::strlen(kw), kw) == 0) return b;
-        pos = text.find('\n', b);
+        if (s >= from && b > item_start)
+            for (const char* kw : keywords)
+                if (text.compare(s, std::strlen(kw), kw) == 0) return b;
+        std::size_t nl = text.find('\n', b);
+        if (nl == std::string::npos) break;
+        b = nl + 1;
     }
     return text.size();
 }
@@ -536,7 +541,7 @@ std::unique_ptr<ast::File> parse_file(const SourceManager& sources, std::uint32_
             auto b = static_cast<std::uint32_t>(e.byte);
             diags.error({file_id, b, b + 1}, msg);
             if (++errors >= 20) break;
-            offset = resync(text, e.byte);
+            offset = resync(text, e.byte, offset);
             if (offset >= text.size()) break;
         }
     }

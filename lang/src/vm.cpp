@@ -243,11 +243,15 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
         case Op::Emit: {
             sp -= I.n;
             const double* p = st + sp;
-            for (int k = 0; k < I.n; ++k)
-                if (!std::isfinite(p[k]))
-                    fail(code, pc,
-                         fmt::format("parameter {} of '{}' is {}", k + 1, env.prog->symbols[I.a].name,
-                                     std::isnan(p[k]) ? "NaN" : "infinite"));
+            for (int k = 0; k < I.n; ++k) {
+                if (!std::isfinite(p[k])) {
+                    std::string msg = fmt::format("parameter {} of '{}' is {}", k + 1, env.prog->symbols[I.a].name,
+                                                  std::isnan(p[k]) ? "NaN" : "infinite");
+                    if (I.b > 0 && static_cast<std::size_t>(k) < code.arg_spans[I.b - 1].size())
+                        throw RuntimeError{code.arg_spans[I.b - 1][k], msg};
+                    fail(code, pc, msg);
+                }
+            }
             auto sym = static_cast<SymbolId>(I.a);
             ModuleId id = 0;
             bool kept = false;

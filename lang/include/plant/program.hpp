@@ -91,6 +91,7 @@ struct Code {
     std::vector<Instr> instrs;
     std::vector<Span> spans; // one per instruction, for runtime errors
     std::vector<double> consts;
+    std::vector<std::vector<Span>> arg_spans; // Emit with b > 0: spans of its numbers, arg_spans[b - 1]
     bool empty() const { return instrs.empty(); }
 };
 

@@ -135,7 +135,9 @@ TEST_CASE("recursion in functions is bounded", "[derive][limits]") {
 TEST_CASE("numbers print in the shortest form that reads back", "[derive]") {
     CHECK(format_double(0.1 + 0.2) == "0.30000000000000004");
     CHECK(format_double(-0.0) == "0");
-    CHECK(format_double(1e21) == "1e+21");
+    CHECK(format_double(1e21) == "1e21");
+    CHECK(format_double(1e-7) == "1e-7");
+    CHECK(format_double(-2.5e-300) == "-2.5e-300");
     CHECK(format_double(137.5) == "137.5");
     CHECK(format_double(0.707) == "0.707");
 }
