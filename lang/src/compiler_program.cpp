@@ -517,6 +517,7 @@ std::unique_ptr<Program> Compiler::compile(std::uint32_t main_file) {
         if (has_consider_) P_.ignored[s] = consider_syms_.count(s) ? 0 : 1;
         else P_.ignored[s] = ignore_syms_.count(s) ? 1 : 0;
     }
+    P_.uses_cut = produced_.count(P_.symbols.cut) > 0;
     finish_rule_set(P_.rules);
     for (auto& g : P_.groups) finish_rule_set(g);
     finish_rule_set(P_.decompose);

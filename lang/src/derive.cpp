@@ -586,6 +586,7 @@ void Derivation::decompose(ModuleString& s, int step_for_env) {
 }
 
 void Derivation::apply_cut(ModuleString& s) const {
+    if (!prog_.uses_cut) return;
     const SymbolId cut = prog_.symbols.cut, open = prog_.symbols.open_bracket, close = prog_.symbols.close_bracket;
     bool any = false;
     for (SymbolId x : s.sym)

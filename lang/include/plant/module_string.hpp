@@ -3,6 +3,8 @@
 // the identity ids[i] (LANGUAGE.md section 6). Vec3 parameters occupy three consecutive doubles.
 #pragma once
 
+#include "plant/big_allocator.hpp"
+
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -13,10 +15,10 @@ using SymbolId = std::uint32_t;
 using ModuleId = std::uint64_t;
 
 struct ModuleString {
-    std::vector<SymbolId> sym;
-    std::vector<std::uint32_t> poff{0}; // size() + 1 entries
-    std::vector<double> params;
-    std::vector<ModuleId> ids;
+    BigVector<SymbolId> sym;
+    BigVector<std::uint32_t> poff{0}; // size() + 1 entries
+    BigVector<double> params;
+    BigVector<ModuleId> ids;
 
     std::size_t size() const { return sym.size(); }
     bool empty() const { return sym.empty(); }
@@ -32,7 +34,7 @@ struct ModuleString {
     }
     void push(SymbolId s, const double* p, std::uint32_t k, ModuleId id) {
         sym.push_back(s);
-        params.insert(params.end(), p, p + k);
+        for (std::uint32_t i = 0; i < k; ++i) params.push_back(p[i]);
         poff.push_back(static_cast<std::uint32_t>(params.size()));
         ids.push_back(id);
     }

@@ -175,6 +175,7 @@ struct Program {
     Code setting_derive, setting_angle, setting_step, setting_width, setting_seed;
     double default_angle = 90, default_step = 1, default_width = 1;
     std::vector<std::uint8_t> ignored; // per symbol: skipped when matching context
+    bool uses_cut = false;             // some successor or the axiom produces '%'
 
     RuleSet rules;                // the unnamed, always-active group
     std::vector<RuleSet> groups;  // named groups, selected by `use`

@@ -44,7 +44,7 @@ struct EvalEnv {
     std::vector<double> arena; // operand stacks and frames of nested calls
     std::size_t arena_top = 0;
 
-    EvalEnv() : arena(1 << 16) {}
+    EvalEnv() = default;
 };
 
 enum class RunStatus { Finished, Produced };
