@@ -469,6 +469,7 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const std::v
     if (threads == 1) {
         Worker w;
         setup(w);
+        w.env.id_base = next_id_; // one thread numbers new modules in string order directly
         w.out.sym.reserve(static_cast<std::size_t>(n * growth_ * 1.02) + 16);
         w.out.ids.reserve(w.out.sym.capacity());
         w.out.poff.reserve(w.out.sym.capacity() + 1);
@@ -488,8 +489,6 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const std::v
             throw;
         }
         out.swap(w.out);
-        for (auto& id : out.ids)
-            if (id & kNewIdBit) id = next_id_ + (id & ~kNewIdBit);
         next_id_ += w.env.new_count;
     } else {
         std::vector<Worker> workers(static_cast<std::size_t>(threads));
@@ -680,9 +679,8 @@ void Derivation::start() {
     ModuleString axiom;
     env.out = &axiom;
     env.max_output = opt_.max_modules;
+    env.id_base = next_id_;
     plant::run(prog_.axiom, nullptr, env);
-    for (auto& id : axiom.ids)
-        if (id & kNewIdBit) id = next_id_ + (id & ~kNewIdBit);
     next_id_ += env.new_count;
     current_.swap(axiom);
     decompose(current_, 0);

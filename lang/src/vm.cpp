@@ -263,7 +263,7 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
                     break;
                 }
             }
-            if (!kept) id = kNewIdBit | env.new_count++;
+            if (!kept) id = env.id_base + env.new_count++;
             env.out->push(sym, p, I.n, id);
             env.produced = true;
             if (env.out->size() > env.max_output) fail(code, pc, "the string outgrew the module limit");

@@ -37,6 +37,7 @@ struct EvalEnv {
     std::uint32_t keep_count = 0;
     std::uint32_t keep_used = 0; // bit mask
     ModuleId new_count = 0;      // new modules emitted by this chunk so far
+    ModuleId id_base = kNewIdBit; // a new module's identity is id_base + new_count
     bool produced = false;
 
     HookEffects* effects = nullptr; // non-null only while a hook runs
