@@ -11,6 +11,11 @@
 // derives from the axiom again; later repetitions run on JIT-warm code, which favours
 // the peer. With --expose-gc the heap is collected between repetitions (untimed).
 //
+// bench/run uses it two ways:
+//   warm: node --expose-gc lsys-peer.mjs BENCH N --reps R --hash   (one process, best of R)
+//   cold: node lsys-peer.mjs BENCH N --reps 1, in R fresh processes: ms is then the
+//         process's first and only iterate(), the time a user running a script sees.
+//
 // --hash adds the SHA-256 of the final string written in ABOP notation (modules back to
 // back, parameters in parentheses separated by commas, numbers as JavaScript prints
 // them), so the harness can compare it with what `plant derive` prints.

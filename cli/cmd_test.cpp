@@ -45,8 +45,10 @@ std::string slurp(const std::string& path) {
     return s;
 }
 
-// Runs this program with `args`, capturing standard output and error through temporary files.
-Outcome run_self(const std::vector<std::string>& args) {
+// Runs this program with `args` in directory `dir`, capturing standard output and error through
+// temporary files. Running in the grammar's own directory keeps the paths in messages the same
+// wherever the tests are run from.
+Outcome run_self(const std::vector<std::string>& args, const fs::path& dir) {
     Outcome o;
     char out_name[] = "/tmp/plant-test-out-XXXXXX";
     char err_name[] = "/tmp/plant-test-err-XXXXXX";
@@ -61,9 +63,11 @@ Outcome run_self(const std::vector<std::string>& args) {
     posix_spawn_file_actions_adddup2(&fa, out_fd, 1);
     posix_spawn_file_actions_adddup2(&fa, err_fd, 2);
     posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+    if (!dir.empty()) posix_spawn_file_actions_addchdir_np(&fa, dir.c_str());
     std::vector<char*> argv;
-    std::string self = fs::read_symlink("/proc/self/exe").string();
-    argv.push_back(self.data());
+    static const std::string self = fs::read_symlink("/proc/self/exe").string();
+    std::string argv0 = self;
+    argv.push_back(argv0.data());
     std::vector<std::string> copy = args;
     for (auto& a : copy) argv.push_back(a.data());
     argv.push_back(nullptr);
@@ -110,7 +114,8 @@ struct Expectations {
 
 Expectations read_expectations(const std::string& text) {
     Expectations e;
-    for (const auto& raw : lines_of(text)) {
+    for (auto raw : lines_of(text)) {
+        if (!raw.empty() && raw.back() == '\r') raw.pop_back(); // files with CRLF line ends
         auto hash = raw.find('#');
         if (hash == std::string::npos) continue;
         std::string c = raw.substr(hash + 1);
@@ -198,9 +203,9 @@ std::string run_one(const fs::path& file, bool bless, bool& blessed) {
     std::string text;
     if (!read_file(file.string(), text)) return "  cannot read the file\n";
     Expectations e = read_expectations(text);
-    std::vector<std::string> args{e.command, file.string()};
+    std::vector<std::string> args{e.command, file.filename().string()};
     args.insert(args.end(), e.args.begin(), e.args.end());
-    Outcome o = run_self(args);
+    Outcome o = run_self(args, file.parent_path());
     if (e.script) {
         std::vector<std::string> errors, warnings;
         parse_diagnostics(o.err, errors, warnings);

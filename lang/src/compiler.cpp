@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -33,21 +34,28 @@ bool read_file(const std::string& path, std::string& out) {
     return true;
 }
 
+// Optimal string alignment distance: insertions, deletions, substitutions and swaps of two
+// neighbouring letters each cost one, so the usual typos ('lenght', 'widht') are one edit away.
 std::size_t edit_distance(std::string_view a, std::string_view b) {
-    std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
-    for (std::size_t j = 0; j <= b.size(); ++j) prev[j] = j;
+    const std::size_t w = b.size() + 1;
+    std::vector<std::size_t> d((a.size() + 1) * w);
+    for (std::size_t i = 0; i <= a.size(); ++i) d[i * w] = i;
+    for (std::size_t j = 0; j <= b.size(); ++j) d[j] = j;
     for (std::size_t i = 1; i <= a.size(); ++i) {
-        cur[0] = i;
-        for (std::size_t j = 1; j <= b.size(); ++j)
-            cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
-        std::swap(prev, cur);
+        for (std::size_t j = 1; j <= b.size(); ++j) {
+            std::size_t cost = a[i - 1] == b[j - 1] ? 0 : 1;
+            std::size_t v = std::min({d[(i - 1) * w + j] + 1, d[i * w + j - 1] + 1, d[(i - 1) * w + j - 1] + cost});
+            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) v = std::min(v, d[(i - 2) * w + j - 2] + 1);
+            d[i * w + j] = v;
+        }
     }
-    return prev[b.size()];
+    return d[a.size() * w + b.size()];
 }
 
 std::string nearest_name(std::string_view name, const std::vector<std::string>& candidates) {
+    // short names get only close suggestions: 'g' should not suggest 'log'
     std::string best;
-    std::size_t best_d = std::max<std::size_t>(2, name.size() / 2) + 1;
+    std::size_t best_d = std::max<std::size_t>(1, name.size() / 3) + 1;
     for (const auto& c : candidates) {
         std::size_t d = edit_distance(name, c);
         if (d < best_d) {
@@ -224,6 +232,10 @@ ValueType Compiler::compile_expr(Ctx& c, const ast::Expr& e) {
             emit(c, Op::LoadGlobal, static_cast<std::int32_t>(g.slot), value_width(g.type), e.span);
             return g.type;
         }
+        if (e.text == "pi") {
+            emit_const(c, std::numbers::pi, e.span);
+            return ValueType::Number;
+        }
         if (env_names_.count(e.text)) {
             diags_.error(e.span, fmt::format("environment '{}' can only be queried with a method, as in '{}.contains(p)'",
                                              e.text, e.text));
@@ -260,6 +272,9 @@ ValueType Compiler::compile_expr(Ctx& c, const ast::Expr& e) {
         patch(c, j_else);
         ValueType b = compile_expr(c, *e.args[2]);
         patch(c, j_end);
+        if (a == ValueType::Void) a = b;
+        if (b == ValueType::Void) b = a;
+        if (a == ValueType::Void) a = b = ValueType::Number;
         if (value_width(a) != value_width(b)) {
             diags_.error(e.span, fmt::format("the two branches of '?:' have different types ({} and {})",
                                              value_type_name(a), value_type_name(b)));
@@ -316,6 +331,9 @@ ValueType Compiler::compile_binary(Ctx& c, const ast::Expr& e) {
     }
     ValueType a = compile_expr(c, *e.args[0]);
     ValueType b = compile_expr(c, *e.args[1]);
+    // an operand of unknown type (a recursive call) takes the other operand's type
+    if (a == ValueType::Void) a = b == ValueType::Vec3 && (op == "+" || op == "-") ? b : ValueType::Number;
+    if (b == ValueType::Void) b = a == ValueType::Vec3 && (op == "+" || op == "-") ? a : ValueType::Number;
     bool na = numeric(a), nb = numeric(b);
     bool va = a == ValueType::Vec3, vb = b == ValueType::Vec3;
     if (na && nb) {
@@ -368,6 +386,9 @@ ValueType Compiler::compile_call(Ctx& c, const ast::Expr& e) {
         }
         if (e.args.size() == fn.param_types.size())
             emit(c, Op::Call, static_cast<std::int32_t>(it->second), 0, e.span);
+        // a recursive call inside the function's own body: its type is not known yet, and the
+        // operators around it take it from their other operand
+        if (fn_state_[it->second] == 1 && !fn_result_known_[it->second]) return ValueType::Void;
         return fn.result;
     }
     if (curve_names_.count(name)) {
@@ -445,6 +466,7 @@ void Compiler::declare_function(const ast::FnDecl& fd) {
     fn_index_[fd.name] = static_cast<std::uint32_t>(P_.functions.size());
     fn_decls_.push_back(&fd);
     fn_state_.push_back(0);
+    fn_result_known_.push_back(false);
     P_.functions.push_back(std::move(fn));
 }
 
@@ -468,6 +490,7 @@ void Compiler::ensure_function_compiled(std::uint32_t index) {
     ValueType result = ValueType::Number;
     if (fd.expr) {
         result = compile_expr(c, *fd.expr);
+        if (result == ValueType::Void) result = ValueType::Number;
         emit(c, Op::Return, 0, value_width(result), fd.expr->span);
     } else {
         c.fn_result = &result;
@@ -478,7 +501,10 @@ void Compiler::ensure_function_compiled(std::uint32_t index) {
         for (int k = 0; k < value_width(result); ++k) emit_const(c, 0, fd.span);
         emit(c, Op::Return, 0, value_width(result), fd.span);
     }
+    if (result == ValueType::Void) result = ValueType::Number;
+    for (std::size_t at : c.void_returns) code.instrs[at].n = static_cast<std::uint8_t>(value_width(result));
     Function& fn = P_.functions[index];
+    fn_result_known_[index] = true;
     fn.code = std::move(code);
     fn.result = result == ValueType::Bool ? ValueType::Number : result;
     if (result == ValueType::Bool) fn.result = ValueType::Bool;
@@ -593,6 +619,11 @@ void Compiler::compile_stmt(Ctx& c, const ast::Stmt& s) {
         }
         ValueType t = s.expr ? compile_expr(c, *s.expr) : ValueType::Number;
         if (!s.expr) emit_const(c, 0, s.span);
+        if (t == ValueType::Void) { // `return f(...)` inside f: the width is set when f is done
+            c.void_returns.push_back(here(c));
+            emit(c, Op::Return, 0, 0, s.span);
+            break;
+        }
         if (c.fn_result_known && value_width(t) != value_width(*c.fn_result))
             diags_.error(s.span, "all 'return' statements of a function must give the same type");
         *c.fn_result = t;

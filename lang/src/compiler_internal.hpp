@@ -34,6 +34,7 @@ struct Ctx {
     std::uint16_t next_slot = 0;
     ValueType* fn_result = nullptr;
     bool fn_result_known = false;
+    std::vector<std::size_t> void_returns; // Return instructions whose width is not known yet
 };
 
 struct ConstVal {
@@ -93,6 +94,7 @@ private:
     void compile_settings(const ast::File& f);
     void check_never_applying();
     void check_raw_runs();
+    void check_queries();
     void finish_rule_set(RuleSet& set);
 
     // helpers (compiler.cpp)
@@ -122,6 +124,7 @@ private:
     std::unordered_map<std::string, std::uint32_t> fn_index_;
     std::vector<const ast::FnDecl*> fn_decls_;
     std::vector<int> fn_state_; // 0 pending, 1 compiling, 2 done
+    std::vector<bool> fn_result_known_;
     std::map<std::string, std::string> env_names_; // env name -> kind
     std::set<std::string> curve_names_;
     std::set<std::string> used_groups_;

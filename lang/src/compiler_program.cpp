@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 
@@ -131,8 +132,14 @@ void Compiler::load(std::uint32_t file_id, std::map<std::string, std::pair<const
         }
         std::uint32_t id = sm_.add(path, std::move(text));
         std::map<std::string, std::pair<const ast::Expr*, Span>> ov;
-        for (std::size_t k = 0; k < im.overrides.size(); ++k)
-            ov[im.overrides[k].first] = {im.overrides[k].second.get(), im.override_spans[k]};
+        for (std::size_t k = 0; k < im.overrides.size(); ++k) {
+            const std::string& name = im.overrides[k].first;
+            if (auto it = ov.find(name); it != ov.end()) {
+                duplicate("override", name, im.override_spans[k], it->second.second);
+                continue;
+            }
+            ov[name] = {im.overrides[k].second.get(), im.override_spans[k]};
+        }
         load(id, std::move(ov), stack);
     }
     stack.pop_back();
@@ -241,7 +248,17 @@ void Compiler::compile_settings(const ast::File& f) {
         ValueType t = compile_expr(c, *s.value);
         if (t != ValueType::Number && t != ValueType::Bool)
             diags_.error(s.value->span, fmt::format("'{}' needs a number, found a {}", s.key, value_type_name(t)));
-        emit(c, Op::Halt, 0, 1, s.span);
+        emit(c, Op::Halt, 0, 1, s.value->span);
+        // settings made of constants are checked now, so `plant check` sees them
+        if (auto v = fold_number(*s.value)) {
+            bool whole = *v == std::floor(*v);
+            if (s.key == "derive" && (!whole || *v < 0 || *v > 1e6))
+                diags_.error(s.value->span, fmt::format("the number of steps must be a whole number from 0 to "
+                                                        "1000000, found {}",
+                                                        *v));
+            if (s.key == "seed" && (!whole || *v < 0))
+                diags_.error(s.value->span, fmt::format("the seed must be a whole number >= 0, found {}", *v));
+        }
     }
     // ignore / consider
     for (const auto& ss : f.symbol_sets) {
@@ -429,6 +446,27 @@ void Compiler::check_never_applying() {
 
 void Compiler::finish_rule_set(RuleSet& set) { set.index(P_.symbols.size()); }
 
+// Query modules are filled by a turtle pass (LANGUAGE.md section 8), which the runtime provides.
+// Until a runtime is connected their parameters keep the values they were produced with; say
+// so once rather than let a grammar read zeros without knowing why.
+void Compiler::check_queries() {
+    auto first_query = [&](const RuleSet& rs) -> const PatternModule* {
+        for (const auto& p : rs.productions)
+            for (const auto* list : {&p.strict, &p.left, &p.right})
+                for (const auto& m : *list)
+                    if (P_.symbols[m.sym].query) return &m;
+        return nullptr;
+    };
+    const PatternModule* q = first_query(P_.rules);
+    for (const auto& g : P_.groups)
+        if (!q) q = first_query(g);
+    if (q)
+        diags_.warning(q->span, fmt::format("'{}' is read here, but query modules are filled by the turtle pass, "
+                                            "which this version of plant does not run yet: it keeps the values it "
+                                            "was produced with",
+                                            P_.symbols[q->sym].name));
+}
+
 // ---- the whole compilation -----------------------------------------------------------------
 
 std::unique_ptr<Program> Compiler::compile(std::uint32_t main_file) {
@@ -525,6 +563,7 @@ std::unique_ptr<Program> Compiler::compile(std::uint32_t main_file) {
     if (!diags_.has_errors()) {
         check_raw_runs();
         check_never_applying();
+        check_queries();
     }
     if (diags_.has_errors()) return nullptr;
     return std::move(program_);

@@ -113,13 +113,38 @@ public:
     void run_backward(Worker& w) {
         w.frame.assign(frame_size, 0.0);
         piece_starts.clear();
-        for (std::size_t k = n; k-- > 0;) {
+        // Going right to left, a predecessor is found by its last module.
+        std::vector<std::vector<std::pair<std::size_t, std::size_t>>> by_last(P.symbols.size());
+        for (std::size_t si = 0; si < sets.size(); ++si)
+            for (std::size_t pi = 0; pi < sets[si]->productions.size(); ++pi)
+                by_last[sets[si]->productions[pi].strict.back().sym].emplace_back(si, pi);
+        std::size_t k = n;
+        while (k-- > 0) {
             piece_starts.push_back(w.out.size());
-            std::size_t used = has_prod[in.sym[k]] ? apply(w, k) : 0;
-            if (used == 0) w.out.append_range(in, k, k + 1);
-            if (used > 1) {
-                // multi-module predecessors end at k; not supported backwards
-                throw RuntimeError{Span{}, "a predecessor of several modules cannot be used with '>>' context"};
+            std::size_t used = 0;
+            for (const auto& [si, pi] : by_last[in.sym[k]]) {
+                const Production& pr = sets[si]->productions[pi];
+                const std::size_t len = pr.strict.size();
+                if (len > k + 1) continue;
+                const std::size_t start = k + 1 - len;
+                w.env.position = start;
+                w.env.draw = 0;
+                w.env.id = in.ids[start];
+                if (!matches(w, start, pr)) continue;
+                if (!pr.weight.empty()) {
+                    const auto& cands = sets[si]->by_symbol[pr.strict[0].sym];
+                    std::size_t ci = 0;
+                    while (ci < cands.size() && cands[ci] != pi) ++ci;
+                    used = choose(w, start, si, ci);
+                } else {
+                    used = run_body(w, start, pr);
+                }
+                if (used) break;
+            }
+            if (used == 0) {
+                w.out.append_range(in, k, k + 1);
+            } else {
+                k -= used - 1; // the predecessor's other modules are consumed too
             }
         }
         piece_starts.push_back(w.out.size());
@@ -648,7 +673,13 @@ void Derivation::run_hook(HookKind kind) {
     env.step = step_;
     env.effects = &effects;
     std::vector<double> frame(std::max<std::size_t>(prog_.hook_frame[k], 1));
-    plant::run(prog_.hooks[k], frame.data(), env);
+    try {
+        plant::run(prog_.hooks[k], frame.data(), env);
+    } catch (RuntimeError& e) {
+        static const char* names[] = {"on start", "on before_step", "on after_step", "on end"};
+        e.message = fmt::format("step {}, {}: {}", step_, names[k], e.message);
+        throw;
+    }
     if (!effects.printed.empty() && opt_.on_print) opt_.on_print(effects.printed);
     if (effects.use_group != -2) group_ = effects.use_group;
     if (effects.stop) stopped_ = true;
@@ -680,11 +711,21 @@ void Derivation::start() {
     env.out = &axiom;
     env.max_output = opt_.max_modules;
     env.id_base = next_id_;
-    plant::run(prog_.axiom, nullptr, env);
+    try {
+        plant::run(prog_.axiom, nullptr, env);
+    } catch (const RuntimeError& e) {
+        if (e.message == "the string outgrew the module limit") check_limits(axiom);
+        throw;
+    }
     next_id_ += env.new_count;
     current_.swap(axiom);
-    decompose(current_, 0);
-    apply_cut(current_);
+    try {
+        decompose(current_, 0);
+        apply_cut(current_);
+    } catch (RuntimeError& e) {
+        if (e.message.rfind("step ", 0) != 0) e.message = "step 0: " + e.message;
+        throw;
+    }
     started_ = true;
     run_hook(HookKind::Start);
 }
