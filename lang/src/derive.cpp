@@ -163,17 +163,7 @@ private:
     }
 
     bool match_module(std::size_t j, const PatternModule& pm, double* frame) const {
-        if (in.sym[j] != pm.sym || in.arity(j) != pm.width) return false;
-        const double* a = in.args(j);
-        for (const auto& pa : pm.args) {
-            if (pa.bind) {
-                for (int k = 0; k < pa.width; ++k) frame[pa.slot + k] = a[k];
-            } else if (!std::isnan(pa.value) && a[0] != pa.value) {
-                return false;
-            }
-            a += pa.width;
-        }
-        return true;
+        return match_in(in, j, pm, frame);
     }
 
     bool match_left(std::size_t i, const std::vector<PatternModule>& pats, double* frame) const {
