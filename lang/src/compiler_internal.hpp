@@ -96,6 +96,7 @@ private:
     void check_raw_runs();
     void check_queries();
     void finish_rule_set(RuleSet& set);
+    void build_template(Production& p);
 
     // helpers (compiler.cpp)
     void emit(Ctx& c, Op op, std::int32_t a, int n, Span span, std::uint16_t b = 0);

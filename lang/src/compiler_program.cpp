@@ -329,6 +329,7 @@ void Compiler::compile_production(const ast::Production& p, RuleSet& set, bool i
         emit(c, Op::ProduceEnd, 0, 0, p.arrow_span);
     }
     cp.frame_size = c.next_slot;
+    if (!p.body_form) build_template(cp);
     if (!cp.left.empty() || !cp.right.empty()) set.needs_brackets = true;
     if (!cp.left_new.empty()) set.uses_left_new = true;
     if (!cp.right_new.empty()) set.uses_right_new = true;
@@ -445,6 +446,57 @@ void Compiler::check_never_applying() {
 }
 
 void Compiler::finish_rule_set(RuleSet& set) { set.index(P_.symbols.size()); }
+
+// Splits an arrow-form body (argument code, Emit, argument code, Emit, ..., ProduceEnd) into a
+// template: a module whose arguments are all constants is copied as it is; the argument code of
+// the others is moved, in order, into `values`. Draws of random numbers happen in the same
+// order as in the body, so both paths derive the same string.
+void Compiler::build_template(Production& p) {
+    SuccessorTemplate t;
+    if (p.strict.size() != 1) return;
+    const Code& body = p.body;
+    t.values.consts = body.consts;
+    std::size_t seg_begin = 0;
+    for (std::size_t pc = 0; pc < body.instrs.size(); ++pc) {
+        const Instr& I = body.instrs[pc];
+        if (I.op == Op::ProduceEnd) break;
+        if (I.op != Op::Emit) continue;
+        const auto sym = static_cast<SymbolId>(I.a);
+        if (t.keep < 0 && sym == p.strict[0].sym) t.keep = static_cast<int>(t.syms.size());
+        t.syms.push_back(sym);
+        const auto first = static_cast<std::uint32_t>(t.params.size());
+        bool constant = true;
+        for (std::size_t k = seg_begin; k < pc; ++k) constant = constant && body.instrs[k].op == Op::Const;
+        if (constant) {
+            for (std::size_t k = seg_begin; k < pc; ++k) t.params.push_back(body.consts[body.instrs[k].a]);
+        } else {
+            const auto shift = static_cast<std::int64_t>(t.values.instrs.size()) - static_cast<std::int64_t>(seg_begin);
+            for (std::size_t k = seg_begin; k < pc; ++k) {
+                Instr J = body.instrs[k];
+                if (J.op == Op::Jump || J.op == Op::JumpIfZero || J.op == Op::JumpIfZeroKeep ||
+                    J.op == Op::JumpIfNonZeroKeep)
+                    J.a = static_cast<std::int32_t>(J.a + shift);
+                if (J.op == Op::Emit || J.op == Op::ProduceEnd || J.op == Op::Return || J.op == Op::Halt) return;
+                t.values.instrs.push_back(J);
+                t.values.spans.push_back(body.spans[k]);
+            }
+            for (int k = 0; k < I.n; ++k) {
+                t.holes.push_back(first + static_cast<std::uint32_t>(k));
+                t.hole_spans.push_back(I.b > 0 ? body.arg_spans[I.b - 1][static_cast<std::size_t>(k)] : body.spans[pc]);
+                t.params.push_back(0);
+            }
+        }
+        t.param_end.push_back(static_cast<std::uint32_t>(t.params.size()));
+        seg_begin = pc + 1;
+    }
+    if (t.holes.size() > 255) return;
+    if (!t.holes.empty()) {
+        t.values.instrs.push_back(Instr{Op::Halt, static_cast<std::uint8_t>(t.holes.size()), 0, 0});
+        t.values.spans.push_back(p.span);
+    }
+    t.valid = true;
+    p.tmpl = std::move(t);
+}
 
 // Query modules are filled by a turtle pass (LANGUAGE.md section 8), which the runtime provides.
 // Until a runtime is connected their parameters keep the values they were produced with; say

@@ -367,7 +367,50 @@ private:
         return 0;
     }
 
+    // The fast path of run_body for arrow-form successors (see SuccessorTemplate).
+    std::size_t apply_template(Worker& w, std::size_t i, const Production& pr) {
+        const SuccessorTemplate& t = pr.tmpl;
+        ModuleString& out = w.out;
+        EvalEnv& env = w.env;
+        double values[256];
+        if (!t.holes.empty()) {
+            env.out = nullptr;
+            run(t.values, w.frame.data(), env, values);
+            for (std::size_t h = 0; h < t.holes.size(); ++h) {
+                if (!std::isfinite(values[h])) {
+                    std::size_t j = 0;
+                    while (t.param_end[j] <= t.holes[h]) ++j;
+                    std::uint32_t k = t.holes[h] - (j ? t.param_end[j - 1] : 0);
+                    throw RuntimeError{t.hole_spans[h],
+                                       fmt::format("parameter {} of '{}' is {}", k + 1, P.symbols[t.syms[j]].name,
+                                                   std::isnan(values[h]) ? "NaN" : "infinite")};
+                }
+            }
+        }
+        const std::size_t m = t.syms.size();
+        const std::size_t m0 = out.sym.size();
+        const std::size_t p0 = out.params.size();
+        out.sym.resize(m0 + m);
+        out.ids.resize(m0 + m);
+        out.poff.resize(m0 + m + 1);
+        out.params.resize(p0 + t.params.size());
+        std::copy(t.syms.begin(), t.syms.end(), out.sym.begin() + static_cast<std::ptrdiff_t>(m0));
+        double* pp = out.params.data() + p0;
+        std::copy(t.params.begin(), t.params.end(), pp);
+        for (std::size_t h = 0; h < t.holes.size(); ++h) pp[t.holes[h]] = values[h];
+        std::uint32_t* po = out.poff.data() + m0 + 1;
+        ModuleId* ids = out.ids.data() + m0;
+        const auto base = static_cast<std::uint32_t>(p0);
+        for (std::size_t j = 0; j < m; ++j) {
+            po[j] = base + t.param_end[j];
+            ids[j] = static_cast<int>(j) == t.keep ? in.ids[i] : env.id_base + env.new_count++;
+        }
+        if (out.size() > env.max_output) throw RuntimeError{Span{}, "module limit"};
+        return 1;
+    }
+
     std::size_t run_body(Worker& w, std::size_t i, const Production& pr) {
+        if (pr.tmpl.valid) return apply_template(w, i, pr);
         EvalEnv& env = w.env;
         SymbolId keep_syms[32];
         ModuleId keep_ids[32];
@@ -506,6 +549,9 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const std::v
         out.swap(w.out);
         next_id_ += w.env.new_count;
     } else {
+        // Worker 0 writes into buffers sized for the whole output and numbers its new modules
+        // directly; the others' parts are appended to it afterwards, so only (T-1)/T of the
+        // string is copied a second time.
         std::vector<Worker> workers(static_cast<std::size_t>(threads));
         {
             std::vector<std::jthread> pool;
@@ -515,9 +561,15 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const std::v
                     setup(w);
                     std::size_t b = n * static_cast<std::size_t>(t) / static_cast<std::size_t>(threads);
                     std::size_t e = n * static_cast<std::size_t>(t + 1) / static_cast<std::size_t>(threads);
-                    w.out.sym.reserve(static_cast<std::size_t>((e - b) * growth_ * 1.02) + 16);
+                    std::size_t modules = (t == 0 ? n : e - b), params = in.params.size() * (e - b) / std::max<std::size_t>(n, 1);
+                    if (t == 0) {
+                        params = in.params.size();
+                        w.env.id_base = next_id_;
+                    }
+                    w.out.sym.reserve(static_cast<std::size_t>(modules * growth_ * 1.02) + 16);
                     w.out.ids.reserve(w.out.sym.capacity());
                     w.out.poff.reserve(w.out.sym.capacity() + 1);
+                    w.out.params.reserve(static_cast<std::size_t>(params * param_growth_ * 1.02) + 16);
                     try {
                         rw.run_range(w, b, e);
                     } catch (const RuntimeError& err) {
@@ -541,11 +593,6 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const std::v
             probe.sym.resize(total);
             check_limits(probe);
         }
-        // join by prefix sums, each worker copying its own part
-        out.sym.resize(total);
-        out.ids.resize(total);
-        out.poff.resize(total + 1);
-        out.params.resize(total_params);
         std::vector<std::size_t> mod_at(workers.size()), par_at(workers.size());
         std::vector<ModuleId> id_at(workers.size());
         std::size_t m = 0, p = 0;
@@ -558,9 +605,14 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const std::v
             p += workers[t].out.params.size();
             ids += workers[t].env.new_count;
         }
+        out.swap(workers[0].out);
+        out.sym.resize(total);
+        out.ids.resize(total);
+        out.poff.resize(total + 1);
+        out.params.resize(total_params);
         {
             std::vector<std::jthread> pool;
-            for (std::size_t t = 0; t < workers.size(); ++t) {
+            for (std::size_t t = 1; t < workers.size(); ++t) {
                 pool.emplace_back([&, t] {
                     ModuleString& src = workers[t].out;
                     std::copy(src.sym.begin(), src.sym.end(), out.sym.begin() + static_cast<std::ptrdiff_t>(mod_at[t]));
@@ -585,10 +637,19 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const std::v
     check_limits(out);
 }
 
+// Whether some module of `s` is the first module of a predecessor in `rs`: a pass over the
+// symbols is much cheaper than a rewrite that copies the whole string unchanged.
+static bool any_candidate(const ModuleString& s, const RuleSet& rs) {
+    for (SymbolId x : s.sym)
+        if (x < rs.by_symbol.size() && !rs.by_symbol[x].empty()) return true;
+    return false;
+}
+
 void Derivation::decompose(ModuleString& s, int step_for_env) {
     if (prog_.decompose.empty()) return;
     std::vector<const RuleSet*> sets{&prog_.decompose};
     for (int pass = 0; pass < prog_.decompose.max_depth; ++pass) {
+        if (!any_candidate(s, prog_.decompose)) break;
         ModuleString next;
         ModuleId before = next_id_;
         rewrite(s, next, sets, (static_cast<std::uint64_t>(step_for_env) << 16) | static_cast<std::uint64_t>(pass + 1),
@@ -639,6 +700,7 @@ ModuleString Derivation::interpreted(const ModuleString& s) const {
     std::vector<const RuleSet*> sets{&prog_.interpret};
     ModuleId saved = next_id_;
     for (int pass = 0; pass < prog_.interpret.max_depth; ++pass) {
+        if (!any_candidate(cur, prog_.interpret)) break;
         ModuleString next;
         rewrite(cur, next, sets, (static_cast<std::uint64_t>(step_) << 16) | 0x8000u | static_cast<std::uint64_t>(pass),
                 step_);

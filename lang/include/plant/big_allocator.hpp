@@ -17,6 +17,7 @@ namespace plant {
 template <typename T> struct BigAllocator {
     using value_type = T;
     static constexpr std::size_t kHuge = std::size_t{2} << 20;
+    static constexpr std::size_t kMapped = std::size_t{256} << 10;
 
     BigAllocator() noexcept = default;
     template <typename U> BigAllocator(const BigAllocator<U>&) noexcept {}
@@ -24,10 +25,17 @@ template <typename T> struct BigAllocator {
     T* allocate(std::size_t n) {
         const std::size_t bytes = n * sizeof(T);
         void* p = nullptr;
-        if (bytes >= kHuge) {
+        if (bytes >= kMapped) {
             p = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-            if (p == MAP_FAILED) p = nullptr;
-            else madvise(p, bytes, MADV_HUGEPAGE);
+            if (p == MAP_FAILED) {
+                p = nullptr;
+            } else {
+                if (bytes >= kHuge) madvise(p, bytes, MADV_HUGEPAGE);
+#ifdef MADV_POPULATE_WRITE
+                // fault the whole block in one call instead of one trap per page
+                madvise(p, bytes, MADV_POPULATE_WRITE);
+#endif
+            }
         } else {
             p = std::malloc(bytes ? bytes : 1);
         }
@@ -35,7 +43,7 @@ template <typename T> struct BigAllocator {
         return static_cast<T*>(p);
     }
     void deallocate(T* p, std::size_t n) noexcept {
-        if (n * sizeof(T) >= kHuge)
+        if (n * sizeof(T) >= kMapped)
             munmap(p, n * sizeof(T));
         else
             std::free(p);

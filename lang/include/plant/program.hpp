@@ -110,12 +110,28 @@ struct PatternModule {
     Span span;
 };
 
+// The successor of an arrow-form production as a fixed sequence of modules: constant parameters
+// are filled in, the others ("holes") are computed by `values`, which leaves them on the stack
+// in order. Applying it copies the modules and writes the computed numbers, without running one
+// Emit instruction per module.
+struct SuccessorTemplate {
+    bool valid = false;
+    std::vector<SymbolId> syms;
+    std::vector<std::uint32_t> param_end; // parameters of module j end at param_end[j] (relative)
+    std::vector<double> params;           // constants; holes are overwritten
+    std::vector<std::uint32_t> holes;     // parameter index of each computed number
+    std::vector<Span> hole_spans;
+    int keep = -1;                        // module that keeps the predecessor's identity
+    Code values;
+};
+
 struct Production {
     Span span;
     std::vector<PatternModule> strict, left, left_new, right, right_new;
     Code condition; // empty: always true
     Code weight;    // empty: not stochastic
     Code body;      // emits the successor; for the arrow form ends with ProduceEnd
+    SuccessorTemplate tmpl;
     std::uint16_t frame_size = 0;
     bool body_form = false;
     bool has_context() const { return !left.empty() || !right.empty(); }
