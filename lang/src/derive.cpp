@@ -82,6 +82,22 @@ public:
         }
         frame_size = frame;
         if (brackets) match = bracket_table(in, P.symbols.open_bracket, P.symbols.close_bracket);
+        // A symbol whose first production always applies (no condition, context or weight, one
+        // predecessor module whose arguments are all bound) needs no matching: with the right
+        // number of parameters, its template is applied at once.
+        direct.assign(P.symbols.size(), nullptr);
+        for (SymbolId s = 0; s < P.symbols.size(); ++s) {
+            for (const RuleSet* rs : sets) {
+                if (rs->by_symbol[s].empty()) continue;
+                const Production& pr = rs->productions[rs->by_symbol[s][0]];
+                bool binds_all = pr.strict.size() == 1;
+                for (const auto& a : pr.strict[0].args) binds_all = binds_all && a.bind;
+                if (binds_all && pr.condition.empty() && pr.weight.empty() && !pr.has_context() &&
+                    !pr.has_new_context() && pr.tmpl.valid)
+                    direct[s] = &pr;
+                break;
+            }
+        }
     }
 
     bool sequential() const { return multi || left_new || right_new; }
@@ -97,6 +113,21 @@ public:
                 w.out.append_range(in, i, j);
                 i = j;
                 if (w.out.size() > w.env.max_output) limit_error(w);
+                continue;
+            }
+            if (const Production* pr = direct[in.sym[i]]; pr && in.arity(i) == pr->strict[0].width) {
+                if (!pr->tmpl.holes.empty()) {
+                    const double* a = in.args(i);
+                    for (const auto& pa : pr->strict[0].args) {
+                        for (int k = 0; k < pa.width; ++k) w.frame[pa.slot + k] = a[k];
+                        a += pa.width;
+                    }
+                    w.env.position = i;
+                    w.env.draw = 0;
+                    w.env.id = in.ids[i];
+                }
+                apply_template(w, i, *pr);
+                ++i;
                 continue;
             }
             std::size_t used = apply(w, i);
@@ -483,6 +514,7 @@ private:
     const std::size_t n;
     std::vector<std::uint8_t> has_prod;
     std::vector<std::uint32_t> match;
+    std::vector<const Production*> direct;
     std::vector<std::size_t> piece_starts;
     std::size_t frame_size = 1;
     bool multi = false, left_new = false, right_new = false;

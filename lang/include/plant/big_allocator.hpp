@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <cstdlib>
 #include <new>
 #include <sys/mman.h>
@@ -22,18 +23,25 @@ template <typename T> struct BigAllocator {
     BigAllocator() noexcept = default;
     template <typename U> BigAllocator(const BigAllocator<U>&) noexcept {}
 
+    // Blocks of kMapped bytes and more are whole 2 MiB pages, 2 MiB aligned.
+    static std::size_t mapped_size(std::size_t bytes) { return (bytes + kHuge - 1) / kHuge * kHuge; }
+
     T* allocate(std::size_t n) {
         const std::size_t bytes = n * sizeof(T);
         void* p = nullptr;
         if (bytes >= kMapped) {
-            p = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-            if (p == MAP_FAILED) {
-                p = nullptr;
-            } else {
-                if (bytes >= kHuge) madvise(p, bytes, MADV_HUGEPAGE);
+            const std::size_t size = mapped_size(bytes);
+            void* raw = mmap(nullptr, size + kHuge, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+            if (raw != MAP_FAILED) {
+                auto begin = reinterpret_cast<std::uintptr_t>(raw);
+                auto aligned = (begin + kHuge - 1) / kHuge * kHuge;
+                if (aligned > begin) munmap(raw, aligned - begin);
+                if (aligned + size < begin + size + kHuge) munmap(reinterpret_cast<void*>(aligned + size), begin + kHuge - aligned);
+                p = reinterpret_cast<void*>(aligned);
+                madvise(p, size, MADV_HUGEPAGE);
 #ifdef MADV_POPULATE_WRITE
                 // fault the whole block in one call instead of one trap per page
-                madvise(p, bytes, MADV_POPULATE_WRITE);
+                madvise(p, size, MADV_POPULATE_WRITE);
 #endif
             }
         } else {
@@ -44,7 +52,7 @@ template <typename T> struct BigAllocator {
     }
     void deallocate(T* p, std::size_t n) noexcept {
         if (n * sizeof(T) >= kMapped)
-            munmap(p, n * sizeof(T));
+            munmap(p, mapped_size(n * sizeof(T)));
         else
             std::free(p);
     }
