@@ -493,6 +493,7 @@ void Compiler::build_template(Production& p) {
     if (!t.holes.empty()) {
         t.values.instrs.push_back(Instr{Op::Halt, static_cast<std::uint8_t>(t.holes.size()), 0, 0});
         t.values.spans.push_back(p.span);
+        fuse(t.values);
     }
     t.valid = true;
     p.tmpl = std::move(t);

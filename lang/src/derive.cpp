@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include <charconv>
+#include <cstring>
 #include <chrono>
 #include <unordered_set>
 #include <cmath>
@@ -22,12 +23,19 @@ namespace plant {
 
 void ModuleString::append_range(const ModuleString& o, std::size_t b, std::size_t e) {
     if (b >= e) return;
-    sym.insert(sym.end(), o.sym.begin() + static_cast<std::ptrdiff_t>(b), o.sym.begin() + static_cast<std::ptrdiff_t>(e));
-    ids.insert(ids.end(), o.ids.begin() + static_cast<std::ptrdiff_t>(b), o.ids.begin() + static_cast<std::ptrdiff_t>(e));
-    const std::uint32_t pb = o.poff[b];
-    const auto shift = static_cast<std::int64_t>(params.size()) - pb;
-    params.insert(params.end(), o.params.begin() + pb, o.params.begin() + o.poff[e]);
-    for (std::size_t i = b + 1; i <= e; ++i) poff.push_back(static_cast<std::uint32_t>(o.poff[i] + shift));
+    const std::size_t n = e - b, m0 = sym.size(), p0 = params.size();
+    const std::uint32_t pb = o.poff[b], pe = o.poff[e];
+    sym.resize(m0 + n);
+    ids.resize(m0 + n);
+    poff.resize(m0 + n + 1);
+    params.resize(p0 + (pe - pb));
+    std::memcpy(sym.data() + m0, o.sym.data() + b, n * sizeof(SymbolId));
+    std::memcpy(ids.data() + m0, o.ids.data() + b, n * sizeof(ModuleId));
+    if (pe > pb) std::memcpy(params.data() + p0, o.params.data() + pb, (pe - pb) * sizeof(double));
+    const auto shift = static_cast<std::uint32_t>(p0 - pb); // unsigned wrap-around is intended
+    std::uint32_t* dst = poff.data() + m0 + 1;
+    const std::uint32_t* src = o.poff.data() + b + 1;
+    for (std::size_t i = 0; i < n; ++i) dst[i] = src[i] + shift;
 }
 
 std::vector<std::uint32_t> bracket_table(const ModuleString& s, SymbolId open, SymbolId close) {
@@ -54,6 +62,8 @@ double now_ms() {
     using namespace std::chrono;
     return duration<double, std::milli>(steady_clock::now().time_since_epoch()).count();
 }
+
+} // namespace
 
 // Everything one thread needs to rewrite a stretch of the string.
 struct Worker {
@@ -101,6 +111,111 @@ public:
     }
 
     bool sequential() const { return multi || left_new || right_new; }
+
+    // ---- the direct path: every module is copied or rewritten by a direct template ----------
+    // Then the size of the output of any stretch is known before writing it, so the output is
+    // allocated once, exactly, and each thread writes its stretch in place.
+    struct Counts {
+        std::size_t modules = 0, params = 0;
+        ModuleId new_ids = 0;
+        bool ok = true;
+    };
+
+    Counts count_direct(std::size_t b, std::size_t e) const {
+        Counts c;
+        for (std::size_t i = b; i < e; ++i) {
+            const SymbolId s = in.sym[i];
+            if (!has_prod[s]) {
+                ++c.modules;
+                c.params += in.arity(i);
+                continue;
+            }
+            const Production* pr = direct[s];
+            if (!pr || in.arity(i) != pr->strict[0].width) {
+                c.ok = false;
+                return c;
+            }
+            c.modules += pr->tmpl.syms.size();
+            c.params += pr->tmpl.params.size();
+            c.new_ids += pr->tmpl.syms.size() - (pr->tmpl.keep >= 0 ? 1 : 0);
+        }
+        return c;
+    }
+
+    // Writes the output of modules [b, e) at module m_at and parameter p_at of `out`, whose
+    // arrays are already sized; new identities are numbered from id_at.
+    void write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at, std::size_t p_at,
+                      ModuleId id_at) {
+        w.frame.assign(frame_size, 0.0);
+        SymbolId* S = out.sym.data() + m_at;
+        ModuleId* ID = out.ids.data() + m_at;
+        std::uint32_t* PO = out.poff.data() + m_at + 1; // poff[m_at] is the previous stretch's end
+        double* PA = out.params.data() + p_at;
+        std::size_t p = p_at;
+        double values[256];
+        std::size_t i = b;
+        while (i < e) {
+            if (!has_prod[in.sym[i]]) { // a run of modules without productions: copy it
+                std::size_t j = i + 1;
+                while (j < e && !has_prod[in.sym[j]]) ++j;
+                const std::size_t n = j - i;
+                const std::uint32_t pb = in.poff[i], pe = in.poff[j];
+                std::memcpy(S, in.sym.data() + i, n * sizeof(SymbolId));
+                std::memcpy(ID, in.ids.data() + i, n * sizeof(ModuleId));
+                if (pe > pb) std::memcpy(PA, in.params.data() + pb, (pe - pb) * sizeof(double));
+                const auto shift = static_cast<std::uint32_t>(p - pb); // wraps around on purpose
+                for (std::size_t k = 0; k < n; ++k) PO[k] = in.poff[i + 1 + k] + shift;
+                S += n;
+                ID += n;
+                PO += n;
+                PA += pe - pb;
+                p += pe - pb;
+                i = j;
+                continue;
+            }
+            const Production& pr = *direct[in.sym[i]];
+            const SuccessorTemplate& t = pr.tmpl;
+            if (!t.holes.empty()) {
+                const double* a = in.args(i);
+                for (const auto& pa : pr.strict[0].args) {
+                    for (int k = 0; k < pa.width; ++k) w.frame[pa.slot + k] = a[k];
+                    a += pa.width;
+                }
+                w.env.position = i;
+                w.env.draw = 0;
+                w.env.id = in.ids[i];
+                w.env.out = nullptr;
+                run(t.values, w.frame.data(), w.env, values);
+                check_holes(t, values);
+            }
+            const std::size_t m = t.syms.size();
+            std::memcpy(S, t.syms.data(), m * sizeof(SymbolId));
+            std::memcpy(PA, t.params.data(), t.params.size() * sizeof(double));
+            for (std::size_t h = 0; h < t.holes.size(); ++h) PA[t.holes[h]] = values[h];
+            for (std::size_t j = 0; j < m; ++j) {
+                PO[j] = static_cast<std::uint32_t>(p + t.param_end[j]);
+                ID[j] = static_cast<int>(j) == t.keep ? in.ids[i] : id_at++;
+            }
+            S += m;
+            ID += m;
+            PO += m;
+            PA += t.params.size();
+            p += t.params.size();
+            ++i;
+        }
+    }
+
+    void check_holes(const SuccessorTemplate& t, const double* values) const {
+        for (std::size_t h = 0; h < t.holes.size(); ++h) {
+            if (std::isfinite(values[h])) continue;
+            std::size_t j = 0;
+            while (t.param_end[j] <= t.holes[h]) ++j;
+            std::uint32_t k = t.holes[h] - (j ? t.param_end[j - 1] : 0);
+            throw RuntimeError{t.hole_spans[h], fmt::format("parameter {} of '{}' is {}", k + 1,
+                                                            P.symbols[t.syms[j]].name,
+                                                            std::isnan(values[h]) ? "NaN" : "infinite")};
+        }
+    }
 
     // Rewrites modules [b, e) into w.out.
     void run_range(Worker& w, std::size_t b, std::size_t e) {
@@ -407,16 +522,7 @@ private:
         if (!t.holes.empty()) {
             env.out = nullptr;
             run(t.values, w.frame.data(), env, values);
-            for (std::size_t h = 0; h < t.holes.size(); ++h) {
-                if (!std::isfinite(values[h])) {
-                    std::size_t j = 0;
-                    while (t.param_end[j] <= t.holes[h]) ++j;
-                    std::uint32_t k = t.holes[h] - (j ? t.param_end[j - 1] : 0);
-                    throw RuntimeError{t.hole_spans[h],
-                                       fmt::format("parameter {} of '{}' is {}", k + 1, P.symbols[t.syms[j]].name,
-                                                   std::isnan(values[h]) ? "NaN" : "infinite")};
-                }
-            }
+            check_holes(t, values);
         }
         const std::size_t m = t.syms.size();
         const std::size_t m0 = out.sym.size();
@@ -520,7 +626,6 @@ private:
     bool multi = false, left_new = false, right_new = false;
 };
 
-} // namespace
 
 // ---- Derivation ------------------------------------------------------------------------------
 
@@ -556,7 +661,9 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const std::v
     int threads = std::max(1, opt_.threads);
     if (rw.sequential() || n < 20000) threads = 1;
     out.clear();
-    if (threads == 1) {
+    if (!rw.sequential() && rewrite_direct(rw, in, out, threads, setup)) {
+        // done
+    } else if (threads == 1) {
         Worker w;
         setup(w);
         w.env.id_base = next_id_; // one thread numbers new modules in string order directly
@@ -675,6 +782,72 @@ static bool any_candidate(const ModuleString& s, const RuleSet& rs) {
     for (SymbolId x : s.sym)
         if (x < rs.by_symbol.size() && !rs.by_symbol[x].empty()) return true;
     return false;
+}
+
+// Tries the direct path (see Rewriter::count_direct): count the output of each thread's stretch,
+// allocate the output once, write the stretches in place. Returns false, having written
+// nothing, when some module needs the general path.
+template <typename Setup>
+bool Derivation::rewrite_direct(Rewriter& rw, const ModuleString& in, ModuleString& out, int threads,
+                                const Setup& setup) const {
+    const std::size_t n = in.size();
+    const auto T = static_cast<std::size_t>(threads);
+    std::vector<Rewriter::Counts> counts(T);
+    auto bounds = [&](std::size_t t) { return std::pair{n * t / T, n * (t + 1) / T}; };
+    auto parallel = [&](auto&& body) {
+        if (T == 1) {
+            body(std::size_t{0});
+            return;
+        }
+        std::vector<std::jthread> pool;
+        for (std::size_t t = 0; t < T; ++t) pool.emplace_back([&body, t] { body(t); });
+    };
+    parallel([&](std::size_t t) {
+        auto [b, e] = bounds(t);
+        counts[t] = rw.count_direct(b, e);
+    });
+    std::size_t modules = 0, params = 0;
+    for (const auto& c : counts) {
+        if (!c.ok) return false;
+        modules += c.modules;
+        params += c.params;
+    }
+    if (modules > opt_.max_modules) {
+        ModuleString probe;
+        probe.sym.resize(modules);
+        check_limits(probe);
+    }
+    out.sym.resize(modules);
+    out.ids.resize(modules);
+    out.poff.resize(modules + 1);
+    out.params.resize(params);
+    out.poff[0] = 0;
+    std::vector<Worker> workers(T);
+    std::vector<std::size_t> m_at(T), p_at(T);
+    std::vector<ModuleId> id_at(T);
+    ModuleId ids = next_id_;
+    for (std::size_t t = 0, m = 0, p = 0; t < T; ++t) {
+        m_at[t] = m;
+        p_at[t] = p;
+        id_at[t] = ids;
+        m += counts[t].modules;
+        p += counts[t].params;
+        ids += counts[t].new_ids;
+    }
+    parallel([&](std::size_t t) {
+        Worker& w = workers[t];
+        setup(w);
+        auto [b, e] = bounds(t);
+        try {
+            rw.write_direct(w, b, e, out, m_at[t], p_at[t], id_at[t]);
+        } catch (const RuntimeError& err) {
+            w.error = err;
+        }
+    });
+    for (auto& w : workers)
+        if (w.error) throw *w.error;
+    next_id_ = ids;
+    return true;
 }
 
 void Derivation::decompose(ModuleString& s, int step_for_env) {

@@ -308,11 +308,37 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
             if (result)
                 for (int k = 0; k < I.n; ++k) result[k] = st[sp - I.n + k];
             return RunStatus::Finished;
+        case Op::LoadMulConst: st[sp++] = frame[I.a] * code.consts[I.b]; break;
+        case Op::LoadAddConst: st[sp++] = frame[I.a] + code.consts[I.b]; break;
         }
     }
     if (result && sp > 0)
         for (int k = 0; k < std::min(sp, 3); ++k) result[k] = st[sp - std::min(sp, 3) + k];
     return RunStatus::Finished;
+}
+
+void fuse(Code& code) {
+    for (const Instr& I : code.instrs)
+        if (I.op == Op::Jump || I.op == Op::JumpIfZero || I.op == Op::JumpIfZeroKeep || I.op == Op::JumpIfNonZeroKeep)
+            return;
+    if (code.consts.size() > 65535) return;
+    std::vector<Instr> out;
+    std::vector<Span> spans;
+    for (std::size_t i = 0; i < code.instrs.size(); ++i) {
+        const Instr& I = code.instrs[i];
+        if (i + 2 < code.instrs.size() && I.op == Op::LoadLocal && I.n == 1 && code.instrs[i + 1].op == Op::Const &&
+            (code.instrs[i + 2].op == Op::Mul || code.instrs[i + 2].op == Op::Add)) {
+            Op fused = code.instrs[i + 2].op == Op::Mul ? Op::LoadMulConst : Op::LoadAddConst;
+            out.push_back(Instr{fused, 0, static_cast<std::uint16_t>(code.instrs[i + 1].a), I.a});
+            spans.push_back(code.spans[i + 2]);
+            i += 2;
+            continue;
+        }
+        out.push_back(I);
+        spans.push_back(code.spans[i]);
+    }
+    code.instrs = std::move(out);
+    code.spans = std::move(spans);
 }
 
 double eval_number(const Code& code, double* frame, EvalEnv& env) {

@@ -1,9 +1,9 @@
 // Allocator for the module string's arrays. Two things a derivation step pays for otherwise:
 // - value-initialisation: resize() would zero memory that is overwritten right after, so
 //   construct() without arguments default-initialises (leaves numbers as they are);
-// - page faults: a step writes hundreds of megabytes into fresh memory, so large blocks are
-//   2 MiB aligned and marked for transparent huge pages, taking one fault per 2 MiB instead of
-//   one per 4 KiB (measured: a third of the time of large steps went to the kernel).
+// - page faults: a step writes its whole output into fresh memory, so blocks of 256 KiB and more
+//   are whole 2 MiB pages, aligned and marked for transparent huge pages: one fault per 2 MiB
+//   instead of one per 4 KiB. Measured on the parametric tree (n = 16): 15 ms -> 6 ms.
 #pragma once
 
 #include <cstddef>
@@ -39,10 +39,8 @@ template <typename T> struct BigAllocator {
                 if (aligned + size < begin + size + kHuge) munmap(reinterpret_cast<void*>(aligned + size), begin + kHuge - aligned);
                 p = reinterpret_cast<void*>(aligned);
                 madvise(p, size, MADV_HUGEPAGE);
-#ifdef MADV_POPULATE_WRITE
-                // fault the whole block in one call instead of one trap per page
-                madvise(p, size, MADV_POPULATE_WRITE);
-#endif
+                // No MADV_POPULATE_WRITE: the thread that first writes a page zeroes it, so
+                // threads writing different parts of a block share that work.
             }
         } else {
             p = std::malloc(bytes ? bytes : 1);

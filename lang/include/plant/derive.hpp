@@ -23,6 +23,8 @@ public:
     virtual void fill_queries(const Program& program, const double* globals, ModuleString& string) = 0;
 };
 
+class Rewriter; // derive.cpp
+
 struct StepStats {
     int step = 0;
     std::size_t modules = 0;
@@ -76,6 +78,9 @@ private:
     void run_hook(HookKind kind);
     void rewrite(const ModuleString& in, ModuleString& out, const std::vector<const RuleSet*>& sets,
                  std::uint64_t phase, int step_for_env) const;
+    template <typename Setup>
+    bool rewrite_direct(Rewriter& rw, const ModuleString& in, ModuleString& out, int threads,
+                        const Setup& setup) const;
     void decompose(ModuleString& s, int step_for_env);
     void apply_cut(ModuleString& s) const;
     void check_limits(const ModuleString& s) const;

@@ -76,8 +76,11 @@ enum class Op : std::uint8_t {
     Use,        // select rule group a (-1: none)
     Stop,       // stop the derivation after the current hook
     Print,      // pop n values described by print_formats[a] and print them
-    ForCheck,   // loop guard: frame[a] < frame[a+1] else jump to b-th label (uses `jump`)
+    ForCheck,   // loop guard: counts turns in frame[a], stops a runaway loop
     Halt,
+    // superinstructions made by fuse() in straight-line code
+    LoadMulConst, // push frame[a] * consts[b]
+    LoadAddConst, // push frame[a] + consts[b]
 };
 
 struct Instr {

@@ -55,6 +55,10 @@ enum class RunStatus { Finished, Produced };
 // module parameter, runaway recursion and the like.
 RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result = nullptr);
 
+// Replaces common instruction sequences by single instructions. Only straight-line code
+// (no jumps) is changed, so no jump target moves.
+void fuse(Code& code);
+
 // Convenience for code that yields one number.
 double eval_number(const Code& code, double* frame, EvalEnv& env);
 

@@ -3,6 +3,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 using namespace plant;
@@ -87,4 +88,31 @@ TEST_CASE("random functions in successors are reproducible across thread counts"
     )";
     CHECK(run_with(g, 5, 1) == run_with(g, 5, 2));
     CHECK(run_with(g, 5, 1) != run_with(g, 6, 1));
+}
+
+TEST_CASE("the direct path (templates written in place) agrees across thread counts", "[threads]") {
+    // every module is either copied or rewritten by an unconditional template: the output is
+    // counted first and each thread writes its stretch in place
+    auto c = test::compile(R"(
+        module A(l, w);
+        derive 12;
+        axiom: A(1, 10);
+        rules { A(l, w) -> F(l, w) [ &(30) A(l * 0.9, w * 0.707) ] /(137.5) [ &(-30) A(l * 0.7, w * 0.707) ]; }
+    )");
+    REQUIRE(c->program);
+    DeriveOptions o1, o2;
+    o1.threads = 1;
+    o2.threads = 2;
+    Derivation d1(*c->program, o1), d2(*c->program, o2);
+    d1.run();
+    d2.run();
+    REQUIRE(d1.string().size() == 9 * 4096 - 8);
+    CHECK(d1.string().sym == d2.string().sym);
+    CHECK(d1.string().params == d2.string().params);
+    CHECK(d1.string().ids == d2.string().ids);
+    CHECK(d1.string().poff == d2.string().poff);
+    // identities are unique
+    std::vector<ModuleId> ids(d1.string().ids.begin(), d1.string().ids.end());
+    std::sort(ids.begin(), ids.end());
+    CHECK(std::adjacent_find(ids.begin(), ids.end()) == ids.end());
 }
