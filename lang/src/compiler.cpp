@@ -246,6 +246,10 @@ ValueType Compiler::compile_expr(Ctx& c, const ast::Expr& e) {
         return ValueType::Number;
     }
     case K::Unary: {
+        if (e.text == "-" && e.args[0]->kind == K::Number) { // a negative literal is a constant
+            emit_const(c, -e.args[0]->number, e.span);
+            return ValueType::Number;
+        }
         ValueType t = compile_expr(c, *e.args[0]);
         if (e.text == "-") {
             if (t == ValueType::Vec3) {

@@ -494,6 +494,23 @@ void Compiler::build_template(Production& p) {
         t.values.instrs.push_back(Instr{Op::Halt, static_cast<std::uint8_t>(t.holes.size()), 0, 0});
         t.values.spans.push_back(p.span);
         fuse(t.values);
+        // the affine fast path: one instruction per computed number, each a slot with a factor
+        std::vector<SuccessorTemplate::Affine> affine;
+        for (std::size_t k = 0; k + 1 < t.values.instrs.size(); ++k) {
+            const Instr& I = t.values.instrs[k];
+            auto slot = static_cast<std::uint16_t>(I.a);
+            using A = SuccessorTemplate::Affine;
+            if (I.op == Op::LoadLocal && I.n == 1)
+                affine.push_back({A::Copy, slot, 0.0});
+            else if (I.op == Op::LoadMulConst)
+                affine.push_back({A::Mul, slot, t.values.consts[I.b]});
+            else if (I.op == Op::LoadAddConst)
+                affine.push_back({A::Add, slot, t.values.consts[I.b]});
+            else
+                break;
+        }
+        if (affine.size() == t.holes.size() && affine.size() + 1 == t.values.instrs.size())
+            t.affine = std::move(affine);
     }
     t.valid = true;
     p.tmpl = std::move(t);

@@ -185,7 +185,7 @@ public:
                 w.env.draw = 0;
                 w.env.id = in.ids[i];
                 w.env.out = nullptr;
-                run(t.values, w.frame.data(), w.env, values);
+                compute_holes(w, t, values);
                 check_holes(t, values);
             }
             const std::size_t m = t.syms.size();
@@ -202,6 +202,18 @@ public:
             PA += t.params.size();
             p += t.params.size();
             ++i;
+        }
+    }
+
+    void compute_holes(Worker& w, const SuccessorTemplate& t, double* values) const {
+        if (t.affine.empty()) {
+            run(t.values, w.frame.data(), w.env, values);
+            return;
+        }
+        const double* f = w.frame.data();
+        for (std::size_t h = 0; h < t.affine.size(); ++h) {
+            const auto& a = t.affine[h];
+            values[h] = a.kind == a.Copy ? f[a.slot] : a.kind == a.Mul ? f[a.slot] * a.constant : f[a.slot] + a.constant;
         }
     }
 
@@ -521,7 +533,7 @@ private:
         double values[256];
         if (!t.holes.empty()) {
             env.out = nullptr;
-            run(t.values, w.frame.data(), env, values);
+            compute_holes(w, t, values);
             check_holes(t, values);
         }
         const std::size_t m = t.syms.size();

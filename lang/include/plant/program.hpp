@@ -126,6 +126,14 @@ struct SuccessorTemplate {
     std::vector<Span> hole_spans;
     int keep = -1;                        // module that keeps the predecessor's identity
     Code values;
+    // When every computed number is a bound name, optionally times or plus a constant (the
+    // common `A(l * r1, w)`), the numbers are computed without the stack machine.
+    struct Affine {
+        enum Kind : std::uint8_t { Copy, Mul, Add } kind;
+        std::uint16_t slot;
+        double constant;
+    };
+    std::vector<Affine> affine; // empty: run `values`
 };
 
 struct Production {
