@@ -17,12 +17,20 @@
 #include <chrono>
 #include <unordered_set>
 #include <cmath>
+#include <span>
 #include <thread>
 
 namespace plant {
 
 void ModuleString::append_range(const ModuleString& o, std::size_t b, std::size_t e) {
     if (b >= e) return;
+    if (e - b == 1) { // the common case in context-sensitive grammars: one module between rewrites
+        sym.push_back(o.sym[b]);
+        ids.push_back(o.ids[b]);
+        for (std::uint32_t k = o.poff[b]; k < o.poff[e]; ++k) params.push_back(o.params[k]);
+        poff.push_back(static_cast<std::uint32_t>(params.size()));
+        return;
+    }
     const std::size_t n = e - b, m0 = sym.size(), p0 = params.size();
     const std::uint32_t pb = o.poff[b], pe = o.poff[e];
     sym.resize(m0 + n);
@@ -66,11 +74,16 @@ double now_ms() {
 } // namespace
 
 // Everything one thread needs to rewrite a stretch of the string.
+constexpr std::int64_t kUnknown = -2;
+
 struct Worker {
     EvalEnv env;
     std::vector<double> frame;
     ModuleString out;
     std::optional<RuntimeError> error;
+    // context neighbours of the module at ctx_at, found once for all its productions
+    std::size_t ctx_at = ~std::size_t{0};
+    std::int64_t ctx_left = kUnknown, ctx_right = kUnknown;
 };
 
 class Rewriter {
@@ -324,29 +337,54 @@ private:
         return match_in(in, j, pm, frame);
     }
 
-    bool match_left(std::size_t i, const std::vector<PatternModule>& pats, double* frame) const {
-        auto j = static_cast<std::int64_t>(i) - 1;
-        for (std::size_t k = pats.size(); k-- > 0;) {
-            for (;;) {
-                if (j < 0) return false;
-                SymbolId s = in.sym[static_cast<std::size_t>(j)];
-                if (s == P.symbols.close_bracket) {
-                    std::uint32_t m = match[static_cast<std::size_t>(j)];
-                    if (m >= n) return false;
-                    j = static_cast<std::int64_t>(m) - 1;
-                } else if (s == P.symbols.open_bracket || P.ignored[s]) {
-                    --j;
-                } else {
-                    break;
-                }
+    // The next module of a left context at or before j: a ']' skips its whole branch, a '['
+    // is stepped over to the parent, ignored modules are stepped over. -1 when there is none.
+    std::int64_t left_step(std::int64_t j) const {
+        while (j >= 0) {
+            SymbolId s = in.sym[static_cast<std::size_t>(j)];
+            if (s == P.symbols.close_bracket) {
+                std::uint32_t m = match[static_cast<std::size_t>(j)];
+                if (m >= n) return -1;
+                j = static_cast<std::int64_t>(m) - 1;
+            } else if (s == P.symbols.open_bracket || P.ignored[s]) {
+                --j;
+            } else {
+                return j;
             }
-            if (!match_module(static_cast<std::size_t>(j), pats[k], frame)) return false;
-            --j;
+        }
+        return -1;
+    }
+
+    // Matches the left context whose last module is at j (as found by left_step).
+    bool match_left_from(std::int64_t j, const std::vector<PatternModule>& pats, double* frame) const {
+        for (std::size_t k = pats.size(); k-- > 0;) {
+            if (j < 0 || !match_module(static_cast<std::size_t>(j), pats[k], frame)) return false;
+            if (k > 0) j = left_step(j - 1);
         }
         return true;
     }
 
-    bool match_right(std::size_t e, const std::vector<PatternModule>& pats, double* frame) const {
+    // The next module of a right context at or after j, for a pattern module that is not a
+    // bracket: lateral branches are skipped, the end of the branch ends the context. n if none.
+    std::size_t right_step(std::size_t j) const {
+        const SymbolId open = P.symbols.open_bracket, close = P.symbols.close_bracket;
+        while (j < n) {
+            SymbolId s = in.sym[j];
+            if (s == open) {
+                if (match[j] >= n) return n;
+                j = match[j] + 1;
+            } else if (s == close) {
+                return n;
+            } else if (P.ignored[s]) {
+                ++j;
+            } else {
+                return j;
+            }
+        }
+        return n;
+    }
+
+    bool match_right(std::size_t e, std::span<const PatternModule> pats, double* frame) const {
         std::size_t j = e;
         const SymbolId open = P.symbols.open_bracket, close = P.symbols.close_bracket;
         for (const auto& p : pats) {
@@ -369,21 +407,8 @@ private:
                 ++j;
                 continue;
             }
-            for (;;) {
-                if (j >= n) return false;
-                SymbolId s = in.sym[j];
-                if (s == open) {
-                    if (match[j] >= n) return false;
-                    j = match[j] + 1;
-                } else if (s == close) {
-                    return false;
-                } else if (P.ignored[s]) {
-                    ++j;
-                } else {
-                    break;
-                }
-            }
-            if (!match_module(j, p, frame)) return false;
+            j = right_step(j);
+            if (j >= n || !match_module(j, p, frame)) return false;
             ++j;
         }
         return true;
@@ -497,8 +522,34 @@ private:
         double* frame = w.frame.data();
         for (std::size_t k = 0; k < pr.strict.size(); ++k)
             if (i + k >= n || !match_module(i + k, pr.strict[k], frame)) return false;
-        if (!pr.left.empty() && !match_left(i, pr.left, frame)) return false;
-        if (!pr.right.empty() && !match_right(i + pr.strict.size(), pr.right, frame)) return false;
+        if (!pr.left.empty() || !pr.right.empty()) {
+            // the neighbours found by scanning are the same for every production tried at i
+            if (w.ctx_at != i) {
+                w.ctx_at = i;
+                w.ctx_left = kUnknown;
+                w.ctx_right = kUnknown;
+            }
+            if (!pr.left.empty()) {
+                if (w.ctx_left == kUnknown) w.ctx_left = left_step(static_cast<std::int64_t>(i) - 1);
+                if (!match_left_from(w.ctx_left, pr.left, frame)) return false;
+            }
+            if (!pr.right.empty()) {
+                const std::size_t e = i + pr.strict.size();
+                if (pr.strict.size() == 1 && pr.right[0].sym != P.symbols.open_bracket &&
+                    pr.right[0].sym != P.symbols.close_bracket) {
+                    if (w.ctx_right == kUnknown) w.ctx_right = static_cast<std::int64_t>(right_step(e));
+                    if (static_cast<std::size_t>(w.ctx_right) >= n ||
+                        !match_module(static_cast<std::size_t>(w.ctx_right), pr.right[0], frame))
+                        return false;
+                    if (pr.right.size() > 1 &&
+                        !match_right(static_cast<std::size_t>(w.ctx_right) + 1,
+                                     std::span<const PatternModule>(pr.right).subspan(1), frame))
+                        return false;
+                } else if (!match_right(e, pr.right, frame)) {
+                    return false;
+                }
+            }
+        }
         if (!pr.left_new.empty() && !match_left_new(w.out, pr.left_new, frame)) return false;
         if (!pr.right_new.empty() && !match_right_new(w.out, pr.right_new, frame)) return false;
         if (!pr.condition.empty() && eval_number(pr.condition, frame, w.env) == 0) return false;
@@ -537,6 +588,16 @@ private:
             check_holes(t, values);
         }
         const std::size_t m = t.syms.size();
+        if (m <= 4 && t.holes.empty()) { // short constant successors: plain appends
+            for (std::size_t j = 0; j < m; ++j) {
+                out.sym.push_back(t.syms[j]);
+                for (std::uint32_t k = j ? t.param_end[j - 1] : 0; k < t.param_end[j]; ++k) out.params.push_back(t.params[k]);
+                out.poff.push_back(static_cast<std::uint32_t>(out.params.size()));
+                out.ids.push_back(static_cast<int>(j) == t.keep ? in.ids[i] : env.id_base + env.new_count++);
+            }
+            if (out.size() > env.max_output) throw RuntimeError{Span{}, "module limit"};
+            return 1;
+        }
         const std::size_t m0 = out.sym.size();
         const std::size_t p0 = out.params.size();
         out.sym.resize(m0 + m);
