@@ -1,6 +1,8 @@
 // plant derive / plant check
 #include "commands.hpp"
 
+#include "plant/query.hpp"
+
 #include <fmt/format.h>
 
 #include <chrono>
@@ -41,6 +43,8 @@ int derive_main(const DeriveCmd& c) {
         if (progress) std::cerr << fmt::format("\rstep {}: {} modules   ", s.step, s.modules) << std::flush;
     };
     opt.on_print = [](const std::string& text) { std::cerr << text; };
+    TurtleQueryPass queries;
+    opt.queries = &queries;
     Derivation d(*program, opt);
     bool ok = run_derivation(d, sources, c.g.color);
     if (progress) std::cerr << "\r\x1b[K" << std::flush;

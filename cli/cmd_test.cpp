@@ -224,13 +224,32 @@ std::string run_one(const fs::path& file, bool bless, bool& blessed) {
     }
     fs::path sidecar = file;
     sidecar.replace_extension(".txt");
+    fs::path mesh_sidecar = file;
+    mesh_sidecar.replace_extension(".mesh.txt");
     if (o.exit_code != 0)
         return fmt::format("  exit code {} (a golden grammar must derive cleanly)\n{}", o.exit_code, o.err);
+    // the mesh summary: counts and bounds of `plant run`'s scene
+    std::string mesh;
+    if (bless || fs::exists(mesh_sidecar)) {
+        char tmp_name[] = "/tmp/plant-test-XXXXXX.mesh.txt";
+        int fd = mkstemps(tmp_name, 9);
+        if (fd < 0) return "  cannot create a temporary file\n";
+        close(fd);
+        std::vector<std::string> run_args{"run", file.filename().string()};
+        run_args.insert(run_args.end(), e.args.begin(), e.args.end());
+        run_args.insert(run_args.end(), {"-o", tmp_name});
+        Outcome m = run_self(run_args, file.parent_path());
+        read_file(tmp_name, mesh);
+        unlink(tmp_name);
+        if (m.exit_code != 0) return fmt::format("  plant run: exit code {}\n{}", m.exit_code, m.err);
+    }
     if (bless) {
-        std::string old;
-        if (!read_file(sidecar.string(), old) || old != o.out) {
-            if (!write_atomically(sidecar, o.out)) return "  cannot write " + sidecar.string() + "\n";
-            blessed = true;
+        for (const auto& [path, content] : {std::pair{sidecar, o.out}, std::pair{mesh_sidecar, mesh}}) {
+            std::string old;
+            if (!read_file(path.string(), old) || old != content) {
+                if (!write_atomically(path, content)) return "  cannot write " + path.string() + "\n";
+                blessed = true;
+            }
         }
         return {};
     }
@@ -238,6 +257,11 @@ std::string run_one(const fs::path& file, bool bless, bool& blessed) {
     if (!read_file(sidecar.string(), want))
         return fmt::format("  no expectations: add '# expect' comments or create {} with --bless\n", sidecar.string());
     if (want != o.out) return first_difference(want, o.out);
+    if (fs::exists(mesh_sidecar)) {
+        std::string want_mesh;
+        read_file(mesh_sidecar.string(), want_mesh);
+        if (want_mesh != mesh) return "  mesh summary (" + mesh_sidecar.filename().string() + ") differs\n" + first_difference(want_mesh, mesh);
+    }
     return {};
 }
 

@@ -12,7 +12,8 @@
 namespace plant::cli {
 
 // Exit codes (sysexits.h): usage 64, unreadable input 66, grammar error 65, runtime error 70.
-enum Exit { kOk = 0, kFailed = 1, kUsage = 64, kGrammar = 65, kNoInput = 66, kRuntime = 70 };
+// 73: an output file cannot be created.
+enum Exit { kOk = 0, kFailed = 1, kUsage = 64, kGrammar = 65, kNoInput = 66, kRuntime = 70, kCantCreate = 73 };
 
 // Options shared by the commands that compile and derive a grammar.
 struct GrammarOptions {
@@ -39,5 +40,6 @@ DeriveOptions derive_options(const GrammarOptions& o);
 void setup_derive(CLI::App& app, int& exit_code);
 void setup_check(CLI::App& app, int& exit_code);
 void setup_test(CLI::App& app, int& exit_code);
+void setup_run(CLI::App& app, int& exit_code);
 
 } // namespace plant::cli

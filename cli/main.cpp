@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
     app.require_subcommand(1);
     app.set_help_all_flag("--help-all", "Show help for every command");
     int exit_code = kOk;
+    setup_run(app, exit_code);
     setup_derive(app, exit_code);
     setup_check(app, exit_code);
     setup_test(app, exit_code);

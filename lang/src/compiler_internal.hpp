@@ -94,9 +94,9 @@ private:
     void compile_settings(const ast::File& f);
     void check_never_applying();
     void check_raw_runs();
-    void check_queries();
     void finish_rule_set(RuleSet& set);
     void build_template(Production& p);
+    void compile_surface(const ast::ShapeDecl& s);
 
     // helpers (compiler.cpp)
     void emit(Ctx& c, Op op, std::int32_t a, int n, Span span, std::uint16_t b = 0);

@@ -447,6 +447,46 @@ void Compiler::check_never_applying() {
 
 void Compiler::finish_rule_set(RuleSet& set) { set.index(P_.symbols.size()); }
 
+void Compiler::compile_surface(const ast::ShapeDecl& s) {
+    SurfaceDef def;
+    def.name = s.name;
+    def.kind = s.kind;
+    def.span = s.span;
+    for (const auto& other : P_.surfaces) {
+        if (other.name == s.name) {
+            duplicate("surface", s.name, s.span, other.span);
+            return;
+        }
+    }
+    if (s.kind == "polygon") {
+        for (const auto& a : s.args) {
+            auto v = eval_const(*a, "a polygon corner");
+            if (!v) return;
+            if (v->type != ValueType::Vec3) {
+                diags_.error(a->span, "a polygon corner must be a vec3, as in vec3(0, 1, 0)");
+                return;
+            }
+            def.points.push_back({v->v[0], v->v[1], v->v[2]});
+        }
+        if (def.points.size() < 3) {
+            diags_.error(s.span, fmt::format("polygon '{}' needs at least 3 corners, found {}", s.name, def.points.size()));
+            return;
+        }
+    } else if (s.kind == "load") {
+        if (s.args.size() != 1 || s.args[0]->kind != ast::ExprKind::String) {
+            diags_.error(s.span, "load(...) takes one quoted file name, as in load(\"leaf.obj\")");
+            return;
+        }
+        fs::path p(s.args[0]->text);
+        if (p.is_relative()) p = fs::path(sm_.file(s.span.file).name()).parent_path() / p;
+        def.path = p.lexically_normal().string();
+    } else {
+        diags_.error(s.kind_span, fmt::format("unknown surface kind '{}': expected polygon(...) or load(\"file\")", s.kind));
+        return;
+    }
+    P_.surfaces.push_back(std::move(def));
+}
+
 // Splits an arrow-form body (argument code, Emit, argument code, Emit, ..., ProduceEnd) into a
 // template: a module whose arguments are all constants is copied as it is; the argument code of
 // the others is moved, in order, into `values`. Draws of random numbers happen in the same
@@ -516,26 +556,6 @@ void Compiler::build_template(Production& p) {
     p.tmpl = std::move(t);
 }
 
-// Query modules are filled by a turtle pass (LANGUAGE.md section 8), which the runtime provides.
-// Until a runtime is connected their parameters keep the values they were produced with; say
-// so once rather than let a grammar read zeros without knowing why.
-void Compiler::check_queries() {
-    auto first_query = [&](const RuleSet& rs) -> const PatternModule* {
-        for (const auto& p : rs.productions)
-            for (const auto* list : {&p.strict, &p.left, &p.right})
-                for (const auto& m : *list)
-                    if (P_.symbols[m.sym].query) return &m;
-        return nullptr;
-    };
-    const PatternModule* q = first_query(P_.rules);
-    for (const auto& g : P_.groups)
-        if (!q) q = first_query(g);
-    if (q)
-        diags_.warning(q->span, fmt::format("'{}' is read here, but query modules are filled by the turtle pass, "
-                                            "which this version of plant does not run yet: it keeps the values it "
-                                            "was produced with",
-                                            P_.symbols[q->sym].name));
-}
 
 // ---- the whole compilation -----------------------------------------------------------------
 
@@ -598,6 +618,7 @@ std::unique_ptr<Program> Compiler::compile(std::uint32_t main_file) {
         }
     }
     for (std::uint32_t i = 0; i < P_.functions.size(); ++i) ensure_function_compiled(i);
+    for (const ast::ShapeDecl* s : P_.deferred.surfaces) compile_surface(*s);
     for (const auto& lf : order_) {
         current_file_ = lf.file->source;
         compile_settings(*lf.file);
@@ -633,7 +654,6 @@ std::unique_ptr<Program> Compiler::compile(std::uint32_t main_file) {
     if (!diags_.has_errors()) {
         check_raw_runs();
         check_never_applying();
-        check_queries();
     }
     if (diags_.has_errors()) return nullptr;
     return std::move(program_);

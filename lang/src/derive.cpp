@@ -1029,7 +1029,7 @@ void Derivation::start() {
     seed_ = opt_.seed ? *opt_.seed : static_cast<std::uint64_t>(std::llround(std::fabs(seed)));
     angle_ = setting(prog_.setting_angle, 90);
     step_length_ = setting(prog_.setting_step, 1);
-    width_ = setting(prog_.setting_width, 1);
+    width_ = setting(prog_.setting_width, 0.1); // a tenth of the default step: a slender branch
     step_ = 0;
     stopped_ = false;
     group_ = -1;
@@ -1080,7 +1080,7 @@ bool Derivation::step() {
             };
             queries = queries || is_query(pr.strict) || is_query(pr.left) || is_query(pr.right);
         }
-    if (queries && opt_.queries) opt_.queries->fill_queries(prog_, globals_.data(), current_);
+    if (queries && opt_.queries) opt_.queries->fill_queries(*this, current_);
     ModuleString next;
     ++step_;
     try {

@@ -14,16 +14,18 @@
 
 namespace plant {
 
+class Rewriter;   // derive.cpp
+class Derivation; // below
+
 // Implemented by the runtime: interprets the string with the turtle and writes the position,
 // heading, up or left vector into every query module (?P ?H ?U ?L). Called before a step whose
 // productions read query modules.
 class QueryPass {
 public:
     virtual ~QueryPass() = default;
-    virtual void fill_queries(const Program& program, const double* globals, ModuleString& string) = 0;
+    virtual void fill_queries(const Derivation& derivation, ModuleString& string) = 0;
 };
 
-class Rewriter; // derive.cpp
 
 struct StepStats {
     int step = 0;
@@ -70,6 +72,7 @@ public:
     std::vector<double>& globals() { return globals_; }
     int active_group() const { return group_; }
     ModuleId next_id() const { return next_id_; }
+    const Program& program() const { return prog_; }
 
     // The string as the turtle sees it: interpretation rules applied (max_depth passes).
     ModuleString interpreted(const ModuleString& s) const;

@@ -190,6 +190,15 @@ struct Deferred {
     std::vector<const ast::InstanceDecl*> instances;
 };
 
+// `surface name = polygon(p0, p1, ...)` or `= load("file.obj")`, evaluated at compile time.
+struct SurfaceDef {
+    std::string name;
+    std::string kind;                 // polygon | load
+    std::vector<std::array<double, 3>> points; // polygon corners
+    std::string path;                 // load: resolved against the grammar's directory
+    Span span;
+};
+
 struct Program {
     SymbolTable symbols;
     std::vector<Global> globals;
@@ -213,6 +222,7 @@ struct Program {
     std::array<std::uint16_t, 4> hook_frame{};
 
     Deferred deferred;
+    std::vector<SurfaceDef> surfaces;
     std::vector<std::unique_ptr<ast::File>> files; // the syntax trees the program was built from
 
     int group_index(std::string_view name) const;

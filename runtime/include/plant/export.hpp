@@ -1,0 +1,30 @@
+// Writing a scene to files. Every writer writes to a temporary file beside the target and
+// renames it, so a failed run never leaves a partial file. Errors throw ExportError.
+#pragma once
+
+#include "plant/scene.hpp"
+
+#include <stdexcept>
+#include <string>
+
+namespace plant {
+
+struct ExportError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+// Writes `bytes` to `path` through a temporary file and a rename.
+void write_file_atomically(const std::string& path, const std::string& bytes);
+
+// .glb (binary) or .gltf (JSON with the buffer embedded as a data URI): one buffer, the tubes as
+// one mesh, each prototype as a mesh shared by all nodes that place it, one material per color.
+void write_gltf(const Scene& scene, const std::string& path);
+
+// A PNG preview: software rasterizer with a z-buffer and Lambert shading, a 3/4 view framed on
+// the scene's bounding box, white background.
+void write_png(const Scene& scene, const std::string& path, int width, int height);
+
+// .obj, .ply or .off through OpenMesh, everything flattened into one triangle mesh.
+void write_mesh_file(const Scene& scene, const std::string& path);
+
+} // namespace plant

@@ -1,0 +1,25 @@
+// The software rasterizer behind write_png, exposed so tests can check pixels without decoding
+// a PNG. Orthographic 3/4 view (from the front-right, somewhat above; y is up) framed on the
+// scene's bounding box with a 5% margin, z-buffer, two-sided Lambert shading plus ambient,
+// 2x2 supersampling, white background. Output is sRGB.
+#pragma once
+
+#include "plant/scene.hpp"
+
+#include <cstdint>
+#include <vector>
+
+namespace plant {
+
+struct Image {
+    int width = 0, height = 0;
+    std::vector<std::uint8_t> rgb; // width * height * 3 bytes, rows top to bottom
+};
+
+// Renders the tubes and every instance, each primitive in its material's color. Degenerate
+// input (no geometry, zero-size bounds, invalid indices) gives a blank or sparse image, never
+// a crash. Throws ExportError (plant/export.hpp) if width or height is not positive or the
+// image is too large (more than 64 million pixels).
+Image render_scene(const Scene& scene, int width, int height);
+
+} // namespace plant

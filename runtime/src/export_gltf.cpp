@@ -1,0 +1,357 @@
+// glTF 2.0 export through tinygltf, and the atomic file writer every exporter shares.
+//
+// Layout of the single buffer: for each non-empty mesh part (the tubes, then each prototype) four
+// tightly packed buffer views, in this order: POSITION (vec3 float), NORMAL (vec3 float),
+// TEXCOORD_0 (vec2 float), indices (uint32). Every primitive of a part shares the part's vertex
+// accessors and has its own index accessor, a window into the part's index view. All components
+// are 4 bytes, so every view and accessor is 4-byte aligned.
+#include "plant/export.hpp"
+
+#include <tiny_gltf.h>
+
+#include <glm/glm.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <cctype>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <sstream>
+#include <system_error>
+#include <unistd.h>
+
+namespace plant {
+
+namespace fs = std::filesystem;
+
+// ---------------------------------------------------------------------------------------------
+// Atomic writes
+
+namespace {
+
+std::string quoted(const std::string& s) { return "'" + s + "'"; }
+
+// Creates a new, empty file beside `path` (same directory, hidden, unique name) and returns its
+// path with `file` open for writing. Throws ExportError when the directory is not writable.
+std::string create_temp_beside(const std::string& path, std::FILE*& file) {
+    static std::atomic<unsigned> counter{0};
+    const fs::path target(path);
+    if (target.filename().empty())
+        throw ExportError("cannot write " + quoted(path) + ": not a file name");
+    const fs::path dir = target.parent_path();
+    for (int attempt = 0;; ++attempt) {
+        const std::string name = "." + target.filename().string() + ".tmp-" +
+                                 std::to_string(::getpid()) + "-" + std::to_string(counter++);
+        const std::string temp = (dir / name).string();
+        // "x": fail if the file exists, so two writers never share a temporary file.
+        file = std::fopen(temp.c_str(), "wbx");
+        if (file) return temp;
+        const int err = errno;
+        if (err == EEXIST && attempt < 100) continue;
+        throw ExportError("cannot write " + quoted(path) + ": cannot create a file in " +
+                          quoted(dir.empty() ? std::string(".") : dir.string()) + ": " +
+                          std::strerror(err));
+    }
+}
+
+void remove_quietly(const std::string& temp) {
+    std::error_code ignored;
+    fs::remove(temp, ignored);
+}
+
+} // namespace
+
+void write_file_atomically(const std::string& path, const std::string& bytes) {
+    std::FILE* file = nullptr;
+    const std::string temp = create_temp_beside(path, file);
+    const std::size_t written = bytes.empty() ? 0 : std::fwrite(bytes.data(), 1, bytes.size(), file);
+    int err = written == bytes.size() ? 0 : errno;
+    if (std::fflush(file) != 0 && err == 0) err = errno;
+    if (std::fclose(file) != 0 && err == 0) err = errno;
+    if (written != bytes.size() && err == 0) err = EIO;
+    if (err != 0) {
+        remove_quietly(temp);
+        throw ExportError("cannot write " + quoted(path) + ": " + std::strerror(err));
+    }
+    std::error_code ec;
+    fs::rename(temp, path, ec);
+    if (ec) {
+        remove_quietly(temp);
+        throw ExportError("cannot write " + quoted(path) + ": " + ec.message());
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// glTF
+
+namespace {
+
+constexpr int array_buffer = 34962;         // ARRAY_BUFFER
+constexpr int element_array_buffer = 34963; // ELEMENT_ARRAY_BUFFER
+
+std::string lower_extension(const std::string& path) {
+    std::string ext = fs::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return ext;
+}
+
+// The double nearest to the shortest decimal that reads back as `f`: JSON then shows 0.1 for
+// 0.1f instead of 0.10000000149011612. Not for accessor min and max, which must match the data.
+double tidy(float f) {
+    char text[32];
+    const auto end = std::to_chars(text, text + sizeof text, f).ptr;
+    double d = 0.0;
+    std::from_chars(text, end, d);
+    return d;
+}
+
+struct GltfBuilder {
+    const Scene& scene;
+    tinygltf::Model model;
+    std::vector<int> material_index; // scene material -> glTF material, -1 while unused
+
+    explicit GltfBuilder(const Scene& s) : scene(s) {
+        model.asset.version = "2.0";
+        model.asset.generator = "plant";
+        material_index.assign(std::max<std::size_t>(scene.materials.size(), 1), -1);
+    }
+
+    std::vector<unsigned char>& data() {
+        if (model.buffers.empty()) model.buffers.emplace_back();
+        return model.buffers[0].data;
+    }
+
+    // Appends raw bytes as a new buffer view (4-byte aligned) and returns its index.
+    int add_view(const void* bytes, std::size_t size, int target) {
+        auto& buf = data();
+        while (buf.size() % 4 != 0) buf.push_back(0);
+        tinygltf::BufferView view;
+        view.buffer = 0;
+        view.byteOffset = buf.size();
+        view.byteLength = size;
+        view.target = target;
+        const auto* p = static_cast<const unsigned char*>(bytes);
+        buf.insert(buf.end(), p, p + size);
+        model.bufferViews.push_back(std::move(view));
+        return static_cast<int>(model.bufferViews.size() - 1);
+    }
+
+    int add_accessor(int view, std::size_t byte_offset, std::size_t count, int type,
+                     int component_type) {
+        tinygltf::Accessor a;
+        a.bufferView = view;
+        a.byteOffset = byte_offset;
+        a.count = count;
+        a.type = type;
+        a.componentType = component_type;
+        model.accessors.push_back(std::move(a));
+        return static_cast<int>(model.accessors.size() - 1);
+    }
+
+    int material(std::uint32_t m, const std::string& part) {
+        if (scene.materials.empty() ? m != 0 : m >= scene.materials.size())
+            throw ExportError("glTF export: " + part + " uses material " + std::to_string(m) +
+                              " but the scene has " + std::to_string(scene.materials.size()));
+        int& index = material_index[m];
+        if (index >= 0) return index;
+        const Material color = scene.materials.empty() ? Material{} : scene.materials[m];
+        tinygltf::Material mat;
+        mat.name = "material" + std::to_string(m);
+        auto channel = [](float x) { return std::isfinite(x) ? tidy(std::clamp(x, 0.0f, 1.0f)) : 0.0; };
+        mat.pbrMetallicRoughness.baseColorFactor = {channel(color.color.r), channel(color.color.g),
+                                                     channel(color.color.b), 1.0};
+        mat.pbrMetallicRoughness.metallicFactor = 0.0;
+        mat.pbrMetallicRoughness.roughnessFactor = 0.9;
+        mat.doubleSided = true;
+        model.materials.push_back(std::move(mat));
+        index = static_cast<int>(model.materials.size() - 1);
+        return index;
+    }
+
+    // Adds `part` as one mesh and returns its index, or -1 when it has no triangles.
+    int add_mesh(const MeshPart& part, const std::string& name) {
+        const std::size_t nv = part.positions.size();
+        if (!part.normals.empty() && part.normals.size() != nv)
+            throw ExportError("glTF export: " + name + " has " + std::to_string(nv) +
+                              " positions but " + std::to_string(part.normals.size()) + " normals");
+        if (!part.uvs.empty() && part.uvs.size() != nv)
+            throw ExportError("glTF export: " + name + " has " + std::to_string(nv) +
+                              " positions but " + std::to_string(part.uvs.size()) +
+                              " texture coordinates");
+        if (part.indices.size() % 3 != 0)
+            throw ExportError("glTF export: " + name + " has an index count (" +
+                              std::to_string(part.indices.size()) + ") that is not a multiple of 3");
+        if (nv > std::numeric_limits<std::uint32_t>::max())
+            throw ExportError("glTF export: " + name + " has too many vertices");
+        for (std::uint32_t i : part.indices)
+            if (i >= nv)
+                throw ExportError("glTF export: " + name + " has index " + std::to_string(i) +
+                                  " but only " + std::to_string(nv) + " vertices");
+
+        // A part without primitives is drawn whole with material 0.
+        std::vector<Primitive> prims = part.primitives;
+        if (prims.empty())
+            prims.push_back({0, static_cast<std::uint32_t>(part.indices.size()), 0});
+        for (const Primitive& p : prims) {
+            if (std::uint64_t(p.first) + p.count > part.indices.size() || p.first % 3 != 0 ||
+                p.count % 3 != 0)
+                throw ExportError("glTF export: " + name + " has a primitive with indices [" +
+                                  std::to_string(p.first) + ", " +
+                                  std::to_string(std::uint64_t(p.first) + p.count) +
+                                  ") that does not fit its " +
+                                  std::to_string(part.indices.size()) + " indices in whole triangles");
+        }
+        prims.erase(std::remove_if(prims.begin(), prims.end(),
+                                   [](const Primitive& p) { return p.count == 0; }),
+                    prims.end());
+        if (prims.empty() || nv == 0) return -1;
+
+        tinygltf::Mesh mesh;
+        mesh.name = name;
+
+        // POSITION, with the min and max the specification requires.
+        glm::vec3 lo(std::numeric_limits<float>::max()), hi(std::numeric_limits<float>::lowest());
+        for (const glm::vec3& p : part.positions) {
+            if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+                throw ExportError("glTF export: " + name + " has a position that is not finite");
+            lo = glm::min(lo, p);
+            hi = glm::max(hi, p);
+        }
+        const int pos_view = add_view(part.positions.data(), nv * sizeof(glm::vec3), array_buffer);
+        const int pos = add_accessor(pos_view, 0, nv, TINYGLTF_TYPE_VEC3,
+                                     TINYGLTF_COMPONENT_TYPE_FLOAT);
+        model.accessors[std::size_t(pos)].minValues = {lo.x, lo.y, lo.z};
+        model.accessors[std::size_t(pos)].maxValues = {hi.x, hi.y, hi.z};
+
+        // NORMAL: the validator rejects non-unit normals, so renormalize while copying.
+        int nrm = -1;
+        if (!part.normals.empty()) {
+            std::vector<glm::vec3> normals(part.normals);
+            for (glm::vec3& n : normals) {
+                const float len = glm::length(n);
+                if (!(len > 1e-20f) || !std::isfinite(len))
+                    n = glm::vec3(0.0f, 1.0f, 0.0f);
+                else if (std::abs(len - 1.0f) > 1e-5f)
+                    n /= len;
+            }
+            const int view = add_view(normals.data(), nv * sizeof(glm::vec3), array_buffer);
+            nrm = add_accessor(view, 0, nv, TINYGLTF_TYPE_VEC3, TINYGLTF_COMPONENT_TYPE_FLOAT);
+        }
+
+        int uv = -1;
+        if (!part.uvs.empty()) {
+            const int view = add_view(part.uvs.data(), nv * sizeof(glm::vec2), array_buffer);
+            uv = add_accessor(view, 0, nv, TINYGLTF_TYPE_VEC2, TINYGLTF_COMPONENT_TYPE_FLOAT);
+        }
+
+        const int idx_view = add_view(part.indices.data(),
+                                      part.indices.size() * sizeof(std::uint32_t),
+                                      element_array_buffer);
+        for (const Primitive& p : prims) {
+            tinygltf::Primitive prim;
+            prim.attributes["POSITION"] = pos;
+            if (nrm >= 0) prim.attributes["NORMAL"] = nrm;
+            if (uv >= 0) prim.attributes["TEXCOORD_0"] = uv;
+            prim.indices = add_accessor(idx_view, std::size_t(p.first) * sizeof(std::uint32_t),
+                                        p.count, TINYGLTF_TYPE_SCALAR,
+                                        TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT);
+            prim.material = material(p.material, name);
+            prim.mode = TINYGLTF_MODE_TRIANGLES; // tinygltf 2.7 writes -1 otherwise
+            mesh.primitives.push_back(std::move(prim));
+        }
+        model.meshes.push_back(std::move(mesh));
+        return static_cast<int>(model.meshes.size() - 1);
+    }
+
+    int add_node(tinygltf::Node node) {
+        model.nodes.push_back(std::move(node));
+        const int index = static_cast<int>(model.nodes.size() - 1);
+        model.scenes[0].nodes.push_back(index);
+        return index;
+    }
+
+    void build() {
+        model.scenes.emplace_back();
+        model.scenes[0].name = "plant";
+        model.defaultScene = 0;
+
+        const int tubes = add_mesh(scene.tubes, "tubes");
+        if (tubes >= 0) {
+            tinygltf::Node node;
+            node.name = "tubes";
+            node.mesh = tubes;
+            add_node(std::move(node));
+        }
+
+        std::vector<int> proto_mesh(scene.prototypes.size(), -1);
+        for (std::size_t i = 0; i < scene.prototypes.size(); ++i) {
+            const std::string name = i < scene.prototype_names.size() &&
+                                             !scene.prototype_names[i].empty()
+                                         ? scene.prototype_names[i]
+                                         : "prototype" + std::to_string(i);
+            proto_mesh[i] = add_mesh(scene.prototypes[i], name);
+        }
+
+        for (const Instance& inst : scene.instances) {
+            if (inst.prototype >= scene.prototypes.size())
+                throw ExportError("glTF export: an instance places prototype " +
+                                  std::to_string(inst.prototype) + " but the scene has " +
+                                  std::to_string(scene.prototypes.size()));
+            const int mesh = proto_mesh[inst.prototype];
+            if (mesh < 0) continue;
+            tinygltf::Node node;
+            node.mesh = mesh;
+            node.matrix.resize(16);
+            for (int c = 0; c < 4; ++c)
+                for (int r = 0; r < 4; ++r) {
+                    const float x = inst.transform[c][r];
+                    if (!std::isfinite(x))
+                        throw ExportError("glTF export: an instance of " +
+                                          model.meshes[std::size_t(mesh)].name +
+                                          " has a transform that is not finite");
+                    node.matrix[std::size_t(c * 4 + r)] = tidy(x);
+                }
+            add_node(std::move(node));
+        }
+
+        if (!model.buffers.empty()) {
+            auto& buf = model.buffers[0].data;
+            while (buf.size() % 4 != 0) buf.push_back(0);
+        }
+    }
+};
+
+} // namespace
+
+void write_gltf(const Scene& scene, const std::string& path) {
+    const std::string ext = lower_extension(path);
+    if (ext != ".glb" && ext != ".gltf")
+        throw ExportError("cannot write " + quoted(path) +
+                          ": a glTF file name must end in .glb or .gltf");
+    const bool binary = ext == ".glb";
+
+    GltfBuilder builder(scene);
+    builder.build();
+    if (binary && !builder.model.buffers.empty() &&
+        builder.model.buffers[0].data.size() > std::numeric_limits<std::uint32_t>::max() - 1024)
+        throw ExportError("cannot write " + quoted(path) +
+                          ": the scene is too large for a .glb file (over 4 GB)");
+
+    std::ostringstream out(std::ios::out | std::ios::binary);
+    tinygltf::TinyGLTF gltf;
+    if (!gltf.WriteGltfSceneToStream(&builder.model, out, /*prettyPrint=*/!binary,
+                                     /*writeBinary=*/binary) ||
+        !out)
+        throw ExportError("cannot write " + quoted(path) + ": glTF serialization failed");
+    // Free the model's copy of the buffer before the file copy is made.
+    builder.model = tinygltf::Model{};
+    write_file_atomically(path, std::move(out).str());
+}
+
+} // namespace plant

@@ -1,0 +1,197 @@
+// .obj, .ply and .off export through OpenMesh: the tubes and every placed prototype flattened into
+// one triangle mesh with vertex normals (and texture coordinates for .obj and .ply).
+#include "plant/export.hpp"
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#include <OpenMesh/Core/IO/MeshIO.hh>
+#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+#pragma GCC diagnostic pop
+
+#include <glm/glm.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <system_error>
+#include <unistd.h>
+
+namespace plant {
+
+namespace {
+
+namespace fs = std::filesystem;
+using Mesh = OpenMesh::TriMesh_ArrayKernelT<>;
+
+std::string quoted(const std::string& s) { return "'" + s + "'"; }
+
+void quiet_openmesh() {
+    static std::once_flag once;
+    std::call_once(once, [] {
+        omlog().disable(); // the OBJ writer logs to stdout
+        omerr().disable(); // add_face reports complex edges; they are handled below
+    });
+}
+
+glm::vec3 unit_or_up(glm::vec3 n) {
+    const float len = glm::length(n);
+    if (!(len > 1e-20f) || !std::isfinite(len)) return {0.0f, 1.0f, 0.0f};
+    return n / len;
+}
+
+class Flattener {
+public:
+    explicit Flattener(Mesh& mesh) : mesh_(mesh) {}
+
+    void add(const MeshPart& part, const glm::mat4& m, bool identity, const std::string& name) {
+        const std::size_t nv = part.positions.size();
+        if (!part.normals.empty() && part.normals.size() != nv)
+            throw ExportError("mesh export: " + name + " has " + std::to_string(nv) +
+                              " positions but " + std::to_string(part.normals.size()) + " normals");
+        if (!part.uvs.empty() && part.uvs.size() != nv)
+            throw ExportError("mesh export: " + name + " has " + std::to_string(nv) +
+                              " positions but " + std::to_string(part.uvs.size()) +
+                              " texture coordinates");
+        if (part.indices.size() % 3 != 0)
+            throw ExportError("mesh export: " + name + " has an index count (" +
+                              std::to_string(part.indices.size()) + ") that is not a multiple of 3");
+        for (std::uint32_t i : part.indices)
+            if (i >= nv)
+                throw ExportError("mesh export: " + name + " has index " + std::to_string(i) +
+                                  " but only " + std::to_string(nv) + " vertices");
+        if (part.indices.empty()) return;
+
+        const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(m)));
+        const bool mirrored = glm::determinant(glm::mat3(m)) < 0.0f; // keep the winding outward
+
+        std::vector<Mesh::VertexHandle> handle(nv);
+        for (std::uint32_t i = 0; i < nv; ++i)
+            handle[i] = new_vertex(part, m, normal_matrix, identity, i);
+
+        for (std::size_t t = 0; t + 2 < part.indices.size(); t += 3) {
+            std::uint32_t a = part.indices[t], b = part.indices[t + 1], c = part.indices[t + 2];
+            if (a == b || b == c || a == c) continue; // no area, and OpenMesh refuses it
+            if (mirrored) std::swap(b, c);
+            if (!mesh_.add_face(handle[a], handle[b], handle[c]).is_valid()) {
+                // A non-manifold configuration (a complex edge or vertex) that the half-edge
+                // structure cannot hold: give this triangle vertices of its own.
+                const auto va = new_vertex(part, m, normal_matrix, identity, a);
+                const auto vb = new_vertex(part, m, normal_matrix, identity, b);
+                const auto vc = new_vertex(part, m, normal_matrix, identity, c);
+                mesh_.add_face(va, vb, vc);
+            }
+        }
+    }
+
+private:
+    Mesh::VertexHandle new_vertex(const MeshPart& part, const glm::mat4& m, const glm::mat3& nm,
+                                  bool identity, std::uint32_t i) {
+        glm::vec3 p = part.positions[i];
+        if (!identity) p = glm::vec3(m * glm::vec4(p, 1.0f));
+        const auto vh = mesh_.add_vertex(Mesh::Point(p.x, p.y, p.z));
+        glm::vec3 n = part.normals.empty() ? glm::vec3(0.0f, 1.0f, 0.0f) : part.normals[i];
+        n = unit_or_up(identity ? n : nm * n);
+        mesh_.set_normal(vh, Mesh::Normal(n.x, n.y, n.z));
+        const glm::vec2 uv = part.uvs.empty() ? glm::vec2(0.0f) : part.uvs[i];
+        mesh_.set_texcoord2D(vh, Mesh::TexCoord2D(uv.x, uv.y));
+        return vh;
+    }
+
+    Mesh& mesh_;
+};
+
+// Creates a new, empty file beside `path` with the same extension (OpenMesh picks its writer by
+// extension) and returns its name. Throws ExportError when the directory is not writable.
+std::string create_temp_beside(const std::string& path, const std::string& ext) {
+    static std::atomic<unsigned> counter{0};
+    const fs::path target(path);
+    const fs::path dir = target.parent_path();
+    for (int attempt = 0;; ++attempt) {
+        const std::string name = "." + target.stem().string() + ".tmp-" +
+                                 std::to_string(::getpid()) + "-" + std::to_string(counter++) + ext;
+        const std::string temp = (dir / name).string();
+        std::FILE* file = std::fopen(temp.c_str(), "wbx");
+        if (file) {
+            std::fclose(file);
+            return temp;
+        }
+        const int err = errno;
+        if (err == EEXIST && attempt < 100) continue;
+        throw ExportError("cannot write " + quoted(path) + ": cannot create a file in " +
+                          quoted(dir.empty() ? std::string(".") : dir.string()) + ": " +
+                          std::strerror(err));
+    }
+}
+
+} // namespace
+
+void write_mesh_file(const Scene& scene, const std::string& path) {
+    std::string ext = fs::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    if (ext != ".obj" && ext != ".ply" && ext != ".off")
+        throw ExportError("cannot write " + quoted(path) +
+                          ": a mesh file name must end in .obj, .ply or .off");
+    quiet_openmesh();
+
+    Mesh mesh;
+    mesh.request_vertex_normals();
+    mesh.request_vertex_texcoords2D();
+    {
+        std::size_t nv = scene.tubes.positions.size(), nf = scene.tubes.triangle_count();
+        for (const Instance& inst : scene.instances) {
+            if (inst.prototype >= scene.prototypes.size())
+                throw ExportError("mesh export: an instance places prototype " +
+                                  std::to_string(inst.prototype) + " but the scene has " +
+                                  std::to_string(scene.prototypes.size()));
+            nv += scene.prototypes[inst.prototype].positions.size();
+            nf += scene.prototypes[inst.prototype].triangle_count();
+        }
+        mesh.reserve(nv, nv + nf, nf); // edges: about V + F for a triangle mesh
+    }
+
+    Flattener flat(mesh);
+    flat.add(scene.tubes, glm::mat4(1.0f), true, "tubes");
+    for (const Instance& inst : scene.instances) {
+        const std::size_t k = inst.prototype;
+        const std::string name = k < scene.prototype_names.size() && !scene.prototype_names[k].empty()
+                                     ? scene.prototype_names[k]
+                                     : "prototype " + std::to_string(k);
+        flat.add(scene.prototypes[k], inst.transform, false, name);
+    }
+
+    OpenMesh::IO::Options options(OpenMesh::IO::Options::VertexNormal);
+    // OFF stays plain NOFF: few readers understand texture coordinates in OFF files.
+    if (ext != ".off") options += OpenMesh::IO::Options::VertexTexCoord;
+
+    const std::string temp = create_temp_beside(path, ext);
+    bool ok = false;
+    {
+        std::ofstream out(temp, std::ios::out | std::ios::binary | std::ios::trunc);
+        ok = out && OpenMesh::IO::write_mesh(mesh, out, ext, options, 7);
+        out.flush();
+        out.close();
+        ok = ok && !out.fail();
+    }
+    if (!ok) {
+        std::error_code ignored;
+        fs::remove(temp, ignored);
+        throw ExportError("cannot write " + quoted(path) + ": OpenMesh failed to write the " +
+                          ext.substr(1) + " file");
+    }
+    std::error_code ec;
+    fs::rename(temp, path, ec);
+    if (ec) {
+        std::error_code ignored;
+        fs::remove(temp, ignored);
+        throw ExportError("cannot write " + quoted(path) + ": " + ec.message());
+    }
+}
+
+} // namespace plant

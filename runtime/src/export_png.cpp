@@ -1,0 +1,483 @@
+// PNG preview: a small software rasterizer (orthographic 3/4 view, z-buffer, Gouraud-shaded
+// two-sided Lambert lighting, 2x2 supersampling) and the PNG writer on top of it.
+//
+// Triangles are set up in 28.4 fixed point with exact 64-bit edge functions and a consistent
+// tie-breaking rule, so meshes are watertight (no background speckles along shared edges) and
+// every sample is covered at most once per mesh surface. Depth and intensity are interpolated
+// as float planes. The PNG bytes come from stb_image_write; on Debian its symbols live in
+// libstb (link with -lstb, do not define STB_IMAGE_WRITE_IMPLEMENTATION here).
+
+#include "plant/export.hpp"
+#include "plant/raster.hpp"
+
+#include <glm/glm.hpp>
+#include <stb/stb_image_write.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <new>
+#include <string>
+#include <vector>
+
+namespace plant {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kAzimuthDeg = 40.0;   // camera swung this far from the front (+z) toward +x
+constexpr double kElevationDeg = 24.0; // and raised this far above the horizon
+constexpr double kMargin = 0.05;       // of the image size, on each side
+constexpr float kAmbient = 0.24f;
+constexpr float kKey = 0.66f;  // directional light from above, left of the viewer
+constexpr float kFill = 0.16f; // a weak headlight so faces turned from the key are not flat
+constexpr int kSubBits = 4;    // fixed-point subsample precision: 1/16 sample
+constexpr int kSub = 1 << kSubBits;
+constexpr double kGuard = double(1 << 20); // screen coordinates are clamped to +-this (samples)
+constexpr std::int64_t kMaxPixels = std::int64_t(64) << 20;
+constexpr std::int64_t kMaxSupersampledPixels = std::int64_t(4) << 20; // 2048 x 2048 output
+constexpr int kLutSize = 4096;
+
+bool finite3(const glm::dvec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+struct Box {
+    glm::dvec3 lo{std::numeric_limits<double>::infinity()};
+    glm::dvec3 hi{-std::numeric_limits<double>::infinity()};
+    void add(const glm::dvec3& p) {
+        if (!finite3(p)) return;
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
+    bool valid() const { return lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z; }
+};
+
+Box part_box(const MeshPart& part) {
+    Box box;
+    for (const glm::vec3& p : part.positions) box.add(glm::dvec3(p));
+    return box;
+}
+
+// The scene's own bounds, unless they are unusable (non-finite, inverted, or a single point
+// while there is geometry, e.g. update_bounds() was not called): then bounds of the geometry,
+// instances through their prototypes' transformed boxes.
+Box framing_box(const Scene& scene) {
+    Box given;
+    given.lo = glm::dvec3(scene.bounds_min);
+    given.hi = glm::dvec3(scene.bounds_max);
+    if (finite3(given.lo) && finite3(given.hi) && given.valid() && given.lo != given.hi)
+        return given;
+
+    Box box = part_box(scene.tubes);
+    std::vector<Box> protos;
+    protos.reserve(scene.prototypes.size());
+    for (const MeshPart& proto : scene.prototypes) protos.push_back(part_box(proto));
+    for (const Instance& inst : scene.instances) {
+        if (inst.prototype >= protos.size() || !protos[inst.prototype].valid()) continue;
+        const Box& pb = protos[inst.prototype];
+        const glm::dmat4 m(inst.transform);
+        for (int corner = 0; corner < 8; ++corner) {
+            glm::dvec3 p((corner & 1) ? pb.hi.x : pb.lo.x, (corner & 2) ? pb.hi.y : pb.lo.y,
+                         (corner & 4) ? pb.hi.z : pb.lo.z);
+            box.add(glm::dvec3(m * glm::dvec4(p, 1.0)));
+        }
+    }
+    if (box.valid()) return box;
+    if (finite3(given.lo) && finite3(given.hi) && given.valid()) return given;
+    Box origin;
+    origin.lo = origin.hi = glm::dvec3(0.0);
+    return origin;
+}
+
+// Orthographic camera in supersampled screen space: x right, y down, in samples; depth grows
+// toward the viewer.
+struct Camera {
+    glm::dvec3 center{0.0};
+    glm::dvec3 right{1, 0, 0}, up{0, 1, 0}, toward{0, 0, 1}; // toward = from the scene to the eye
+    glm::dvec3 light{0, 1, 0};                               // unit, toward the light
+    double scale = 1.0;                                      // samples per world unit
+    double cx = 0.0, cy = 0.0;                               // screen position of `center`
+};
+
+Camera make_camera(const Scene& scene, int width, int height) {
+    Camera cam;
+    const double az = kAzimuthDeg * kPi / 180.0, el = kElevationDeg * kPi / 180.0;
+    cam.toward = glm::dvec3(std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az));
+    const glm::dvec3 forward = -cam.toward;
+    cam.right = glm::normalize(glm::cross(forward, glm::dvec3(0, 1, 0)));
+    cam.up = glm::cross(cam.right, forward);
+    cam.light = glm::normalize(0.55 * cam.toward + 0.75 * glm::dvec3(0, 1, 0) - 0.4 * cam.right);
+
+    const Box box = framing_box(scene);
+    cam.center = 0.5 * (box.lo + box.hi);
+    const glm::dvec3 half = 0.5 * (box.hi - box.lo);
+    // The projection of a box is symmetric about the projected center: its half-size along a
+    // screen axis a is sum |a_i| * half_i.
+    const double hw = std::abs(cam.right.x) * half.x + std::abs(cam.right.y) * half.y +
+                      std::abs(cam.right.z) * half.z;
+    const double hh =
+        std::abs(cam.up.x) * half.x + std::abs(cam.up.y) * half.y + std::abs(cam.up.z) * half.z;
+    const double avail_w = 0.5 * width * (1.0 - 2.0 * kMargin);
+    const double avail_h = 0.5 * height * (1.0 - 2.0 * kMargin);
+    double scale = std::numeric_limits<double>::infinity();
+    if (hw > 0.0) scale = std::min(scale, avail_w / hw);
+    if (hh > 0.0) scale = std::min(scale, avail_h / hh);
+    if (!std::isfinite(scale) || scale <= 0.0) scale = 1.0; // a point: nothing has any area
+    cam.scale = scale;
+    cam.cx = 0.5 * width;
+    cam.cy = 0.5 * height;
+    return cam;
+}
+
+struct ScreenVertex {
+    std::int32_t x = 0, y = 0; // fixed point, 1/kSub sample
+    float z = 0.0f;            // depth, larger is nearer
+    float nl = 0.0f, nv = 0.0f; // dot(normal, light), dot(normal, toward); NaN: no usable normal
+    bool ok = false;
+};
+
+struct Raster {
+    int width = 0, height = 0;
+    std::vector<float> depth;
+    std::vector<std::uint8_t> rgb; // sRGB samples
+    std::array<std::uint8_t, kLutSize> encode{};
+};
+
+std::uint8_t linear_to_srgb8(double v) {
+    v = std::clamp(v, 0.0, 1.0);
+    const double s = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+    return static_cast<std::uint8_t>(std::lround(s * 255.0));
+}
+
+double srgb8_to_linear(int c) {
+    const double s = c / 255.0;
+    return s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4);
+}
+
+// floor(a / b) and ceil(a / b) for b > 0.
+std::int64_t floor_div(std::int64_t a, std::int64_t b) {
+    return a >= 0 ? a / b : -((-a + b - 1) / b);
+}
+std::int64_t ceil_div(std::int64_t a, std::int64_t b) { return -floor_div(-a, b); }
+
+// Twice the signed area of (a, b, p) in fixed point; positive when p is on the inner side of
+// a->b for a positively oriented triangle.
+inline std::int64_t orient(std::int64_t ax, std::int64_t ay, std::int64_t bx, std::int64_t by,
+                           std::int64_t px, std::int64_t py) {
+    return (bx - ax) * (py - ay) - (by - ay) * (px - ax);
+}
+
+// Edges take samples exactly on them only for one of their two directions, so two triangles
+// sharing an edge never both skip (or both take) a sample on it.
+inline std::int64_t edge_bias(std::int64_t ax, std::int64_t ay, std::int64_t bx, std::int64_t by) {
+    const std::int64_t dy = by - ay, dx = bx - ax;
+    return (dy > 0 || (dy == 0 && dx < 0)) ? 0 : -1;
+}
+
+struct ShadedVertex {
+    std::int64_t x, y;
+    float z, t; // depth, light intensity
+};
+
+void fill_triangle(Raster& r, ShadedVertex a, ShadedVertex b, ShadedVertex c,
+                   const std::array<float, 3>& color_lut_scale) {
+    std::int64_t area = orient(a.x, a.y, b.x, b.y, c.x, c.y);
+    if (area == 0) return;
+    if (area < 0) {
+        std::swap(b, c);
+        area = -area;
+    }
+    const std::int64_t minx = std::min({a.x, b.x, c.x}), maxx = std::max({a.x, b.x, c.x});
+    const std::int64_t miny = std::min({a.y, b.y, c.y}), maxy = std::max({a.y, b.y, c.y});
+    // Sample (i, j) sits at fixed (i * kSub + kSub / 2, j * kSub + kSub / 2).
+    const std::int64_t x0 = std::max<std::int64_t>(0, ceil_div(minx - kSub / 2, kSub));
+    const std::int64_t x1 = std::min<std::int64_t>(r.width - 1, floor_div(maxx - kSub / 2, kSub));
+    const std::int64_t y0 = std::max<std::int64_t>(0, ceil_div(miny - kSub / 2, kSub));
+    const std::int64_t y1 = std::min<std::int64_t>(r.height - 1, floor_div(maxy - kSub / 2, kSub));
+    if (x0 > x1 || y0 > y1) return;
+
+    // Edge functions at the first sample, and their steps per sample in x and y.
+    const std::int64_t px = x0 * kSub + kSub / 2, py = y0 * kSub + kSub / 2;
+    std::int64_t w0row = orient(b.x, b.y, c.x, c.y, px, py) + edge_bias(b.x, b.y, c.x, c.y);
+    std::int64_t w1row = orient(c.x, c.y, a.x, a.y, px, py) + edge_bias(c.x, c.y, a.x, a.y);
+    std::int64_t w2row = orient(a.x, a.y, b.x, b.y, px, py) + edge_bias(a.x, a.y, b.x, b.y);
+    const std::int64_t a0 = -(c.y - b.y) * kSub, b0 = (c.x - b.x) * kSub;
+    const std::int64_t a1 = -(a.y - c.y) * kSub, b1 = (a.x - c.x) * kSub;
+    const std::int64_t a2 = -(b.y - a.y) * kSub, b2 = (b.x - a.x) * kSub;
+
+    // Depth and intensity planes, per sample.
+    const double e1x = double(b.x - a.x) / kSub, e1y = double(b.y - a.y) / kSub;
+    const double e2x = double(c.x - a.x) / kSub, e2y = double(c.y - a.y) / kSub;
+    const double det = e1x * e2y - e2x * e1y; // > 0
+    const double dz1 = double(b.z) - a.z, dz2 = double(c.z) - a.z;
+    const double dt1 = double(b.t) - a.t, dt2 = double(c.t) - a.t;
+    const double dzdx = (dz1 * e2y - dz2 * e1y) / det, dzdy = (dz2 * e1x - dz1 * e2x) / det;
+    const double dtdx = (dt1 * e2y - dt2 * e1y) / det, dtdy = (dt2 * e1x - dt1 * e2x) / det;
+    const double ox = double(px) / kSub - double(a.x) / kSub;
+    const double oy = double(py) / kSub - double(a.y) / kSub;
+    const double zrow0 = a.z + dzdx * ox + dzdy * oy;
+    const double trow0 = a.t + dtdx * ox + dtdy * oy;
+    const float fdzdx = float(dzdx), fdtdx = float(dtdx);
+
+    const float cr = color_lut_scale[0], cg = color_lut_scale[1], cb = color_lut_scale[2];
+    const std::uint8_t* lut = r.encode.data();
+    for (std::int64_t y = y0; y <= y1; ++y) {
+        std::int64_t w0 = w0row, w1 = w1row, w2 = w2row;
+        const double dy = double(y - y0);
+        float z = float(zrow0 + dzdy * dy);
+        float t = float(trow0 + dtdy * dy);
+        float* zline = r.depth.data() + y * r.width;
+        std::uint8_t* cline = r.rgb.data() + y * r.width * 3;
+        for (std::int64_t x = x0; x <= x1; ++x) {
+            if ((w0 | w1 | w2) >= 0 && z > zline[x]) {
+                zline[x] = z;
+                const float tt = std::clamp(t, 0.0f, 1.0f);
+                std::uint8_t* px3 = cline + x * 3;
+                px3[0] = lut[int(cr * tt + 0.5f)];
+                px3[1] = lut[int(cg * tt + 0.5f)];
+                px3[2] = lut[int(cb * tt + 0.5f)];
+            }
+            w0 += a0;
+            w1 += a1;
+            w2 += a2;
+            z += fdzdx;
+            t += fdtdx;
+        }
+        w0row += b0;
+        w1row += b1;
+        w2row += b2;
+    }
+}
+
+float clamp01(float v) { return std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f; }
+
+std::array<float, 3> lut_scale_for(const Scene& scene, std::uint32_t material) {
+    Material m;
+    if (material < scene.materials.size()) m = scene.materials[material];
+    else if (!scene.materials.empty()) m = scene.materials.front();
+    const float s = float(kLutSize - 1);
+    return {clamp01(m.color.r) * s, clamp01(m.color.g) * s, clamp01(m.color.b) * s};
+}
+
+struct Renderer {
+    const Scene& scene;
+    Raster& raster;
+    const Camera& cam;
+    glm::dvec3 light_view; // the light in (right, up, toward) coordinates
+    std::vector<ScreenVertex> verts;
+
+    // Transforms the part's vertices (by `model` first, if given) to screen space.
+    void transform(const MeshPart& part, const glm::dmat4* model) {
+        // screen = R * (M p) + o, with R's rows scale * right, -scale * up, toward.
+        glm::dmat3 view_rows(cam.scale * cam.right, -cam.scale * cam.up, cam.toward);
+        const glm::dmat3 view = glm::transpose(view_rows); // columns -> rows
+        const glm::dvec3 offset = glm::dvec3(cam.cx, cam.cy, 0.0) - view * cam.center;
+        glm::dmat3 lin = view;
+        glm::dvec3 trans = offset;
+        glm::dmat3 normal_mat(1.0);
+        bool normals_ok = part.normals.size() == part.positions.size();
+        if (model) {
+            const glm::dmat3 m3(*model);
+            lin = view * m3;
+            trans = view * glm::dvec3((*model)[3]) + offset;
+            normal_mat = glm::transpose(glm::inverse(m3));
+            for (int i = 0; i < 3; ++i)
+                if (!finite3(normal_mat[i])) normals_ok = false;
+        }
+        const glm::mat3 flin(lin);
+        const glm::vec3 ftrans(trans);
+        const glm::mat3 fnormal(normal_mat);
+        const glm::vec3 flight(cam.light), ftoward(cam.toward);
+        const float nan = std::numeric_limits<float>::quiet_NaN();
+
+        verts.resize(part.positions.size());
+        for (std::size_t i = 0; i < part.positions.size(); ++i) {
+            ScreenVertex& v = verts[i];
+            const glm::vec3 s = flin * part.positions[i] + ftrans;
+            v.ok = std::isfinite(s.x) && std::isfinite(s.y) && std::isfinite(s.z);
+            if (!v.ok) continue;
+            v.x = std::int32_t(std::lround(std::clamp<double>(s.x, -kGuard, kGuard) * kSub));
+            v.y = std::int32_t(std::lround(std::clamp<double>(s.y, -kGuard, kGuard) * kSub));
+            v.z = s.z;
+            v.nl = v.nv = nan;
+            if (normals_ok) {
+                const glm::vec3 n = fnormal * part.normals[i];
+                const float len2 = glm::dot(n, n);
+                if (std::isfinite(len2) && len2 > 1e-20f) {
+                    const float inv = 1.0f / std::sqrt(len2);
+                    v.nl = glm::dot(n, flight) * inv;
+                    v.nv = glm::dot(n, ftoward) * inv;
+                }
+            }
+        }
+    }
+
+    // Face normal from the screen-space triangle, turned toward the viewer.
+    void face_terms(const ScreenVertex& a, const ScreenVertex& b, const ScreenVertex& c, float& nl,
+                    float& nv) const {
+        const double k = 1.0 / (kSub * cam.scale);
+        const glm::dvec3 e1(double(b.x - a.x) * k, -double(b.y - a.y) * k, double(b.z) - a.z);
+        const glm::dvec3 e2(double(c.x - a.x) * k, -double(c.y - a.y) * k, double(c.z) - a.z);
+        glm::dvec3 n = glm::cross(e1, e2);
+        const double len = glm::length(n);
+        if (!(len > 0.0) || !std::isfinite(len)) {
+            nl = nv = 1.0f;
+            return;
+        }
+        n /= len;
+        if (n.z < 0.0) n = -n;
+        nl = float(glm::dot(n, light_view));
+        nv = float(n.z);
+    }
+
+    void draw_triangle(const ScreenVertex& a, const ScreenVertex& b, const ScreenVertex& c,
+                       const std::array<float, 3>& color) {
+        if (!a.ok || !b.ok || !c.ok) return;
+        float nl[3] = {a.nl, b.nl, c.nl}, nv[3] = {a.nv, b.nv, c.nv};
+        if (std::isnan(nl[0]) || std::isnan(nl[1]) || std::isnan(nl[2])) {
+            float fl = 0.0f, fv = 0.0f;
+            face_terms(a, b, c, fl, fv);
+            nl[0] = nl[1] = nl[2] = fl;
+            nv[0] = nv[1] = nv[2] = fv;
+        } else if (nv[0] + nv[1] + nv[2] < 0.0f) {
+            // Seen from behind (the back of a leaf): light the side that faces the viewer.
+            for (int k = 0; k < 3; ++k) {
+                nl[k] = -nl[k];
+                nv[k] = -nv[k];
+            }
+        }
+        float t[3];
+        for (int k = 0; k < 3; ++k)
+            t[k] = kAmbient + kKey * std::max(0.0f, nl[k]) + kFill * std::max(0.0f, nv[k]);
+        fill_triangle(raster, {a.x, a.y, a.z, t[0]}, {b.x, b.y, b.z, t[1]}, {c.x, c.y, c.z, t[2]},
+                      color);
+    }
+
+    void draw_range(const MeshPart& part, std::size_t first, std::size_t count,
+                    std::uint32_t material) {
+        const std::size_t n = part.indices.size();
+        if (first >= n) return;
+        const std::size_t end = first + std::min(count, n - first);
+        const std::array<float, 3> color = lut_scale_for(scene, material);
+        const std::size_t nv = verts.size();
+        for (std::size_t i = first; i + 3 <= end; i += 3) {
+            const std::uint32_t ia = part.indices[i], ib = part.indices[i + 1],
+                                ic = part.indices[i + 2];
+            if (ia >= nv || ib >= nv || ic >= nv) continue;
+            draw_triangle(verts[ia], verts[ib], verts[ic], color);
+        }
+    }
+
+    void draw_part(const MeshPart& part, const glm::dmat4* model) {
+        if (part.indices.empty() || part.positions.empty()) return;
+        transform(part, model);
+        if (part.primitives.empty()) {
+            draw_range(part, 0, part.indices.size(), 0);
+            return;
+        }
+        for (const Primitive& prim : part.primitives)
+            draw_range(part, prim.first, prim.count, prim.material);
+    }
+};
+
+} // namespace
+
+Image render_scene(const Scene& scene, int width, int height) {
+    if (width <= 0 || height <= 0)
+        throw ExportError("PNG size must be positive, got " + std::to_string(width) + "x" +
+                          std::to_string(height));
+    const std::int64_t pixels = std::int64_t(width) * height;
+    if (pixels > kMaxPixels)
+        throw ExportError("PNG size " + std::to_string(width) + "x" + std::to_string(height) +
+                          " is too large");
+    const int ss = pixels <= kMaxSupersampledPixels ? 2 : 1;
+
+    Raster r;
+    r.width = width * ss;
+    r.height = height * ss;
+    const std::size_t samples = std::size_t(r.width) * std::size_t(r.height);
+    try {
+        r.depth.assign(samples, -std::numeric_limits<float>::infinity());
+        r.rgb.assign(samples * 3, 255);
+    } catch (const std::bad_alloc&) {
+        throw ExportError("out of memory rendering a " + std::to_string(width) + "x" +
+                          std::to_string(height) + " PNG");
+    }
+    for (int i = 0; i < kLutSize; ++i) r.encode[i] = linear_to_srgb8(double(i) / (kLutSize - 1));
+
+    const Camera cam = make_camera(scene, r.width, r.height);
+    Renderer ren{scene, r, cam,
+                 glm::dvec3(glm::dot(cam.light, cam.right), glm::dot(cam.light, cam.up),
+                            glm::dot(cam.light, cam.toward)),
+                 {}};
+    ren.draw_part(scene.tubes, nullptr);
+    for (const Instance& inst : scene.instances) {
+        if (inst.prototype >= scene.prototypes.size()) continue;
+        const glm::dmat4 model(inst.transform);
+        ren.draw_part(scene.prototypes[inst.prototype], &model);
+    }
+
+    Image img;
+    img.width = width;
+    img.height = height;
+    if (ss == 1) {
+        img.rgb = std::move(r.rgb);
+        return img;
+    }
+    // Box filter in linear light.
+    std::array<float, 256> decode{};
+    for (int i = 0; i < 256; ++i) decode[i] = float(srgb8_to_linear(i));
+    img.rgb.resize(std::size_t(pixels) * 3);
+    const std::size_t row = std::size_t(r.width) * 3;
+    for (int y = 0; y < height; ++y) {
+        const std::uint8_t* s0 = r.rgb.data() + std::size_t(2 * y) * row;
+        const std::uint8_t* s1 = s0 + row;
+        std::uint8_t* out = img.rgb.data() + std::size_t(y) * width * 3;
+        for (int x = 0; x < width; ++x) {
+            for (int ch = 0; ch < 3; ++ch) {
+                const std::size_t k = std::size_t(x) * 6 + ch;
+                if (s0[k] == s0[k + 3] && s0[k] == s1[k] && s0[k] == s1[k + 3]) {
+                    out[x * 3 + ch] = s0[k];
+                    continue;
+                }
+                const float v = 0.25f * (decode[s0[k]] + decode[s0[k + 3]] + decode[s1[k]] +
+                                         decode[s1[k + 3]]);
+                out[x * 3 + ch] = r.encode[std::size_t(v * (kLutSize - 1) + 0.5f)];
+            }
+        }
+    }
+    return img;
+}
+
+namespace {
+
+struct PngSink {
+    std::string bytes;
+    bool failed = false;
+};
+
+void png_sink_write(void* context, void* data, int size) {
+    auto* sink = static_cast<PngSink*>(context);
+    if (sink->failed || size <= 0) return;
+    try {
+        sink->bytes.append(static_cast<const char*>(data), std::size_t(size));
+    } catch (...) { // never unwind through the C encoder
+        sink->failed = true;
+    }
+}
+
+} // namespace
+
+void write_png(const Scene& scene, const std::string& path, int width, int height) {
+    const Image img = render_scene(scene, width, height);
+    PngSink sink;
+    const int ok = stbi_write_png_to_func(png_sink_write, &sink, img.width, img.height, 3,
+                                          img.rgb.data(), img.width * 3);
+    if (!ok || sink.failed || sink.bytes.empty())
+        throw ExportError("cannot encode PNG for " + path);
+    write_file_atomically(path, sink.bytes);
+}
+
+} // namespace plant

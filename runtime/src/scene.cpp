@@ -1,0 +1,187 @@
+// The scene: tubes of all axes grouped by material, organ prototypes meshed once per shape and
+// color, one instance per placement.
+#include "plant/mesh.hpp"
+
+#include "plant/export.hpp"
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#include <OpenMesh/Core/IO/MeshIO.hh>
+#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+#pragma GCC diagnostic pop
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <map>
+#include <numbers>
+
+namespace plant {
+
+void Scene::update_bounds() {
+    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    for (const auto& p : tubes.positions) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
+    for (const auto& inst : instances) {
+        const MeshPart& proto = prototypes[inst.prototype];
+        for (const auto& p : proto.positions) {
+            glm::vec3 w = glm::vec3(inst.transform * glm::vec4(p, 1.0f));
+            lo = glm::min(lo, w);
+            hi = glm::max(hi, w);
+        }
+    }
+    if (lo.x > hi.x) lo = hi = glm::vec3(0.0f);
+    bounds_min = lo;
+    bounds_max = hi;
+}
+
+namespace {
+
+// A flat polygon, fanned from its first corner, with a front and a back face.
+MeshPart polygon_prototype(const SurfaceDef& s) {
+    MeshPart m;
+    std::vector<glm::vec3> pts;
+    for (const auto& p : s.points) pts.emplace_back(p[0], p[1], p[2]);
+    glm::vec3 n(0.0f);
+    for (std::size_t i = 1; i + 1 < pts.size(); ++i) n += glm::cross(pts[i] - pts[0], pts[i + 1] - pts[0]);
+    n = glm::length(n) > 1e-12f ? glm::normalize(n) : glm::vec3(0, 0, 1);
+    glm::vec3 lo = pts[0], hi = pts[0];
+    for (const auto& p : pts) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
+    glm::vec3 ext = glm::max(hi - lo, glm::vec3(1e-6f));
+    for (int side = 0; side < 2; ++side) {
+        auto base = static_cast<std::uint32_t>(m.positions.size());
+        for (const auto& p : pts) {
+            m.positions.push_back(p);
+            m.normals.push_back(side == 0 ? n : -n);
+            m.uvs.emplace_back((p.x - lo.x) / ext.x, (p.y - lo.y) / ext.y);
+        }
+        for (std::uint32_t i = 1; i + 1 < pts.size(); ++i) {
+            if (side == 0)
+                m.indices.insert(m.indices.end(), {base, base + i, base + i + 1});
+            else
+                m.indices.insert(m.indices.end(), {base, base + i + 1, base + i});
+        }
+    }
+    m.primitives.push_back(Primitive{0, static_cast<std::uint32_t>(m.indices.size()), 0});
+    return m;
+}
+
+MeshPart sphere_prototype() {
+    MeshPart m;
+    const int slices = 12, stacks = 8;
+    const double pi = std::numbers::pi;
+    for (int i = 0; i <= stacks; ++i) {
+        double v = double(i) / stacks, th = v * pi;
+        for (int j = 0; j <= slices; ++j) {
+            double u = double(j) / slices, ph = u * 2 * pi;
+            glm::vec3 p(static_cast<float>(std::sin(th) * std::cos(ph)), static_cast<float>(std::cos(th)),
+                        static_cast<float>(std::sin(th) * std::sin(ph)));
+            m.positions.push_back(p);
+            m.normals.push_back(p);
+            m.uvs.emplace_back(static_cast<float>(u), static_cast<float>(v));
+        }
+    }
+    for (int i = 0; i < stacks; ++i) {
+        for (int j = 0; j < slices; ++j) {
+            auto a = static_cast<std::uint32_t>(i * (slices + 1) + j), b = a + 1, d = a + slices + 1, c = d + 1;
+            if (i != 0) m.indices.insert(m.indices.end(), {a, d, b});         // skip degenerate pole triangles
+            if (i != stacks - 1) m.indices.insert(m.indices.end(), {b, d, c});
+        }
+    }
+    m.primitives.push_back(Primitive{0, static_cast<std::uint32_t>(m.indices.size()), 0});
+    return m;
+}
+
+MeshPart loaded_prototype(const SurfaceDef& s) {
+    using Mesh = OpenMesh::TriMesh_ArrayKernelT<>;
+    Mesh mesh;
+    mesh.request_vertex_normals();
+    mesh.request_face_normals();
+    omlog().disable();
+    OpenMesh::IO::Options opt;
+    if (!OpenMesh::IO::read_mesh(mesh, s.path, opt))
+        throw RuntimeError(s.span, fmt::format("cannot load surface '{}' from '{}'", s.name, s.path));
+    mesh.triangulate();
+    mesh.update_normals();
+    MeshPart m;
+    for (auto v : mesh.vertices()) {
+        auto p = mesh.point(v);
+        auto n = mesh.normal(v);
+        m.positions.emplace_back(p[0], p[1], p[2]);
+        glm::vec3 nn(n[0], n[1], n[2]);
+        m.normals.push_back(glm::length(nn) > 1e-12f ? glm::normalize(nn) : glm::vec3(0, 0, 1));
+        m.uvs.emplace_back(0.0f, 0.0f);
+    }
+    for (auto f : mesh.faces())
+        for (auto v : mesh.fv_range(f)) m.indices.push_back(static_cast<std::uint32_t>(v.idx()));
+    if (m.indices.empty()) throw RuntimeError(s.span, fmt::format("surface '{}' loaded from '{}' has no faces", s.name, s.path));
+    m.primitives.push_back(Primitive{0, static_cast<std::uint32_t>(m.indices.size()), 0});
+    return m;
+}
+
+} // namespace
+
+Scene build_scene(const Program& program, const Skeleton& skeleton, const MeshOptions& options) {
+    Scene scene;
+    std::map<std::array<float, 3>, std::uint32_t> material_index;
+    auto material_of = [&](const glm::vec3& c) -> std::uint32_t {
+        std::array<float, 3> key{c.x, c.y, c.z};
+        auto it = material_index.find(key);
+        if (it != material_index.end()) return it->second;
+        auto id = static_cast<std::uint32_t>(scene.materials.size());
+        scene.materials.push_back(Material{c});
+        material_index.emplace(key, id);
+        return id;
+    };
+    std::vector<std::vector<std::uint32_t>> by_material;
+    for (const auto& axis : skeleton.axes) mesh_axis(axis, options, scene.tubes, by_material, material_of);
+    for (std::uint32_t m = 0; m < by_material.size(); ++m) {
+        if (by_material[m].empty()) continue;
+        auto first = static_cast<std::uint32_t>(scene.tubes.indices.size());
+        scene.tubes.indices.insert(scene.tubes.indices.end(), by_material[m].begin(), by_material[m].end());
+        scene.tubes.primitives.push_back(Primitive{first, static_cast<std::uint32_t>(by_material[m].size()), m});
+    }
+    // organs: one prototype per (shape, color), meshed once
+    std::map<std::pair<std::string, std::uint32_t>, std::uint32_t> prototype_index;
+    std::map<std::string, MeshPart> shapes;
+    for (const auto& organ : skeleton.organs) {
+        std::uint32_t material = material_of(organ.color);
+        auto key = std::pair{organ.shape, material};
+        auto it = prototype_index.find(key);
+        if (it == prototype_index.end()) {
+            auto sit = shapes.find(organ.shape);
+            if (sit == shapes.end()) {
+                MeshPart shape;
+                if (organ.shape == "@O") {
+                    shape = sphere_prototype();
+                } else {
+                    const SurfaceDef* def = nullptr;
+                    for (const auto& s : program.surfaces)
+                        if (s.name == organ.shape) def = &s;
+                    if (!def)
+                        throw RuntimeError(Span{}, fmt::format("'~{}' places a surface that is not declared: add "
+                                                               "'surface {} = polygon(...);'",
+                                                               organ.shape, organ.shape));
+                    shape = def->kind == "load" ? loaded_prototype(*def) : polygon_prototype(*def);
+                }
+                sit = shapes.emplace(organ.shape, std::move(shape)).first;
+            }
+            MeshPart proto = sit->second;
+            for (auto& p : proto.primitives) p.material = material;
+            it = prototype_index.emplace(key, static_cast<std::uint32_t>(scene.prototypes.size())).first;
+            scene.prototypes.push_back(std::move(proto));
+            scene.prototype_names.push_back(organ.shape);
+        }
+        scene.instances.push_back(Instance{it->second, glm::mat4(organ.transform)});
+    }
+    if (scene.materials.empty()) scene.materials.push_back(Material{});
+    scene.update_bounds();
+    return scene;
+}
+
+} // namespace plant

@@ -1,0 +1,163 @@
+// Mesh invariants, checked on tubes built from real grammars.
+#include "helpers.hpp"
+#include "plant/mesh.hpp"
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+#pragma GCC diagnostic pop
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <map>
+
+using namespace plant;
+
+namespace {
+
+Skeleton skeleton_of(const std::string& grammar, int steps) {
+    auto c = test::compile(grammar);
+    REQUIRE(c->program);
+    DeriveOptions o;
+    o.steps = steps;
+    Derivation d(*c->program, o);
+    d.run();
+    return build_skeleton(*c->program, d.interpreted(d.string()),
+                          TurtleOptions{d.default_angle(), d.default_step(), d.default_width()});
+}
+
+MeshPart tube_of(const SkeletonAxis& axis, const MeshOptions& o) {
+    MeshPart part;
+    std::vector<std::vector<std::uint32_t>> by_material;
+    mesh_axis(axis, o, part, by_material, [](const glm::vec3&) { return 0u; });
+    for (auto& idx : by_material) part.indices.insert(part.indices.end(), idx.begin(), idx.end());
+    return part;
+}
+
+// Boundary loops of a tube, through OpenMesh, with the texture seam welded (its two copies of a
+// vertex have the same position).
+int boundary_loops(const MeshPart& part, bool& manifold) {
+    using Mesh = OpenMesh::TriMesh_ArrayKernelT<>;
+    Mesh mesh;
+    std::map<std::array<float, 3>, Mesh::VertexHandle> weld;
+    std::vector<Mesh::VertexHandle> handle(part.positions.size());
+    for (std::size_t i = 0; i < part.positions.size(); ++i) {
+        const auto& p = part.positions[i];
+        std::array<float, 3> key{p.x, p.y, p.z};
+        auto it = weld.find(key);
+        if (it == weld.end()) it = weld.emplace(key, mesh.add_vertex(Mesh::Point(p.x, p.y, p.z))).first;
+        handle[i] = it->second;
+    }
+    manifold = true;
+    for (std::size_t t = 0; t + 2 < part.indices.size(); t += 3) {
+        auto f = mesh.add_face(handle[part.indices[t]], handle[part.indices[t + 1]], handle[part.indices[t + 2]]);
+        if (!f.is_valid()) manifold = false; // OpenMesh refuses faces that would make it non-manifold
+    }
+    for (auto v : mesh.vertices())
+        if (!mesh.is_manifold(v)) manifold = false;
+    int loops = 0;
+    std::vector<bool> seen(mesh.n_halfedges(), false);
+    for (auto h : mesh.halfedges()) {
+        if (!mesh.is_boundary(h) || seen[static_cast<std::size_t>(h.idx())]) continue;
+        ++loops;
+        auto cur = h;
+        do {
+            seen[static_cast<std::size_t>(cur.idx())] = true;
+            cur = mesh.next_halfedge_handle(cur);
+        } while (cur != h);
+    }
+    return loops;
+}
+
+const char* kGrammars[] = {
+    // Honda's monopodial tree (ABOP Fig. 2.6a): gentle joints, tapering widths
+    R"(param r1 = 0.9; param r2 = 0.6; param a0 = 45; param a2 = 45; const d = 137.5; const wr = 0.707;
+       module A(l, w); module B(l, w); module C(l, w); axiom: A(1, 10);
+       rules { A(l, w) -> !(w) F(l) [ &(a0) B(l * r2, w * wr) ] /(d) A(l * r1, w * wr);
+               B(l, w) -> !(w) F(l) [ -(a2) $ C(l * r2, w * wr) ] C(l * r1, w * wr);
+               C(l, w) -> !(w) F(l) [ +(a2) $ B(l * r2, w * wr) ] B(l * r1, w * wr); })",
+    // ABOP Fig. 1.24a with widths: many short segments and small turns
+    "angle 25.7; axiom: !(0.2) F; rules { F -> F[+F]F[-F]F; }",
+    // sharp corners (90 and 120 degrees) get rounded with extra rings
+    "axiom: !(0.3) F F +(90) F F -(120) F &(100) F F;",
+};
+
+} // namespace
+
+TEST_CASE("ring centers are the turtle's points and ring vertices lie at the radius", "[mesh]") {
+    Skeleton sk = skeleton_of("axiom: !(0.5) F +(20) F(2) !(0.3) -(30) F;", 0);
+    REQUIRE(sk.axes.size() == 1);
+    const SkeletonAxis& axis = sk.axes[0];
+    MeshOptions o;
+    o.sides = 8;
+    MeshPart m = tube_of(axis, o);
+    const std::size_t stride = 9;
+    REQUIRE(m.positions.size() == axis.points.size() * stride);
+    for (std::size_t k = 0; k < axis.points.size(); ++k) {
+        glm::dvec3 center(0.0);
+        for (std::size_t j = 0; j < 8; ++j) center += glm::dvec3(m.positions[k * stride + j]);
+        center /= 8.0;
+        CHECK(glm::length(center - axis.points[k].position) < 1e-5);
+        if (k == 0 || k + 1 == axis.points.size()) {
+            // end rings are perpendicular to the axis: every vertex at the radius
+            double r = axis.points[k].radius * (k + 1 == axis.points.size() ? o.tip_taper : 1.0);
+            for (std::size_t j = 0; j < 8; ++j)
+                CHECK(glm::length(glm::dvec3(m.positions[k * stride + j]) - axis.points[k].position) == Approx(r).epsilon(1e-5));
+        } else {
+            // joint rings are widened along the bend (a miter): no vertex comes closer than the radius
+            for (std::size_t j = 0; j < 8; ++j)
+                CHECK(glm::length(glm::dvec3(m.positions[k * stride + j]) - axis.points[k].position) >=
+                      axis.points[k].radius * (1 - 1e-5));
+        }
+    }
+}
+
+TEST_CASE("every tube is a manifold with two boundary loops, unit normals and no degenerate triangles", "[mesh]") {
+    for (const char* g : kGrammars) {
+        INFO(g);
+        Skeleton sk = skeleton_of(g, 4);
+        REQUIRE(!sk.axes.empty());
+        MeshOptions o;
+        o.sides = 6;
+        int tubes = 0;
+        for (const auto& axis : sk.axes) {
+            MeshPart m = tube_of(axis, o);
+            if (m.empty()) continue;
+            ++tubes;
+            bool manifold = false;
+            INFO("axis with " << axis.points.size() << " points");
+            CHECK(boundary_loops(m, manifold) == 2);
+            CHECK(manifold);
+            for (const auto& n : m.normals) {
+                REQUIRE(std::isfinite(n.x));
+                CHECK(glm::length(n) == Approx(1.0f).epsilon(1e-4));
+            }
+            for (std::size_t t = 0; t < m.indices.size(); t += 3) {
+                const auto& a = m.positions[m.indices[t]];
+                const auto& b = m.positions[m.indices[t + 1]];
+                const auto& c = m.positions[m.indices[t + 2]];
+                REQUIRE(std::isfinite(a.x));
+                CHECK((a != b && b != c && a != c));
+            }
+        }
+        CHECK(tubes > 0);
+    }
+}
+
+TEST_CASE("the scene shares organ prototypes between placements and bounds include them", "[mesh]") {
+    auto c = test::compile(R"(
+        surface leaf = polygon(vec3(0, 0, 0), vec3(0.5, 1, 0), vec3(0, 2, 0), vec3(-0.5, 1, 0));
+        axiom: F [ +(45) ~leaf(1) ] F [ -(45) ~leaf(1) ] F ;(1) ~leaf(2) @O(0.5);
+    )");
+    REQUIRE(c->program);
+    Derivation d(*c->program, {});
+    d.run();
+    Skeleton sk = build_skeleton(*c->program, d.string(), TurtleOptions{});
+    Scene s = build_scene(*c->program, sk, MeshOptions{});
+    CHECK(s.instances.size() == 4);
+    CHECK(s.prototypes.size() == 3); // leaf in two colors, one sphere
+    CHECK(s.prototypes[0].triangle_count() == 4); // a quad, front and back
+    CHECK(s.bounds_max.y >= 3.0f + 2.0f * 1.0f - 1e-4f); // the top leaf (length 2, scale 2) reaches y = 3 + 4
+    CHECK(s.tubes.triangle_count() > 0);
+}

@@ -1,0 +1,149 @@
+#include "helpers.hpp"
+#include "plant/query.hpp"
+#include "plant/skeleton.hpp"
+
+#include <catch2/catch.hpp>
+
+using namespace plant;
+
+namespace {
+
+// Records every segment end and the final state.
+struct Recorder : TurtleSink {
+    std::vector<glm::dvec3> ends;
+    std::vector<int> axes;
+    TurtleState last;
+    void axis_begin(int axis, int, const TurtleState&) override { axes.push_back(axis); }
+    void segment(const TurtleSegment& s) override {
+        ends.push_back(s.to);
+        last = *s.state;
+    }
+};
+
+Recorder draw(const std::string& axiom, const std::string& head = "") {
+    auto c = test::compile(head + " axiom: " + axiom + ";");
+    REQUIRE(c->program);
+    Derivation d(*c->program, {});
+    d.run();
+    Recorder r;
+    interpret(*c->program, d.string(), TurtleOptions{d.default_angle(), d.default_step(), d.default_width()}, r);
+    return r;
+}
+
+void near(const glm::dvec3& a, const glm::dvec3& b) {
+    CHECK(a.x == Approx(b.x).margin(1e-9));
+    CHECK(a.y == Approx(b.y).margin(1e-9));
+    CHECK(a.z == Approx(b.z).margin(1e-9));
+}
+
+} // namespace
+
+TEST_CASE("the turtle starts at the origin heading +Y, left -X, up +Z", "[turtle]") {
+    auto r = draw("F");
+    REQUIRE(r.ends.size() == 1);
+    near(r.ends[0], {0, 1, 0});
+    near(r.last.left, {-1, 0, 0});
+    near(r.last.up, {0, 0, 1});
+}
+
+TEST_CASE("turns, pitches and rolls", "[turtle]") {
+    near(draw("+(90) F").ends[0], {-1, 0, 0}); // '+' turns toward L
+    near(draw("-(90) F").ends[0], {1, 0, 0});
+    near(draw("&(90) F").ends[0], {0, 0, -1}); // '&' pitches down, away from U
+    near(draw("^(90) F").ends[0], {0, 0, 1});
+    near(draw("/(90) +(90) F").ends[0], {0, 0, 1}); // '/' rolls L toward U
+    near(draw("\\(90) +(90) F").ends[0], {0, 0, -1});
+    near(draw("| F").ends[0], {0, -1, 0});
+    near(draw("+ F", "angle 90;").ends[0], {-1, 0, 0}); // the grammar's default angle
+    near(draw("F(2.5)").ends[0], {0, 2.5, 0});
+    near(draw("F", "step 3;").ends[0], {0, 3, 0});
+    near(draw("f F").ends[0], {0, 2, 0});
+}
+
+TEST_CASE("the frame stays orthonormal and right-handed after many rotations", "[turtle]") {
+    auto r = draw("+(17) &(23) /(31) ^(11) \\(7) -(13) F $ F");
+    const TurtleState& t = r.last;
+    CHECK(glm::length(t.heading) == Approx(1.0));
+    CHECK(glm::dot(t.heading, t.left) == Approx(0.0).margin(1e-12));
+    near(glm::cross(t.heading, t.left), t.up);
+    CHECK(t.left.y == Approx(0.0).margin(1e-12)); // '$' made L horizontal
+}
+
+TEST_CASE("branches: '[' saves and ']' restores the state; a branch is a new axis", "[turtle]") {
+    auto r = draw("F [ +(90) F ] F");
+    REQUIRE(r.ends.size() == 3);
+    near(r.ends[1], {-1, 1, 0});
+    near(r.ends[2], {0, 2, 0});
+    CHECK(r.axes == std::vector<int>{0, 1}); // the main axis continues after the branch
+}
+
+TEST_CASE("popping an empty stack is a runtime error naming the module", "[turtle]") {
+    auto c = test::compile("axiom: F ] F;");
+    Derivation d(*c->program, {});
+    d.run();
+    Recorder r;
+    CHECK_THROWS_WITH(interpret(*c->program, d.string(), TurtleOptions{}, r),
+                      "']' at module 2 of the string closes no '[' (the turtle's stack is empty)");
+}
+
+TEST_CASE("@M moves, SetHead sets the heading, @O places a sphere", "[turtle]") {
+    near(draw("@M(1, 2, 3) F").ends[0], {1, 3, 3});
+    near(draw("SetHead(1, 0, 0, 0, 1, 0) F").ends[0], {1, 0, 0});
+    auto c = test::compile("axiom: !(4) F @O(2) ~leaf(3); surface leaf = polygon(vec3(0,0,0), vec3(1,0,0), vec3(0,1,0));");
+    REQUIRE(c->program);
+    Derivation d(*c->program, {});
+    d.run();
+    Skeleton sk = build_skeleton(*c->program, d.string(), TurtleOptions{});
+    REQUIRE(sk.axes.size() == 1);
+    CHECK(sk.axes[0].points.back().radius == Approx(2.0)); // !(4): width 4, radius 2
+    REQUIRE(sk.organs.size() == 2);
+    CHECK(sk.organs[0].shape == "@O");
+    CHECK(sk.organs[0].transform[3][1] == Approx(1.0)); // placed at the turtle's position
+    CHECK(glm::length(glm::dvec3(sk.organs[1].transform[1])) == Approx(3.0)); // scaled by 3
+}
+
+TEST_CASE("tropism bends the heading toward the tropism vector", "[turtle]") {
+    auto r = draw("@Tp(0, -1, 0) @Ts(0.3) -(90) F F F");
+    // heading started along +X; each F turns it toward -Y
+    CHECK(r.last.heading.y < -0.2);
+    CHECK(r.last.heading.x > 0);
+    CHECK(glm::length(r.last.heading) == Approx(1.0));
+}
+
+TEST_CASE("query modules read the turtle after interpretation rules (the L-Py case)", "[turtle][query]") {
+    auto c = test::compile(R"(
+        module I(x); module R(x, y, z);
+        interpret { I(x) -> F(x); }
+        axiom: I(10) ?P(0, 0, 0);
+        derive 1;
+        rules { ?P(x, y, z) -> R(x, y, z); }
+    )");
+    REQUIRE(c->program);
+    TurtleQueryPass q;
+    DeriveOptions o;
+    o.queries = &q;
+    Derivation d(*c->program, o);
+    d.run();
+    CHECK(format_string(*c->program, d.string()) == "I(10)R(0,10,0)");
+}
+
+TEST_CASE("?H ?U ?L read the frame; a vec3 binding reads all three numbers", "[turtle][query]") {
+    auto c = test::compile(R"(
+        module R(v: vec3);
+        axiom: +(90) ?H(0, 0, 0) ?L(0, 0, 0) ?U(0, 0, 0);
+        derive 1;
+        rules { ?H(v) -> R(v); ?L(v) -> R(v); ?U(v) -> R(v); }
+    )");
+    REQUIRE(c->program);
+    TurtleQueryPass q;
+    DeriveOptions o;
+    o.queries = &q;
+    Derivation d(*c->program, o);
+    d.run();
+    const ModuleString& s = d.string();
+    REQUIRE(s.size() == 4);
+    auto v = [&](std::size_t i) { return glm::dvec3(s.args(i)[0], s.args(i)[1], s.args(i)[2]); };
+    near(v(1), {-1, 0, 0}); // heading after turning left by 90 degrees
+    near(v(2), {0, -1, 0}); // left
+    near(v(3), {0, 0, 1});  // up
+}
