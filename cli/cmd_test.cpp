@@ -277,8 +277,11 @@ int test_main(const TestCmd& c) {
     for (const auto& p : paths) {
         std::error_code ec;
         if (fs::is_directory(p, ec)) {
-            for (const auto& entry : fs::recursive_directory_iterator(p, ec))
-                if (entry.is_regular_file() && entry.path().extension() == ".plant") files.push_back(entry.path());
+            fs::recursive_directory_iterator it(p, fs::directory_options::skip_permission_denied, ec), end;
+            for (; !ec && it != end; it.increment(ec)) {
+                std::error_code fe;
+                if (it->is_regular_file(fe) && it->path().extension() == ".plant") files.push_back(it->path());
+            }
         } else if (fs::exists(p, ec)) {
             files.emplace_back(p);
         } else {

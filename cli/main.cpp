@@ -34,6 +34,12 @@ int main(int argc, char** argv) {
         std::cerr << "plant: " << e.what() << "\n"
                   << "Run 'plant " << (which.empty() ? "" : which + " ") << "--help' for usage.\n";
         return kUsage;
+    } catch (const std::bad_alloc&) {
+        std::cerr << "plant: out of memory (lower --max-modules or the derivation length)\n";
+        return kRuntime;
+    } catch (const std::exception& e) {
+        std::cerr << "plant: internal error: " << e.what() << "\n";
+        return kRuntime;
     }
     return exit_code;
 }

@@ -77,14 +77,42 @@ std::string Compiler::where(Span s) const {
 void Compiler::duplicate(const std::string& what, const std::string& name, Span here, Span first) {
     Diagnostic d{Severity::Error, here, fmt::format("duplicate definition of {} '{}'", what, name), {}};
     d.notes.emplace_back(first, fmt::format("'{}' was first defined here", name));
-    diags_.add(std::move(d));
+    diags_->add(std::move(d));
 }
 
 // ---- emission helpers ----------------------------------------------------------------------
 
+// The operand stack is a fixed 1024 slots (vm.cpp): code that could need more is refused here.
+constexpr int kMaxStack = 1000;
+
 void Compiler::emit(Ctx& c, Op op, std::int32_t a, int n, Span span, std::uint16_t b) {
     c.code->instrs.push_back(Instr{op, static_cast<std::uint8_t>(n), b, a});
     c.code->spans.push_back(span);
+    // stack effect, conservative along both branches of a jump
+    switch (op) {
+    case Op::Const: case Op::LoadMulConst: case Op::LoadAddConst: c.depth += 1; break;
+    case Op::Const3: c.depth += 3; break;
+    case Op::LoadLocal: case Op::LoadGlobal: c.depth += n; break;
+    case Op::StoreLocal: case Op::StoreGlobal: case Op::Pop: case Op::Emit: case Op::Print: c.depth -= n; break;
+    case Op::Add: case Op::Sub: case Op::Mul: case Op::Div: case Op::Mod: case Op::Lt: case Op::Le: case Op::Gt:
+    case Op::Ge: case Op::Eq: case Op::Ne: case Op::JumpIfZero: case Op::JumpIfZeroKeep: case Op::JumpIfNonZeroKeep:
+    case Op::VMulS: case Op::VSMul: case Op::VDivS: c.depth -= 1; break;
+    case Op::VAdd: case Op::VSub: c.depth -= 3; break;
+    case Op::VEq: case Op::VNe: c.depth -= 5; break;
+    case Op::Member: c.depth -= 2; break;
+    case Op::Builtin: c.depth += b - n; break; // b: width of the result
+    case Op::Call: {
+        const Function& fn = P_.functions[static_cast<std::size_t>(a)];
+        c.depth += std::max(1, value_width(fn.result)) - fn.param_width;
+        break;
+    }
+    default: break;
+    }
+    if (c.depth > kMaxStack && !c.stack_error) {
+        c.stack_error = true;
+        diags_->error(span, "this expression is too large: it needs more than 1000 values at once");
+    }
+    if (c.depth < 0) c.depth = 0;
 }
 
 void Compiler::emit_const(Ctx& c, double v, Span span) {
@@ -103,11 +131,11 @@ std::optional<ConstVal> Compiler::eval_const(const ast::Expr& e, const char* wha
     Ctx c;
     c.code = &code;
     c.kind = CtxKind::Global;
-    std::size_t errors = diags_.error_count();
+    std::size_t errors = diags_->error_count();
     ValueType t = compile_expr(c, e);
-    if (diags_.error_count() != errors) return std::nullopt;
+    if (diags_->error_count() != errors) return std::nullopt;
     if (t == ValueType::String) {
-        diags_.error(e.span, fmt::format("{} must be a number or vector, not a string", what));
+        diags_->error(e.span, fmt::format("{} must be a number or vector, not a string", what));
         return std::nullopt;
     }
     emit(c, Op::Halt, 0, value_width(t), e.span);
@@ -121,12 +149,12 @@ std::optional<ConstVal> Compiler::eval_const(const ast::Expr& e, const char* wha
     try {
         run(code, nullptr, env, v.v);
     } catch (const RuntimeError& err) {
-        diags_.error(err.span.valid() ? err.span : e.span, err.message);
+        diags_->error(err.span.valid() ? err.span : e.span, err.message);
         return std::nullopt;
     }
     for (int k = 0; k < value_width(t); ++k) {
         if (!std::isfinite(v.v[k])) {
-            diags_.error(e.span, fmt::format("{} is not a finite number", what));
+            diags_->error(e.span, fmt::format("{} is not a finite number", what));
             return std::nullopt;
         }
     }
@@ -180,6 +208,11 @@ const LocalVar* Compiler::find_local(Ctx& c, const std::string& name) const {
 }
 
 std::uint16_t Compiler::add_local(Ctx& c, const std::string& name, ValueType t) {
+    if (c.next_slot > 60000) {
+        if (c.next_slot < 60004) diags_->error(Span{}, fmt::format("too many local variables (at '{}')", name));
+        c.next_slot = 60004;
+        return 0;
+    }
     std::uint16_t slot = c.next_slot;
     c.next_slot = static_cast<std::uint16_t>(c.next_slot + std::max(1, value_width(t)));
     c.locals.push_back({name, t, slot});
@@ -202,7 +235,7 @@ void Compiler::unknown_name(Ctx& c, const std::string& name, Span span, const ch
         for (const auto& b : builtin_table()) names.emplace_back(b.name);
     }
     std::string near = nearest_name(name, names);
-    diags_.error(span, near.empty() ? fmt::format("unknown {} '{}'", what, name)
+    diags_->error(span, near.empty() ? fmt::format("unknown {} '{}'", what, name)
                                     : fmt::format("unknown {} '{}'; did you mean '{}'?", what, name, near));
 }
 
@@ -214,7 +247,7 @@ ValueType Compiler::compile_expr(Ctx& c, const ast::Expr& e) {
     case K::Number: emit_const(c, e.number, e.span); return ValueType::Number;
     case K::Bool: emit_const(c, e.number, e.span); return ValueType::Bool;
     case K::String:
-        diags_.error(e.span, "a string is allowed only as an argument of print(...) or load(...)");
+        diags_->error(e.span, "a string is allowed only as an argument of print(...) or load(...)");
         emit_const(c, 0, e.span);
         return ValueType::Number;
     case K::Name: {
@@ -237,7 +270,7 @@ ValueType Compiler::compile_expr(Ctx& c, const ast::Expr& e) {
             return ValueType::Number;
         }
         if (env_names_.count(e.text)) {
-            diags_.error(e.span, fmt::format("environment '{}' can only be queried with a method, as in '{}.contains(p)'",
+            diags_->error(e.span, fmt::format("environment '{}' can only be queried with a method, as in '{}.contains(p)'",
                                              e.text, e.text));
         } else {
             unknown_name(c, e.text, e.span, "name");
@@ -267,7 +300,7 @@ ValueType Compiler::compile_expr(Ctx& c, const ast::Expr& e) {
     case K::Binary: return compile_binary(c, e);
     case K::Ternary: {
         ValueType ct = compile_expr(c, *e.args[0]);
-        if (!numeric(ct)) diags_.error(e.args[0]->span, "the condition of '?:' must be a number or bool");
+        if (!numeric(ct)) diags_->error(e.args[0]->span, "the condition of '?:' must be a number or bool");
         std::size_t j_else = here(c);
         emit(c, Op::JumpIfZero, 0, 0, e.span);
         ValueType a = compile_expr(c, *e.args[1]);
@@ -280,7 +313,7 @@ ValueType Compiler::compile_expr(Ctx& c, const ast::Expr& e) {
         if (b == ValueType::Void) b = a;
         if (a == ValueType::Void) a = b = ValueType::Number;
         if (value_width(a) != value_width(b)) {
-            diags_.error(e.span, fmt::format("the two branches of '?:' have different types ({} and {})",
+            diags_->error(e.span, fmt::format("the two branches of '?:' have different types ({} and {})",
                                              value_type_name(a), value_type_name(b)));
         }
         return a == b ? a : (numeric(a) && numeric(b) ? ValueType::Number : a);
@@ -290,7 +323,7 @@ ValueType Compiler::compile_expr(Ctx& c, const ast::Expr& e) {
         ValueType t = compile_expr(c, *e.args[0]);
         int comp = e.text == "x" ? 0 : e.text == "y" ? 1 : e.text == "z" ? 2 : -1;
         if (t != ValueType::Vec3 || comp < 0) {
-            diags_.error(e.span, comp < 0 ? fmt::format("unknown member '.{}': vectors have .x, .y and .z", e.text)
+            diags_->error(e.span, comp < 0 ? fmt::format("unknown member '.{}': vectors have .x, .y and .z", e.text)
                                           : fmt::format("'.{}' needs a vec3, found a {}", e.text, value_type_name(t)));
             if (t == ValueType::Vec3) emit(c, Op::Member, 0, 0, e.span);
             return ValueType::Number;
@@ -301,11 +334,11 @@ ValueType Compiler::compile_expr(Ctx& c, const ast::Expr& e) {
     case K::Method: {
         const ast::Expr& obj = *e.args[0];
         if (obj.kind == K::Name && env_names_.count(obj.text)) {
-            diags_.error(e.span, fmt::format("environment '{}' (kind '{}') cannot be queried yet: environment "
+            diags_->error(e.span, fmt::format("environment '{}' (kind '{}') cannot be queried yet: environment "
                                              "objects are parsed but not yet run by this version",
                                              obj.text, env_names_[obj.text]));
         } else {
-            diags_.error(e.span, fmt::format("'.{}(...)' is a method call, and only environment objects have methods",
+            diags_->error(e.span, fmt::format("'.{}(...)' is a method call, and only environment objects have methods",
                                              e.text));
         }
         emit_const(c, 0, e.span);
@@ -316,7 +349,7 @@ ValueType Compiler::compile_expr(Ctx& c, const ast::Expr& e) {
 }
 
 void Compiler::type_error(Span span, const std::string& op, ValueType a, ValueType b) {
-    diags_.error(span, fmt::format("operator '{}' cannot be applied to {} and {}", op, value_type_name(a),
+    diags_->error(span, fmt::format("operator '{}' cannot be applied to {} and {}", op, value_type_name(a),
                                    value_type_name(b)));
 }
 
@@ -368,23 +401,32 @@ ValueType Compiler::compile_binary(Ctx& c, const ast::Expr& e) {
 ValueType Compiler::compile_call(Ctx& c, const ast::Expr& e) {
     const std::string& name = e.text;
     if (name == "print") {
-        diags_.error(e.span, "print(...) is a statement and gives no value; use it in a hook");
+        diags_->error(e.span, "print(...) is a statement and gives no value; use it in a hook");
         emit_const(c, 0, e.span);
         return ValueType::Number;
     }
     // user functions
     if (auto it = fn_index_.find(name); it != fn_index_.end()) {
         Function& fn = P_.functions[it->second];
-        ensure_function_compiled(it->second);
+        // while a result type is being inferred, other functions are not compiled yet (their
+        // diagnostics would be lost with the inference's); their result is unknown for now
+        if (!inferring_ || fn_state_[it->second] != 0) ensure_function_compiled(it->second);
+        if (fn_random_[it->second]) {
+            if (c.kind == CtxKind::Global)
+                diags_->error(e.span, fmt::format("'{}' draws random numbers, so it cannot be used where the value "
+                                                  "must be known before the derivation starts",
+                                                  name));
+            if (c.function >= 0) fn_random_[static_cast<std::size_t>(c.function)] = true;
+        }
         if (e.args.size() != fn.param_types.size()) {
-            diags_.error(e.span, fmt::format("function '{}' takes {} argument{}, given {} (declared at {})", name,
+            diags_->error(e.span, fmt::format("function '{}' takes {} argument{}, given {} (declared at {})", name,
                                              fn.param_types.size(), fn.param_types.size() == 1 ? "" : "s",
                                              e.args.size(), where(fn.span)));
         }
         for (std::size_t i = 0; i < e.args.size(); ++i) {
             ValueType t = compile_expr(c, *e.args[i]);
             if (i < fn.param_types.size() && value_width(t) != value_width(fn.param_types[i]))
-                diags_.error(e.args[i]->span, fmt::format("argument {} of '{}' must be a {}, found a {}", i + 1,
+                diags_->error(e.args[i]->span, fmt::format("argument {} of '{}' must be a {}, found a {}", i + 1,
                                                           name, value_type_name(fn.param_types[i]),
                                                           value_type_name(t)));
         }
@@ -392,11 +434,11 @@ ValueType Compiler::compile_call(Ctx& c, const ast::Expr& e) {
             emit(c, Op::Call, static_cast<std::int32_t>(it->second), 0, e.span);
         // a recursive call inside the function's own body: its type is not known yet, and the
         // operators around it take it from their other operand
-        if (fn_state_[it->second] == 1 && !fn_result_known_[it->second]) return ValueType::Void;
+        if (!fn_result_known_[it->second]) return ValueType::Void;
         return fn.result;
     }
     if (curve_names_.count(name)) {
-        diags_.error(e.span, fmt::format("curve '{}' cannot be evaluated yet: curves are parsed but not yet run by "
+        diags_->error(e.span, fmt::format("curve '{}' cannot be evaluated yet: curves are parsed but not yet run by "
                                          "this version",
                                          name));
         emit_const(c, 0, e.span);
@@ -422,11 +464,16 @@ ValueType Compiler::compile_call(Ctx& c, const ast::Expr& e) {
         if ((b.id == BuiltinId::Uniform || b.id == BuiltinId::Normal || b.id == BuiltinId::Chance ||
              b.id == BuiltinId::Id) &&
             c.kind == CtxKind::Global) {
-            diags_.error(e.span, fmt::format("'{}' depends on the module being rewritten and cannot be used where "
+            diags_->error(e.span, fmt::format("'{}' depends on the module being rewritten and cannot be used where "
                                              "the value must be known before the derivation starts",
                                              name));
         }
-        emit(c, Op::Builtin, static_cast<std::int32_t>(b.id), width, e.span);
+        if ((b.id == BuiltinId::Uniform || b.id == BuiltinId::Normal || b.id == BuiltinId::Chance ||
+             b.id == BuiltinId::Id) &&
+            c.function >= 0)
+            fn_random_[static_cast<std::size_t>(c.function)] = true;
+        emit(c, Op::Builtin, static_cast<std::int32_t>(b.id), width, e.span,
+             static_cast<std::uint16_t>(value_width(b.result)));
         return b.result;
     }
     if (!name_known) {
@@ -435,12 +482,12 @@ ValueType Compiler::compile_call(Ctx& c, const ast::Expr& e) {
         std::string counts;
         for (const auto& b : builtin_table())
             if (name == b.name) counts += (counts.empty() ? "" : " or ") + std::to_string(b.nargs);
-        diags_.error(e.span, fmt::format("'{}' takes {} argument{}, given {}", name, counts,
+        diags_->error(e.span, fmt::format("'{}' takes {} argument{}, given {}", name, counts,
                                          counts == "1" ? "" : "s", e.args.size()));
     } else {
         std::string got;
         for (auto t : types) got += (got.empty() ? "" : ", ") + std::string(value_type_name(t));
-        diags_.error(e.span, fmt::format("'{}' cannot take arguments of types ({})", name, got));
+        diags_->error(e.span, fmt::format("'{}' cannot take arguments of types ({})", name, got));
     }
     emit_const(c, 0, e.span);
     return ValueType::Number;
@@ -455,7 +502,7 @@ void Compiler::declare_function(const ast::FnDecl& fd) {
     }
     for (const auto& b : builtin_table()) {
         if (fd.name == b.name) {
-            diags_.error(fd.span, fmt::format("'{}' is a built-in function and cannot be redefined", fd.name));
+            diags_->error(fd.span, fmt::format("'{}' is a built-in function and cannot be redefined", fd.name));
             return;
         }
     }
@@ -471,6 +518,7 @@ void Compiler::declare_function(const ast::FnDecl& fd) {
     fn_decls_.push_back(&fd);
     fn_state_.push_back(0);
     fn_result_known_.push_back(false);
+    fn_random_.push_back(false);
     P_.functions.push_back(std::move(fn));
 }
 
@@ -478,41 +526,68 @@ ValueType Compiler::param_type(const ast::ParamName& p) {
     if (p.type.empty() || p.type == "number") return ValueType::Number;
     if (p.type == "vec3") return ValueType::Vec3;
     if (p.type == "bool") return ValueType::Bool;
-    diags_.error(p.span, fmt::format("unknown type '{}': expected number, bool or vec3", p.type));
+    diags_->error(p.span, fmt::format("unknown type '{}': expected number, bool or vec3", p.type));
     return ValueType::Number;
+}
+
+// Compiles a function body into `code`; returns its result type (Void if only recursive calls
+// decide it).
+ValueType Compiler::compile_function_body(std::uint32_t index, Code& code, std::uint16_t& frame_size) {
+    const ast::FnDecl& fd = *fn_decls_[index];
+    Ctx c;
+    c.code = &code;
+    c.kind = CtxKind::Function;
+    c.function = static_cast<int>(index);
+    for (std::size_t i = 0; i < fd.params.size(); ++i) add_local(c, fd.params[i].name, P_.functions[index].param_types[i]);
+    ValueType result = ValueType::Number;
+    if (fd.expr) {
+        result = compile_expr(c, *fd.expr);
+        emit(c, Op::Return, 0, value_width(result == ValueType::Void ? ValueType::Number : result), fd.expr->span);
+    } else {
+        c.fn_result = &result;
+        c.fn_result_known = false;
+        compile_block(c, fd.body);
+        if (!c.fn_result_known) result = ValueType::Void;
+        ValueType fall = result == ValueType::Void ? ValueType::Number : result;
+        // falling off the end returns zero
+        for (int k = 0; k < value_width(fall); ++k) emit_const(c, 0, fd.span);
+        emit(c, Op::Return, 0, value_width(fall), fd.span);
+        for (std::size_t at : c.void_returns) code.instrs[at].n = static_cast<std::uint8_t>(value_width(fall));
+    }
+    frame_size = c.next_slot;
+    return result;
 }
 
 void Compiler::ensure_function_compiled(std::uint32_t index) {
     if (fn_state_[index] != 0) return; // compiled, or being compiled (recursion)
     fn_state_[index] = 1;
-    const ast::FnDecl& fd = *fn_decls_[index];
-    Code code;
-    Ctx c;
-    c.code = &code;
-    c.kind = CtxKind::Function;
-    for (std::size_t i = 0; i < fd.params.size(); ++i) add_local(c, fd.params[i].name, P_.functions[index].param_types[i]);
-    ValueType result = ValueType::Number;
-    if (fd.expr) {
-        result = compile_expr(c, *fd.expr);
-        if (result == ValueType::Void) result = ValueType::Number;
-        emit(c, Op::Return, 0, value_width(result), fd.expr->span);
-    } else {
-        c.fn_result = &result;
-        c.fn_result_known = false;
-        compile_block(c, fd.body);
-        if (!c.fn_result_known) result = ValueType::Number;
-        // falling off the end returns zero
-        for (int k = 0; k < value_width(result); ++k) emit_const(c, 0, fd.span);
-        emit(c, Op::Return, 0, value_width(result), fd.span);
+    // First pass, quietly: learn the result type, which recursive calls need. Second pass: the
+    // real code, with recursive calls typed.
+    {
+        Diagnostics scratch;
+        Diagnostics* saved = diags_;
+        const bool was_inferring = inferring_;
+        diags_ = &scratch;
+        inferring_ = true;
+        Code code;
+        std::uint16_t frame = 0;
+        ValueType t = compile_function_body(index, code, frame);
+        diags_ = saved;
+        inferring_ = was_inferring;
+        P_.functions[index].result = t == ValueType::Void ? ValueType::Number : t;
+        fn_result_known_[index] = true;
     }
+    Code code;
+    std::uint16_t frame = 0;
+    ValueType result = compile_function_body(index, code, frame);
     if (result == ValueType::Void) result = ValueType::Number;
-    for (std::size_t at : c.void_returns) code.instrs[at].n = static_cast<std::uint8_t>(value_width(result));
     Function& fn = P_.functions[index];
-    fn_result_known_[index] = true;
+    if (value_width(result) != value_width(fn.result))
+        diags_->error(fn.span, fmt::format("function '{}' gives a {} on some paths and a {} on others", fn.name,
+                                           value_type_name(fn.result), value_type_name(result)));
     fn.code = std::move(code);
-    fn.result = result == ValueType::Bool ? ValueType::Number : result;
-    if (result == ValueType::Bool) fn.result = ValueType::Bool;
-    fn.frame_size = c.next_slot;
+    fn.result = result;
+    fn.frame_size = frame;
     fn_state_[index] = 2;
 }
 
@@ -529,7 +604,7 @@ void Compiler::compile_stmt(Ctx& c, const ast::Stmt& s) {
     switch (s.kind) {
     case K::Let: {
         ValueType t = compile_expr(c, *s.expr);
-        if (t == ValueType::String) t = ValueType::Number;
+        if (t == ValueType::String || t == ValueType::Void) t = ValueType::Number;
         std::uint16_t slot = add_local(c, s.name, t);
         emit(c, Op::StoreLocal, slot, value_width(t), s.span);
         break;
@@ -537,7 +612,7 @@ void Compiler::compile_stmt(Ctx& c, const ast::Stmt& s) {
     case K::Assign: compile_assign(c, s); break;
     case K::If: {
         ValueType t = compile_expr(c, *s.expr);
-        if (!numeric(t)) diags_.error(s.expr->span, "the condition of 'if' must be a number or bool");
+        if (!numeric(t)) diags_->error(s.expr->span, "the condition of 'if' must be a number or bool");
         std::size_t j_else = here(c);
         emit(c, Op::JumpIfZero, 0, 0, s.span);
         compile_block(c, s.body);
@@ -559,7 +634,7 @@ void Compiler::compile_stmt(Ctx& c, const ast::Stmt& s) {
         std::uint16_t var = add_local(c, s.name, ValueType::Number);
         emit(c, Op::StoreLocal, var, 1, s.span);
         ValueType tb = compile_expr(c, *s.expr2);
-        if (!numeric(ta) || !numeric(tb)) diags_.error(s.span, "the bounds of a 'for' range must be numbers");
+        if (!numeric(ta) || !numeric(tb)) diags_->error(s.span, "the bounds of a 'for' range must be numbers");
         std::uint16_t end = add_local(c, " end", ValueType::Number);
         emit(c, Op::StoreLocal, end, 1, s.span);
         std::uint16_t guard = add_local(c, " guard", ValueType::Number);
@@ -585,7 +660,7 @@ void Compiler::compile_stmt(Ctx& c, const ast::Stmt& s) {
     case K::Produce:
     case K::NProduce:
         if (c.kind != CtxKind::Production) {
-            diags_.error(s.span, fmt::format("'{}' is allowed only in the body of a production",
+            diags_->error(s.span, fmt::format("'{}' is allowed only in the body of a production",
                                              s.kind == K::Produce ? "produce" : "nproduce"));
             break;
         }
@@ -594,7 +669,7 @@ void Compiler::compile_stmt(Ctx& c, const ast::Stmt& s) {
         break;
     case K::Use: {
         if (c.kind != CtxKind::Hook) {
-            diags_.error(s.span, "'use' is allowed only in hooks (on start, on before_step, ...)");
+            diags_->error(s.span, "'use' is allowed only in hooks (on start, on before_step, ...)");
             break;
         }
         int g = s.name == "none" ? -1 : P_.group_index(s.name);
@@ -602,7 +677,7 @@ void Compiler::compile_stmt(Ctx& c, const ast::Stmt& s) {
             std::vector<std::string> names;
             for (const auto& rs : P_.groups) names.push_back(rs.name);
             std::string near = nearest_name(s.name, names);
-            diags_.error(s.span, near.empty() ? fmt::format("unknown rule group '{}'", s.name)
+            diags_->error(s.span, near.empty() ? fmt::format("unknown rule group '{}'", s.name)
                                               : fmt::format("unknown rule group '{}'; did you mean '{}'?", s.name, near));
         }
         used_groups_.insert(s.name);
@@ -611,14 +686,14 @@ void Compiler::compile_stmt(Ctx& c, const ast::Stmt& s) {
     }
     case K::Stop:
         if (c.kind != CtxKind::Hook) {
-            diags_.error(s.span, "'stop' is allowed only in hooks");
+            diags_->error(s.span, "'stop' is allowed only in hooks");
             break;
         }
         emit(c, Op::Stop, 0, 0, s.span);
         break;
     case K::Return: {
         if (c.kind != CtxKind::Function) {
-            diags_.error(s.span, "'return' is allowed only in functions");
+            diags_->error(s.span, "'return' is allowed only in functions");
             break;
         }
         ValueType t = s.expr ? compile_expr(c, *s.expr) : ValueType::Number;
@@ -629,7 +704,7 @@ void Compiler::compile_stmt(Ctx& c, const ast::Stmt& s) {
             break;
         }
         if (c.fn_result_known && value_width(t) != value_width(*c.fn_result))
-            diags_.error(s.span, "all 'return' statements of a function must give the same type");
+            diags_->error(s.span, "all 'return' statements of a function must give the same type");
         *c.fn_result = t;
         c.fn_result_known = true;
         emit(c, Op::Return, 0, value_width(t), s.span);
@@ -647,8 +722,9 @@ void Compiler::compile_stmt(Ctx& c, const ast::Stmt& s) {
             break;
         }
         ValueType t = compile_expr(c, e);
+        if (t == ValueType::Void) t = ValueType::Number;
         emit(c, Op::Pop, 0, value_width(t), s.span);
-        diags_.warning(s.span, "this expression's value is not used");
+        diags_->warning(s.span, "this expression's value is not used");
         break;
     }
     }
@@ -656,7 +732,7 @@ void Compiler::compile_stmt(Ctx& c, const ast::Stmt& s) {
 
 void Compiler::compile_print(Ctx& c, const ast::Expr& e) {
     if (c.kind != CtxKind::Hook) {
-        diags_.error(e.span, "print(...) is allowed only in hooks");
+        diags_->error(e.span, "print(...) is allowed only in hooks");
         return;
     }
     std::string format;
@@ -670,6 +746,10 @@ void Compiler::compile_print(Ctx& c, const ast::Expr& e) {
         format += t == ValueType::Vec3 ? 'v' : t == ValueType::Bool ? 'b' : 'n';
         width += value_width(t);
     }
+    if (width > 255) {
+        diags_->error(e.span, "print(...) can show at most 255 numbers at once");
+        return;
+    }
     P_.print_formats.push_back(format);
     emit(c, Op::Print, static_cast<std::int32_t>(P_.print_formats.size() - 1), width, e.span);
 }
@@ -678,8 +758,9 @@ void Compiler::compile_assign(Ctx& c, const ast::Stmt& s) {
     auto compile_value = [&](ValueType target) {
         if (s.op == "=") {
             ValueType t = compile_expr(c, *s.expr);
+            if (t == ValueType::Void) t = ValueType::Number;
             if (value_width(t) != value_width(target))
-                diags_.error(s.expr->span, fmt::format("cannot assign a {} to '{}', which holds a {}",
+                diags_->error(s.expr->span, fmt::format("cannot assign a {} to '{}', which holds a {}",
                                                        value_type_name(t), s.name, value_type_name(target)));
             return;
         }
@@ -690,6 +771,7 @@ void Compiler::compile_assign(Ctx& c, const ast::Stmt& s) {
         load.span = s.span;
         compile_expr(c, load);
         ValueType t = compile_expr(c, *s.expr);
+        if (t == ValueType::Void) t = ValueType::Number;
         char op = s.op[0];
         if (target == ValueType::Vec3 && t == ValueType::Vec3 && (op == '+' || op == '-'))
             emit(c, op == '+' ? Op::VAdd : Op::VSub, 0, 0, s.span);
@@ -702,7 +784,7 @@ void Compiler::compile_assign(Ctx& c, const ast::Stmt& s) {
     };
     if (const LocalVar* l = find_local(c, s.name)) {
         if (l->bound) {
-            diags_.error(s.span, fmt::format("'{}' is bound by the predecessor and cannot be assigned; use 'let'",
+            diags_->error(s.span, fmt::format("'{}' is bound by the predecessor and cannot be assigned; use 'let'",
                                              s.name));
             return;
         }
@@ -712,14 +794,14 @@ void Compiler::compile_assign(Ctx& c, const ast::Stmt& s) {
         return;
     }
     if (auto it = consts_.find(s.name); it != consts_.end()) {
-        diags_.error(s.span, fmt::format("'{}' is a const and cannot be assigned (defined at {})", s.name,
+        diags_->error(s.span, fmt::format("'{}' is a const and cannot be assigned (defined at {})", s.name,
                                          where(it->second.span)));
         return;
     }
     if (auto it = P_.global_index.find(s.name); it != P_.global_index.end()) {
         const Global g = P_.globals[it->second];
         if (c.kind != CtxKind::Hook) {
-            diags_.error(s.span, fmt::format("'{}' is a {}: it can be assigned only in hooks (on start, on "
+            diags_->error(s.span, fmt::format("'{}' is a {}: it can be assigned only in hooks (on start, on "
                                              "before_step, on after_step, on end)",
                                              s.name, g.kind == GlobalKind::Param ? "param" : "var"));
             return;
@@ -776,7 +858,7 @@ void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list, Span span)
     (void)span;
     for (const auto& m : list) {
         if (m.name == "*") {
-            diags_.error(m.span, "'*' (any context) is allowed only in a context pattern");
+            diags_->error(m.span, "'*' (any context) is allowed only in a context pattern");
             continue;
         }
         auto parts = split_run(m);
@@ -789,12 +871,12 @@ void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list, Span span)
             std::size_t nargs = last ? m.args.size() : 0;
             if (info.arity >= 0 && (last ? m.has_args || info.arity > 0 : info.arity > 0) &&
                 static_cast<int>(nargs) != info.arity) {
-                diags_.error(last ? m.span : Span{parts[k].second},
+                diags_->error(last ? m.span : Span{parts[k].second},
                              fmt::format("module '{}' takes {} parameter{}, given {} (declared at {})", info.name,
                                          info.arity, info.arity == 1 ? "" : "s", nargs, where(info.decl_span)));
             }
             if (sym == P_.symbols.open_bracket || sym == P_.symbols.close_bracket) {
-                if (nargs) diags_.error(m.span, "brackets take no parameters");
+                if (nargs) diags_->error(m.span, "brackets take no parameters");
                 emit(c, Op::Emit, static_cast<std::int32_t>(sym), 0, m.span);
                 continue;
             }
@@ -805,14 +887,14 @@ void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list, Span span)
                 if (t == ValueType::String) t = ValueType::Number;
                 if (info.arity >= 0 && i < info.param_types.size() &&
                     value_width(t) != value_width(info.param_types[i])) {
-                    diags_.error(m.args[i]->span,
+                    diags_->error(m.args[i]->span,
                                  fmt::format("parameter '{}' of '{}' is a {}, found a {}", info.param_names[i],
                                              info.name, value_type_name(info.param_types[i]), value_type_name(t)));
                 }
                 width += value_width(t);
             }
             if (width > 255) {
-                diags_.error(m.span, "a module can carry at most 255 numbers");
+                diags_->error(m.span, "a module can carry at most 255 numbers");
                 width = 0;
             }
             std::uint16_t spans_index = 0;
@@ -838,13 +920,13 @@ std::vector<PatternModule> Compiler::compile_pattern(Ctx& c, const ast::ModuleLi
             const bool last = k + 1 == parts.size();
             bool bracket = pm.sym == P_.symbols.open_bracket || pm.sym == P_.symbols.close_bracket;
             if (bracket && role != PatternRole::Right) {
-                diags_.error(m.span, role == PatternRole::Strict
+                diags_->error(m.span, role == PatternRole::Strict
                                          ? "a predecessor cannot contain '[' or ']'"
                                          : "brackets are allowed only in a right context");
             }
             std::size_t nargs = last ? m.args.size() : 0;
             if (info.arity >= 0 && static_cast<int>(nargs) != info.arity) {
-                diags_.error(last ? m.span : pm.span,
+                diags_->error(last ? m.span : pm.span,
                              fmt::format("module '{}' takes {} parameter{}, the pattern gives {} (declared at {})",
                                          info.name, info.arity, info.arity == 1 ? "" : "s", nargs,
                                          where(info.decl_span)));
@@ -863,7 +945,7 @@ std::vector<PatternModule> Compiler::compile_pattern(Ctx& c, const ast::ModuleLi
                     } else {
                         for (const auto& l : c.locals) {
                             if (l.name == a.text) {
-                                diags_.error(a.span, fmt::format("'{}' is bound twice in this production", a.text));
+                                diags_->error(a.span, fmt::format("'{}' is bound twice in this production", a.text));
                                 break;
                             }
                         }
@@ -873,9 +955,9 @@ std::vector<PatternModule> Compiler::compile_pattern(Ctx& c, const ast::ModuleLi
                 } else if (auto v = fold_number(a)) {
                     pa.bind = false;
                     pa.value = *v;
-                    if (t == ValueType::Vec3) diags_.error(a.span, "a vec3 parameter cannot be matched against a number");
+                    if (t == ValueType::Vec3) diags_->error(a.span, "a vec3 parameter cannot be matched against a number");
                 } else {
-                    diags_.error(a.span, "a pattern argument must be a name to bind or a constant value");
+                    diags_->error(a.span, "a pattern argument must be a name to bind or a constant value");
                 }
                 pm.width += pa.width;
                 pm.args.push_back(pa);

@@ -35,6 +35,9 @@ struct Ctx {
     ValueType* fn_result = nullptr;
     bool fn_result_known = false;
     std::vector<std::size_t> void_returns; // Return instructions whose width is not known yet
+    int depth = 0;                         // operand stack depth after the last instruction
+    bool stack_error = false;
+    int function = -1;                     // the function being compiled, if any
 };
 
 struct ConstVal {
@@ -60,7 +63,7 @@ std::string nearest_name(std::string_view name, const std::vector<std::string>& 
 
 class Compiler {
 public:
-    Compiler(SourceManager& sm, const CompileOptions& opts, Diagnostics& diags) : sm_(sm), opts_(opts), diags_(diags) {}
+    Compiler(SourceManager& sm, const CompileOptions& opts, Diagnostics& diags) : sm_(sm), opts_(opts), diags_(&diags) {}
     std::unique_ptr<Program> compile(std::uint32_t main_file);
 
     // expressions (compiler.cpp)
@@ -79,6 +82,7 @@ public:
     SymbolId module_symbol(const std::string& name, Span span);
     void declare_function(const ast::FnDecl& fd);
     void ensure_function_compiled(std::uint32_t index);
+    ValueType compile_function_body(std::uint32_t index, Code& code, std::uint16_t& frame_size);
     ValueType param_type(const ast::ParamName& p);
 
 private:
@@ -113,7 +117,8 @@ private:
 
     SourceManager& sm_;
     const CompileOptions& opts_;
-    Diagnostics& diags_;
+    Diagnostics* diags_; // swapped for a scratch list while a function's result type is inferred
+    bool inferring_ = false;
     std::unique_ptr<Program> program_ = std::make_unique<Program>();
     Program& P_ = *program_;
     std::uint32_t current_file_ = 0;
@@ -126,6 +131,7 @@ private:
     std::vector<const ast::FnDecl*> fn_decls_;
     std::vector<int> fn_state_; // 0 pending, 1 compiling, 2 done
     std::vector<bool> fn_result_known_;
+    std::vector<bool> fn_random_; // the function (or one it calls) draws random numbers
     std::map<std::string, std::string> env_names_; // env name -> kind
     std::set<std::string> curve_names_;
     std::set<std::string> used_groups_;

@@ -102,7 +102,7 @@ std::string Compiler::resolve_import(const ast::Import& im, std::uint32_t from_f
 
 void Compiler::load(std::uint32_t file_id, std::map<std::string, std::pair<const ast::Expr*, Span>> overrides,
                     std::vector<std::string>& stack) {
-    auto file = parse_file(sm_, file_id, diags_);
+    auto file = parse_file(sm_, file_id, *diags_);
     ast::File* f = file.get();
     P_.files.push_back(std::move(file));
     std::string self = fs::path(sm_.file(file_id).name()).lexically_normal().string();
@@ -112,14 +112,14 @@ void Compiler::load(std::uint32_t file_id, std::map<std::string, std::pair<const
         std::vector<std::string> searched;
         std::string path = resolve_import(im, file_id, searched);
         if (path.empty()) {
-            diags_.error(im.span, im.is_path ? fmt::format("cannot find imported file '{}' (looked for {})", im.target,
+            diags_->error(im.span, im.is_path ? fmt::format("cannot find imported file '{}' (looked for {})", im.target,
                                                            searched.empty() ? "?" : searched[0])
                                              : fmt::format("cannot find library '{}' (searched {})", im.target,
                                                            fmt::join(searched, ", ")));
             continue;
         }
         if (std::find(stack.begin(), stack.end(), path) != stack.end()) {
-            diags_.error(im.span, fmt::format("import cycle: '{}' imports '{}', which is already being imported "
+            diags_->error(im.span, fmt::format("import cycle: '{}' imports '{}', which is already being imported "
                                               "(chain: {})",
                                               self, path, fmt::join(stack, " -> ")));
             continue;
@@ -127,7 +127,7 @@ void Compiler::load(std::uint32_t file_id, std::map<std::string, std::pair<const
         if (loaded_paths_.count(path)) continue; // imported already through another path
         std::string text;
         if (!read_file(path, text)) {
-            diags_.error(im.span, fmt::format("cannot read imported file '{}'", path));
+            diags_->error(im.span, fmt::format("cannot read imported file '{}'", path));
             continue;
         }
         std::uint32_t id = sm_.add(path, std::move(text));
@@ -159,7 +159,7 @@ void Compiler::declare_modules(const ast::File& f) {
             names.push_back(p.name);
         }
         if (info.turtle || info.query) {
-            diags_.error(m.span, fmt::format("'{}' is a built-in turtle or query module and cannot be declared", m.name));
+            diags_->error(m.span, fmt::format("'{}' is a built-in turtle or query module and cannot be declared", m.name));
             continue;
         }
         if (info.arity >= 0) {
@@ -194,7 +194,7 @@ void Compiler::declare_values(const LoadedFile& lf) {
         const ast::Expr* value = v.value.get();
         if (auto it = lf.overrides.find(v.name); it != lf.overrides.end()) {
             if (v.kind != ast::DeclKind::Param)
-                diags_.error(it->second.second, fmt::format("'{}' is a {}, and only params can be overridden",
+                diags_->error(it->second.second, fmt::format("'{}' is a {}, and only params can be overridden",
                                                             v.name, v.kind == ast::DeclKind::Const ? "const" : "var"));
             else
                 value = it->second.first;
@@ -224,7 +224,7 @@ void Compiler::declare_values(const LoadedFile& lf) {
     }
     for (const auto& [name, ov] : lf.overrides) {
         if (!value_spans_.count(name) || value_spans_[name].file != f.source)
-            diags_.error(ov.second, fmt::format("the imported file has no param '{}'", name));
+            diags_->error(ov.second, fmt::format("the imported file has no param '{}'", name));
     }
 }
 
@@ -247,17 +247,17 @@ void Compiler::compile_settings(const ast::File& f) {
         c.kind = CtxKind::Global;
         ValueType t = compile_expr(c, *s.value);
         if (t != ValueType::Number && t != ValueType::Bool)
-            diags_.error(s.value->span, fmt::format("'{}' needs a number, found a {}", s.key, value_type_name(t)));
+            diags_->error(s.value->span, fmt::format("'{}' needs a number, found a {}", s.key, value_type_name(t)));
         emit(c, Op::Halt, 0, 1, s.value->span);
         // settings made of constants are checked now, so `plant check` sees them
         if (auto v = fold_number(*s.value)) {
             bool whole = *v == std::floor(*v);
             if (s.key == "derive" && (!whole || *v < 0 || *v > 1e6))
-                diags_.error(s.value->span, fmt::format("the number of steps must be a whole number from 0 to "
+                diags_->error(s.value->span, fmt::format("the number of steps must be a whole number from 0 to "
                                                         "1000000, found {}",
                                                         *v));
             if (s.key == "seed" && (!whole || *v < 0))
-                diags_.error(s.value->span, fmt::format("the seed must be a whole number >= 0, found {}", *v));
+                diags_->error(s.value->span, fmt::format("the seed must be a whole number >= 0, found {}", *v));
         }
     }
     // ignore / consider
@@ -272,7 +272,7 @@ void Compiler::compile_settings(const ast::File& f) {
         if (ss.ignore) has_ignore_ = true;
         else has_consider_ = true;
         if (has_ignore_ && has_consider_)
-            diags_.error(ss.span, "a grammar can have 'ignore:' or 'consider:', not both");
+            diags_->error(ss.span, "a grammar can have 'ignore:' or 'consider:', not both");
     }
     if (!f.axioms.empty()) {
         if (f.axioms.size() > 1) duplicate("axiom", "axiom", f.axioms[1].span, f.axioms[0].span);
@@ -300,15 +300,15 @@ void Compiler::compile_production(const ast::Production& p, RuleSet& set, bool i
     cp.right = compile_pattern(c, p.right, PatternRole::Right);
     cp.right_new = compile_pattern(c, p.right_new, PatternRole::RightNew);
     if (cp.strict.empty()) {
-        diags_.error(p.span, "a production needs a predecessor");
+        diags_->error(p.span, "a production needs a predecessor");
         return;
     }
-    if (cp.strict.size() > 32) diags_.error(p.span, "a predecessor can have at most 32 modules");
+    if (cp.strict.size() > 32) diags_->error(p.span, "a predecessor can have at most 32 modules");
     if (p.condition) {
         c.code = &cp.condition;
         ValueType t = compile_expr(c, *p.condition);
         if (t != ValueType::Number && t != ValueType::Bool)
-            diags_.error(p.condition->span, fmt::format("a condition must be a bool or number, found a {}",
+            diags_->error(p.condition->span, fmt::format("a condition must be a bool or number, found a {}",
                                                         value_type_name(t)));
         emit(c, Op::Halt, 0, 1, p.condition->span);
     }
@@ -316,7 +316,7 @@ void Compiler::compile_production(const ast::Production& p, RuleSet& set, bool i
         c.code = &cp.weight;
         ValueType t = compile_expr(c, *p.weight);
         if (t != ValueType::Number && t != ValueType::Bool)
-            diags_.error(p.weight->span, fmt::format("a weight must be a number, found a {}", value_type_name(t)));
+            diags_->error(p.weight->span, fmt::format("a weight must be a number, found a {}", value_type_name(t)));
         emit(c, Op::Halt, 0, 1, p.weight->span);
     }
     c.code = &cp.body;
@@ -334,7 +334,7 @@ void Compiler::compile_production(const ast::Production& p, RuleSet& set, bool i
     if (!cp.left_new.empty()) set.uses_left_new = true;
     if (!cp.right_new.empty()) set.uses_right_new = true;
     if (set.uses_left_new && set.uses_right_new)
-        diags_.error(p.span, "one rule set cannot read both the forward (<<) and the backward (>>) new context");
+        diags_->error(p.span, "one rule set cannot read both the forward (<<) and the backward (>>) new context");
     // shadowing: an earlier production that always applies to the same predecessor
     for (const auto& q : set.productions) {
         bool same = q.strict.size() == cp.strict.size();
@@ -350,13 +350,13 @@ void Compiler::compile_production(const ast::Production& p, RuleSet& set, bool i
                                      "to '{}'",
                                      where(q.span), P_.symbols[cp.strict[0].sym].name),
                          {}};
-            diags_.add(std::move(d));
+            diags_->add(std::move(d));
             break;
         }
     }
     if (p.condition) {
         if (auto v = fold_number(*p.condition); v && *v == 0)
-            diags_.warning(p.condition->span, "this production can never apply: its condition is always false");
+            diags_->warning(p.condition->span, "this production can never apply: its condition is always false");
     }
     set.productions.push_back(std::move(cp));
 }
@@ -371,7 +371,7 @@ void Compiler::compile_rules(const ast::File& f) {
             if (rb.max_depth) {
                 if (auto v = eval_const(*rb.max_depth, "max_depth")) {
                     if (v->v[0] < 1 || v->v[0] > 1000 || v->v[0] != std::floor(v->v[0]))
-                        diags_.error(rb.max_depth->span, "max_depth must be a whole number from 1 to 1000");
+                        diags_->error(rb.max_depth->span, "max_depth must be a whole number from 1 to 1000");
                     else
                         set->max_depth = static_cast<int>(v->v[0]);
                 }
@@ -412,7 +412,7 @@ void Compiler::check_raw_runs() {
         }
         if (meaningful || !reported.insert({run.span.file, run.span.begin}).second) continue;
         std::string near = nearest_name(run.text, declared);
-        diags_.warning(run.span,
+        diags_->warning(run.span,
                        near.empty()
                            ? fmt::format("'{}' is not a declared module and is read as {} separate letters, none of "
                                          "which has a rule or a turtle meaning; declare it with 'module {}(...);'",
@@ -428,7 +428,7 @@ void Compiler::check_never_applying() {
         for (const auto& p : rs.productions) {
             SymbolId s = p.strict[0].sym;
             if (!produced_.count(s)) {
-                diags_.warning(p.span, fmt::format("this production can never apply: neither the axiom nor any "
+                diags_->warning(p.span, fmt::format("this production can never apply: neither the axiom nor any "
                                                    "successor produces '{}'",
                                                    P_.symbols[s].name));
             }
@@ -441,7 +441,7 @@ void Compiler::check_never_applying() {
     for (const auto& [name, span, dummy] : group_decls_) {
         (void)dummy;
         if (!used_groups_.count(name))
-            diags_.warning(span, fmt::format("rule group '{}' is never selected: no hook says 'use {};'", name, name));
+            diags_->warning(span, fmt::format("rule group '{}' is never selected: no hook says 'use {};'", name, name));
     }
 }
 
@@ -463,25 +463,25 @@ void Compiler::compile_surface(const ast::ShapeDecl& s) {
             auto v = eval_const(*a, "a polygon corner");
             if (!v) return;
             if (v->type != ValueType::Vec3) {
-                diags_.error(a->span, "a polygon corner must be a vec3, as in vec3(0, 1, 0)");
+                diags_->error(a->span, "a polygon corner must be a vec3, as in vec3(0, 1, 0)");
                 return;
             }
             def.points.push_back({v->v[0], v->v[1], v->v[2]});
         }
         if (def.points.size() < 3) {
-            diags_.error(s.span, fmt::format("polygon '{}' needs at least 3 corners, found {}", s.name, def.points.size()));
+            diags_->error(s.span, fmt::format("polygon '{}' needs at least 3 corners, found {}", s.name, def.points.size()));
             return;
         }
     } else if (s.kind == "load") {
         if (s.args.size() != 1 || s.args[0]->kind != ast::ExprKind::String) {
-            diags_.error(s.span, "load(...) takes one quoted file name, as in load(\"leaf.obj\")");
+            diags_->error(s.span, "load(...) takes one quoted file name, as in load(\"leaf.obj\")");
             return;
         }
         fs::path p(s.args[0]->text);
         if (p.is_relative()) p = fs::path(sm_.file(s.span.file).name()).parent_path() / p;
         def.path = p.lexically_normal().string();
     } else {
-        diags_.error(s.kind_span, fmt::format("unknown surface kind '{}': expected polygon(...) or load(\"file\")", s.kind));
+        diags_->error(s.kind_span, fmt::format("unknown surface kind '{}': expected polygon(...) or load(\"file\")", s.kind));
         return;
     }
     P_.surfaces.push_back(std::move(def));
@@ -563,13 +563,15 @@ std::unique_ptr<Program> Compiler::compile(std::uint32_t main_file) {
     // -D values are expressions, parsed from their own small sources
     for (const auto& [name, text] : opts_.defines) {
         std::uint32_t id = sm_.add(fmt::format("-D {}", name), text);
-        auto e = parse_expression(sm_, id, diags_);
+        auto e = parse_expression(sm_, id, *diags_);
         if (e) defines_[name] = {std::move(e), id};
     }
     std::vector<std::string> stack;
     load(main_file, {}, stack);
-    if (diags_.has_errors()) return nullptr; // do not pile checks on a broken parse
+    if (diags_->has_errors()) return nullptr; // do not pile checks on a broken parse
 
+    for (const auto& info : P_.symbols.all())
+        if (info.declared) max_declared_len_ = std::max(max_declared_len_, info.name.size());
     for (const auto& lf : order_) {
         current_file_ = lf.file->source;
         declare_modules(*lf.file);
@@ -611,7 +613,7 @@ std::unique_ptr<Program> Compiler::compile(std::uint32_t main_file) {
             for (const auto& g : P_.globals)
                 if (g.kind == GlobalKind::Param) params.push_back(g.name);
             std::string near = nearest_name(name, params);
-            diags_.error(Span{},
+            diags_->error(Span{},
                          near.empty() ? fmt::format("-D {}: the grammar has no param '{}'", name, name)
                                       : fmt::format("-D {}: the grammar has no param '{}'; did you mean '{}'?", name,
                                                     name, near));
@@ -637,7 +639,7 @@ std::unique_ptr<Program> Compiler::compile(std::uint32_t main_file) {
     }
     current_file_ = main_file;
     if (!has_axiom_) {
-        diags_.error(Span{main_file, 0, 0}, "the grammar has no axiom: add a line such as 'axiom: F;'");
+        diags_->error(Span{main_file, 0, 0}, "the grammar has no axiom: add a line such as 'axiom: F;'");
     }
     // the set of modules skipped when matching context
     P_.ignored.assign(P_.symbols.size(), 0);
@@ -647,15 +649,24 @@ std::unique_ptr<Program> Compiler::compile(std::uint32_t main_file) {
         else P_.ignored[s] = ignore_syms_.count(s) ? 1 : 0;
     }
     P_.uses_cut = produced_.count(P_.symbols.cut) > 0;
+    // a named group runs together with the unnamed one: together they may read only one
+    // direction of new context
+    for (const auto& g : P_.groups) {
+        bool left = g.uses_left_new || P_.rules.uses_left_new, right = g.uses_right_new || P_.rules.uses_right_new;
+        if (left && right)
+            diags_->error(g.span, fmt::format("rule group '{}' and the unnamed rules together read both the forward "
+                                              "(<<) and the backward (>>) new context; use one direction",
+                                              g.name));
+    }
     finish_rule_set(P_.rules);
     for (auto& g : P_.groups) finish_rule_set(g);
     finish_rule_set(P_.decompose);
     finish_rule_set(P_.interpret);
-    if (!diags_.has_errors()) {
+    if (!diags_->has_errors()) {
         check_raw_runs();
         check_never_applying();
     }
-    if (diags_.has_errors()) return nullptr;
+    if (diags_->has_errors()) return nullptr;
     return std::move(program_);
 }
 

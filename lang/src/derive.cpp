@@ -252,7 +252,7 @@ public:
                 while (j < e && !has_prod[in.sym[j]]) ++j;
                 w.out.append_range(in, i, j);
                 i = j;
-                if (w.out.size() > w.env.max_output) limit_error(w);
+                if (w.out.size() > w.env.max_output || w.out.params.size() > w.env.max_params) limit_error(w);
                 continue;
             }
             if (const Production* pr = direct[in.sym[i]]; pr && in.arity(i) == pr->strict[0].width) {
@@ -306,7 +306,7 @@ public:
                     const auto& cands = sets[si]->by_symbol[pr.strict[0].sym];
                     std::size_t ci = 0;
                     while (ci < cands.size() && cands[ci] != pi) ++ci;
-                    used = choose(w, start, si, ci);
+                    used = choose(w, start, si, ci, len); // only predecessors that end at k
                 } else {
                     used = run_body(w, start, pr);
                 }
@@ -648,7 +648,7 @@ private:
     }
 
     // cpfg semantics: all applicable weighted productions of the module, one drawn by weight.
-    std::size_t choose(Worker& w, std::size_t i, std::size_t set0, std::size_t cand0) {
+    std::size_t choose(Worker& w, std::size_t i, std::size_t set0, std::size_t cand0, std::size_t length = 0) {
         struct Option {
             const Production* pr;
             double weight;
@@ -661,7 +661,7 @@ private:
             const auto& cands = sets[si]->by_symbol[sym];
             for (std::size_t ci = si == set0 ? cand0 : 0; ci < cands.size(); ++ci) {
                 const Production& pr = sets[si]->productions[cands[ci]];
-                if (pr.weight.empty() || !matches(w, i, pr)) continue;
+                if (pr.weight.empty() || (length && pr.strict.size() != length) || !matches(w, i, pr)) continue;
                 double wt = eval_number(pr.weight, w.frame.data(), w.env);
                 if (!(wt >= 0) || !std::isfinite(wt))
                     throw RuntimeError{pr.weight.spans.empty() ? pr.span : pr.weight.spans.back(),
@@ -706,13 +706,15 @@ Derivation::Derivation(const Program& program, DeriveOptions options) : prog_(pr
     globals_ = prog_.global_values;
 }
 
-void Derivation::check_limits(const ModuleString& s) const {
-    if (s.size() > opt_.max_modules)
+void Derivation::check_limits(const ModuleString& s) const { check_limits(s.size(), s.params.size()); }
+
+void Derivation::check_limits(std::size_t modules, std::size_t params) const {
+    if (modules > opt_.max_modules)
         throw RuntimeError{Span{}, fmt::format("step {}: the string grew past the limit of {} modules (raise it "
                                                "with --max-modules)",
                                                step_, opt_.max_modules)};
-    std::size_t estimate = s.size() * (sizeof(SymbolId) + sizeof(std::uint32_t) + sizeof(ModuleId)) +
-                           s.params.size() * sizeof(double);
+    std::size_t estimate = modules * (sizeof(SymbolId) + sizeof(std::uint32_t) + sizeof(ModuleId)) +
+                           params * sizeof(double);
     if (estimate > opt_.max_bytes)
         throw RuntimeError{Span{}, fmt::format("step {}: the string needs about {:.1f} GiB, more than the limit of "
                                                "{:.1f} GiB",
@@ -729,6 +731,7 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const std::v
         w.env.phase = phase;
         w.env.step = step_for_env;
         w.env.max_output = opt_.max_modules;
+        w.env.max_params = opt_.max_bytes / sizeof(double);
     };
     const std::size_t n = in.size();
     int threads = std::max(1, opt_.threads);
@@ -748,8 +751,13 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const std::v
             bool backward = false;
             for (const RuleSet* rs : sets) backward = backward || rs->uses_right_new;
             if (backward) {
+                // right to left: new modules are marked, then numbered in string order
+                w.env.id_base = kNewIdBit;
                 rw.run_backward(w);
                 w.out = rw.assemble_backward(w.out);
+                ModuleId next = next_id_;
+                for (auto& id : w.out.ids)
+                    if (id & kNewIdBit) id = next++;
             } else {
                 rw.run_range(w, 0, n);
             }
@@ -801,9 +809,7 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const std::v
             total_params += w.out.params.size();
         }
         if (total > opt_.max_modules) {
-            ModuleString probe;
-            probe.sym.resize(total);
-            check_limits(probe);
+            check_limits(total, total_params);
         }
         std::vector<std::size_t> mod_at(workers.size()), par_at(workers.size());
         std::vector<ModuleId> id_at(workers.size());
@@ -885,11 +891,7 @@ bool Derivation::rewrite_direct(Rewriter& rw, const ModuleString& in, ModuleStri
         modules += c.modules;
         params += c.params;
     }
-    if (modules > opt_.max_modules) {
-        ModuleString probe;
-        probe.sym.resize(modules);
-        check_limits(probe);
-    }
+    check_limits(modules, params); // before allocating anything
     out.sym.resize(modules);
     out.ids.resize(modules);
     out.poff.resize(modules + 1);
@@ -1026,7 +1028,10 @@ void Derivation::start() {
                            fmt::format("the number of steps must be a whole number from 0 to 1000000, found {}", steps)};
     target_ = static_cast<int>(steps);
     double seed = setting(prog_.setting_seed, 0);
-    seed_ = opt_.seed ? *opt_.seed : static_cast<std::uint64_t>(std::llround(std::fabs(seed)));
+    if (!(seed >= 0 && seed < 9.0e18) || seed != std::floor(seed))
+        throw RuntimeError{prog_.setting_seed.spans.empty() ? Span{} : prog_.setting_seed.spans.back(),
+                           fmt::format("the seed must be a whole number from 0 to 9e18, found {}", seed)};
+    seed_ = opt_.seed ? *opt_.seed : static_cast<std::uint64_t>(seed);
     angle_ = setting(prog_.setting_angle, 90);
     step_length_ = setting(prog_.setting_step, 1);
     width_ = setting(prog_.setting_width, 0.1); // a tenth of the default step: a slender branch
@@ -1139,11 +1144,11 @@ std::string format_string(const Program& program, const ModuleString& s, bool wi
         bool letter_start = !name.empty() && (std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_');
         // a space only where reading back would merge two names
         if (prev && letter_start) {
-            if (prev->size() > 1 || prefixes.count(*prev + name[0])) out += ' ';
+            if (prev->size() > 1 || *prev == "~" || prefixes.count(*prev + name[0])) out += ' ';
         }
         out += name;
         std::uint32_t k = s.arity(i);
-        if (k > 0) {
+        if (k > 0 || name == ";") { // a bare ';' would end the statement when read back
             out += '(';
             const double* a = s.args(i);
             for (std::uint32_t j = 0; j < k; ++j) {
@@ -1154,7 +1159,8 @@ std::string format_string(const Program& program, const ModuleString& s, bool wi
         }
         if (with_ids) out += fmt::format("#{}", s.ids[i]);
         bool ends_letters = !name.empty() && (std::isalnum(static_cast<unsigned char>(name.back())) || name.back() == '_');
-        prev = (k == 0 && !with_ids && ends_letters) ? &name : nullptr;
+        // a bare '~' followed by a letter would read back as one surface name
+        prev = (k == 0 && !with_ids && (ends_letters || name == "~")) ? &name : nullptr;
     }
     return out;
 }

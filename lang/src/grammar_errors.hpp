@@ -120,6 +120,9 @@ template <> inline constexpr bool is_nesting<call_args> = true;
 template <> inline constexpr bool is_nesting<module_args> = true;
 template <> inline constexpr bool is_nesting<block> = true;
 template <> inline constexpr bool is_nesting<instance_body> = true;
+template <> inline constexpr bool is_nesting<ternary_then> = true;
+template <> inline constexpr bool is_nesting<ternary_else> = true;
+template <> inline constexpr bool is_nesting<else_part> = true;
 inline constexpr std::size_t max_nesting = 200;
 
 // Byte offsets of the constructs open at the current point of the parse.

@@ -39,6 +39,8 @@ using selector = pt::selector<
 
 namespace {
 
+constexpr std::size_t kMaxChain = 1000;
+
 class Lowering {
 public:
     Lowering(std::uint32_t file, Diagnostics& diags) : file_(file), diags_(diags) {}
@@ -108,7 +110,12 @@ public:
             return cur;
         } else if (n.is_type<g::mul>() || n.is_type<g::add>() || n.is_type<g::rel>() || n.is_type<g::eqx>() ||
                    n.is_type<g::and_x>() || n.is_type<g::or_x>()) {
-            // operand (op operand)*, left associative
+            // operand (op operand)*, left associative; the tree is as deep as the chain is long,
+            // and everything that walks it recurses, so very long chains are refused
+            if (n.children.size() > 2 * kMaxChain) {
+                diags_.error(e->span, fmt::format("more than {} operands in a row; split the expression", kMaxChain));
+                return e;
+            }
             ast::ExprPtr cur = expr(*n.children.at(0));
             for (std::size_t i = 1; i + 1 < n.children.size(); i += 2) {
                 auto be = std::make_unique<ast::Expr>();
@@ -250,6 +257,9 @@ public:
             const Node& pat = *parts[k].pat;
             ast::ModuleList list = module_list(pat);
             bool wildcard = list.size() == 1 && list[0].name == "*";
+            if (!wildcard)
+                for (const auto& m : list)
+                    if (m.name == "*") diags_.error(m.span, "'*' stands for a whole context, not for one module in it");
             std::string role;
             if (k < strict) {
                 role = parts[k + 1].op_before; // the operator after this part says what it is
@@ -481,6 +491,23 @@ std::string describe_found(const std::string& text, std::size_t byte) {
     return fmt::format("'{}'", static_cast<char>(c));
 }
 
+// A grammar error as a diagnostic: {at} becomes the line:column where the construct began, and
+// what was found at the error is named.
+void report(const g::GrammarError& e, const SourceFile& src, std::uint32_t file_id, Diagnostics& diags) {
+    std::string msg = e.message;
+    if (auto p = msg.find("{at}"); p != std::string::npos) {
+        std::string at = "?";
+        if (e.at != std::string::npos) {
+            LineCol a = src.line_col(static_cast<std::uint32_t>(e.at));
+            at = fmt::format("{}:{}", a.line, a.col);
+        }
+        msg.replace(p, 4, at);
+    }
+    msg += ", found " + describe_found(src.text(), e.byte);
+    auto b = static_cast<std::uint32_t>(e.byte);
+    diags.error({file_id, b, b + 1}, msg);
+}
+
 // After an error, restart at the first line that starts with a top-level keyword at or after the
 // error (the error may be the keyword itself, as when a ';' is missing at the end of the line
 // before), but always after `item_start` so that parsing makes progress.
@@ -528,18 +555,7 @@ std::unique_ptr<ast::File> parse_file(const SourceManager& sources, std::uint32_
             if (next <= offset) break;
             offset = next;
         } catch (const g::GrammarError& e) {
-            std::string msg = e.message;
-            if (auto p = msg.find("{at}"); p != std::string::npos) {
-                std::string at = "?";
-                if (e.at != std::string::npos) {
-                    LineCol a = src.line_col(static_cast<std::uint32_t>(e.at));
-                    at = fmt::format("{}:{}", a.line, a.col);
-                }
-                msg.replace(p, 4, at);
-            }
-            msg += ", found " + describe_found(text, e.byte);
-            auto b = static_cast<std::uint32_t>(e.byte);
-            diags.error({file_id, b, b + 1}, msg);
+            report(e, src, file_id, diags);
             if (++errors >= 20) break;
             offset = resync(text, e.byte, offset);
             if (offset >= text.size()) break;
@@ -563,8 +579,7 @@ ast::ExprPtr parse_expression(const SourceManager& sources, std::uint32_t file_i
         Lowering lower(file_id, diags);
         return lower.expr(*root->children.at(0));
     } catch (const g::GrammarError& e) {
-        auto b = static_cast<std::uint32_t>(e.byte);
-        diags.error({file_id, b, b + 1}, e.message + ", found " + describe_found(src.text(), e.byte));
+        report(e, src, file_id, diags);
         return nullptr;
     }
 }

@@ -266,7 +266,8 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
             if (!kept) id = env.id_base + env.new_count++;
             env.out->push(sym, p, I.n, id);
             env.produced = true;
-            if (env.out->size() > env.max_output) fail(code, pc, "the string outgrew the module limit");
+            if (env.out->size() > env.max_output || env.out->params.size() > env.max_params)
+                fail(code, pc, "the string outgrew the module limit");
             break;
         }
         case Op::ProduceEnd: env.produced = true; return RunStatus::Produced;

@@ -87,6 +87,7 @@ private:
     void decompose(ModuleString& s, int step_for_env);
     void apply_cut(ModuleString& s) const;
     void check_limits(const ModuleString& s) const;
+    void check_limits(std::size_t modules, std::size_t params) const;
 
     const Program& prog_;
     DeriveOptions opt_;

@@ -28,7 +28,8 @@ struct EvalEnv {
     std::uint32_t draw = 0;     // random draws made so far for this module
     int step = 0;
     ModuleId id = 0;
-    std::size_t max_output = ~std::size_t{0};
+    std::size_t max_output = ~std::size_t{0}; // module limit of the output
+    std::size_t max_params = ~std::size_t{0}; // parameter limit of the output
 
     // Output of production bodies.
     ModuleString* out = nullptr;

@@ -142,6 +142,16 @@ TEST_CASE("numbers print in the shortest form that reads back", "[derive]") {
     CHECK(format_double(0.707) == "0.707");
 }
 
+TEST_CASE("string output reads back as the same modules", "[derive]") {
+    CHECK(derive("axiom: ~ F ;() F;") == "~ F;()F");
+    // letter runs split by longest match over declared names, built-in ones included
+    CHECK(derive("axiom: F SetColor(1, 0, 0) FSetColor(0, 1, 0);") == "FSetColor(1,0,0)FSetColor(0,1,0)");
+    auto c = test::compile("axiom: FSetColor(1, 0, 0);");
+    Derivation d(*c->program, {});
+    d.run();
+    CHECK(d.string().size() == 2);
+}
+
 TEST_CASE("string output: modules back to back, parameters in parentheses", "[derive]") {
     CHECK(derive("module B(l, w); axiom: !(10)F(1)[&(45)B(0.6, 7.07)];") == "!(10)F(1)[&(45)B(0.6,7.07)]");
 }
