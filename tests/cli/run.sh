@@ -2,7 +2,7 @@
 # Command-line behaviour that script tests cannot reach: help on every command, usage errors,
 # unreadable input, and exit codes.
 set -u
-plant=${1:?usage: run.sh PLANT}
+plant=$(realpath "${1:?usage: run.sh PLANT}")
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 pass=0
@@ -31,7 +31,7 @@ printf 'axiom: F;\nderive 2;\nrules { F -> F+F; }\n' >"$tmp/ok.plant"
 
 check "top-level help" 0 "$plant" --help
 contains "top-level help lists derive" "$tmp/out" "derive"
-for cmd in derive check test; do
+for cmd in run derive check test; do
   check "$cmd --help" 0 "$plant" "$cmd" --help
   contains "$cmd --help shows usage" "$tmp/out" "Usage"
 done
@@ -62,6 +62,34 @@ check "explosion" 70 "$plant" derive "$tmp/boom.plant" --max-modules 1000
 contains "explosion names the step" "$tmp/err" "step 10: the string grew past the limit of 1000 modules"
 check "threads agree" 0 "$plant" derive "$tmp/ok.plant" --threads 2
 check "test of missing path" 66 "$plant" test "$tmp/none"
+
+# plant run
+printf 'surface leaf = polygon(vec3(0,0,0), vec3(1,1,0), vec3(0,2,0));\naxiom: F [ + F ~leaf(1) ] F;\n' >"$tmp/plant.plant"
+(cd "$tmp" && check "run with default outputs" 0 "$plant" run plant.plant)
+for f in out/plant.glb out/plant.png; do
+  if [ -s "$tmp/$f" ]; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL default output $f missing"; fi
+done
+check "run every format" 0 "$plant" run "$tmp/plant.plant" -o "$tmp/a.glb" -o "$tmp/a.gltf" -o "$tmp/a.obj" \
+  -o "$tmp/a.ply" -o "$tmp/a.off" -o "$tmp/a.png" -o "$tmp/a.svg" -o "$tmp/a.txt" -o "$tmp/a.skel.json" -o "$tmp/a.mesh.txt"
+for f in a.glb a.gltf a.obj a.ply a.off a.png a.svg a.txt a.skel.json a.mesh.txt; do
+  if [ -s "$tmp/$f" ]; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL output $f missing"; fi
+done
+contains "PNG signature" "$tmp/a.png" "PNG"
+contains "string output" "$tmp/a.txt" "F[+F~leaf(1)]F"
+contains "mesh summary" "$tmp/a.mesh.txt" "instances 1"
+check "unknown output format" 64 "$plant" run "$tmp/plant.plant" -o "$tmp/a.xyz"
+contains "format message" "$tmp/err" "cannot tell the format of"
+check "bad --size" 64 "$plant" run "$tmp/plant.plant" --size 10 -o "$tmp/b.png"
+mkdir -p "$tmp/ro" && chmod 555 "$tmp/ro"
+if [ "$(id -u)" -ne 0 ]; then
+  check "unwritable output" 73 "$plant" run "$tmp/plant.plant" -o "$tmp/ro/x.glb"
+fi
+printf 'axiom: F ] F;\n' >"$tmp/pop.plant"
+check "empty turtle stack" 70 "$plant" run "$tmp/pop.plant" -o "$tmp/pop.glb" -o "$tmp/pop.png"
+contains "empty stack message" "$tmp/err" "closes no '['"
+if [ -e "$tmp/pop.glb" ] || [ -e "$tmp/pop.png" ]; then fail=$((fail + 1)); echo "FAIL partial output after an error"; else pass=$((pass + 1)); fi
+printf 'axiom: F ~nothing(1);\n' >"$tmp/nosurf.plant"
+check "undeclared surface" 70 "$plant" run "$tmp/nosurf.plant" -o "$tmp/n.glb"
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
