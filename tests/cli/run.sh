@@ -8,15 +8,15 @@ trap 'rm -rf "$tmp"' EXIT
 pass=0
 fail=0
 
-check() { # check NAME EXPECTED_EXIT COMMAND... ; stderr/stdout saved in $tmp/out, $tmp/err
+check() { # check NAME EXPECTED_EXIT COMMAND... ; output saved in $tmp/stdout and $tmp/stderr
   local name=$1 want=$2
   shift 2
-  "$@" >"$tmp/out" 2>"$tmp/err"
+  "$@" >"$tmp/stdout" 2>"$tmp/stderr"
   local got=$?
   if [ "$got" -eq "$want" ]; then pass=$((pass + 1)); else
     fail=$((fail + 1))
     echo "FAIL $name: exit $got, expected $want"
-    sed 's/^/  /' "$tmp/err" | head -5
+    sed 's/^/  /' "$tmp/stderr" | head -5
   fi
 }
 contains() { # contains NAME FILE TEXT
@@ -30,10 +30,10 @@ contains() { # contains NAME FILE TEXT
 printf 'axiom: F;\nderive 2;\nrules { F -> F+F; }\n' >"$tmp/ok.plant"
 
 check "top-level help" 0 "$plant" --help
-contains "top-level help lists derive" "$tmp/out" "derive"
+contains "top-level help lists derive" "$tmp/stdout" "derive"
 for cmd in run derive check test; do
   check "$cmd --help" 0 "$plant" "$cmd" --help
-  contains "$cmd --help shows usage" "$tmp/out" "Usage"
+  contains "$cmd --help shows usage" "$tmp/stdout" "Usage"
 done
 check "no command" 64 "$plant"
 check "unknown command" 64 "$plant" grow
@@ -41,25 +41,25 @@ check "unknown option" 64 "$plant" derive "$tmp/ok.plant" --frobnicate
 check "bad -n" 64 "$plant" derive "$tmp/ok.plant" -n minus
 check "bad -D" 64 "$plant" derive "$tmp/ok.plant" -D nothing
 check "missing file" 66 "$plant" derive "$tmp/none.plant"
-contains "missing file message" "$tmp/err" "cannot read '$tmp/none.plant': no such file"
+contains "missing file message" "$tmp/stderr" "cannot read '$tmp/none.plant': no such file"
 check "directory as file" 66 "$plant" check "$tmp"
 check "derive ok" 0 "$plant" derive "$tmp/ok.plant"
-contains "derive output" "$tmp/out" "F+F+F+F"
+contains "derive output" "$tmp/stdout" "F+F+F+F"
 check "derive -n" 0 "$plant" derive "$tmp/ok.plant" -n 1
-contains "derive -n output" "$tmp/out" "F+F"
+contains "derive -n output" "$tmp/stdout" "F+F"
 check "derive --stats" 0 "$plant" derive "$tmp/ok.plant" --stats
-contains "stats total line" "$tmp/out" "total steps=2 modules=7"
+contains "stats total line" "$tmp/stdout" "total steps=2 modules=7"
 check "check ok" 0 "$plant" check "$tmp/ok.plant"
 head -c 4096 /dev/urandom >"$tmp/garbage.plant"
 printf '\x00\x01binary' >>"$tmp/garbage.plant"
 check "binary garbage" 65 "$plant" derive "$tmp/garbage.plant"
-contains "binary garbage is positioned" "$tmp/err" "garbage.plant:1:"
+contains "binary garbage is positioned" "$tmp/stderr" "garbage.plant:1:"
 : >"$tmp/empty.plant"
 check "empty file" 65 "$plant" derive "$tmp/empty.plant"
-contains "empty file message" "$tmp/err" "the grammar has no axiom"
+contains "empty file message" "$tmp/stderr" "the grammar has no axiom"
 printf 'axiom: F;\nderive 40;\nrules { F -> FF; }\n' >"$tmp/boom.plant"
 check "explosion" 70 "$plant" derive "$tmp/boom.plant" --max-modules 1000
-contains "explosion names the step" "$tmp/err" "step 10: the string grew past the limit of 1000 modules"
+contains "explosion names the step" "$tmp/stderr" "step 10: the string grew past the limit of 1000 modules"
 check "threads agree" 0 "$plant" derive "$tmp/ok.plant" --threads 2
 check "test of missing path" 66 "$plant" test "$tmp/none"
 
@@ -78,7 +78,7 @@ contains "PNG signature" "$tmp/a.png" "PNG"
 contains "string output" "$tmp/a.txt" "F[+F~leaf(1)]F"
 contains "mesh summary" "$tmp/a.mesh.txt" "instances 1"
 check "unknown output format" 64 "$plant" run "$tmp/plant.plant" -o "$tmp/a.xyz"
-contains "format message" "$tmp/err" "cannot tell the format of"
+contains "format message" "$tmp/stderr" "cannot tell the format of"
 check "bad --size" 64 "$plant" run "$tmp/plant.plant" --size 10 -o "$tmp/b.png"
 mkdir -p "$tmp/ro" && chmod 555 "$tmp/ro"
 if [ "$(id -u)" -ne 0 ]; then
@@ -86,7 +86,7 @@ if [ "$(id -u)" -ne 0 ]; then
 fi
 printf 'axiom: F ] F;\n' >"$tmp/pop.plant"
 check "empty turtle stack" 70 "$plant" run "$tmp/pop.plant" -o "$tmp/pop.glb" -o "$tmp/pop.png"
-contains "empty stack message" "$tmp/err" "closes no '['"
+contains "empty stack message" "$tmp/stderr" "closes no '['"
 if [ -e "$tmp/pop.glb" ] || [ -e "$tmp/pop.png" ]; then fail=$((fail + 1)); echo "FAIL partial output after an error"; else pass=$((pass + 1)); fi
 printf 'axiom: F ~nothing(1);\n' >"$tmp/nosurf.plant"
 check "undeclared surface" 70 "$plant" run "$tmp/nosurf.plant" -o "$tmp/n.glb"
