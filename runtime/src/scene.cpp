@@ -103,6 +103,7 @@ MeshPart loaded_prototype(const SurfaceDef& s) {
     mesh.request_vertex_normals();
     mesh.request_face_normals();
     omlog().disable();
+    omerr().disable(); // failures are reported as our own diagnostics
     OpenMesh::IO::Options opt;
     if (!OpenMesh::IO::read_mesh(mesh, s.path, opt))
         throw RuntimeError(s.span, fmt::format("cannot load surface '{}' from '{}'", s.name, s.path));

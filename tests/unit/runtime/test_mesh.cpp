@@ -161,3 +161,23 @@ TEST_CASE("the scene shares organ prototypes between placements and bounds inclu
     CHECK(s.bounds_max.y >= 3.0f + 2.0f * 1.0f - 1e-4f); // the top leaf (length 2, scale 2) reaches y = 3 + 4
     CHECK(s.tubes.triangle_count() > 0);
 }
+
+TEST_CASE("a surface loaded from a file is meshed once and placed by transform", "[mesh]") {
+    auto c = test::compile(std::string("surface leaf = load(\"") + PLANT_TEST_DATA + "/leaf.obj\"); axiom: F ~leaf(2) F ~leaf(1);");
+    REQUIRE(c->program);
+    Derivation d(*c->program, {});
+    d.run();
+    Skeleton sk = build_skeleton(*c->program, d.string(), TurtleOptions{});
+    Scene s = build_scene(*c->program, sk, MeshOptions{});
+    REQUIRE(s.prototypes.size() == 1);
+    CHECK(s.prototypes[0].triangle_count() == 2);
+    CHECK(s.instances.size() == 2);
+    CHECK(s.bounds_max.y == Approx(1.0f + 2 * 1.2f)); // the first leaf, at y = 1 and scaled by 2, reaches highest
+    auto bad = test::compile("surface leaf = load(\"/nonexistent/leaf.obj\"); axiom: ~leaf(1);");
+    REQUIRE(bad->program);
+    Derivation d2(*bad->program, {});
+    d2.run();
+    Skeleton sk2 = build_skeleton(*bad->program, d2.string(), TurtleOptions{});
+    CHECK_THROWS_WITH(build_scene(*bad->program, sk2, MeshOptions{}),
+                      "cannot load surface 'leaf' from '/nonexistent/leaf.obj'");
+}
