@@ -66,6 +66,23 @@ void remove_quietly(const std::string& temp) {
 
 } // namespace
 
+void check_mesh_part(const MeshPart& part, const std::string& what) {
+    const std::size_t nv = part.positions.size();
+    if (!part.normals.empty() && part.normals.size() != nv)
+        throw ExportError(what + " has " + std::to_string(nv) + " positions but " + std::to_string(part.normals.size()) +
+                          " normals");
+    if (!part.uvs.empty() && part.uvs.size() != nv)
+        throw ExportError(what + " has " + std::to_string(nv) + " positions but " + std::to_string(part.uvs.size()) +
+                          " texture coordinates");
+    if (part.indices.size() % 3 != 0)
+        throw ExportError(what + " has an index count (" + std::to_string(part.indices.size()) +
+                          ") that is not a multiple of 3");
+    for (std::uint32_t i : part.indices)
+        if (i >= nv)
+            throw ExportError(what + " has index " + std::to_string(i) + " but only " + std::to_string(nv) +
+                              " vertices");
+}
+
 void write_file_atomically(const std::string& path, const std::string& bytes) {
     std::FILE* file = nullptr;
     const std::string temp = create_temp_beside(path, file);
@@ -177,22 +194,9 @@ struct GltfBuilder {
     // Adds `part` as one mesh and returns its index, or -1 when it has no triangles.
     int add_mesh(const MeshPart& part, const std::string& name) {
         const std::size_t nv = part.positions.size();
-        if (!part.normals.empty() && part.normals.size() != nv)
-            throw ExportError("glTF export: " + name + " has " + std::to_string(nv) +
-                              " positions but " + std::to_string(part.normals.size()) + " normals");
-        if (!part.uvs.empty() && part.uvs.size() != nv)
-            throw ExportError("glTF export: " + name + " has " + std::to_string(nv) +
-                              " positions but " + std::to_string(part.uvs.size()) +
-                              " texture coordinates");
-        if (part.indices.size() % 3 != 0)
-            throw ExportError("glTF export: " + name + " has an index count (" +
-                              std::to_string(part.indices.size()) + ") that is not a multiple of 3");
+        check_mesh_part(part, "glTF export: " + name);
         if (nv > std::numeric_limits<std::uint32_t>::max())
             throw ExportError("glTF export: " + name + " has too many vertices");
-        for (std::uint32_t i : part.indices)
-            if (i >= nv)
-                throw ExportError("glTF export: " + name + " has index " + std::to_string(i) +
-                                  " but only " + std::to_string(nv) + " vertices");
 
         // A part without primitives is drawn whole with material 0.
         std::vector<Primitive> prims = part.primitives;

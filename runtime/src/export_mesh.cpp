@@ -51,20 +51,7 @@ public:
 
     void add(const MeshPart& part, const glm::mat4& m, bool identity, const std::string& name) {
         const std::size_t nv = part.positions.size();
-        if (!part.normals.empty() && part.normals.size() != nv)
-            throw ExportError("mesh export: " + name + " has " + std::to_string(nv) +
-                              " positions but " + std::to_string(part.normals.size()) + " normals");
-        if (!part.uvs.empty() && part.uvs.size() != nv)
-            throw ExportError("mesh export: " + name + " has " + std::to_string(nv) +
-                              " positions but " + std::to_string(part.uvs.size()) +
-                              " texture coordinates");
-        if (part.indices.size() % 3 != 0)
-            throw ExportError("mesh export: " + name + " has an index count (" +
-                              std::to_string(part.indices.size()) + ") that is not a multiple of 3");
-        for (std::uint32_t i : part.indices)
-            if (i >= nv)
-                throw ExportError("mesh export: " + name + " has index " + std::to_string(i) +
-                                  " but only " + std::to_string(nv) + " vertices");
+        check_mesh_part(part, "mesh export: " + name);
         if (part.indices.empty()) return;
 
         const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(m)));

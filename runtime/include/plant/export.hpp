@@ -13,6 +13,10 @@ struct ExportError : std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
+// Throws ExportError, naming `what` ("glTF export: tubes"), when the part's arrays disagree:
+// normals or uvs present but not one per position, a partial triangle, an index out of range.
+void check_mesh_part(const MeshPart& part, const std::string& what);
+
 // Writes `bytes` to `path` through a temporary file and a rename.
 void write_file_atomically(const std::string& path, const std::string& bytes);
 

@@ -1,0 +1,105 @@
+// The module string's helpers and its printed form (LANGUAGE.md section 11).
+#include "plant/derive.hpp"
+
+#include <fmt/format.h>
+
+#include <charconv>
+#include <cstring>
+#include <unordered_set>
+
+namespace plant {
+
+void ModuleString::append_range(const ModuleString& o, std::size_t b, std::size_t e) {
+    if (b >= e) return;
+    if (e - b == 1) { // the common case in context-sensitive grammars: one module between rewrites
+        sym.push_back(o.sym[b]);
+        ids.push_back(o.ids[b]);
+        for (std::uint32_t k = o.poff[b]; k < o.poff[e]; ++k) params.push_back(o.params[k]);
+        poff.push_back(static_cast<std::uint32_t>(params.size()));
+        return;
+    }
+    const std::size_t n = e - b, m0 = sym.size(), p0 = params.size();
+    const std::uint32_t pb = o.poff[b], pe = o.poff[e];
+    sym.resize(m0 + n);
+    ids.resize(m0 + n);
+    poff.resize(m0 + n + 1);
+    params.resize(p0 + (pe - pb));
+    std::memcpy(sym.data() + m0, o.sym.data() + b, n * sizeof(SymbolId));
+    std::memcpy(ids.data() + m0, o.ids.data() + b, n * sizeof(ModuleId));
+    if (pe > pb) std::memcpy(params.data() + p0, o.params.data() + pb, (pe - pb) * sizeof(double));
+    const auto shift = static_cast<std::uint32_t>(p0 - pb); // unsigned wrap-around is intended
+    std::uint32_t* dst = poff.data() + m0 + 1;
+    const std::uint32_t* src = o.poff.data() + b + 1;
+    for (std::size_t i = 0; i < n; ++i) dst[i] = src[i] + shift;
+}
+
+std::vector<std::uint32_t> bracket_table(const ModuleString& s, SymbolId open, SymbolId close) {
+    const auto n = static_cast<std::uint32_t>(s.size());
+    std::vector<std::uint32_t> match(s.size(), n);
+    std::vector<std::uint32_t> stack;
+    for (std::uint32_t i = 0; i < n; ++i) {
+        if (s.sym[i] == open) {
+            stack.push_back(i);
+        } else if (s.sym[i] == close && !stack.empty()) {
+            match[i] = stack.back();
+            match[stack.back()] = i;
+            stack.pop_back();
+        }
+    }
+    return match;
+}
+
+// ---- printing --------------------------------------------------------------------------------
+
+std::string format_double(double v) {
+    if (v == 0) return "0"; // also for -0
+    char buf[64];
+    auto r = std::to_chars(buf, buf + sizeof buf, v);
+    std::string s(buf, r.ptr);
+    // to_chars writes exponents as e+21 and e-07; the shortest reading-back form is e21 and e-7
+    if (auto e = s.find('e'); e != std::string::npos) {
+        std::string mant = s.substr(0, e), exp = s.substr(e + 1);
+        bool neg = !exp.empty() && exp[0] == '-';
+        if (!exp.empty() && (exp[0] == '+' || exp[0] == '-')) exp.erase(0, 1);
+        while (exp.size() > 1 && exp[0] == '0') exp.erase(0, 1);
+        s = mant + "e" + (neg ? "-" : "") + exp;
+    }
+    return s;
+}
+
+std::string format_string(const Program& program, const ModuleString& s, bool with_ids) {
+    std::string out;
+    out.reserve(s.size() * 2);
+    // Prefixes of declared multi-letter names: "F" then "b" must be spaced when "Fb..." is declared.
+    std::unordered_set<std::string> prefixes;
+    for (const auto& info : program.symbols.all())
+        if (info.declared && info.name.size() > 1 && std::isalpha(static_cast<unsigned char>(info.name[0])))
+            for (std::size_t l = 2; l <= info.name.size(); ++l) prefixes.insert(info.name.substr(0, l));
+    const std::string* prev = nullptr; // name of the previous module when it ends in a letter run
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        const std::string& name = program.symbols[s.sym[i]].name;
+        bool letter_start = !name.empty() && (std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_');
+        // a space only where reading back would merge two names
+        if (prev && letter_start) {
+            if (prev->size() > 1 || *prev == "~" || prefixes.count(*prev + name[0])) out += ' ';
+        }
+        out += name;
+        std::uint32_t k = s.arity(i);
+        if (k > 0 || name == ";") { // a bare ';' would end the statement when read back
+            out += '(';
+            const double* a = s.args(i);
+            for (std::uint32_t j = 0; j < k; ++j) {
+                if (j) out += ',';
+                out += format_double(a[j]);
+            }
+            out += ')';
+        }
+        if (with_ids) out += fmt::format("#{}", s.ids[i]);
+        bool ends_letters = !name.empty() && (std::isalnum(static_cast<unsigned char>(name.back())) || name.back() == '_');
+        // a bare '~' followed by a letter would read back as one surface name
+        prev = (k == 0 && !with_ids && (ends_letters || name == "~")) ? &name : nullptr;
+    }
+    return out;
+}
+
+} // namespace plant

@@ -1,0 +1,648 @@
+// One rewriting pass over the module string: matching (tree-aware context, new context,
+// conditions), stochastic choice, successor templates, the direct path that writes in place.
+// Private to derive.cpp, which runs it on one or several threads.
+#pragma once
+
+#include "plant/derive.hpp"
+#include "plant/random.hpp"
+#include "plant/vm.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <cstring>
+#include <optional>
+#include <span>
+
+namespace plant {
+
+constexpr std::uint64_t kChoiceDraw = 0xffffffffULL; // draw index of the stochastic choice
+
+// Everything one thread needs to rewrite a stretch of the string.
+constexpr std::int64_t kUnknown = -2;
+
+struct Worker {
+    EvalEnv env;
+    std::vector<double> frame;
+    ModuleString out;
+    std::optional<RuntimeError> error;
+    // context neighbours of the module at ctx_at, found once for all its productions
+    std::size_t ctx_at = ~std::size_t{0};
+    std::int64_t ctx_left = kUnknown, ctx_right = kUnknown;
+};
+
+class Rewriter {
+public:
+    Rewriter(const Program& p, const ModuleString& in, const std::vector<const RuleSet*>& sets)
+        : P(p), in(in), sets(sets), n(in.size()) {
+        bool brackets = false;
+        std::size_t frame = 1;
+        has_prod.assign(P.symbols.size(), 0);
+        for (const RuleSet* rs : sets) {
+            brackets = brackets || rs->needs_brackets || rs->uses_left_new || rs->uses_right_new;
+            for (const auto& pr : rs->productions) {
+                frame = std::max<std::size_t>(frame, pr.frame_size);
+                has_prod[pr.strict[0].sym] = 1;
+                if (pr.strict.size() > 1) multi = true;
+            }
+            left_new = left_new || rs->uses_left_new;
+            right_new = right_new || rs->uses_right_new;
+        }
+        frame_size = frame;
+        if (brackets) match = bracket_table(in, P.symbols.open_bracket, P.symbols.close_bracket);
+        // A symbol whose first production always applies (no condition, context or weight, one
+        // predecessor module whose arguments are all bound) needs no matching: with the right
+        // number of parameters, its template is applied at once.
+        direct.assign(P.symbols.size(), nullptr);
+        for (SymbolId s = 0; s < P.symbols.size(); ++s) {
+            for (const RuleSet* rs : sets) {
+                if (rs->by_symbol[s].empty()) continue;
+                const Production& pr = rs->productions[rs->by_symbol[s][0]];
+                bool binds_all = pr.strict.size() == 1;
+                for (const auto& a : pr.strict[0].args) binds_all = binds_all && a.bind;
+                if (binds_all && pr.condition.empty() && pr.weight.empty() && !pr.has_context() &&
+                    !pr.has_new_context() && pr.tmpl.valid)
+                    direct[s] = &pr;
+                break;
+            }
+        }
+    }
+
+    bool sequential() const { return multi || left_new || right_new; }
+
+    // ---- the direct path: every module is copied or rewritten by a direct template ----------
+    // Then the size of the output of any stretch is known before writing it, so the output is
+    // allocated once, exactly, and each thread writes its stretch in place.
+    struct Counts {
+        std::size_t modules = 0, params = 0;
+        ModuleId new_ids = 0;
+        bool ok = true;
+    };
+
+    Counts count_direct(std::size_t b, std::size_t e) const {
+        Counts c;
+        for (std::size_t i = b; i < e; ++i) {
+            const SymbolId s = in.sym[i];
+            if (!has_prod[s]) {
+                ++c.modules;
+                c.params += in.arity(i);
+                continue;
+            }
+            const Production* pr = direct[s];
+            if (!pr || in.arity(i) != pr->strict[0].width) {
+                c.ok = false;
+                return c;
+            }
+            c.modules += pr->tmpl.syms.size();
+            c.params += pr->tmpl.params.size();
+            c.new_ids += pr->tmpl.syms.size() - (pr->tmpl.keep >= 0 ? 1 : 0);
+        }
+        return c;
+    }
+
+    // Writes the output of modules [b, e) at module m_at and parameter p_at of `out`, whose
+    // arrays are already sized; new identities are numbered from id_at.
+    void write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at, std::size_t p_at,
+                      ModuleId id_at) {
+        w.frame.assign(frame_size, 0.0);
+        SymbolId* S = out.sym.data() + m_at;
+        ModuleId* ID = out.ids.data() + m_at;
+        std::uint32_t* PO = out.poff.data() + m_at + 1; // poff[m_at] is the previous stretch's end
+        double* PA = out.params.data() + p_at;
+        std::size_t p = p_at;
+        double values[256];
+        std::size_t i = b;
+        while (i < e) {
+            if (!has_prod[in.sym[i]]) { // a run of modules without productions: copy it
+                std::size_t j = i + 1;
+                while (j < e && !has_prod[in.sym[j]]) ++j;
+                const std::size_t n = j - i;
+                const std::uint32_t pb = in.poff[i], pe = in.poff[j];
+                std::memcpy(S, in.sym.data() + i, n * sizeof(SymbolId));
+                std::memcpy(ID, in.ids.data() + i, n * sizeof(ModuleId));
+                if (pe > pb) std::memcpy(PA, in.params.data() + pb, (pe - pb) * sizeof(double));
+                const auto shift = static_cast<std::uint32_t>(p - pb); // wraps around on purpose
+                for (std::size_t k = 0; k < n; ++k) PO[k] = in.poff[i + 1 + k] + shift;
+                S += n;
+                ID += n;
+                PO += n;
+                PA += pe - pb;
+                p += pe - pb;
+                i = j;
+                continue;
+            }
+            const Production& pr = *direct[in.sym[i]];
+            const SuccessorTemplate& t = pr.tmpl;
+            if (!t.holes.empty()) {
+                const double* a = in.args(i);
+                for (const auto& pa : pr.strict[0].args) {
+                    for (int k = 0; k < pa.width; ++k) w.frame[pa.slot + k] = a[k];
+                    a += pa.width;
+                }
+                w.env.position = i;
+                w.env.draw = 0;
+                w.env.id = in.ids[i];
+                w.env.out = nullptr;
+                compute_holes(w, t, values);
+                check_holes(t, values);
+            }
+            const std::size_t m = t.syms.size();
+            std::memcpy(S, t.syms.data(), m * sizeof(SymbolId));
+            std::memcpy(PA, t.params.data(), t.params.size() * sizeof(double));
+            for (std::size_t h = 0; h < t.holes.size(); ++h) PA[t.holes[h]] = values[h];
+            for (std::size_t j = 0; j < m; ++j) {
+                PO[j] = static_cast<std::uint32_t>(p + t.param_end[j]);
+                ID[j] = static_cast<int>(j) == t.keep ? in.ids[i] : id_at++;
+            }
+            S += m;
+            ID += m;
+            PO += m;
+            PA += t.params.size();
+            p += t.params.size();
+            ++i;
+        }
+    }
+
+    void compute_holes(Worker& w, const SuccessorTemplate& t, double* values) const {
+        if (t.affine.empty()) {
+            run(t.values, w.frame.data(), w.env, values);
+            return;
+        }
+        const double* f = w.frame.data();
+        for (std::size_t h = 0; h < t.affine.size(); ++h) {
+            const auto& a = t.affine[h];
+            values[h] = a.kind == a.Copy ? f[a.slot] : a.kind == a.Mul ? f[a.slot] * a.constant : f[a.slot] + a.constant;
+        }
+    }
+
+    void check_holes(const SuccessorTemplate& t, const double* values) const {
+        for (std::size_t h = 0; h < t.holes.size(); ++h) {
+            if (std::isfinite(values[h])) continue;
+            std::size_t j = 0;
+            while (t.param_end[j] <= t.holes[h]) ++j;
+            std::uint32_t k = t.holes[h] - (j ? t.param_end[j - 1] : 0);
+            throw RuntimeError{t.hole_spans[h], fmt::format("parameter {} of '{}' is {}", k + 1,
+                                                            P.symbols[t.syms[j]].name,
+                                                            std::isnan(values[h]) ? "NaN" : "infinite")};
+        }
+    }
+
+    // Rewrites modules [b, e) into w.out.
+    void run_range(Worker& w, std::size_t b, std::size_t e) {
+        w.frame.assign(frame_size, 0.0);
+        std::size_t i = b;
+        while (i < e) {
+            if (!has_prod[in.sym[i]]) {
+                std::size_t j = i + 1;
+                while (j < e && !has_prod[in.sym[j]]) ++j;
+                w.out.append_range(in, i, j);
+                i = j;
+                if (w.out.size() > w.env.max_output || w.out.params.size() > w.env.max_params) limit_error(w);
+                continue;
+            }
+            if (const Production* pr = direct[in.sym[i]]; pr && in.arity(i) == pr->strict[0].width) {
+                if (!pr->tmpl.holes.empty()) {
+                    const double* a = in.args(i);
+                    for (const auto& pa : pr->strict[0].args) {
+                        for (int k = 0; k < pa.width; ++k) w.frame[pa.slot + k] = a[k];
+                        a += pa.width;
+                    }
+                    w.env.position = i;
+                    w.env.draw = 0;
+                    w.env.id = in.ids[i];
+                }
+                apply_template(w, i, *pr);
+                ++i;
+                continue;
+            }
+            std::size_t used = apply(w, i);
+            if (used == 0) {
+                w.out.append_range(in, i, i + 1);
+                used = 1;
+            }
+            i += used;
+        }
+    }
+
+    // Backward processing for `>>`: modules right to left; each successor becomes a piece and
+    // the new string to the right is the pieces made so far, newest first.
+    void run_backward(Worker& w) {
+        w.frame.assign(frame_size, 0.0);
+        piece_starts.clear();
+        // Going right to left, a predecessor is found by its last module.
+        std::vector<std::vector<std::pair<std::size_t, std::size_t>>> by_last(P.symbols.size());
+        for (std::size_t si = 0; si < sets.size(); ++si)
+            for (std::size_t pi = 0; pi < sets[si]->productions.size(); ++pi)
+                by_last[sets[si]->productions[pi].strict.back().sym].emplace_back(si, pi);
+        std::size_t k = n;
+        while (k-- > 0) {
+            piece_starts.push_back(w.out.size());
+            std::size_t used = 0;
+            for (const auto& [si, pi] : by_last[in.sym[k]]) {
+                const Production& pr = sets[si]->productions[pi];
+                const std::size_t len = pr.strict.size();
+                if (len > k + 1) continue;
+                const std::size_t start = k + 1 - len;
+                w.env.position = start;
+                w.env.draw = 0;
+                w.env.id = in.ids[start];
+                if (!matches(w, start, pr)) continue;
+                if (!pr.weight.empty()) {
+                    const auto& cands = sets[si]->by_symbol[pr.strict[0].sym];
+                    std::size_t ci = 0;
+                    while (ci < cands.size() && cands[ci] != pi) ++ci;
+                    used = choose(w, start, si, ci, len); // only predecessors that end at k
+                } else {
+                    used = run_body(w, start, pr);
+                }
+                if (used) break;
+            }
+            if (used == 0) {
+                w.out.append_range(in, k, k + 1);
+            } else {
+                k -= used - 1; // the predecessor's other modules are consumed too
+            }
+        }
+        piece_starts.push_back(w.out.size());
+    }
+
+    ModuleString assemble_backward(const ModuleString& pieces) const {
+        ModuleString out;
+        for (std::size_t p = piece_starts.size() - 1; p-- > 0;) out.append_range(pieces, piece_starts[p], piece_starts[p + 1]);
+        return out;
+    }
+
+private:
+    [[noreturn]] void limit_error(Worker& w) const {
+        (void)w;
+        throw RuntimeError{Span{}, "module limit"};
+    }
+
+    bool match_module(std::size_t j, const PatternModule& pm, double* frame) const {
+        return match_in(in, j, pm, frame);
+    }
+
+    // The next module of a left context at or before j: a ']' skips its whole branch, a '['
+    // is stepped over to the parent, ignored modules are stepped over. -1 when there is none.
+    std::int64_t left_step(std::int64_t j) const {
+        while (j >= 0) {
+            SymbolId s = in.sym[static_cast<std::size_t>(j)];
+            if (s == P.symbols.close_bracket) {
+                std::uint32_t m = match[static_cast<std::size_t>(j)];
+                if (m >= n) return -1;
+                j = static_cast<std::int64_t>(m) - 1;
+            } else if (s == P.symbols.open_bracket || P.ignored[s]) {
+                --j;
+            } else {
+                return j;
+            }
+        }
+        return -1;
+    }
+
+    // Matches the left context whose last module is at j (as found by left_step).
+    bool match_left_from(std::int64_t j, const std::vector<PatternModule>& pats, double* frame) const {
+        for (std::size_t k = pats.size(); k-- > 0;) {
+            if (j < 0 || !match_module(static_cast<std::size_t>(j), pats[k], frame)) return false;
+            if (k > 0) j = left_step(j - 1);
+        }
+        return true;
+    }
+
+    // The next module of a right context at or after j, for a pattern module that is not a
+    // bracket: lateral branches are skipped, the end of the branch ends the context. n if none.
+    std::size_t right_step(std::size_t j) const {
+        const SymbolId open = P.symbols.open_bracket, close = P.symbols.close_bracket;
+        while (j < n) {
+            SymbolId s = in.sym[j];
+            if (s == open) {
+                if (match[j] >= n) return n;
+                j = match[j] + 1;
+            } else if (s == close) {
+                return n;
+            } else if (P.ignored[s]) {
+                ++j;
+            } else {
+                return j;
+            }
+        }
+        return n;
+    }
+
+    bool match_right(std::size_t e, std::span<const PatternModule> pats, double* frame) const {
+        std::size_t j = e;
+        const SymbolId open = P.symbols.open_bracket, close = P.symbols.close_bracket;
+        for (const auto& p : pats) {
+            if (p.sym == open) {
+                while (j < n && P.ignored[in.sym[j]]) ++j;
+                if (j >= n || in.sym[j] != open) return false;
+                ++j;
+                continue;
+            }
+            if (p.sym == close) { // skip the rest of the current branch
+                while (j < n && in.sym[j] != close) {
+                    if (in.sym[j] == open) {
+                        if (match[j] >= n) return false;
+                        j = match[j] + 1;
+                    } else {
+                        ++j;
+                    }
+                }
+                if (j >= n) return false;
+                ++j;
+                continue;
+            }
+            j = right_step(j);
+            if (j >= n || !match_module(j, p, frame)) return false;
+            ++j;
+        }
+        return true;
+    }
+
+    // Left context in the new string (forward processing): the output made so far.
+    bool match_left_new(const ModuleString& out, const std::vector<PatternModule>& pats, double* frame) const {
+        const SymbolId open = P.symbols.open_bracket, close = P.symbols.close_bracket;
+        auto j = static_cast<std::int64_t>(out.size()) - 1;
+        for (std::size_t k = pats.size(); k-- > 0;) {
+            for (;;) {
+                if (j < 0) return false;
+                SymbolId s = out.sym[static_cast<std::size_t>(j)];
+                if (s == close) { // skip the whole preceding branch
+                    int depth = 0;
+                    for (; j >= 0; --j) {
+                        SymbolId t = out.sym[static_cast<std::size_t>(j)];
+                        if (t == close) ++depth;
+                        else if (t == open && --depth == 0) break;
+                    }
+                    if (j < 0) return false;
+                    --j;
+                } else if (s == open || P.ignored[s]) {
+                    --j;
+                } else {
+                    break;
+                }
+            }
+            if (!match_in(out, static_cast<std::size_t>(j), pats[k], frame)) return false;
+            --j;
+        }
+        return true;
+    }
+
+    // Walks the new string to the right of the module being rewritten in backward processing:
+    // the pieces made so far, the newest (the right neighbour's successor) first.
+    struct PieceIter {
+        const std::vector<std::size_t>& ps;
+        std::size_t p = 0, i = 0;
+        bool valid = false;
+        explicit PieceIter(const std::vector<std::size_t>& starts) : ps(starts) {
+            if (ps.size() >= 2) {
+                p = ps.size() - 2;
+                i = ps[p];
+                valid = true;
+                normalize();
+            }
+        }
+        void normalize() {
+            while (valid && i >= ps[p + 1]) {
+                if (p == 0) {
+                    valid = false;
+                    break;
+                }
+                --p;
+                i = ps[p];
+            }
+        }
+        void next() {
+            ++i;
+            normalize();
+        }
+    };
+
+    bool match_right_new(const ModuleString& out, const std::vector<PatternModule>& pats, double* frame) const {
+        const SymbolId open = P.symbols.open_bracket, close = P.symbols.close_bracket;
+        PieceIter it(piece_starts);
+        for (const auto& pat : pats) {
+            for (;;) {
+                if (!it.valid) return false;
+                SymbolId s = out.sym[it.i];
+                if (s == open && pat.sym != open) { // skip the lateral branch
+                    int depth = 0;
+                    for (; it.valid; it.next()) {
+                        SymbolId t = out.sym[it.i];
+                        if (t == open) ++depth;
+                        else if (t == close && --depth == 0) break;
+                    }
+                    if (!it.valid) return false;
+                    it.next();
+                } else if (s == close && pat.sym != close) {
+                    return false;
+                } else if (s != open && s != close && P.ignored[s]) {
+                    it.next();
+                } else {
+                    break;
+                }
+            }
+            if (!match_in(out, it.i, pat, frame)) return false;
+            it.next();
+        }
+        return true;
+    }
+
+    bool match_in(const ModuleString& s, std::size_t j, const PatternModule& pm, double* frame) const {
+        if (s.sym[j] != pm.sym || s.arity(j) != pm.width) return false;
+        const double* a = s.args(j);
+        for (const auto& pa : pm.args) {
+            if (pa.bind) {
+                for (int k = 0; k < pa.width; ++k) frame[pa.slot + k] = a[k];
+            } else if (!std::isnan(pa.value) && a[0] != pa.value) {
+                return false;
+            }
+            a += pa.width;
+        }
+        return true;
+    }
+
+    // Pattern, context and condition. Binds the frame.
+    bool matches(Worker& w, std::size_t i, const Production& pr) {
+        double* frame = w.frame.data();
+        for (std::size_t k = 0; k < pr.strict.size(); ++k)
+            if (i + k >= n || !match_module(i + k, pr.strict[k], frame)) return false;
+        if (!pr.left.empty() || !pr.right.empty()) {
+            // the neighbours found by scanning are the same for every production tried at i
+            if (w.ctx_at != i) {
+                w.ctx_at = i;
+                w.ctx_left = kUnknown;
+                w.ctx_right = kUnknown;
+            }
+            if (!pr.left.empty()) {
+                if (w.ctx_left == kUnknown) w.ctx_left = left_step(static_cast<std::int64_t>(i) - 1);
+                if (!match_left_from(w.ctx_left, pr.left, frame)) return false;
+            }
+            if (!pr.right.empty()) {
+                const std::size_t e = i + pr.strict.size();
+                if (pr.strict.size() == 1 && pr.right[0].sym != P.symbols.open_bracket &&
+                    pr.right[0].sym != P.symbols.close_bracket) {
+                    if (w.ctx_right == kUnknown) w.ctx_right = static_cast<std::int64_t>(right_step(e));
+                    if (static_cast<std::size_t>(w.ctx_right) >= n ||
+                        !match_module(static_cast<std::size_t>(w.ctx_right), pr.right[0], frame))
+                        return false;
+                    if (pr.right.size() > 1 &&
+                        !match_right(static_cast<std::size_t>(w.ctx_right) + 1,
+                                     std::span<const PatternModule>(pr.right).subspan(1), frame))
+                        return false;
+                } else if (!match_right(e, pr.right, frame)) {
+                    return false;
+                }
+            }
+        }
+        if (!pr.left_new.empty() && !match_left_new(w.out, pr.left_new, frame)) return false;
+        if (!pr.right_new.empty() && !match_right_new(w.out, pr.right_new, frame)) return false;
+        if (!pr.condition.empty() && eval_number(pr.condition, frame, w.env) == 0) return false;
+        return true;
+    }
+
+    // Tries the productions for module i; returns the number of modules consumed (0: none applied).
+    std::size_t apply(Worker& w, std::size_t i) {
+        EvalEnv& env = w.env;
+        env.position = i;
+        env.draw = 0;
+        env.id = in.ids[i];
+        const SymbolId sym = in.sym[i];
+        for (std::size_t si = 0; si < sets.size(); ++si) {
+            const RuleSet& rs = *sets[si];
+            const auto& cands = rs.by_symbol[sym];
+            for (std::size_t ci = 0; ci < cands.size(); ++ci) {
+                const Production& pr = rs.productions[cands[ci]];
+                if (!matches(w, i, pr)) continue;
+                if (!pr.weight.empty()) return choose(w, i, si, ci);
+                if (std::size_t used = run_body(w, i, pr)) return used;
+            }
+        }
+        return 0;
+    }
+
+    // The fast path of run_body for arrow-form successors (see SuccessorTemplate).
+    std::size_t apply_template(Worker& w, std::size_t i, const Production& pr) {
+        const SuccessorTemplate& t = pr.tmpl;
+        ModuleString& out = w.out;
+        EvalEnv& env = w.env;
+        double values[256];
+        if (!t.holes.empty()) {
+            env.out = nullptr;
+            compute_holes(w, t, values);
+            check_holes(t, values);
+        }
+        const std::size_t m = t.syms.size();
+        if (m <= 4 && t.holes.empty()) { // short constant successors: plain appends
+            for (std::size_t j = 0; j < m; ++j) {
+                out.sym.push_back(t.syms[j]);
+                for (std::uint32_t k = j ? t.param_end[j - 1] : 0; k < t.param_end[j]; ++k) out.params.push_back(t.params[k]);
+                out.poff.push_back(static_cast<std::uint32_t>(out.params.size()));
+                out.ids.push_back(static_cast<int>(j) == t.keep ? in.ids[i] : env.id_base + env.new_count++);
+            }
+            if (out.size() > env.max_output) throw RuntimeError{Span{}, "module limit"};
+            return 1;
+        }
+        const std::size_t m0 = out.sym.size();
+        const std::size_t p0 = out.params.size();
+        out.sym.resize(m0 + m);
+        out.ids.resize(m0 + m);
+        out.poff.resize(m0 + m + 1);
+        out.params.resize(p0 + t.params.size());
+        std::copy(t.syms.begin(), t.syms.end(), out.sym.begin() + static_cast<std::ptrdiff_t>(m0));
+        double* pp = out.params.data() + p0;
+        std::copy(t.params.begin(), t.params.end(), pp);
+        for (std::size_t h = 0; h < t.holes.size(); ++h) pp[t.holes[h]] = values[h];
+        std::uint32_t* po = out.poff.data() + m0 + 1;
+        ModuleId* ids = out.ids.data() + m0;
+        const auto base = static_cast<std::uint32_t>(p0);
+        for (std::size_t j = 0; j < m; ++j) {
+            po[j] = base + t.param_end[j];
+            ids[j] = static_cast<int>(j) == t.keep ? in.ids[i] : env.id_base + env.new_count++;
+        }
+        if (out.size() > env.max_output) throw RuntimeError{Span{}, "module limit"};
+        return 1;
+    }
+
+    std::size_t run_body(Worker& w, std::size_t i, const Production& pr) {
+        if (pr.tmpl.valid) return apply_template(w, i, pr);
+        EvalEnv& env = w.env;
+        SymbolId keep_syms[32];
+        ModuleId keep_ids[32];
+        const std::size_t k = std::min<std::size_t>(pr.strict.size(), 32);
+        for (std::size_t m = 0; m < k; ++m) {
+            keep_syms[m] = in.sym[i + m];
+            keep_ids[m] = in.ids[i + m];
+        }
+        env.keep_syms = keep_syms;
+        env.keep_ids = keep_ids;
+        env.keep_count = static_cast<std::uint32_t>(k);
+        env.keep_used = 0;
+        env.produced = false;
+        env.out = &w.out;
+        const std::size_t mark = w.out.size();
+        RunStatus st = run(pr.body, w.frame.data(), env);
+        env.keep_count = 0;
+        if (st == RunStatus::Produced || env.produced) return pr.strict.size();
+        // not applied: drop anything a partial body emitted
+        w.out.sym.resize(mark);
+        w.out.ids.resize(mark);
+        w.out.params.resize(w.out.poff[mark]);
+        w.out.poff.resize(mark + 1);
+        return 0;
+    }
+
+    // cpfg semantics: all applicable weighted productions of the module, one drawn by weight.
+    std::size_t choose(Worker& w, std::size_t i, std::size_t set0, std::size_t cand0, std::size_t length = 0) {
+        struct Option {
+            const Production* pr;
+            double weight;
+        };
+        Option options[64];
+        std::size_t count = 0;
+        double total = 0;
+        const SymbolId sym = in.sym[i];
+        for (std::size_t si = set0; si < sets.size(); ++si) {
+            const auto& cands = sets[si]->by_symbol[sym];
+            for (std::size_t ci = si == set0 ? cand0 : 0; ci < cands.size(); ++ci) {
+                const Production& pr = sets[si]->productions[cands[ci]];
+                if (pr.weight.empty() || (length && pr.strict.size() != length) || !matches(w, i, pr)) continue;
+                double wt = eval_number(pr.weight, w.frame.data(), w.env);
+                if (!(wt >= 0) || !std::isfinite(wt))
+                    throw RuntimeError{pr.weight.spans.empty() ? pr.span : pr.weight.spans.back(),
+                                       fmt::format("a production weight must be a finite number >= 0, found {}", wt)};
+                if (wt == 0 || count == 64) continue;
+                options[count++] = {&pr, wt};
+                total += wt;
+            }
+        }
+        if (count == 0) return 0;
+        double u = random_unit(random_bits(w.env.seed, w.env.phase, i, kChoiceDraw)) * total;
+        std::size_t pick = count - 1;
+        for (std::size_t k = 0; k < count; ++k) {
+            if (u < options[k].weight) {
+                pick = k;
+                break;
+            }
+            u -= options[k].weight;
+        }
+        const Production& pr = *options[pick].pr;
+        w.env.draw = 0;
+        matches(w, i, pr); // bind the chosen production's names again
+        return run_body(w, i, pr);
+    }
+
+    const Program& P;
+    const ModuleString& in;
+    const std::vector<const RuleSet*>& sets;
+    const std::size_t n;
+    std::vector<std::uint8_t> has_prod;
+    std::vector<std::uint32_t> match;
+    std::vector<const Production*> direct;
+    std::vector<std::size_t> piece_starts;
+    std::size_t frame_size = 1;
+    bool multi = false, left_new = false, right_new = false;
+};
+
+
+} // namespace plant
