@@ -14,10 +14,8 @@
 
 #include <fmt/format.h>
 
-#include <barrier>
 #include <chrono>
 #include <cmath>
-#include <exception>
 #include <thread>
 
 namespace plant {
