@@ -147,3 +147,22 @@ TEST_CASE("?H ?U ?L read the frame; a vec3 binding reads all three numbers", "[t
     near(v(2), {0, -1, 0}); // left
     near(v(3), {0, 0, 1});  // up
 }
+
+TEST_CASE("G draws like F; colors come from ;(c) and SetColor", "[turtle]") {
+    near(draw("G(2)").ends[0], {0, 2, 0});
+    auto c = test::compile("axiom: F ;(1) F SetColor(255, 0, 0) F SetColor(0, 0.5, 1) F @R(1, 0, 0) F;");
+    REQUIRE(c->program);
+    Derivation d(*c->program, {});
+    d.run();
+    Skeleton sk = build_skeleton(*c->program, d.string(), TurtleOptions{});
+    REQUIRE(sk.axes.size() == 1);
+    const auto& pts = sk.axes[0].points;
+    REQUIRE(pts.size() == 6);
+    CHECK(pts[1].color == palette_color(0));
+    CHECK(pts[2].color == palette_color(1));
+    CHECK(pts[3].color == glm::vec3(1, 0, 0)); // 0..255 is scaled to 0..1
+    CHECK(pts[4].color == glm::vec3(0, 0.5f, 1));
+    near(pts[5].position - pts[4].position, {1, 0, 0}); // @R set the heading to +X
+    CHECK(pts[5].module == "F");
+    CHECK(pts[5].id != 0);
+}
