@@ -1,5 +1,6 @@
 // plant run: derive, interpret with the turtle, mesh and write every requested file.
 #include "commands.hpp"
+#include "outputs.hpp"
 
 #include "plant/export.hpp"
 #include "plant/export_text.hpp"
@@ -26,39 +27,6 @@ struct RunCmd {
     std::string size = "800x800";
 };
 
-enum class Format { Glb, Gltf, Obj, Ply, Off, Png, Svg, Txt, Skeleton, MeshSummary };
-
-// Counts and bounds of the meshed scene in a fixed format, for golden files.
-std::string mesh_summary(const Scene& s) {
-    std::size_t vertices = s.tubes.positions.size(), triangles = s.tubes.triangle_count();
-    for (const auto& p : s.prototypes) {
-        vertices += p.positions.size();
-        triangles += p.triangle_count();
-    }
-    return fmt::format("vertices {}\ntriangles {}\nprototypes {}\ninstances {}\nbounds {:.4f} {:.4f} {:.4f} {:.4f} "
-                       "{:.4f} {:.4f}\n",
-                       vertices, triangles, s.prototypes.size(), s.instances.size(), s.bounds_min.x, s.bounds_min.y,
-                       s.bounds_min.z, s.bounds_max.x, s.bounds_max.y, s.bounds_max.z);
-}
-
-std::optional<Format> format_of(const std::string& path) {
-    auto ends = [&](const char* ext) {
-        std::string e = ext;
-        return path.size() > e.size() && path.compare(path.size() - e.size(), e.size(), e) == 0;
-    };
-    if (ends(".skel.json")) return Format::Skeleton;
-    if (ends(".mesh.txt")) return Format::MeshSummary;
-    if (ends(".glb")) return Format::Glb;
-    if (ends(".gltf")) return Format::Gltf;
-    if (ends(".obj")) return Format::Obj;
-    if (ends(".ply")) return Format::Ply;
-    if (ends(".off")) return Format::Off;
-    if (ends(".png")) return Format::Png;
-    if (ends(".svg")) return Format::Svg;
-    if (ends(".txt")) return Format::Txt;
-    return std::nullopt;
-}
-
 double ms_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -75,16 +43,11 @@ int run_main(RunCmd& c) {
         std::string stem = fs::path(c.g.file).stem().string();
         c.outputs = {"out/" + stem + ".glb", "out/" + stem + ".png"};
     }
-    std::vector<Format> formats;
     for (const auto& o : c.outputs) {
-        auto f = format_of(o);
-        if (!f) {
-            std::cerr << fmt::format("plant: cannot tell the format of '{}': use .glb .gltf .obj .ply .off .png .svg "
-                                     ".txt .skel.json or .mesh.txt\n",
-                                     o);
+        if (!format_of(o)) {
+            std::cerr << fmt::format("plant: cannot tell the format of '{}': use {}\n", o, known_extensions());
             return kUsage;
         }
-        formats.push_back(*f);
     }
     int exit_code = kOk;
     SourceManager sources;
@@ -103,45 +66,14 @@ int run_main(RunCmd& c) {
     if (!run_derivation(d, sources, c.g.color)) return kRuntime;
     if (progress) std::cerr << "\r\x1b[K" << std::flush;
     try {
-        bool need_skeleton = false, need_scene = false;
-        for (Format f : formats) {
-            need_skeleton = need_skeleton || f != Format::Txt;
-            need_scene = need_scene || (f != Format::Txt && f != Format::Svg && f != Format::Skeleton);
-        }
-        Skeleton skeleton;
-        Scene scene;
-        if (need_skeleton) {
-            ModuleString interpreted = d.interpreted(d.string());
-            skeleton = build_skeleton(*program, interpreted, TurtleOptions{d.default_angle(), d.default_step(),
-                                                                           d.default_width()});
-        }
-        if (need_scene) {
-            MeshOptions mo;
-            mo.sides = c.sides;
-            scene = build_scene(*program, skeleton, mo);
-        }
-        for (std::size_t k = 0; k < formats.size(); ++k) {
-            const std::string& path = c.outputs[k];
-            fs::path parent = fs::path(path).parent_path();
-            std::error_code ec;
-            if (!parent.empty()) fs::create_directories(parent, ec);
-            switch (formats[k]) {
-            case Format::Glb:
-            case Format::Gltf: write_gltf(scene, path); break;
-            case Format::Obj:
-            case Format::Ply:
-            case Format::Off: write_mesh_file(scene, path); break;
-            case Format::Png: write_png(scene, path, width, height); break;
-            case Format::Svg: write_svg(skeleton, path); break;
-            case Format::Skeleton: write_skeleton_json(skeleton, path); break;
-            case Format::Txt: write_file_atomically(path, format_string(*program, d.string()) + "\n"); break;
-            case Format::MeshSummary: write_file_atomically(path, mesh_summary(scene)); break;
-            }
-            if (progress) std::cerr << fmt::format("wrote {}\n", path);
-        }
+        OutputOptions oo;
+        oo.sides = c.sides;
+        oo.width = width;
+        oo.height = height;
+        OutputSummary summary = write_outputs(*program, d, c.outputs, oo);
         if (progress)
             std::cerr << fmt::format("{} modules, {} triangles, {} organs in {:.0f} ms\n", d.string().size(),
-                                     scene.tubes.triangle_count(), scene.instances.size(), ms_since(t0));
+                                     summary.triangles, summary.organs, ms_since(t0));
     } catch (const RuntimeError& e) {
         std::cerr << render(Diagnostic{Severity::Error, e.span, e.message, {}}, sources, c.g.color);
         return kRuntime;

@@ -41,5 +41,6 @@ void setup_derive(CLI::App& app, int& exit_code);
 void setup_check(CLI::App& app, int& exit_code);
 void setup_test(CLI::App& app, int& exit_code);
 void setup_run(CLI::App& app, int& exit_code);
+void setup_repl(CLI::App& app, int& exit_code);
 
 } // namespace plant::cli

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
     setup_derive(app, exit_code);
     setup_check(app, exit_code);
     setup_test(app, exit_code);
+    setup_repl(app, exit_code);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp&) {

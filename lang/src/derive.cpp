@@ -62,6 +62,7 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const std::v
         w.env.step = step_for_env;
         w.env.max_output = opt_.max_modules;
         w.env.max_params = opt_.max_bytes / sizeof(double);
+        w.env.interrupt = opt_.interrupt;
     };
     const std::size_t n = in.size();
     int threads = std::max(1, opt_.threads);

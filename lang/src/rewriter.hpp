@@ -112,7 +112,12 @@ public:
         std::size_t p = p_at;
         double values[256];
         std::size_t i = b;
+        std::size_t next_check = b + 65536;
         while (i < e) {
+            if (i >= next_check) { // a long step can be interrupted (Ctrl-C in the REPL)
+                next_check = i + 65536;
+                if (w.env.interrupt && w.env.interrupt->load()) throw RuntimeError{Span{}, "interrupted"};
+            }
             if (!has_prod[in.sym[i]]) { // a run of modules without productions: copy it
                 std::size_t j = i + 1;
                 while (j < e && !has_prod[in.sym[j]]) ++j;

@@ -71,6 +71,8 @@ public:
     double default_width() const { return width_; }
     std::vector<double>& globals() { return globals_; }
     int active_group() const { return group_; }
+    void use_group(int group) { group_ = group; } // -1: none (the REPL's :use)
+    void set_seed(std::uint64_t seed) { seed_ = seed; }
     ModuleId next_id() const { return next_id_; }
     const Program& program() const { return prog_; }
 

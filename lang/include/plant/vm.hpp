@@ -3,6 +3,7 @@
 
 #include "plant/program.hpp"
 
+#include <atomic>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,7 @@ struct EvalEnv {
     ModuleId id = 0;
     std::size_t max_output = ~std::size_t{0}; // module limit of the output
     std::size_t max_params = ~std::size_t{0}; // parameter limit of the output
+    const std::atomic<bool>* interrupt = nullptr;
 
     // Output of production bodies.
     ModuleString* out = nullptr;

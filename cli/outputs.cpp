@@ -1,0 +1,97 @@
+#include "outputs.hpp"
+
+#include "plant/export.hpp"
+#include "plant/export_text.hpp"
+#include "plant/mesh.hpp"
+
+#include <fmt/format.h>
+
+#include <filesystem>
+
+namespace plant::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Counts and bounds of the meshed scene in a fixed format, for golden files.
+std::string mesh_summary(const Scene& s) {
+    std::size_t vertices = s.tubes.positions.size(), triangles = s.tubes.triangle_count();
+    for (const auto& p : s.prototypes) {
+        vertices += p.positions.size();
+        triangles += p.triangle_count();
+    }
+    return fmt::format("vertices {}\ntriangles {}\nprototypes {}\ninstances {}\nbounds {:.4f} {:.4f} {:.4f} {:.4f} "
+                       "{:.4f} {:.4f}\n",
+                       vertices, triangles, s.prototypes.size(), s.instances.size(), s.bounds_min.x, s.bounds_min.y,
+                       s.bounds_min.z, s.bounds_max.x, s.bounds_max.y, s.bounds_max.z);
+}
+
+} // namespace
+
+std::optional<Format> format_of(const std::string& path) {
+    auto ends = [&](const char* ext) {
+        std::string e = ext;
+        return path.size() > e.size() && path.compare(path.size() - e.size(), e.size(), e) == 0;
+    };
+    if (ends(".skel.json")) return Format::Skeleton;
+    if (ends(".mesh.txt")) return Format::MeshSummary;
+    if (ends(".glb")) return Format::Glb;
+    if (ends(".gltf")) return Format::Gltf;
+    if (ends(".obj")) return Format::Obj;
+    if (ends(".ply")) return Format::Ply;
+    if (ends(".off")) return Format::Off;
+    if (ends(".png")) return Format::Png;
+    if (ends(".svg")) return Format::Svg;
+    if (ends(".txt")) return Format::Txt;
+    return std::nullopt;
+}
+
+
+const char* known_extensions() { return ".glb .gltf .obj .ply .off .png .svg .txt .skel.json or .mesh.txt"; }
+
+OutputSummary write_outputs(const Program& program, const Derivation& d, const std::vector<std::string>& paths,
+                            const OutputOptions& options) {
+    std::vector<Format> formats;
+    for (const auto& p : paths) {
+        auto f = format_of(p);
+        if (!f) throw ExportError(fmt::format("cannot tell the format of '{}': use {}", p, known_extensions()));
+        formats.push_back(*f);
+    }
+    bool need_skeleton = false, need_scene = false;
+    for (Format f : formats) {
+        need_skeleton = need_skeleton || f != Format::Txt;
+        need_scene = need_scene || (f != Format::Txt && f != Format::Svg && f != Format::Skeleton);
+    }
+    Skeleton skeleton;
+    Scene scene;
+    if (need_skeleton)
+        skeleton = build_skeleton(program, d.interpreted(d.string()),
+                                  TurtleOptions{d.default_angle(), d.default_step(), d.default_width()});
+    if (need_scene) {
+        MeshOptions mo;
+        mo.sides = options.sides;
+        scene = build_scene(program, skeleton, mo);
+    }
+    for (std::size_t k = 0; k < formats.size(); ++k) {
+        const std::string& path = paths[k];
+        fs::path parent = fs::path(path).parent_path();
+        std::error_code ec;
+        if (!parent.empty()) fs::create_directories(parent, ec);
+        switch (formats[k]) {
+        case Format::Glb:
+        case Format::Gltf: write_gltf(scene, path); break;
+        case Format::Obj:
+        case Format::Ply:
+        case Format::Off: write_mesh_file(scene, path); break;
+        case Format::Png: write_png(scene, path, options.width, options.height); break;
+        case Format::Svg: write_svg(skeleton, path); break;
+        case Format::Skeleton: write_skeleton_json(skeleton, path); break;
+        case Format::Txt: write_file_atomically(path, format_string(program, d.string()) + "\n"); break;
+        case Format::MeshSummary: write_file_atomically(path, mesh_summary(scene)); break;
+        }
+    }
+    return OutputSummary{scene.tubes.triangle_count(), scene.instances.size()};
+}
+
+} // namespace plant::cli

@@ -1,0 +1,521 @@
+// The REPL session: every change (a typed production, axiom or :set) recompiles the session's
+// grammar and replays the same number of steps, so what is shown is always what a fresh
+// `plant derive` of the same grammar would give.
+#include "repl.hpp"
+
+#include "outputs.hpp"
+#include "plant/export.hpp"
+#include "plant/query.hpp"
+#include "plant/vm.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <sstream>
+#include <thread>
+
+namespace plant::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string trim(const std::string& s) {
+    std::size_t b = s.find_first_not_of(" \t\r\n"), e = s.find_last_not_of(" \t\r\n");
+    return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
+}
+
+struct CommandInfo {
+    const char* name;
+    const char* usage;
+    const char* help;
+};
+
+const CommandInfo kCommands[] = {
+    {"load", ":load FILE", "read a grammar file; the session starts again at step 0"},
+    {"reload", ":reload", "read the file again, keep :set values and typed rules, replay the same number of steps"},
+    {"step", ":step [N]", "derive N more steps (default 1)"},
+    {"back", ":back [N]", "undo the last N steps (default 1)"},
+    {"reset", ":reset", "go back to the axiom (step 0)"},
+    {"show", ":show [A..B] [--ids]", "print the string, or modules A to B; long strings are shortened"},
+    {"find", ":find NAME[(ARITY)]", "list the modules with that name, with their positions and identities"},
+    {"set", ":set NAME VALUE", "change a param (VALUE is an expression) and replay"},
+    {"params", ":params", "list the params and vars with their current values"},
+    {"seed", ":seed S", "change the random seed and replay"},
+    {"rules", ":rules", "list the productions, typed ones included"},
+    {"use", ":use GROUP", "select a rule group for the next steps (:use none to clear)"},
+    {"stats", ":stats", "modules per symbol, branch depth, steps and the time of the last step"},
+    {"time", ":time", "the time of the last step"},
+    {"export", ":export FILE...", "write files as plant run does (.glb .png .obj .svg .txt .skel.json ...)"},
+    {"render", ":render [FILE.png]", "write a PNG preview (default out/repl.png)"},
+    {"help", ":help [COMMAND]", "list the commands, or explain one"},
+    {"quit", ":quit", "end the session"},
+};
+
+} // namespace
+
+Session::Session(std::ostream& out, std::ostream& err, bool color) : out_(out), err_(err), color_(color) {}
+
+DeriveOptions Session::options() const {
+    DeriveOptions o;
+    o.steps = 1000000; // the REPL decides when to stop, not the grammar's `derive N;`
+    o.seed = seed_;
+    o.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    o.interrupt = interrupt_;
+    static TurtleQueryPass queries;
+    o.queries = &queries;
+    std::ostream* out = &out_;
+    o.on_print = [out](const std::string& text) { *out << text; };
+    return o;
+}
+
+std::string Session::session_source(const std::string* extra_fn) const {
+    std::string s;
+    if (!file_.empty()) s += fmt::format("import \"{}\";\n", file_);
+    if (axiom_) s += "axiom: " + *axiom_ + ";\n";
+    if (!extra_rules_.empty()) {
+        s += "rules {\n";
+        for (const auto& r : extra_rules_) s += r + "\n";
+        s += "}\n";
+    }
+    if (extra_fn) s += *extra_fn + "\n";
+    return s;
+}
+
+bool Session::rebuild(int steps, const std::string* extra_fn, bool warnings) {
+    auto sources = std::make_unique<SourceManager>();
+    CompileOptions co;
+    for (const auto& [name, value] : params_) co.defines.emplace_back(name, value);
+    Diagnostics diags;
+    std::uint32_t id = sources->add("<session>", session_source(extra_fn));
+    auto program = compile_source(*sources, id, co, diags);
+    if (!warnings) { // the same warnings were shown when the grammar was first built
+        Diagnostics errors;
+        for (const auto& d : diags.all())
+            if (d.severity == Severity::Error) errors.add(d);
+        diags = errors;
+    }
+    err_ << render_all(diags, *sources, color_);
+    if (!program) return false;
+    std::vector<std::unique_ptr<Derivation>> history;
+    try {
+        history.push_back(std::make_unique<Derivation>(*program, options()));
+        history.back()->start();
+        for (int k = 0; k < steps; ++k) {
+            auto next = std::make_unique<Derivation>(*history.back());
+            int before = next->steps_done();
+            auto t0 = std::chrono::steady_clock::now();
+            next->step();
+            last_step_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+            if (next->steps_done() == before) break; // a hook said stop
+            history.push_back(std::move(next));
+        }
+    } catch (const RuntimeError& e) {
+        err_ << render(Diagnostic{Severity::Error, e.span, e.message, {}}, *sources, color_);
+        return false;
+    }
+    if (extra_fn) return true; // an evaluation: the caller reads the program, the session stays
+    sources_ = std::move(sources);
+    program_ = std::move(program);
+    history_ = std::move(history);
+    return true;
+}
+
+bool Session::load(const std::string& path) {
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec)) {
+        err_ << fmt::format("plant: cannot read '{}': no such file\n", path);
+        return false;
+    }
+    std::string saved = file_;
+    file_ = fs::path(path).lexically_normal().string(); // as given: messages stay short and portable
+    axiom_.reset();
+    extra_rules_.clear();
+    if (!rebuild(0)) {
+        file_ = saved;
+        return false;
+    }
+    out_ << fmt::format("loaded {}: {} modules at step 0\n", path, current().string().size());
+    return true;
+}
+
+bool Session::need_derivation() {
+    if (!history_.empty()) return true;
+    err_ << "no grammar yet: :load FILE, or type an axiom such as 'axiom: F;'\n";
+    return false;
+}
+
+bool Session::step(int n) {
+    if (!need_derivation()) return true;
+    for (int k = 0; k < n; ++k) {
+        auto next = std::make_unique<Derivation>(current());
+        int before = next->steps_done();
+        auto t0 = std::chrono::steady_clock::now();
+        try {
+            next->step();
+        } catch (const RuntimeError& e) {
+            err_ << render(Diagnostic{Severity::Error, e.span, e.message, {}}, *sources_, color_);
+            if (e.message.find("interrupted") != std::string::npos)
+                err_ << fmt::format("interrupted; still at step {}\n", current().steps_done());
+            return false;
+        }
+        last_step_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        if (next->steps_done() == before) {
+            out_ << fmt::format("the derivation has stopped (a hook said stop) at step {}\n", before);
+            return true;
+        }
+        history_.push_back(std::move(next));
+    }
+    out_ << fmt::format("step {}: {} modules ({:.3f} ms)\n", current().steps_done(), current().string().size(),
+                        last_step_ms_);
+    return true;
+}
+
+void Session::show(const std::string& rest) {
+    if (!need_derivation()) return;
+    std::istringstream in(rest);
+    std::string word, range;
+    bool ids = false;
+    while (in >> word) {
+        if (word == "--ids")
+            ids = true;
+        else
+            range = word;
+    }
+    const ModuleString& s = current().string();
+    std::size_t b = 0, e = s.size();
+    if (!range.empty()) {
+        auto dots = range.find("..");
+        try {
+            b = std::stoul(range.substr(0, dots));
+            e = dots == std::string::npos ? b + 1 : std::stoul(range.substr(dots + 2));
+        } catch (...) {
+            err_ << fmt::format("':show' expects a range such as 0..20, found '{}'\n", range);
+            return;
+        }
+        e = std::min(e, s.size());
+        if (b >= e) {
+            err_ << fmt::format("the range {} is empty: the string has {} modules\n", range, s.size());
+            return;
+        }
+    }
+    // format a piece at a time: a long string is shortened without printing all of it first
+    const std::size_t limit = 2000;
+    std::string text;
+    std::size_t i = b;
+    while (i < e && text.size() <= limit) {
+        ModuleString part;
+        std::size_t j = std::min(e, i + 256);
+        part.append_range(s, i, j);
+        text += format_string(*program_, part, ids);
+        i = j;
+    }
+    if (text.size() > limit || i < e) {
+        out_ << text.substr(0, limit)
+             << fmt::format("... ({} modules; :show A..B shows a part)\n", e - b);
+    } else {
+        out_ << text << "\n";
+    }
+}
+
+void Session::find(const std::string& pattern) {
+    if (!need_derivation()) return;
+    std::string name = pattern;
+    std::optional<std::uint32_t> arity;
+    if (auto p = pattern.find('('); p != std::string::npos) {
+        name = trim(pattern.substr(0, p));
+        try {
+            arity = static_cast<std::uint32_t>(std::stoul(pattern.substr(p + 1)));
+        } catch (...) {
+            err_ << "':find' expects NAME or NAME(ARITY), as in A(2)\n";
+            return;
+        }
+    }
+    auto sym = program_->symbols.find(name);
+    const ModuleString& s = current().string();
+    std::size_t found = 0;
+    for (std::size_t i = 0; sym && i < s.size(); ++i) {
+        if (s.sym[i] != *sym || (arity && s.arity(i) != *arity)) continue;
+        if (found++ < 50) {
+            ModuleString one;
+            one.append_range(s, i, i + 1);
+            out_ << fmt::format("  {:>8}  #{:<8} {}\n", i, s.ids[i], format_string(*program_, one));
+        }
+    }
+    if (found > 50) out_ << fmt::format("  ... and {} more\n", found - 50);
+    out_ << fmt::format("{} module{} named '{}'\n", found, found == 1 ? "" : "s", name);
+}
+
+void Session::stats() {
+    if (!need_derivation()) return;
+    const ModuleString& s = current().string();
+    std::map<SymbolId, std::size_t> counts;
+    int depth = 0, max_depth = 0;
+    for (SymbolId x : s.sym) {
+        ++counts[x];
+        if (x == program_->symbols.open_bracket) max_depth = std::max(max_depth, ++depth);
+        if (x == program_->symbols.close_bracket) --depth;
+    }
+    std::vector<std::pair<std::size_t, SymbolId>> sorted;
+    for (auto [sym, n] : counts) sorted.emplace_back(n, sym);
+    std::sort(sorted.begin(), sorted.end(), [](auto a, auto b) { return a.first != b.first ? a.first > b.first : a.second < b.second; });
+    out_ << fmt::format("step {}, {} modules, {} parameters, branch depth {}, last step {:.3f} ms\n",
+                        current().steps_done(), s.size(), s.params.size(), max_depth, last_step_ms_);
+    for (std::size_t k = 0; k < sorted.size() && k < 20; ++k)
+        out_ << fmt::format("  {:<10} {}\n", program_->symbols[sorted[k].second].name, sorted[k].first);
+}
+
+void Session::rules() {
+    if (!program_) {
+        need_derivation();
+        return;
+    }
+    auto text_of = [&](Span sp) {
+        const std::string& t = sources_->file(sp.file).text();
+        std::string s = t.substr(sp.begin, sp.end - sp.begin);
+        std::replace(s.begin(), s.end(), '\n', ' ');
+        return trim(s);
+    };
+    // the grammar's files first (imports come before the session's own text), typed rules last
+    for (auto it = program_->files.rbegin(); it != program_->files.rend(); ++it) {
+        const ast::File& f = **it;
+        const bool typed = sources_->file(f.source).name() == "<session>";
+        for (const auto& rb : f.rule_blocks) {
+            const char* kind = rb.kind == ast::RuleKind::Rules ? "rules" : rb.kind == ast::RuleKind::Decompose
+                                                                             ? "decompose"
+                                                                             : "interpret";
+            out_ << kind << (rb.group.empty() ? "" : " " + rb.group) << (typed ? " (typed)" : "") << ":\n";
+            for (const auto& p : rb.productions) out_ << "  " << text_of(p.span) << "\n";
+        }
+    }
+}
+
+void Session::params() {
+    if (!need_derivation()) return;
+    for (const auto& gl : program_->globals) {
+        const double* v = current().globals().data() + gl.slot;
+        std::string value = gl.type == ValueType::Vec3
+                                ? fmt::format("vec3({}, {}, {})", format_double(v[0]), format_double(v[1]),
+                                              format_double(v[2]))
+                                : format_double(v[0]);
+        out_ << fmt::format("  {} {} = {}\n", gl.kind == GlobalKind::Param ? "param" : "var", gl.name, value);
+    }
+}
+
+void Session::evaluate(const std::string& expr) {
+    static const std::string kFn = "__repl_value__";
+    std::string fn = fmt::format("fn {}() = ({});", kFn, expr);
+    // compile the session with the expression as a function, then run it on the current globals
+    auto sources = std::make_unique<SourceManager>();
+    CompileOptions co;
+    for (const auto& [name, value] : params_) co.defines.emplace_back(name, value);
+    Diagnostics diags;
+    std::string text = history_.empty() ? fn + "\naxiom: ;\n" : session_source(&fn);
+    auto program = compile_source(*sources, sources->add("<session>", text), co, diags);
+    // the session's own warnings were shown when it was built; show only errors here
+    Diagnostics errors;
+    for (const auto& d : diags.all())
+        if (d.severity == Severity::Error) errors.add(d);
+    err_ << render_all(errors, *sources, color_);
+    if (!program) return;
+    const Function* f = nullptr;
+    for (const auto& candidate : program->functions)
+        if (candidate.name == kFn) f = &candidate;
+    if (!f) return;
+    std::vector<double> globals = program->global_values;
+    if (!history_.empty() && current().globals().size() == globals.size()) globals = current().globals();
+    EvalEnv env;
+    env.prog = program.get();
+    env.globals = globals.data();
+    env.seed = seed_.value_or(0);
+    if (!history_.empty()) env.step = current().steps_done();
+    std::vector<double> frame(std::max<std::size_t>(f->frame_size, 1));
+    double r[3] = {0, 0, 0};
+    try {
+        run(f->code, frame.data(), env, r);
+    } catch (const RuntimeError& e) {
+        err_ << render(Diagnostic{Severity::Error, e.span, e.message, {}}, *sources, color_);
+        return;
+    }
+    if (f->result == ValueType::Vec3)
+        out_ << fmt::format("vec3({}, {}, {})\n", format_double(r[0]), format_double(r[1]), format_double(r[2]));
+    else if (f->result == ValueType::Bool)
+        out_ << (r[0] != 0 ? "true" : "false") << "\n";
+    else
+        out_ << format_double(r[0]) << "\n";
+}
+
+void Session::export_files(const std::vector<std::string>& paths) {
+    if (!need_derivation()) return;
+    try {
+        OutputSummary s = write_outputs(*program_, current(), paths, OutputOptions{});
+        for (const auto& p : paths) out_ << "wrote " << p << "\n";
+        out_ << fmt::format("{} triangles, {} organs\n", s.triangles, s.organs);
+    } catch (const RuntimeError& e) {
+        err_ << render(Diagnostic{Severity::Error, e.span, e.message, {}}, *sources_, color_);
+    } catch (const ExportError& e) {
+        err_ << "plant: " << e.what() << "\n";
+    }
+}
+
+void Session::help(const std::string& topic) {
+    std::string name = topic.empty() || topic[0] != ':' ? topic : topic.substr(1);
+    for (const auto& c : kCommands) {
+        if (name.empty()) {
+            out_ << fmt::format("  {:<22} {}\n", c.usage, c.help);
+        } else if (name == c.name) {
+            out_ << c.usage << "\n  " << c.help << "\n";
+            return;
+        }
+    }
+    if (!name.empty()) {
+        err_ << fmt::format("no command ':{}'; :help lists them\n", name);
+        return;
+    }
+    out_ << "Anything else is a production (A(x) -> B(x + 1);), an axiom (axiom: A(1);) or an expression "
+            "to evaluate (2 * pi).\n";
+}
+
+bool Session::command(const std::string& name, const std::string& rest) {
+    auto count = [&](int fallback) -> std::optional<int> {
+        if (rest.empty()) return fallback;
+        if (rest.size() <= 7 && rest.find_first_not_of("0123456789") == std::string::npos) return std::stoi(rest);
+        err_ << fmt::format("':{}' expects a whole number, found '{}'\n", name, rest);
+        return std::nullopt;
+    };
+    if (name == "quit" || name == "q" || name == "exit") return false;
+    if (name == "help" || name == "h" || name == "?") {
+        help(rest);
+    } else if (name == "load") {
+        if (rest.empty()) err_ << "':load' expects a file name\n";
+        else load(rest);
+    } else if (name == "reload") {
+        if (file_.empty()) {
+            err_ << "nothing to reload: :load a file first\n";
+        } else {
+            int steps = history_.empty() ? 0 : current().steps_done();
+            if (rebuild(steps)) out_ << fmt::format("reloaded; step {}: {} modules\n", current().steps_done(), current().string().size());
+        }
+    } else if (name == "step" || name == "s") {
+        if (auto n = count(1)) step(*n);
+    } else if (name == "back" || name == "b") {
+        if (auto n = count(1); n && need_derivation()) {
+            int k = std::min<int>(*n, static_cast<int>(history_.size()) - 1);
+            history_.resize(history_.size() - static_cast<std::size_t>(k));
+            out_ << fmt::format("step {}: {} modules\n", current().steps_done(), current().string().size());
+        }
+    } else if (name == "reset") {
+        if (need_derivation() && rebuild(0, nullptr, false)) out_ << fmt::format("step 0: {} modules\n", current().string().size());
+    } else if (name == "show") {
+        show(rest);
+    } else if (name == "find") {
+        find(rest);
+    } else if (name == "set") {
+        std::istringstream in(rest);
+        std::string pname;
+        in >> pname;
+        std::string value;
+        std::getline(in, value);
+        value = trim(value);
+        if (pname.empty() || value.empty()) {
+            err_ << "':set' expects NAME VALUE, as in :set r1 0.8\n";
+        } else {
+            auto saved = params_;
+            params_[pname] = value;
+            int steps = history_.empty() ? 0 : current().steps_done();
+            if (rebuild(steps, nullptr, false))
+                out_ << fmt::format("{} = {}; step {}: {} modules\n", pname, value, current().steps_done(),
+                                    current().string().size());
+            else
+                params_ = saved;
+        }
+    } else if (name == "params") {
+        params();
+    } else if (name == "seed") {
+        try {
+            auto saved = seed_;
+            seed_ = std::stoull(rest);
+            int steps = history_.empty() ? 0 : current().steps_done();
+            if (history_.empty() || rebuild(steps, nullptr, false)) out_ << fmt::format("seed {}\n", *seed_);
+            else seed_ = saved;
+        } catch (...) {
+            err_ << fmt::format("':seed' expects a whole number, found '{}'\n", rest);
+        }
+    } else if (name == "rules") {
+        rules();
+    } else if (name == "use") {
+        if (need_derivation()) {
+            int g = rest == "none" ? -1 : program_->group_index(rest);
+            if (g < 0 && rest != "none") err_ << fmt::format("no rule group '{}'\n", rest);
+            else {
+                current().use_group(g);
+                out_ << fmt::format("using {}\n", rest);
+            }
+        }
+    } else if (name == "stats") {
+        stats();
+    } else if (name == "time") {
+        out_ << fmt::format("last step: {:.3f} ms\n", last_step_ms_);
+    } else if (name == "export") {
+        std::istringstream in(rest);
+        std::vector<std::string> paths;
+        for (std::string p; in >> p;) paths.push_back(p);
+        if (paths.empty()) err_ << "':export' expects one or more file names\n";
+        else export_files(paths);
+    } else if (name == "render") {
+        export_files({rest.empty() ? std::string("out/repl.png") : rest});
+    } else {
+        err_ << fmt::format("unknown command ':{}'; :help lists the commands\n", name);
+    }
+    return true;
+}
+
+bool Session::execute(const std::string& raw) {
+    std::string line = trim(raw);
+    if (line.empty() || line[0] == '#') return true;
+    if (line[0] == ':') {
+        std::size_t sp = line.find_first_of(" \t");
+        std::string name = line.substr(1, sp == std::string::npos ? std::string::npos : sp - 1);
+        std::string rest = sp == std::string::npos ? std::string() : trim(line.substr(sp));
+        return command(name, rest);
+    }
+    int steps = history_.empty() ? 0 : current().steps_done();
+    if (line.rfind("axiom:", 0) == 0) {
+        auto saved = axiom_;
+        std::string a = trim(line.substr(6));
+        if (!a.empty() && a.back() == ';') a.pop_back();
+        axiom_ = a;
+        if (rebuild(steps, nullptr, false)) out_ << fmt::format("axiom set; step {}: {} modules\n", current().steps_done(), current().string().size());
+        else axiom_ = saved;
+        return true;
+    }
+    bool production = line.find("->") != std::string::npos || (line.back() == '}' && line.find('{') != std::string::npos);
+    if (production) {
+        if (line.back() != ';' && line.back() != '}') line += ';';
+        extra_rules_.push_back(line);
+        if (rebuild(steps))
+            out_ << fmt::format("rule added; step {}: {} modules\n", current().steps_done(), current().string().size());
+        else
+            extra_rules_.pop_back();
+        return true;
+    }
+    evaluate(line);
+    return true;
+}
+
+std::vector<std::string> Session::completions() const {
+    std::vector<std::string> out;
+    for (const auto& c : kCommands) out.push_back(std::string(":") + c.name);
+    if (program_) {
+        for (const auto& g : program_->globals) out.push_back(g.name);
+        for (const auto& s : program_->symbols.all())
+            if (s.arity >= 0 && !s.name.empty()) out.push_back(s.name);
+        for (const auto& g : program_->groups) out.push_back(g.name);
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+}
+
+} // namespace plant::cli

@@ -1,0 +1,68 @@
+// plant repl: a session to grow a grammar step by step, inspect it, change it and look at it.
+// The session is independent of the terminal: the front end (repl_main.cpp) feeds it lines.
+#pragma once
+
+#include "plant/compiler.hpp"
+#include "plant/derive.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <map>
+#include <memory>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace plant::cli {
+
+class Session {
+public:
+    Session(std::ostream& out, std::ostream& err, bool color);
+    // Runs one input line: a :command, `axiom: ...`, a production, or an expression.
+    // Returns false when the session should end (:quit).
+    bool execute(const std::string& line);
+    // Names for tab completion: commands, params, modules, rule groups.
+    std::vector<std::string> completions() const;
+    void set_interrupt(const std::atomic<bool>* flag) { interrupt_ = flag; }
+    bool load(const std::string& path); // :load
+
+private:
+    bool command(const std::string& name, const std::string& rest);
+    void help(const std::string& topic);
+    // Recompiles the session's grammar and replays `steps` steps. Keeps the previous state and
+    // reports the error when the new grammar does not compile or derive.
+    bool rebuild(int steps, const std::string* extra_fn = nullptr, bool warnings = true);
+    std::string session_source(const std::string* extra_fn) const;
+    bool step(int n);
+    void show(const std::string& rest);
+    void find(const std::string& pattern);
+    void stats();
+    void rules();
+    void params();
+    void evaluate(const std::string& expr);
+    void export_files(const std::vector<std::string>& paths);
+    bool need_derivation();
+    Derivation& current() { return *history_.back(); }
+    DeriveOptions options() const;
+
+    std::ostream& out_;
+    std::ostream& err_;
+    bool color_;
+    const std::atomic<bool>* interrupt_ = nullptr;
+
+    std::string file_;                         // absolute path of the loaded grammar, if any
+    std::optional<std::string> axiom_;         // typed `axiom: ...`
+    std::vector<std::string> extra_rules_;     // typed productions
+    std::map<std::string, std::string> params_; // :set NAME VALUE
+    std::optional<std::uint64_t> seed_;
+
+    std::unique_ptr<SourceManager> sources_;
+    std::unique_ptr<Program> program_;
+    std::vector<std::unique_ptr<Derivation>> history_; // one state per step; back() is current
+    double last_step_ms_ = 0;
+};
+
+int repl_main(const std::string& file, bool color);
+
+} // namespace plant::cli

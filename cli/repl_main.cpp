@@ -1,0 +1,105 @@
+// The REPL's front end: libedit line editing, history in ~/.plant_history and tab completion
+// when standard input is a terminal; plain line reading otherwise (scripts and tests).
+#include "commands.hpp"
+#include "repl.hpp"
+
+#include <editline/readline.h>
+#include <fmt/format.h>
+
+#include <csignal>
+#include <cstdlib>
+#include <cstring>
+#include <iostream>
+#include <unistd.h>
+
+namespace plant::cli {
+
+namespace {
+
+std::atomic<bool> g_interrupt{false};
+Session* g_session = nullptr;
+
+extern "C" void on_sigint(int) { g_interrupt.store(true); }
+
+std::vector<std::string> g_matches;
+
+char* completion_generator(const char* text, int state) {
+    static std::size_t next = 0;
+    if (state == 0) {
+        next = 0;
+        g_matches.clear();
+        std::string prefix = text;
+        for (const auto& c : g_session->completions())
+            if (c.rfind(prefix, 0) == 0) g_matches.push_back(c);
+    }
+    if (next >= g_matches.size()) return nullptr;
+    return strdup(g_matches[next++].c_str());
+}
+
+char** complete(const char* text, int, int) {
+    rl_attempted_completion_over = 1; // no file name completion
+    return rl_completion_matches(text, completion_generator);
+}
+
+std::string history_path() {
+    const char* home = std::getenv("HOME");
+    return home ? std::string(home) + "/.plant_history" : std::string(".plant_history");
+}
+
+} // namespace
+
+int repl_main(const std::string& file, bool color) {
+    const bool interactive = isatty(0) != 0;
+    Session session(std::cout, std::cerr, color && interactive);
+    g_session = &session;
+    session.set_interrupt(&g_interrupt);
+    struct sigaction sa {};
+    sa.sa_handler = on_sigint;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, nullptr);
+    if (!file.empty() && !session.load(file) && !interactive) return kGrammar;
+    if (!interactive) {
+        // scripts: one line at a time, no prompt; the exit code says whether a line failed
+        std::string line;
+        while (std::getline(std::cin, line)) {
+            g_interrupt.store(false);
+            bool go_on = session.execute(line);
+            std::cout.flush();
+            std::cerr.flush();
+            if (!go_on) break;
+        }
+        return kOk;
+    }
+    std::cout << "plant repl: :help lists the commands, :quit ends; Tab completes names\n";
+    rl_attempted_completion_function = complete;
+    const std::string hist = history_path();
+    read_history(hist.c_str());
+    for (;;) {
+        g_interrupt.store(false);
+        char* raw = readline("plant> ");
+        if (!raw) { // Ctrl-D
+            std::cout << "\n";
+            break;
+        }
+        std::string line = raw;
+        std::free(raw);
+        if (line.find_first_not_of(" \t") != std::string::npos) add_history(line.c_str());
+        bool go_on = session.execute(line);
+        std::cout.flush();
+        if (!go_on) break;
+    }
+    write_history(hist.c_str());
+    return kOk;
+}
+
+void setup_repl(CLI::App& app, int& exit_code) {
+    auto file = std::make_shared<std::string>();
+    CLI::App* cmd = app.add_subcommand("repl", "An interactive session: step a derivation, inspect the string, change "
+                                               "rules and params, look at the plant");
+    cmd->add_option("FILE", *file, "A grammar to load");
+    cmd->footer("Reads commands from standard input without a prompt when it is not a terminal:\n"
+                "  plant repl grammar.plant < script");
+    cmd->callback([file, &exit_code] { exit_code = repl_main(*file, isatty(2) != 0 && !std::getenv("NO_COLOR")); });
+}
+
+} // namespace plant::cli
