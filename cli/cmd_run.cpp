@@ -35,8 +35,10 @@ int run_main(RunCmd& c) {
     // check the outputs before doing any work
     int width = 0, height = 0;
     if (std::sscanf(c.size.c_str(), "%dx%d", &width, &height) != 2 || width < 16 || height < 16 || width > 16384 ||
-        height > 16384) {
-        std::cerr << fmt::format("plant: --size expects WIDTHxHEIGHT between 16 and 16384, found '{}'\n", c.size);
+        height > 16384 || static_cast<long long>(width) * height > 64LL * 1000 * 1000) {
+        std::cerr << fmt::format("plant: --size expects WIDTHxHEIGHT, each from 16 to 16384 and at most 64 million "
+                                 "pixels, found '{}'\n",
+                                 c.size);
         return kUsage;
     }
     if (c.outputs.empty()) {

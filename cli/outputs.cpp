@@ -6,7 +6,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <unistd.h>
 
 namespace plant::cli {
 
@@ -29,7 +31,9 @@ std::string mesh_summary(const Scene& s) {
 
 } // namespace
 
-std::optional<Format> format_of(const std::string& path) {
+std::optional<Format> format_of(const std::string& given) {
+    std::string path = given;
+    std::transform(path.begin(), path.end(), path.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
     auto ends = [&](const char* ext) {
         std::string e = ext;
         return path.size() > e.size() && path.compare(path.size() - e.size(), e.size(), e) == 0;
@@ -73,11 +77,26 @@ OutputSummary write_outputs(const Program& program, const Derivation& d, const s
         mo.sides = options.sides;
         scene = build_scene(program, skeleton, mo);
     }
+    // All or nothing: every file is first written under a temporary name beside its target
+    // (same extension, which the writers go by); only when all succeeded are they renamed.
+    std::vector<std::string> temps;
+    auto discard = [&] {
+        for (const auto& t : temps) {
+            std::error_code ignored;
+            fs::remove(t, ignored);
+        }
+    };
+    try {
     for (std::size_t k = 0; k < formats.size(); ++k) {
-        const std::string& path = paths[k];
-        fs::path parent = fs::path(path).parent_path();
+        const fs::path target(paths[k]);
+        fs::path parent = target.parent_path();
         std::error_code ec;
         if (!parent.empty()) fs::create_directories(parent, ec);
+        std::string name = target.filename().string();
+        std::string path = (parent / ("." + name + ".plant-tmp" + std::to_string(::getpid()) + "-" + std::to_string(k) +
+                                      name.substr(name.find('.') == std::string::npos ? name.size() : name.find('.'))))
+                               .string();
+        temps.push_back(path);
         switch (formats[k]) {
         case Format::Glb:
         case Format::Gltf: write_gltf(scene, path); break;
@@ -90,6 +109,15 @@ OutputSummary write_outputs(const Program& program, const Derivation& d, const s
         case Format::Txt: write_file_atomically(path, format_string(program, d.string()) + "\n"); break;
         case Format::MeshSummary: write_file_atomically(path, mesh_summary(scene)); break;
         }
+    }
+    for (std::size_t k = 0; k < temps.size(); ++k) {
+        std::error_code ec;
+        fs::rename(temps[k], paths[k], ec);
+        if (ec) throw ExportError(fmt::format("cannot write '{}': {}", paths[k], ec.message()));
+    }
+    } catch (...) {
+        discard();
+        throw;
     }
     return OutputSummary{scene.tubes.triangle_count(), scene.instances.size()};
 }

@@ -11,15 +11,27 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <charconv>
 #include <filesystem>
 #include <sstream>
 #include <thread>
+#include <tuple>
 
 namespace plant::cli {
 
 namespace fs = std::filesystem;
 
 namespace {
+
+// A whole number written with digits only, as the REPL's counts and seeds are.
+std::optional<std::uint64_t> whole_number(const std::string& text) {
+    std::uint64_t v = 0;
+    auto r = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (text.empty() || r.ec != std::errc() || r.ptr != text.data() + text.size()) return std::nullopt;
+    return v;
+}
+
+std::string modules(std::size_t n) { return fmt::format("{} module{}", n, n == 1 ? "" : "s"); }
 
 std::string trim(const std::string& s) {
     std::size_t b = s.find_first_not_of(" \t\r\n"), e = s.find_last_not_of(" \t\r\n");
@@ -83,25 +95,47 @@ std::string Session::session_source(const std::string* extra_fn) const {
     return s;
 }
 
-bool Session::rebuild(int steps, const std::string* extra_fn, bool warnings) {
-    auto sources = std::make_unique<SourceManager>();
+CompileOptions Session::compile_options() const {
     CompileOptions co;
     for (const auto& [name, value] : params_) co.defines.emplace_back(name, value);
+    if (!file_.empty()) co.file_texts[file_] = file_text_; // the file as :load or :reload read it
+    return co;
+}
+
+// Diagnostics not shown before in this session: a rebuild repeats the grammar's warnings, which
+// the user has seen already.
+Diagnostics Session::news(const Diagnostics& diags, const SourceManager& sources) {
+    Diagnostics out;
+    for (const auto& d : diags.all()) {
+        // by message and source line, not position: the session's own lines move as it grows
+        std::string key = d.message;
+        if (d.span.valid()) key += "|" + std::string(sources.file(d.span.file).line_text(sources.file(d.span.file).line_col(d.span.begin).line));
+        if (d.severity == Severity::Error || shown_.insert(key).second) out.add(d);
+    }
+    return out;
+}
+
+bool Session::rebuild(int steps, const std::string* extra_fn) {
+    auto sources = std::make_unique<SourceManager>();
+    CompileOptions co = compile_options();
     Diagnostics diags;
     std::uint32_t id = sources->add("<session>", session_source(extra_fn));
     auto program = compile_source(*sources, id, co, diags);
-    if (!warnings) { // the same warnings were shown when the grammar was first built
-        Diagnostics errors;
-        for (const auto& d : diags.all())
-            if (d.severity == Severity::Error) errors.add(d);
-        diags = errors;
+    err_ << render_all(news(diags, *sources), *sources, color_);
+    if (!program) {
+        failed_ = true;
+        return false;
     }
-    err_ << render_all(diags, *sources, color_);
-    if (!program) return false;
     std::vector<std::unique_ptr<Derivation>> history;
     try {
         history.push_back(std::make_unique<Derivation>(*program, options()));
         history.back()->start();
+        // :use choices are replayed at the steps where they were made
+        auto apply_uses = [&](Derivation& d) {
+            for (const auto& [at, group] : uses_)
+                if (at == d.steps_done()) d.use_group(group.empty() ? -1 : program->group_index(group));
+        };
+        apply_uses(*history.back());
         for (int k = 0; k < steps; ++k) {
             auto next = std::make_unique<Derivation>(*history.back());
             int before = next->steps_done();
@@ -109,12 +143,15 @@ bool Session::rebuild(int steps, const std::string* extra_fn, bool warnings) {
             next->step();
             last_step_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
             if (next->steps_done() == before) break; // a hook said stop
+            apply_uses(*next);
             history.push_back(std::move(next));
         }
     } catch (const RuntimeError& e) {
-        err_ << render(Diagnostic{Severity::Error, e.span, e.message, {}}, *sources, color_);
+        error() << render(Diagnostic{Severity::Error, e.span, e.message, {}}, *sources, color_);
+        last_error_runtime_ = true;
         return false;
     }
+    last_error_runtime_ = false;
     if (extra_fn) return true; // an evaluation: the caller reads the program, the session stays
     sources_ = std::move(sources);
     program_ = std::move(program);
@@ -122,27 +159,33 @@ bool Session::rebuild(int steps, const std::string* extra_fn, bool warnings) {
     return true;
 }
 
-bool Session::load(const std::string& path) {
+int Session::load(const std::string& path) {
     std::error_code ec;
     if (!fs::is_regular_file(path, ec)) {
-        err_ << fmt::format("plant: cannot read '{}': no such file\n", path);
-        return false;
+        error() << fmt::format("plant: cannot read '{}': {}\n", path,
+                               fs::is_directory(path, ec) ? "it is a directory" : "no such file");
+        return 66;
     }
-    std::string saved = file_;
+    // a new grammar starts a new session; a grammar that does not build leaves the old one as it was
+    auto saved = std::tuple{file_, file_text_, axiom_, extra_rules_, params_, seed_, uses_};
     file_ = fs::path(path).lexically_normal().string(); // as given: messages stay short and portable
+    read_file(file_, file_text_);
     axiom_.reset();
     extra_rules_.clear();
+    params_.clear();
+    seed_.reset();
+    uses_.clear();
     if (!rebuild(0)) {
-        file_ = saved;
-        return false;
+        std::tie(file_, file_text_, axiom_, extra_rules_, params_, seed_, uses_) = saved;
+        return last_error_runtime_ ? 70 : 65;
     }
-    out_ << fmt::format("loaded {}: {} modules at step 0\n", path, current().string().size());
-    return true;
+    out_ << fmt::format("loaded {}: {} at step 0\n", path, modules(current().string().size()));
+    return 0;
 }
 
 bool Session::need_derivation() {
     if (!history_.empty()) return true;
-    err_ << "no grammar yet: :load FILE, or type an axiom such as 'axiom: F;'\n";
+    error() << "no grammar yet: :load FILE, or type an axiom such as 'axiom: F;'\n";
     return false;
 }
 
@@ -155,9 +198,9 @@ bool Session::step(int n) {
         try {
             next->step();
         } catch (const RuntimeError& e) {
-            err_ << render(Diagnostic{Severity::Error, e.span, e.message, {}}, *sources_, color_);
+            error() << render(Diagnostic{Severity::Error, e.span, e.message, {}}, *sources_, color_);
             if (e.message.find("interrupted") != std::string::npos)
-                err_ << fmt::format("interrupted; still at step {}\n", current().steps_done());
+                error() << fmt::format("interrupted; still at step {}\n", current().steps_done());
             return false;
         }
         last_step_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -167,7 +210,7 @@ bool Session::step(int n) {
         }
         history_.push_back(std::move(next));
     }
-    out_ << fmt::format("step {}: {} modules ({:.3f} ms)\n", current().steps_done(), current().string().size(),
+    out_ << fmt::format("step {}: {} ({:.3f} ms)\n", current().steps_done(), modules(current().string().size()),
                         last_step_ms_);
     return true;
 }
@@ -187,40 +230,37 @@ void Session::show(const std::string& rest) {
     std::size_t b = 0, e = s.size();
     if (!range.empty()) {
         auto dots = range.find("..");
-        try {
-            b = std::stoul(range.substr(0, dots));
-            e = dots == std::string::npos ? b + 1 : std::stoul(range.substr(dots + 2));
-        } catch (...) {
-            err_ << fmt::format("':show' expects a range such as 0..20, found '{}'\n", range);
+        auto b_ok = whole_number(range.substr(0, dots));
+        auto e_ok = dots == std::string::npos ? std::optional<std::uint64_t>(b_ok ? *b_ok + 1 : 0)
+                                              : whole_number(range.substr(dots + 2));
+        if (!b_ok || !e_ok) {
+            error() << fmt::format("':show' expects a range such as 0..20, found '{}'\n", range);
             return;
         }
+        b = static_cast<std::size_t>(*b_ok);
+        e = static_cast<std::size_t>(*e_ok);
         e = std::min(e, s.size());
         if (b >= e) {
-            err_ << fmt::format("the range {} is empty: the string has {} modules\n", range, s.size());
+            error() << fmt::format("the range {} is empty: the string has {} modules\n", range, s.size());
             return;
         }
     }
-    // format a piece at a time: a long string is shortened without printing all of it first
+    ModuleString part;
+    part.append_range(s, b, e);
     const std::size_t limit = 2000;
-    std::string text;
-    std::size_t i = b;
-    while (i < e && text.size() <= limit) {
-        ModuleString part;
-        std::size_t j = std::min(e, i + 256);
-        part.append_range(s, i, j);
-        text += format_string(*program_, part, ids);
-        i = j;
-    }
-    if (text.size() > limit || i < e) {
-        out_ << text.substr(0, limit)
-             << fmt::format("... ({} modules; :show A..B shows a part)\n", e - b);
-    } else {
+    std::string text = format_string(*program_, part, ids, limit); // stops soon after the limit
+    if (text.size() > limit)
+        out_ << text.substr(0, limit) << fmt::format("... ({} modules; :show A..B shows a part)\n", e - b);
+    else
         out_ << text << "\n";
-    }
 }
 
 void Session::find(const std::string& pattern) {
     if (!need_derivation()) return;
+    if (pattern.empty()) {
+        error() << "':find' expects a module name, as in :find A or :find A(2)\n";
+        return;
+    }
     std::string name = pattern;
     std::optional<std::uint32_t> arity;
     if (auto p = pattern.find('('); p != std::string::npos) {
@@ -228,7 +268,7 @@ void Session::find(const std::string& pattern) {
         try {
             arity = static_cast<std::uint32_t>(std::stoul(pattern.substr(p + 1)));
         } catch (...) {
-            err_ << "':find' expects NAME or NAME(ARITY), as in A(2)\n";
+            error() << "':find' expects NAME or NAME(ARITY), as in A(2)\n";
             return;
         }
     }
@@ -305,20 +345,19 @@ void Session::params() {
 
 void Session::evaluate(const std::string& expr) {
     static const std::string kFn = "__repl_value__";
-    std::string fn = fmt::format("fn {}() = ({});", kFn, expr);
+    // the expression on a line of its own, so that errors point into what the user typed
+    std::string fn = fmt::format("fn {}() =\n{}\n;", kFn, expr);
     // compile the session with the expression as a function, then run it on the current globals
     auto sources = std::make_unique<SourceManager>();
-    CompileOptions co;
-    for (const auto& [name, value] : params_) co.defines.emplace_back(name, value);
+    CompileOptions co = compile_options();
     Diagnostics diags;
     std::string text = history_.empty() ? fn + "\naxiom: ;\n" : session_source(&fn);
     auto program = compile_source(*sources, sources->add("<session>", text), co, diags);
-    // the session's own warnings were shown when it was built; show only errors here
-    Diagnostics errors;
-    for (const auto& d : diags.all())
-        if (d.severity == Severity::Error) errors.add(d);
-    err_ << render_all(errors, *sources, color_);
-    if (!program) return;
+    err_ << render_all(news(diags, *sources), *sources, color_);
+    if (!program) {
+        failed_ = true;
+        return;
+    }
     const Function* f = nullptr;
     for (const auto& candidate : program->functions)
         if (candidate.name == kFn) f = &candidate;
@@ -335,7 +374,7 @@ void Session::evaluate(const std::string& expr) {
     try {
         run(f->code, frame.data(), env, r);
     } catch (const RuntimeError& e) {
-        err_ << render(Diagnostic{Severity::Error, e.span, e.message, {}}, *sources, color_);
+        error() << render(Diagnostic{Severity::Error, e.span, e.message, {}}, *sources, color_);
         return;
     }
     if (f->result == ValueType::Vec3)
@@ -353,9 +392,9 @@ void Session::export_files(const std::vector<std::string>& paths) {
         for (const auto& p : paths) out_ << "wrote " << p << "\n";
         out_ << fmt::format("{} triangles, {} organs\n", s.triangles, s.organs);
     } catch (const RuntimeError& e) {
-        err_ << render(Diagnostic{Severity::Error, e.span, e.message, {}}, *sources_, color_);
+        error() << render(Diagnostic{Severity::Error, e.span, e.message, {}}, *sources_, color_);
     } catch (const ExportError& e) {
-        err_ << "plant: " << e.what() << "\n";
+        error() << "plant: " << e.what() << "\n";
     }
 }
 
@@ -370,7 +409,7 @@ void Session::help(const std::string& topic) {
         }
     }
     if (!name.empty()) {
-        err_ << fmt::format("no command ':{}'; :help lists them\n", name);
+        error() << fmt::format("no command ':{}'; :help lists them\n", name);
         return;
     }
     out_ << "Anything else is a production (A(x) -> B(x + 1);), an axiom (axiom: A(1);) or an expression "
@@ -380,33 +419,44 @@ void Session::help(const std::string& topic) {
 bool Session::command(const std::string& name, const std::string& rest) {
     auto count = [&](int fallback) -> std::optional<int> {
         if (rest.empty()) return fallback;
-        if (rest.size() <= 7 && rest.find_first_not_of("0123456789") == std::string::npos) return std::stoi(rest);
-        err_ << fmt::format("':{}' expects a whole number, found '{}'\n", name, rest);
+        if (auto v = whole_number(rest); v && *v <= 1000000) return static_cast<int>(*v);
+        error() << fmt::format("':{}' expects a whole number from 0 to 1000000, found '{}'\n", name, rest);
         return std::nullopt;
     };
     if (name == "quit" || name == "q" || name == "exit") return false;
     if (name == "help" || name == "h" || name == "?") {
         help(rest);
     } else if (name == "load") {
-        if (rest.empty()) err_ << "':load' expects a file name\n";
+        if (rest.empty()) error() << "':load' expects a file name\n";
         else load(rest);
     } else if (name == "reload") {
         if (file_.empty()) {
-            err_ << "nothing to reload: :load a file first\n";
+            error() << "nothing to reload: :load a file first\n";
         } else {
             int steps = history_.empty() ? 0 : current().steps_done();
-            if (rebuild(steps)) out_ << fmt::format("reloaded; step {}: {} modules\n", current().steps_done(), current().string().size());
+            std::string saved = file_text_;
+            if (!read_file(file_, file_text_)) {
+                error() << fmt::format("plant: cannot read '{}'\n", file_);
+            } else if (rebuild(steps)) {
+                out_ << fmt::format("reloaded; step {}: {}\n", current().steps_done(), modules(current().string().size()));
+            } else {
+                file_text_ = saved;
+            }
         }
     } else if (name == "step" || name == "s") {
         if (auto n = count(1)) step(*n);
     } else if (name == "back" || name == "b") {
         if (auto n = count(1); n && need_derivation()) {
             int k = std::min<int>(*n, static_cast<int>(history_.size()) - 1);
+            if (k == 0)
+                out_ << "nothing to undo\n";
+            else if (k < *n)
+                out_ << fmt::format("only {} step{} to undo\n", k, k == 1 ? "" : "s");
             history_.resize(history_.size() - static_cast<std::size_t>(k));
-            out_ << fmt::format("step {}: {} modules\n", current().steps_done(), current().string().size());
+            out_ << fmt::format("step {}: {}\n", current().steps_done(), modules(current().string().size()));
         }
     } else if (name == "reset") {
-        if (need_derivation() && rebuild(0, nullptr, false)) out_ << fmt::format("step 0: {} modules\n", current().string().size());
+        if (need_derivation() && rebuild(0)) out_ << fmt::format("step 0: {}\n", modules(current().string().size()));
     } else if (name == "show") {
         show(rest);
     } else if (name == "find") {
@@ -419,37 +469,44 @@ bool Session::command(const std::string& name, const std::string& rest) {
         std::getline(in, value);
         value = trim(value);
         if (pname.empty() || value.empty()) {
-            err_ << "':set' expects NAME VALUE, as in :set r1 0.8\n";
+            error() << "':set' expects NAME VALUE, as in :set r1 0.8\n";
+        } else if (program_ && std::none_of(program_->globals.begin(), program_->globals.end(), [&](const Global& g) {
+                       return g.kind == GlobalKind::Param && g.name == pname;
+                   })) {
+            error() << fmt::format("no param '{}'; :params lists them\n", pname);
         } else {
             auto saved = params_;
             params_[pname] = value;
             int steps = history_.empty() ? 0 : current().steps_done();
-            if (rebuild(steps, nullptr, false))
-                out_ << fmt::format("{} = {}; step {}: {} modules\n", pname, value, current().steps_done(),
-                                    current().string().size());
+            if (rebuild(steps))
+                out_ << fmt::format("{} = {}; step {}: {}\n", pname, value, current().steps_done(),
+                                    modules(current().string().size()));
             else
                 params_ = saved;
         }
     } else if (name == "params") {
         params();
     } else if (name == "seed") {
-        try {
+        if (auto v = whole_number(rest)) {
             auto saved = seed_;
-            seed_ = std::stoull(rest);
+            seed_ = *v;
             int steps = history_.empty() ? 0 : current().steps_done();
-            if (history_.empty() || rebuild(steps, nullptr, false)) out_ << fmt::format("seed {}\n", *seed_);
+            if (history_.empty() || rebuild(steps)) out_ << fmt::format("seed {}\n", *seed_);
             else seed_ = saved;
-        } catch (...) {
-            err_ << fmt::format("':seed' expects a whole number, found '{}'\n", rest);
+        } else {
+            error() << fmt::format("':seed' expects a whole number, found '{}'\n", rest);
         }
     } else if (name == "rules") {
         rules();
     } else if (name == "use") {
         if (need_derivation()) {
             int g = rest == "none" ? -1 : program_->group_index(rest);
-            if (g < 0 && rest != "none") err_ << fmt::format("no rule group '{}'\n", rest);
+            if (g < 0 && rest != "none") error() << fmt::format("no rule group '{}'\n", rest);
             else {
                 current().use_group(g);
+                // remembered with its step, for replays; later choices at the same step win
+                std::erase_if(uses_, [&](const auto& u) { return u.first >= current().steps_done(); });
+                uses_.emplace_back(current().steps_done(), rest == "none" ? std::string() : rest);
                 out_ << fmt::format("using {}\n", rest);
             }
         }
@@ -461,14 +518,19 @@ bool Session::command(const std::string& name, const std::string& rest) {
         std::istringstream in(rest);
         std::vector<std::string> paths;
         for (std::string p; in >> p;) paths.push_back(p);
-        if (paths.empty()) err_ << "':export' expects one or more file names\n";
+        if (paths.empty()) error() << "':export' expects one or more file names\n";
         else export_files(paths);
     } else if (name == "render") {
         export_files({rest.empty() ? std::string("out/repl.png") : rest});
     } else {
-        err_ << fmt::format("unknown command ':{}'; :help lists the commands\n", name);
+        error() << fmt::format("unknown command ':{}'; :help lists the commands\n", name);
     }
     return true;
+}
+
+std::ostream& Session::error() {
+    failed_ = true;
+    return err_;
 }
 
 bool Session::execute(const std::string& raw) {
@@ -486,7 +548,7 @@ bool Session::execute(const std::string& raw) {
         std::string a = trim(line.substr(6));
         if (!a.empty() && a.back() == ';') a.pop_back();
         axiom_ = a;
-        if (rebuild(steps, nullptr, false)) out_ << fmt::format("axiom set; step {}: {} modules\n", current().steps_done(), current().string().size());
+        if (rebuild(steps)) out_ << fmt::format("axiom set; step {}: {}\n", current().steps_done(), modules(current().string().size()));
         else axiom_ = saved;
         return true;
     }
@@ -495,11 +557,12 @@ bool Session::execute(const std::string& raw) {
         if (line.back() != ';' && line.back() != '}') line += ';';
         extra_rules_.push_back(line);
         if (rebuild(steps))
-            out_ << fmt::format("rule added; step {}: {} modules\n", current().steps_done(), current().string().size());
+            out_ << fmt::format("rule added; step {}: {}\n", current().steps_done(), modules(current().string().size()));
         else
             extra_rules_.pop_back();
         return true;
     }
+    if (line.back() == ';') line.pop_back(); // `2 * r1;` is an expression too
     evaluate(line);
     return true;
 }

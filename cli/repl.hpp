@@ -10,6 +10,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -25,14 +26,22 @@ public:
     // Names for tab completion: commands, params, modules, rule groups.
     std::vector<std::string> completions() const;
     void set_interrupt(const std::atomic<bool>* flag) { interrupt_ = flag; }
-    bool load(const std::string& path); // :load
+    int load(const std::string& path); // :load; 0, or the exit code of the failure (65, 66, 70)
+    // Whether some line since the last call reported an error (scripts exit 1 when one did).
+    bool take_failed() {
+        bool f = failed_;
+        failed_ = false;
+        return f;
+    }
 
 private:
     bool command(const std::string& name, const std::string& rest);
     void help(const std::string& topic);
     // Recompiles the session's grammar and replays `steps` steps. Keeps the previous state and
     // reports the error when the new grammar does not compile or derive.
-    bool rebuild(int steps, const std::string* extra_fn = nullptr, bool warnings = true);
+    bool rebuild(int steps, const std::string* extra_fn = nullptr);
+    CompileOptions compile_options() const;
+    Diagnostics news(const Diagnostics& diags, const SourceManager& sources);
     std::string session_source(const std::string* extra_fn) const;
     bool step(int n);
     void show(const std::string& rest);
@@ -51,11 +60,17 @@ private:
     bool color_;
     const std::atomic<bool>* interrupt_ = nullptr;
 
-    std::string file_;                         // absolute path of the loaded grammar, if any
+    std::string file_;                         // the loaded grammar's path, as given
+    std::string file_text_;                    // its text as :load or :reload read it
     std::optional<std::string> axiom_;         // typed `axiom: ...`
     std::vector<std::string> extra_rules_;     // typed productions
     std::map<std::string, std::string> params_; // :set NAME VALUE
     std::optional<std::uint64_t> seed_;
+    std::vector<std::pair<int, std::string>> uses_; // :use GROUP at step N, replayed by rebuilds
+    std::set<std::string> shown_; // warnings already shown
+    bool failed_ = false;
+    bool last_error_runtime_ = false;
+    std::ostream& error(); // err_, marking the line as failed
 
     std::unique_ptr<SourceManager> sources_;
     std::unique_ptr<Program> program_;

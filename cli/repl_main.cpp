@@ -52,24 +52,30 @@ int repl_main(const std::string& file, bool color) {
     const bool interactive = isatty(0) != 0;
     Session session(std::cout, std::cerr, color && interactive);
     g_session = &session;
+    if (!file.empty()) {
+        int code = session.load(file);
+        if (code != 0 && !interactive) return code;
+    }
+    if (!interactive) {
+        // scripts: one line at a time, no prompt; exit 1 when some line failed (Ctrl-C ends
+        // the script as usual: no handler is installed)
+        std::string line;
+        bool failed = false;
+        while (std::getline(std::cin, line)) {
+            bool go_on = session.execute(line);
+            failed = session.take_failed() || failed;
+            std::cout.flush();
+            std::cerr.flush();
+            if (!go_on) break;
+        }
+        return failed ? kFailed : kOk;
+    }
+    // interactive: Ctrl-C interrupts a long step and returns to the prompt
     session.set_interrupt(&g_interrupt);
     struct sigaction sa {};
     sa.sa_handler = on_sigint;
     sigemptyset(&sa.sa_mask);
     sigaction(SIGINT, &sa, nullptr);
-    if (!file.empty() && !session.load(file) && !interactive) return kGrammar;
-    if (!interactive) {
-        // scripts: one line at a time, no prompt; the exit code says whether a line failed
-        std::string line;
-        while (std::getline(std::cin, line)) {
-            g_interrupt.store(false);
-            bool go_on = session.execute(line);
-            std::cout.flush();
-            std::cerr.flush();
-            if (!go_on) break;
-        }
-        return kOk;
-    }
     std::cout << "plant repl: :help lists the commands, :quit ends; Tab completes names\n";
     rl_attempted_completion_function = complete;
     const std::string hist = history_path();
@@ -77,6 +83,10 @@ int repl_main(const std::string& file, bool color) {
     for (;;) {
         g_interrupt.store(false);
         char* raw = readline("plant> ");
+        if (!raw && g_interrupt.load()) { // Ctrl-C at the prompt: a fresh line, not the end
+            std::cout << "\n";
+            continue;
+        }
         if (!raw) { // Ctrl-D
             std::cout << "\n";
             break;
@@ -85,6 +95,7 @@ int repl_main(const std::string& file, bool color) {
         std::free(raw);
         if (line.find_first_not_of(" \t") != std::string::npos) add_history(line.c_str());
         bool go_on = session.execute(line);
+        session.take_failed();
         std::cout.flush();
         if (!go_on) break;
     }

@@ -77,6 +77,7 @@ std::string Compiler::resolve_import(const ast::Import& im, std::uint32_t from_f
     std::error_code ec;
     if (im.is_path) {
         fs::path p = fs::path(im.target).is_absolute() ? fs::path(im.target) : from_dir / im.target;
+        if (opts_.file_texts.count(p.lexically_normal().string())) return p.lexically_normal().string();
         searched.push_back(p.string());
         return fs::exists(p, ec) ? p.lexically_normal().string() : std::string();
     }
@@ -126,7 +127,9 @@ void Compiler::load(std::uint32_t file_id, std::map<std::string, std::pair<const
         }
         if (loaded_paths_.count(path)) continue; // imported already through another path
         std::string text;
-        if (!read_file(path, text)) {
+        if (auto it = opts_.file_texts.find(path); it != opts_.file_texts.end()) {
+            text = it->second;
+        } else if (!read_file(path, text)) {
             diags_->error(im.span, fmt::format("cannot read imported file '{}'", path));
             continue;
         }

@@ -67,7 +67,7 @@ std::string format_double(double v) {
     return s;
 }
 
-std::string format_string(const Program& program, const ModuleString& s, bool with_ids) {
+std::string format_string(const Program& program, const ModuleString& s, bool with_ids, std::size_t max_chars) {
     std::string out;
     out.reserve(s.size() * 2);
     // Prefixes of declared multi-letter names: "F" then "b" must be spaced when "Fb..." is declared.
@@ -76,7 +76,7 @@ std::string format_string(const Program& program, const ModuleString& s, bool wi
         if (info.declared && info.name.size() > 1 && std::isalpha(static_cast<unsigned char>(info.name[0])))
             for (std::size_t l = 2; l <= info.name.size(); ++l) prefixes.insert(info.name.substr(0, l));
     const std::string* prev = nullptr; // name of the previous module when it ends in a letter run
-    for (std::size_t i = 0; i < s.size(); ++i) {
+    for (std::size_t i = 0; i < s.size() && out.size() <= max_chars; ++i) {
         const std::string& name = program.symbols[s.sym[i]].name;
         bool letter_start = !name.empty() && (std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_');
         // a space only where reading back would merge two names

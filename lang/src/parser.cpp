@@ -71,6 +71,7 @@ public:
         } else if (n.is_type<g::name_ref>()) {
             e->kind = ast::ExprKind::Name;
             e->text = n.children.at(0)->string();
+            e->span = span(*n.children.at(0)); // the name, without the space after it
         } else if (n.is_type<g::call>()) {
             e->kind = ast::ExprKind::Call;
             e->text = n.children.at(0)->string();
@@ -80,7 +81,8 @@ public:
             e->text = n.children.at(0)->string();
             e->args.push_back(expr(*n.children.at(1)));
         } else if (n.is_type<g::paren_expr>()) {
-            // the value is the inner expression; the span covers the parentheses
+            // the value is the inner expression; its span takes in the parentheses, so that a
+            // message about `x / (x - 1)` shows the whole divisor
             ast::ExprPtr inner = expr(*n.children.at(0));
             std::string_view text = n.string_view();
             auto close = text.rfind(')');

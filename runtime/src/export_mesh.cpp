@@ -18,6 +18,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <mutex>
 #include <system_error>
 #include <unistd.h>
@@ -93,29 +94,6 @@ private:
     Mesh& mesh_;
 };
 
-// Creates a new, empty file beside `path` with the same extension (OpenMesh picks its writer by
-// extension) and returns its name. Throws ExportError when the directory is not writable.
-std::string create_temp_beside(const std::string& path, const std::string& ext) {
-    static std::atomic<unsigned> counter{0};
-    const fs::path target(path);
-    const fs::path dir = target.parent_path();
-    for (int attempt = 0;; ++attempt) {
-        const std::string name = "." + target.stem().string() + ".tmp-" +
-                                 std::to_string(::getpid()) + "-" + std::to_string(counter++) + ext;
-        const std::string temp = (dir / name).string();
-        std::FILE* file = std::fopen(temp.c_str(), "wbx");
-        if (file) {
-            std::fclose(file);
-            return temp;
-        }
-        const int err = errno;
-        if (err == EEXIST && attempt < 100) continue;
-        throw ExportError("cannot write " + quoted(path) + ": cannot create a file in " +
-                          quoted(dir.empty() ? std::string(".") : dir.string()) + ": " +
-                          std::strerror(err));
-    }
-}
-
 } // namespace
 
 void write_mesh_file(const Scene& scene, const std::string& path) {
@@ -157,28 +135,10 @@ void write_mesh_file(const Scene& scene, const std::string& path) {
     // OFF stays plain NOFF: few readers understand texture coordinates in OFF files.
     if (ext != ".off") options += OpenMesh::IO::Options::VertexTexCoord;
 
-    const std::string temp = create_temp_beside(path, ext);
-    bool ok = false;
-    {
-        std::ofstream out(temp, std::ios::out | std::ios::binary | std::ios::trunc);
-        ok = out && OpenMesh::IO::write_mesh(mesh, out, ext, options, 7);
-        out.flush();
-        out.close();
-        ok = ok && !out.fail();
-    }
-    if (!ok) {
-        std::error_code ignored;
-        fs::remove(temp, ignored);
-        throw ExportError("cannot write " + quoted(path) + ": OpenMesh failed to write the " +
-                          ext.substr(1) + " file");
-    }
-    std::error_code ec;
-    fs::rename(temp, path, ec);
-    if (ec) {
-        std::error_code ignored;
-        fs::remove(temp, ignored);
-        throw ExportError("cannot write " + quoted(path) + ": " + ec.message());
-    }
+    std::ostringstream out(std::ios::out | std::ios::binary);
+    if (!OpenMesh::IO::write_mesh(mesh, out, ext, options, 7))
+        throw ExportError("cannot write " + quoted(path) + ": OpenMesh failed to write the " + ext.substr(1) + " file");
+    write_file_atomically(path, out.str());
 }
 
 } // namespace plant

@@ -34,6 +34,11 @@ glm::dvec3 transport(const glm::dvec3& v, const glm::dvec3& a, const glm::dvec3&
     return v * std::cos(angle) + glm::cross(axis, v) * std::sin(angle) + axis * glm::dot(axis, v) * (1 - std::cos(angle));
 }
 
+// Rotates v about the unit axis k by phi, right-handed.
+glm::dvec3 transport_about(const glm::dvec3& v, const glm::dvec3& k, double phi) {
+    return v * std::cos(phi) + glm::cross(k, v) * std::sin(phi) + k * glm::dot(k, v) * (1 - std::cos(phi));
+}
+
 glm::dvec3 any_perpendicular(const glm::dvec3& t) {
     glm::dvec3 p = std::fabs(t.y) < 0.9 ? glm::cross(t, glm::dvec3(0, 1, 0)) : glm::cross(t, glm::dvec3(1, 0, 0));
     return glm::normalize(p);
@@ -69,18 +74,27 @@ std::vector<Ring> rings_of(const SkeletonAxis& axis, const MeshOptions& o) {
                                  p.color});
             continue;
         }
-        // round the corner: rings along a quadratic Bezier tangent to both segments
-        // the curve bends with a radius of about 1.5 tube radii, so the inner side does not collapse
-        double a = std::min({0.45 * seg_len(k - 1), 0.45 * seg_len(k), 1.5 * r * std::tan(std::min(theta, 2.8) / 2)});
-        a = std::max(a, 1e-6);
-        glm::dvec3 A = p.position - d0 * a, B = p.position + d1 * a;
+        // round the corner with a circular arc tangent to both segments, of radius 1.5 tube radii
+        // where the segments are long enough (a radius below the tube's folds the inner side)
+        const double half = std::min(theta, 3.0) / 2;
+        double rho = 1.5 * r;
+        double a = rho * std::tan(half);
+        const double room = 0.45 * std::min(seg_len(k - 1), seg_len(k));
+        if (a > room) {
+            a = room;
+            rho = a / std::tan(half);
+        }
+        glm::dvec3 turn = glm::cross(d0, d1);
+        double tl = glm::length(turn);
+        turn = tl > 1e-12 ? turn / tl : any_perpendicular(d0);
+        const glm::dvec3 start = p.position - d0 * a;
+        const glm::dvec3 center = start + glm::cross(turn, d0) * rho; // toward the inside of the turn
         int n = std::max(2, static_cast<int>(std::ceil(theta / (22.5 * kPi / 180.0))));
         for (int j = 0; j <= n; ++j) {
-            double u = double(j) / n;
-            glm::dvec3 c = (1 - u) * (1 - u) * A + 2 * u * (1 - u) * p.position + u * u * B;
-            glm::dvec3 t = 2 * (1 - u) * (p.position - A) + 2 * u * (B - p.position);
-            double tl = glm::length(t);
-            rings.push_back(Ring{c, tl > 1e-12 ? t / tl : d0, r, glm::dvec3(0), 1.0, p.color});
+            double phi = theta * j / n;
+            glm::dvec3 c = center + transport_about(start - center, turn, phi);
+            glm::dvec3 t = transport_about(d0, turn, phi);
+            rings.push_back(Ring{c, glm::normalize(t), r, glm::dvec3(0), 1.0, p.color});
         }
     }
     rings.back().radius *= o.tip_taper; // a tapered tip

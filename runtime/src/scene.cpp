@@ -89,8 +89,9 @@ MeshPart sphere_prototype() {
     for (int i = 0; i < stacks; ++i) {
         for (int j = 0; j < slices; ++j) {
             auto a = static_cast<std::uint32_t>(i * (slices + 1) + j), b = a + 1, d = a + slices + 1, c = d + 1;
-            if (i != 0) m.indices.insert(m.indices.end(), {a, d, b});         // skip degenerate pole triangles
-            if (i != stacks - 1) m.indices.insert(m.indices.end(), {b, d, c});
+            // counter-clockwise seen from outside; the pole rows would be degenerate
+            if (i != 0) m.indices.insert(m.indices.end(), {a, b, d});
+            if (i != stacks - 1) m.indices.insert(m.indices.end(), {b, c, d});
         }
     }
     m.primitives.push_back(Primitive{0, static_cast<std::uint32_t>(m.indices.size()), 0});
@@ -182,6 +183,12 @@ Scene build_scene(const Program& program, const Skeleton& skeleton, const MeshOp
     }
     if (scene.materials.empty()) scene.materials.push_back(Material{});
     scene.update_bounds();
+    // meshes are single precision: a plant beyond its range cannot be meshed
+    for (float v : {scene.bounds_min.x, scene.bounds_min.y, scene.bounds_min.z, scene.bounds_max.x, scene.bounds_max.y,
+                    scene.bounds_max.z})
+        if (!std::isfinite(v))
+            throw RuntimeError(Span{}, "the plant reaches coordinates beyond the range of single-precision numbers "
+                                       "(about 3e38) and cannot be meshed");
     return scene;
 }
 

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -36,7 +37,12 @@ void orthonormalize(TurtleState& t) {
 
 // Sets the heading, keeping up as close as possible to `up_hint`.
 void set_heading(TurtleState& t, glm::dvec3 h, glm::dvec3 up_hint) {
-    if (glm::length(h) < 1e-12) return;
+    // scale first, so that huge components do not overflow the length
+    double m = std::max({std::fabs(h.x), std::fabs(h.y), std::fabs(h.z)});
+    if (!(m > 0) || !std::isfinite(m)) return;
+    h /= m;
+    double um = std::max({std::fabs(up_hint.x), std::fabs(up_hint.y), std::fabs(up_hint.z)});
+    up_hint = um > 0 && std::isfinite(um) ? up_hint / um : t.up;
     h = glm::normalize(h);
     glm::dvec3 l = glm::cross(up_hint, h);
     if (glm::length(l) < 1e-9) l = glm::cross(glm::dvec3(0, 0, 1), h);
@@ -110,8 +116,8 @@ void interpret(const Program& program, const ModuleString& s, const TurtleOption
         return glm::dvec3(a[k], a[k + 1], a[k + 2]);
     };
     auto check = [&](std::size_t i) {
-        const glm::dvec3& p = t.position;
-        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !std::isfinite(t.heading.x))
+        auto finite = [](const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+        if (!finite(t.position) || !finite(t.heading) || !finite(t.left) || !finite(t.up))
             throw RuntimeError(Span{}, fmt::format("the turtle left finite space at module {} ('{}') of the string", i + 1,
                                                    program.symbols[s.sym[i]].name));
     };
@@ -178,7 +184,7 @@ void interpret(const Program& program, const ModuleString& s, const TurtleOption
         } else if (sym == y.bang) {
             t.width = arg(i, 0, t.width);
         } else if (sym == y.semi) {
-            t.color_index = static_cast<int>(arg(i, 0, t.color_index + 1));
+            t.color_index = static_cast<int>(std::clamp(arg(i, 0, t.color_index + 1), -1e6, 1e6));
             t.color = palette_color(t.color_index);
         } else if (sym == y.set_color) {
             glm::dvec3 c(arg(i, 0, 0), arg(i, 1, 0), arg(i, 2, 0));
@@ -192,6 +198,7 @@ void interpret(const Program& program, const ModuleString& s, const TurtleOption
                 set_heading(t, vec_arg(i, 0), vec_arg(i, 3));
             else if (s.arity(i) >= 3)
                 set_heading(t, vec_arg(i, 0), t.up);
+            check(i);
         } else if (sym == y.move_to) {
             if (s.arity(i) >= 3) t.position = vec_arg(i, 0);
             t.axis = -1;

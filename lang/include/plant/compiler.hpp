@@ -4,6 +4,7 @@
 #include "plant/diagnostics.hpp"
 #include "plant/program.hpp"
 
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -13,6 +14,7 @@ namespace plant {
 struct CompileOptions {
     std::vector<std::pair<std::string, std::string>> defines; // -D name=value
     std::vector<std::string> include_dirs;                    // -I dir, then PLANT_PATH, then stdlib
+    std::map<std::string, std::string> file_texts;            // imported files' text, instead of reading them
 };
 
 // Reads, parses and compiles `path` and everything it imports. Returns null when there were

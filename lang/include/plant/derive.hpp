@@ -107,7 +107,9 @@ private:
 };
 
 // Formats a string in ABOP notation (LANGUAGE.md section 11).
-std::string format_string(const Program& program, const ModuleString& s, bool with_ids = false);
+// With `max_chars`, stops after the module that passes that length (the REPL's :show).
+std::string format_string(const Program& program, const ModuleString& s, bool with_ids = false,
+                          std::size_t max_chars = ~std::size_t{0});
 // Shortest text that reads back to the same double.
 std::string format_double(double v);
 

@@ -66,7 +66,7 @@ struct TurtleOptions {
 };
 
 // Interprets `s` (already passed through the interpretation rules). Throws RuntimeError for a
-// ']' without '[' (positioned at the module's source when known) and for non-finite results.
+// ']' without '[' (naming its place in the string) and for non-finite results.
 void interpret(const Program& program, const ModuleString& s, const TurtleOptions& options, TurtleSink& sink);
 
 // Named colors for ;(c): index c in a small palette of plant colors.
