@@ -88,6 +88,22 @@ printf 'axiom: F ] F;\n' >"$tmp/pop.plant"
 check "empty turtle stack" 70 "$plant" run "$tmp/pop.plant" -o "$tmp/pop.glb" -o "$tmp/pop.png"
 contains "empty stack message" "$tmp/stderr" "closes no '['"
 if [ -e "$tmp/pop.glb" ] || [ -e "$tmp/pop.png" ]; then fail=$((fail + 1)); echo "FAIL partial output after an error"; else pass=$((pass + 1)); fi
+# all or nothing: one output that cannot be written means none is left behind
+check "one unwritable output of two" 73 "$plant" run "$tmp/plant.plant" -o "$tmp/both.glb" -o /proc/nope/x.png
+if [ -e "$tmp/both.glb" ]; then fail=$((fail + 1)); echo "FAIL both.glb left behind"; else pass=$((pass + 1)); fi
+if ls -a "$tmp" | grep -q plant-tmp; then fail=$((fail + 1)); echo "FAIL temporary files left behind"; else pass=$((pass + 1)); fi
+check "upper-case extension" 0 "$plant" run "$tmp/plant.plant" -o "$tmp/UP.GLB"
+printf 'axiom: F @R(1e308, 1e308, 0) F;\n' >"$tmp/huge.plant"
+check "huge heading" 0 "$plant" run "$tmp/huge.plant" -o "$tmp/huge.skel.json"
+if grep -q nan "$tmp/huge.skel.json"; then fail=$((fail + 1)); echo "FAIL NaN in the skeleton"; else pass=$((pass + 1)); fi
+printf 'axiom: F(1e39);\n' >"$tmp/far.plant"
+check "beyond single precision" 70 "$plant" run "$tmp/far.plant" -o "$tmp/far.glb"
+# the REPL: exit codes of scripts
+printf ':step 1\n' >"$tmp/ok.repl"
+printf ':step x\n:step 1\n' >"$tmp/bad.repl"
+check "repl script" 0 "$plant" repl "$tmp/plant.plant" <"$tmp/ok.repl"
+check "repl script with a failing line" 1 "$plant" repl "$tmp/plant.plant" <"$tmp/bad.repl"
+check "repl with a missing file" 66 "$plant" repl "$tmp/none.plant"
 printf 'axiom: F ~nothing(1);\n' >"$tmp/nosurf.plant"
 check "undeclared surface" 70 "$plant" run "$tmp/nosurf.plant" -o "$tmp/n.glb"
 

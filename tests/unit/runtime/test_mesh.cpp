@@ -162,6 +162,22 @@ TEST_CASE("the scene shares organ prototypes between placements and bounds inclu
     CHECK(s.tubes.triangle_count() > 0);
 }
 
+TEST_CASE("sphere faces are wound outward, like their normals", "[mesh]") {
+    auto c = test::compile("axiom: @O(1);");
+    REQUIRE(c->program);
+    Derivation d(*c->program, {});
+    d.run();
+    Scene s = build_scene(*c->program, build_skeleton(*c->program, d.string(), TurtleOptions{}), MeshOptions{});
+    REQUIRE(s.prototypes.size() == 1);
+    const MeshPart& m = s.prototypes[0];
+    REQUIRE(m.triangle_count() > 0);
+    for (std::size_t t = 0; t < m.indices.size(); t += 3) {
+        glm::vec3 a = m.positions[m.indices[t]], b = m.positions[m.indices[t + 1]], c2 = m.positions[m.indices[t + 2]];
+        glm::vec3 face = glm::cross(b - a, c2 - a);
+        CHECK(glm::dot(face, a + b + c2) > 0); // the face normal points away from the center
+    }
+}
+
 TEST_CASE("a surface loaded from a file is meshed once and placed by transform", "[mesh]") {
     auto c = test::compile(std::string("surface leaf = load(\"") + PLANT_TEST_DATA + "/leaf.obj\"); axiom: F ~leaf(2) F ~leaf(1);");
     REQUIRE(c->program);
