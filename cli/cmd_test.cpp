@@ -13,6 +13,8 @@
 // sidecar NAME.txt beside it, which `--bless` rewrites.
 #include "commands.hpp"
 
+#include "plant/export.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -187,15 +189,12 @@ std::string first_difference(const std::string& want, const std::string& got) {
 }
 
 bool write_atomically(const fs::path& path, const std::string& text) {
-    fs::path tmp = path;
-    tmp += ".tmp";
-    {
-        std::ofstream f(tmp, std::ios::binary);
-        if (!f.write(text.data(), static_cast<std::streamsize>(text.size()))) return false;
+    try {
+        write_file_atomically(path.string(), text);
+        return true;
+    } catch (const ExportError&) {
+        return false;
     }
-    std::error_code ec;
-    fs::rename(tmp, path, ec);
-    return !ec;
 }
 
 // Returns an empty string when the test passed, else what went wrong.
