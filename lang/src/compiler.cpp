@@ -437,11 +437,16 @@ ValueType Compiler::compile_call(Ctx& c, const ast::Expr& e) {
         if (!fn_result_known_[it->second]) return ValueType::Void;
         return fn.result;
     }
-    if (curve_names_.count(name)) {
-        diags_->error(e.span, fmt::format("curve '{}' cannot be evaluated yet: curves are parsed but not yet run by "
-                                         "this version",
-                                         name));
-        emit_const(c, 0, e.span);
+    for (std::size_t k = 0; k < P_.curves.size(); ++k) {
+        if (P_.curves[k].name != name) continue;
+        if (e.args.size() != 1) {
+            diags_->error(e.span, fmt::format("curve '{}' takes one argument, t from 0 to 1", name));
+            emit_const(c, 0, e.span);
+            return ValueType::Number;
+        }
+        ValueType t = compile_expr(c, *e.args[0]);
+        if (!numeric(t)) diags_->error(e.args[0]->span, fmt::format("curve '{}' takes a number", name));
+        emit(c, Op::Curve, static_cast<std::int32_t>(k), 0, e.span);
         return ValueType::Number;
     }
     // built-ins: first row whose name and argument types fit

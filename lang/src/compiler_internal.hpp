@@ -101,6 +101,7 @@ private:
     void finish_rule_set(RuleSet& set);
     void build_template(Production& p);
     void compile_surface(const ast::ShapeDecl& s);
+    void compile_curve(const ast::ShapeDecl& s);
 
     // helpers (compiler.cpp)
     void emit(Ctx& c, Op op, std::int32_t a, int n, Span span, std::uint16_t b = 0);

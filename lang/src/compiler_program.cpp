@@ -450,6 +450,49 @@ void Compiler::check_never_applying() {
 
 void Compiler::finish_rule_set(RuleSet& set) { set.index(P_.symbols.size()); }
 
+void Compiler::compile_curve(const ast::ShapeDecl& s) {
+    CurveDef def;
+    def.name = s.name;
+    def.span = s.span;
+    for (const auto& other : P_.curves) {
+        if (other.name == s.name) {
+            duplicate("curve", s.name, s.span, other.span);
+            return;
+        }
+    }
+    if (s.kind != "linear" && s.kind != "bezier") {
+        diags_->error(s.kind_span, fmt::format("unknown curve kind '{}': expected linear(...) or bezier(...)", s.kind));
+        return;
+    }
+    def.bezier = s.kind == "bezier";
+    bool points = false;
+    for (std::size_t i = 0; i < s.args.size(); ++i) {
+        auto v = eval_const(*s.args[i], "a curve's control value");
+        if (!v) return;
+        bool vec = v->type == ValueType::Vec3;
+        if (i == 0) points = vec;
+        if (vec != points) {
+            diags_->error(s.args[i]->span, "a curve's control values are all numbers or all vec3 points");
+            return;
+        }
+        def.xs.push_back(vec ? v->v[0] : 0.0);
+        def.ys.push_back(vec ? v->v[1] : v->v[0]);
+    }
+    if (def.ys.size() < 2) {
+        diags_->error(s.span, fmt::format("curve '{}' needs at least two control values", s.name));
+        return;
+    }
+    if (!points)
+        for (std::size_t i = 0; i < def.xs.size(); ++i) def.xs[i] = double(i) / double(def.xs.size() - 1);
+    for (std::size_t i = 1; i < def.xs.size(); ++i) {
+        if (def.xs[i] < def.xs[i - 1]) {
+            diags_->error(s.args[i]->span, "the x of a curve's points must not decrease (x is t, from 0 to 1)");
+            return;
+        }
+    }
+    P_.curves.push_back(std::move(def));
+}
+
 void Compiler::compile_surface(const ast::ShapeDecl& s) {
     SurfaceDef def;
     def.name = s.name;
@@ -622,6 +665,7 @@ std::unique_ptr<Program> Compiler::compile(std::uint32_t main_file) {
                                                     name, near));
         }
     }
+    for (const ast::ShapeDecl* s : P_.deferred.curves) compile_curve(*s); // before the code that calls them
     for (std::uint32_t i = 0; i < P_.functions.size(); ++i) ensure_function_compiled(i);
     for (const ast::ShapeDecl* s : P_.deferred.surfaces) compile_surface(*s);
     for (const auto& lf : order_) {

@@ -311,11 +311,50 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
             return RunStatus::Finished;
         case Op::LoadMulConst: st[sp++] = frame[I.a] * code.consts[I.b]; break;
         case Op::LoadAddConst: st[sp++] = frame[I.a] + code.consts[I.b]; break;
+        case Op::Curve: st[sp - 1] = env.prog->curves[static_cast<std::size_t>(I.a)](st[sp - 1]); break;
         }
     }
     if (result && sp > 0)
         for (int k = 0; k < std::min(sp, 3); ++k) result[k] = st[sp - std::min(sp, 3) + k];
     return RunStatus::Finished;
+}
+
+double CurveDef::operator()(double t) const {
+    if (!(t >= 0)) t = 0; // NaN too
+    if (t > 1) t = 1;
+    const std::size_t n = ys.size();
+    if (!bezier) {
+        // piecewise linear through (xs[i], ys[i])
+        if (t <= xs.front()) return ys.front();
+        for (std::size_t i = 1; i < n; ++i)
+            if (t <= xs[i]) {
+                double w = xs[i] > xs[i - 1] ? (t - xs[i - 1]) / (xs[i] - xs[i - 1]) : 1.0;
+                return ys[i - 1] + (ys[i] - ys[i - 1]) * w;
+            }
+        return ys.back();
+    }
+    // Bezier curve (x(u), y(u)) with Bernstein weights (de Casteljau); x increases with u, so
+    // the u with x(u) = t is found by bisection; the ends are exact
+    if (t <= xs.front()) return ys.front();
+    if (t >= xs.back()) return ys.back();
+    auto point = [&](double u, double& x, double& y) {
+        std::vector<double> px(xs), py(ys);
+        for (std::size_t r = 1; r < n; ++r)
+            for (std::size_t i = 0; i + r < n; ++i) {
+                px[i] = px[i] * (1 - u) + px[i + 1] * u;
+                py[i] = py[i] * (1 - u) + py[i + 1] * u;
+            }
+        x = px[0];
+        y = py[0];
+    };
+    double lo = 0, hi = 1, x = 0, y = 0;
+    for (int k = 0; k < 50; ++k) {
+        double mid = (lo + hi) / 2;
+        point(mid, x, y);
+        (x < t ? lo : hi) = mid;
+    }
+    point((lo + hi) / 2, x, y);
+    return y;
 }
 
 void fuse(Code& code) {

@@ -81,6 +81,7 @@ enum class Op : std::uint8_t {
     // superinstructions made by fuse() in straight-line code
     LoadMulConst, // push frame[a] * consts[b]
     LoadAddConst, // push frame[a] + consts[b]
+    Curve,        // replace t on top of the stack by curves[a](t)
 };
 
 struct Instr {
@@ -190,6 +191,17 @@ struct Deferred {
     std::vector<const ast::InstanceDecl*> instances;
 };
 
+// `curve name = linear(...)` or `bezier(...)`: a function of t in [0, 1], as cpfg's function
+// files. Control values are numbers (equally spaced in t) or vec3 points whose x is t and y the
+// value (x increasing).
+struct CurveDef {
+    std::string name;
+    bool bezier = false;
+    std::vector<double> xs, ys;
+    Span span;
+    double operator()(double t) const;
+};
+
 // `surface name = polygon(p0, p1, ...)` or `= load("file.obj")`, evaluated at compile time.
 struct SurfaceDef {
     std::string name;
@@ -223,6 +235,7 @@ struct Program {
 
     Deferred deferred;
     std::vector<SurfaceDef> surfaces;
+    std::vector<CurveDef> curves;
     std::vector<std::unique_ptr<ast::File>> files; // the syntax trees the program was built from
 
     int group_index(std::string_view name) const;
