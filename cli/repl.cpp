@@ -51,7 +51,7 @@ const CommandInfo kCommands[] = {
     {"back", ":back [N]", "undo the last N steps (default 1)"},
     {"reset", ":reset", "go back to the axiom (step 0)"},
     {"show", ":show [A..B] [--ids]", "print the string, or modules A to B; long strings are shortened"},
-    {"find", ":find NAME[(ARITY)]", "list the modules with that name, with their positions and identities"},
+    {"find", ":find PATTERN", "list the modules a name or predecessor pattern matches (A, A(x) : x > 2, B < A(x)), with positions and identities"},
     {"set", ":set NAME VALUE", "change a param (VALUE is an expression) and replay"},
     {"params", ":params", "list the params and vars with their current values"},
     {"seed", ":seed S", "change the random seed and replay"},
@@ -241,7 +241,7 @@ void Session::show(const std::string& rest) {
         e = static_cast<std::size_t>(*e_ok);
         e = std::min(e, s.size());
         if (b >= e) {
-            error() << fmt::format("the range {} is empty: the string has {} modules\n", range, s.size());
+            error() << fmt::format("the range {} is empty: the string has {}\n", range, modules(s.size()));
             return;
         }
     }
@@ -258,33 +258,55 @@ void Session::show(const std::string& rest) {
 void Session::find(const std::string& pattern) {
     if (!need_derivation()) return;
     if (pattern.empty()) {
-        error() << "':find' expects a module name, as in :find A or :find A(2)\n";
+        error() << "':find' expects a predecessor pattern, as in :find A(x) : x > 2 or :find B < A\n";
         return;
     }
-    std::string name = pattern;
-    std::optional<std::uint32_t> arity;
-    if (auto p = pattern.find('('); p != std::string::npos) {
-        name = trim(pattern.substr(0, p));
-        try {
-            arity = static_cast<std::uint32_t>(std::stoul(pattern.substr(p + 1)));
-        } catch (...) {
-            error() << "':find' expects NAME or NAME(ARITY), as in A(2)\n";
-            return;
-        }
-    }
-    auto sym = program_->symbols.find(name);
     const ModuleString& s = current().string();
-    std::size_t found = 0;
-    for (std::size_t i = 0; sym && i < s.size(); ++i) {
-        if (s.sym[i] != *sym || (arity && s.arity(i) != *arity)) continue;
-        if (found++ < 50) {
+    auto list = [&](const std::vector<std::size_t>& found, const char* what) {
+        for (std::size_t k = 0; k < found.size() && k < 50; ++k) {
             ModuleString one;
-            one.append_range(s, i, i + 1);
-            out_ << fmt::format("  {:>8}  #{:<8} {}\n", i, s.ids[i], format_string(*program_, one));
+            one.append_range(s, found[k], found[k] + 1);
+            out_ << fmt::format("  {:>8}  #{:<8} {}\n", found[k], s.ids[found[k]], format_string(*program_, one));
         }
+        if (found.size() > 50) out_ << fmt::format("  ... and {} more\n", found.size() - 50);
+        out_ << fmt::format("{} {}{}\n", found.size(), what, found.size() == 1 ? "" : "es");
+    };
+    // a bare name finds every module of that name, whatever its parameters
+    if (pattern.find_first_of("()<>:[] \t") == std::string::npos) {
+        std::vector<std::size_t> found;
+        if (auto sym = program_->symbols.find(pattern))
+            for (std::size_t i = 0; i < s.size(); ++i)
+                if (s.sym[i] == *sym) found.push_back(i);
+        list(found, "match");
+        return;
     }
-    if (found > 50) out_ << fmt::format("  ... and {} more\n", found - 50);
-    out_ << fmt::format("{} module{} named '{}'\n", found, found == 1 ? "" : "s", name);
+    // a pattern becomes the only production of a rule group of its own, compiled with the
+    // session's grammar, then matched (context and condition included) against the string
+    std::string group = fmt::format("rules __find__ {{\n{} -> ;\n}}", pattern);
+    auto sources = std::make_unique<SourceManager>();
+    Diagnostics diags;
+    auto program = compile_source(*sources, sources->add("<session>", session_source(&group)), compile_options(), diags);
+    Diagnostics errors;
+    for (const auto& d : diags.all())
+        if (d.severity == Severity::Error) errors.add(d);
+    error_if(errors, *sources);
+    if (!program) return;
+    int g = program->group_index("__find__");
+    if (g < 0) return;
+    const Derivation& d = current();
+    std::vector<std::size_t> found;
+    try {
+        found = find_matches(d, *program, program->groups[static_cast<std::size_t>(g)]);
+    } catch (const RuntimeError& e) {
+        error() << render(Diagnostic{Severity::Error, e.span, e.message, {}}, *sources, color_);
+        return;
+    }
+    list(found, "match");
+}
+
+void Session::error_if(const Diagnostics& errors, const SourceManager& sources) {
+    if (errors.all().empty()) return;
+    error() << render_all(errors, sources, color_);
 }
 
 void Session::stats() {

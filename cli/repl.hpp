@@ -46,6 +46,7 @@ private:
     bool step(int n);
     void show(const std::string& rest);
     void find(const std::string& pattern);
+    void error_if(const Diagnostics& errors, const SourceManager& sources);
     void stats();
     void rules();
     void params();

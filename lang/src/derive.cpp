@@ -443,4 +443,22 @@ void Derivation::run() {
     finish();
 }
 
+std::vector<std::size_t> find_matches(const Derivation& d, const Program& program, const RuleSet& rules) {
+    std::vector<std::size_t> out;
+    if (rules.productions.empty()) return out;
+    const ModuleString& s = d.string();
+    std::vector<const RuleSet*> sets{&rules};
+    Rewriter rw(program, s, sets);
+    Worker w;
+    w.env.prog = &program;
+    std::vector<double> globals = const_cast<Derivation&>(d).globals();
+    w.env.globals = globals.data();
+    w.env.seed = d.seed();
+    w.env.step = d.steps_done();
+    const Production& pr = rules.productions[0];
+    for (std::size_t i = 0; i < s.size(); ++i)
+        if (s.sym[i] == pr.strict[0].sym && rw.matches_at(w, i, pr)) out.push_back(i);
+    return out;
+}
+
 } // namespace plant

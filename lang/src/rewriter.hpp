@@ -70,6 +70,16 @@ public:
 
     bool sequential() const { return multi || left_new || right_new; }
 
+    // Whether production `pr` (pattern, context and condition) matches at module i: the REPL's
+    // :find. Binds the worker's frame.
+    bool matches_at(Worker& w, std::size_t i, const Production& pr) {
+        if (w.frame.size() < frame_size) w.frame.assign(frame_size, 0.0);
+        w.env.position = i;
+        w.env.draw = 0;
+        w.env.id = in.ids[i];
+        return matches(w, i, pr);
+    }
+
     // ---- the direct path: every module is copied or rewritten by a direct template ----------
     // Then the size of the output of any stretch is known before writing it, so the output is
     // allocated once, exactly, and each thread writes its stretch in place.

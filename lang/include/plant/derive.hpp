@@ -106,6 +106,10 @@ private:
     mutable double growth_ = 2.0, param_growth_ = 2.0; // last step's growth, for reserving memory
 };
 
+// The positions where the first production of `rules` matches in the derivation's current string
+// (its pattern, context and condition): what `:find PATTERN` lists in the REPL.
+std::vector<std::size_t> find_matches(const Derivation& d, const Program& program, const RuleSet& rules);
+
 // Formats a string in ABOP notation (LANGUAGE.md section 11).
 // With `max_chars`, stops after the module that passes that length (the REPL's :show).
 std::string format_string(const Program& program, const ModuleString& s, bool with_ids = false,
