@@ -91,14 +91,14 @@ type_text ":find Q"
 keys BSpace
 type_text "A"
 keys Enter
-expect_count "Backspace deletes: the fixed ':find A' ran" "4 modules named 'A'" 1
+expect_count "Backspace deletes: the fixed ':find A' ran" "4 matches" 1
 
 # history within the session: Up brings back ':find A'; run again, it is in the history twice,
 # so ':show' is three lines up
 keys Up
 expect_line "Up recalls the previous command" "plant> :find A"
 keys Enter
-expect_count "the recalled command runs again" "4 modules named 'A'" 2
+expect_count "the recalled command runs again" "4 matches" 2
 keys Up Up Up
 expect_line "Up three times recalls the command before" "plant> :show"
 keys Enter
