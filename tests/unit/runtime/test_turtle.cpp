@@ -30,6 +30,21 @@ Recorder draw(const std::string& axiom, const std::string& head = "") {
     return r;
 }
 
+// The skeleton of a grammar's axiom (0 steps), kept with its program.
+struct Drawn {
+    std::unique_ptr<test::Compiled> compiled;
+    Skeleton skeleton;
+};
+Drawn skeleton_of(const std::string& grammar) {
+    Drawn out;
+    out.compiled = test::compile(grammar);
+    REQUIRE(out.compiled->program);
+    Derivation d(*out.compiled->program, {});
+    d.run();
+    out.skeleton = build_skeleton(*out.compiled->program, d.string(), TurtleOptions{});
+    return out;
+}
+
 void near(const glm::dvec3& a, const glm::dvec3& b) {
     CHECK(a.x == Approx(b.x).margin(1e-9));
     CHECK(a.y == Approx(b.y).margin(1e-9));
@@ -89,11 +104,8 @@ TEST_CASE("popping an empty stack is a runtime error naming the module", "[turtl
 TEST_CASE("@M moves, SetHead sets the heading, @O places a sphere", "[turtle]") {
     near(draw("@M(1, 2, 3) F").ends[0], {1, 3, 3});
     near(draw("SetHead(1, 0, 0, 0, 1, 0) F").ends[0], {1, 0, 0});
-    auto c = test::compile("axiom: !(4) F @O(2) ~leaf(3); surface leaf = polygon(vec3(0,0,0), vec3(1,0,0), vec3(0,1,0));");
-    REQUIRE(c->program);
-    Derivation d(*c->program, {});
-    d.run();
-    Skeleton sk = build_skeleton(*c->program, d.string(), TurtleOptions{});
+    Drawn drawn = skeleton_of("axiom: !(4) F @O(2) ~leaf(3); surface leaf = polygon(vec3(0,0,0), vec3(1,0,0), vec3(0,1,0));");
+    const Skeleton& sk = drawn.skeleton;
     REQUIRE(sk.axes.size() == 1);
     CHECK(sk.axes[0].points.back().radius == Approx(2.0)); // !(4): width 4, radius 2
     REQUIRE(sk.organs.size() == 2);
@@ -150,11 +162,8 @@ TEST_CASE("?H ?U ?L read the frame; a vec3 binding reads all three numbers", "[t
 
 TEST_CASE("G draws like F; colors come from ;(c) and SetColor", "[turtle]") {
     near(draw("G(2)").ends[0], {0, 2, 0});
-    auto c = test::compile("axiom: F ;(1) F SetColor(255, 0, 0) F SetColor(0, 0.5, 1) F @R(1, 0, 0) F;");
-    REQUIRE(c->program);
-    Derivation d(*c->program, {});
-    d.run();
-    Skeleton sk = build_skeleton(*c->program, d.string(), TurtleOptions{});
+    Drawn drawn = skeleton_of("axiom: F ;(1) F SetColor(255, 0, 0) F SetColor(0, 0.5, 1) F @R(1, 0, 0) F;");
+    const Skeleton& sk = drawn.skeleton;
     REQUIRE(sk.axes.size() == 1);
     const auto& pts = sk.axes[0].points;
     REQUIRE(pts.size() == 6);
