@@ -1,5 +1,7 @@
 #include "commands.hpp"
 
+#include "plant/environments.hpp"
+
 #include <fmt/format.h>
 
 #include <filesystem>
@@ -41,6 +43,7 @@ std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& so
     }
     CompileOptions co;
     co.include_dirs = o.include_dirs;
+    co.environments = runtime_environments();
     for (const auto& d : o.defines) {
         auto eq = d.find('=');
         if (eq == std::string::npos || eq == 0) {

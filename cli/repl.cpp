@@ -4,6 +4,7 @@
 #include "repl.hpp"
 
 #include "outputs.hpp"
+#include "plant/environments.hpp"
 #include "plant/export.hpp"
 #include "plant/query.hpp"
 #include "plant/vm.hpp"
@@ -99,6 +100,7 @@ CompileOptions Session::compile_options() const {
     CompileOptions co;
     for (const auto& [name, value] : params_) co.defines.emplace_back(name, value);
     if (!file_.empty()) co.file_texts[file_] = file_text_; // the file as :load or :reload read it
+    co.environments = runtime_environments();
     return co;
 }
 

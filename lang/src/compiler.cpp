@@ -101,6 +101,7 @@ void Compiler::emit(Ctx& c, Op op, std::int32_t a, int n, Span span, std::uint16
     case Op::VEq: case Op::VNe: c.depth -= 5; break;
     case Op::Member: c.depth -= 2; break;
     case Op::Builtin: c.depth += b - n; break; // b: width of the result
+    case Op::EnvCall: c.depth += 3 - n; break; // at most a vec3
     case Op::Call: {
         const Function& fn = P_.functions[static_cast<std::size_t>(a)];
         c.depth += std::max(1, value_width(fn.result)) - fn.param_width;
@@ -333,10 +334,18 @@ ValueType Compiler::compile_expr(Ctx& c, const ast::Expr& e) {
     }
     case K::Method: {
         const ast::Expr& obj = *e.args[0];
+        std::size_t env = P_.environment_names.size();
+        if (obj.kind == K::Name)
+            for (std::size_t k = 0; k < P_.environment_names.size(); ++k)
+                if (P_.environment_names[k] == obj.text && P_.environments[k]) env = k;
+        if (env < P_.environments.size()) return compile_env_call(c, e, env);
         if (obj.kind == K::Name && env_names_.count(obj.text)) {
-            diags_->error(e.span, fmt::format("environment '{}' (kind '{}') cannot be queried yet: environment "
-                                             "objects are parsed but not yet run by this version",
-                                             obj.text, env_names_[obj.text]));
+            diags_->error(e.span, opts_.environments
+                                      ? fmt::format("environment '{}' is not available: its declaration has an error",
+                                                    obj.text)
+                                      : fmt::format("environment '{}' (kind '{}') cannot be queried here: no runtime "
+                                                    "provides environments to this compilation",
+                                                    obj.text, env_names_[obj.text]));
         } else {
             diags_->error(e.span, fmt::format("'.{}(...)' is a method call, and only environment objects have methods",
                                              e.text));
@@ -396,6 +405,44 @@ ValueType Compiler::compile_binary(Ctx& c, const ast::Expr& e) {
     if (na && vb && op == "*") { emit(c, Op::VSMul, 0, 0, e.span); return ValueType::Vec3; }
     type_error(e.span, op, a, b);
     return ValueType::Number;
+}
+
+ValueType Compiler::compile_env_call(Ctx& c, const ast::Expr& e, std::size_t env) {
+    const Environment& object = *P_.environments[env];
+    const std::string& env_name = P_.environment_names[env];
+    const auto& methods = object.methods();
+    std::size_t m = 0;
+    while (m < methods.size() && methods[m].name != e.text) ++m;
+    if (m == methods.size()) {
+        std::vector<std::string> names;
+        for (const auto& mm : methods) names.push_back(mm.name);
+        std::string near = nearest_name(e.text, names);
+        diags_->error(e.span, near.empty() ? fmt::format("environment '{}' has no method '{}'", env_name, e.text)
+                                           : fmt::format("environment '{}' has no method '{}'; did you mean '{}'?",
+                                                         env_name, e.text, near));
+        emit_const(c, 0, e.span);
+        return ValueType::Number;
+    }
+    const EnvMethod& method = methods[m];
+    const std::size_t given = e.args.size() - 1;
+    if (given != method.args.size()) {
+        diags_->error(e.span, fmt::format("'{}.{}' takes {} argument{}, given {}", env_name, e.text, method.args.size(),
+                                          method.args.size() == 1 ? "" : "s", given));
+        emit_const(c, 0, e.span);
+        return ValueType::Number;
+    }
+    int width = 0;
+    for (std::size_t i = 0; i < given; ++i) {
+        ValueType t = compile_expr(c, *e.args[i + 1]);
+        bool fits = method.args[i] == ValueType::Vec3 ? t == ValueType::Vec3 : numeric(t);
+        if (!fits)
+            diags_->error(e.args[i + 1]->span, fmt::format("argument {} of '{}.{}' must be a {}, found a {}", i + 1,
+                                                           env_name, e.text, value_type_name(method.args[i]),
+                                                           value_type_name(t)));
+        width += value_width(t);
+    }
+    emit(c, Op::EnvCall, static_cast<std::int32_t>(env), width, e.span, static_cast<std::uint16_t>(m));
+    return method.result;
 }
 
 ValueType Compiler::compile_call(Ctx& c, const ast::Expr& e) {

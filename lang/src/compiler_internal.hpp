@@ -102,6 +102,8 @@ private:
     void build_template(Production& p);
     void compile_surface(const ast::ShapeDecl& s);
     void compile_curve(const ast::ShapeDecl& s);
+    void compile_environment(const ast::ShapeDecl& s);
+    ValueType compile_env_call(Ctx& c, const ast::Expr& e, std::size_t env);
 
     // helpers (compiler.cpp)
     void emit(Ctx& c, Op op, std::int32_t a, int n, Span span, std::uint16_t b = 0);

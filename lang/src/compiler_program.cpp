@@ -450,6 +450,37 @@ void Compiler::check_never_applying() {
 
 void Compiler::finish_rule_set(RuleSet& set) { set.index(P_.symbols.size()); }
 
+void Compiler::compile_environment(const ast::ShapeDecl& s) {
+    for (const ast::ShapeDecl* other : P_.deferred.envs) {
+        if (other == &s) break;
+        if (other->name == s.name) {
+            duplicate("environment", s.name, s.span, other->span);
+            return;
+        }
+    }
+    P_.environment_names.push_back(s.name);
+    P_.environments.emplace_back(); // null until made
+    if (!opts_.environments) return; // no runtime: using it is reported where it is used
+    std::vector<EnvArg> args;
+    for (std::size_t i = 0; i < s.args.size(); ++i) {
+        auto v = eval_const(*s.args[i], "an environment's argument");
+        if (!v) return;
+        EnvArg a;
+        a.key = s.keys[i];
+        a.type = v->type;
+        std::copy(v->v, v->v + 3, a.v);
+        a.span = s.args[i]->span;
+        args.push_back(a);
+    }
+    std::string error;
+    auto env = opts_.environments(s.kind, args, error);
+    if (!env) {
+        diags_->error(s.kind_span, error.empty() ? fmt::format("unknown environment kind '{}'", s.kind) : error);
+        return;
+    }
+    P_.environments.back() = std::shared_ptr<Environment>(std::move(env));
+}
+
 void Compiler::compile_curve(const ast::ShapeDecl& s) {
     CurveDef def;
     def.name = s.name;
@@ -666,6 +697,7 @@ std::unique_ptr<Program> Compiler::compile(std::uint32_t main_file) {
         }
     }
     for (const ast::ShapeDecl* s : P_.deferred.curves) compile_curve(*s); // before the code that calls them
+    for (const ast::ShapeDecl* s : P_.deferred.envs) compile_environment(*s);
     for (std::uint32_t i = 0; i < P_.functions.size(); ++i) ensure_function_compiled(i);
     for (const ast::ShapeDecl* s : P_.deferred.surfaces) compile_surface(*s);
     for (const auto& lf : order_) {

@@ -416,7 +416,8 @@ bool Derivation::step() {
             };
             queries = queries || is_query(pr.strict) || is_query(pr.left) || is_query(pr.right);
         }
-    if (queries && opt_.queries) opt_.queries->fill_queries(*this, current_);
+    // the turtle pass fills query modules and shows the environments the plant as it is now
+    if ((queries || !prog_.environments.empty()) && opt_.queries) opt_.queries->fill_queries(*this, current_);
     ModuleString next;
     ++step_;
     try {

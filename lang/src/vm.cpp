@@ -1,6 +1,7 @@
 #include "plant/vm.hpp"
 
 #include "plant/builtins.hpp"
+#include "plant/environment.hpp"
 #include "plant/random.hpp"
 
 #include <fmt/format.h>
@@ -312,6 +313,15 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
         case Op::LoadMulConst: st[sp++] = frame[I.a] * code.consts[I.b]; break;
         case Op::LoadAddConst: st[sp++] = frame[I.a] + code.consts[I.b]; break;
         case Op::Curve: st[sp - 1] = env.prog->curves[static_cast<std::size_t>(I.a)](st[sp - 1]); break;
+        case Op::EnvCall: {
+            const auto& object = *env.prog->environments[static_cast<std::size_t>(I.a)];
+            sp -= I.n;
+            double r[3] = {0, 0, 0};
+            object.call(I.b, st + sp, r);
+            const ValueType t = object.methods()[I.b].result;
+            for (int k = 0; k < value_width(t); ++k) st[sp++] = r[k];
+            break;
+        }
         }
     }
     if (result && sp > 0)

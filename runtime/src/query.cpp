@@ -1,6 +1,10 @@
 #include "plant/query.hpp"
 
+#include "plant/environments.hpp"
+#include "plant/skeleton.hpp"
 #include "plant/turtle.hpp"
+
+#include <optional>
 
 #include <unordered_map>
 
@@ -25,12 +29,46 @@ private:
 
 } // namespace
 
+// Feeds one turtle pass to the query sink and, when environments want the plant, a skeleton.
+class BothSinks : public TurtleSink {
+public:
+    BothSinks(TurtleSink& a, TurtleSink* b) : a_(a), b_(b) {}
+    void axis_begin(int axis, int parent, const TurtleState& t) override {
+        a_.axis_begin(axis, parent, t);
+        if (b_) b_->axis_begin(axis, parent, t);
+    }
+    void segment(const TurtleSegment& s) override {
+        a_.segment(s);
+        if (b_) b_->segment(s);
+    }
+    void organ(const TurtleOrgan& o) override {
+        a_.organ(o);
+        if (b_) b_->organ(o);
+    }
+    void query(std::size_t module, const TurtleState& t) override {
+        a_.query(module, t);
+        if (b_) b_->query(module, t);
+    }
+
+private:
+    TurtleSink& a_;
+    TurtleSink* b_;
+};
+
 void TurtleQueryPass::fill_queries(const Derivation& d, ModuleString& string) {
     const Program& p = d.program();
     ModuleString interpreted = d.interpreted(string);
     QuerySink sink(p, interpreted);
+    std::optional<SkeletonBuilder> skeleton;
+    if (!p.environments.empty()) skeleton.emplace(p, interpreted);
+    BothSinks both(sink, skeleton ? &*skeleton : nullptr);
     TurtleOptions o{d.default_angle(), d.default_step(), d.default_width()};
-    interpret(p, interpreted, o, sink);
+    interpret(p, interpreted, o, both);
+    if (skeleton) {
+        Skeleton sk = skeleton->take();
+        for (const auto& env : p.environments)
+            if (auto* seeing = dynamic_cast<SkeletonEnvironment*>(env.get())) seeing->update(sk);
+    }
     for (std::size_t i = 0; i < string.size(); ++i) {
         if (!p.symbols[string.sym[i]].query || string.arity(i) != 3) continue;
         auto it = sink.found.find(string.ids[i]);

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "plant/diagnostics.hpp"
+#include "plant/environment.hpp"
 #include "plant/program.hpp"
 
 #include <map>
@@ -15,6 +16,7 @@ struct CompileOptions {
     std::vector<std::pair<std::string, std::string>> defines; // -D name=value
     std::vector<std::string> include_dirs;                    // -I dir, then PLANT_PATH, then stdlib
     std::map<std::string, std::string> file_texts;            // imported files' text, instead of reading them
+    EnvironmentFactory environments;                          // the runtime's kinds; none: `env` cannot be used
 };
 
 // Reads, parses and compiles `path` and everything it imports. Returns null when there were

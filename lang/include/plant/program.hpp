@@ -9,6 +9,7 @@
 #include <array>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <unordered_map>
@@ -82,6 +83,7 @@ enum class Op : std::uint8_t {
     LoadMulConst, // push frame[a] * consts[b]
     LoadAddConst, // push frame[a] + consts[b]
     Curve,        // replace t on top of the stack by curves[a](t)
+    EnvCall,      // environments[a]->call(b, n argument numbers), pushes the result
 };
 
 struct Instr {
@@ -211,6 +213,8 @@ struct SurfaceDef {
     Span span;
 };
 
+class Environment;
+
 struct Program {
     SymbolTable symbols;
     std::vector<Global> globals;
@@ -236,6 +240,8 @@ struct Program {
     Deferred deferred;
     std::vector<SurfaceDef> surfaces;
     std::vector<CurveDef> curves;
+    std::vector<std::shared_ptr<Environment>> environments; // `env` declarations, in file order
+    std::vector<std::string> environment_names;
     std::vector<std::unique_ptr<ast::File>> files; // the syntax trees the program was built from
 
     int group_index(std::string_view name) const;

@@ -1,0 +1,31 @@
+// The environment kinds of the runtime (LANGUAGE.md section 8), made by `runtime_environments()`
+// for the compiler and updated from the skeleton after every turtle pass.
+//
+//   env crown = ellipsoid(center: vec3(0, 4, 0), radii: vec3(3, 2, 3));
+//     crown.contains(p)          p inside the ellipsoid
+//     crown.contains_scaled(p, g) p inside the ellipsoid shrunk (g < 1) or grown about its center
+//     crown.level(p)             |(p - center) / radii|: 1 on the surface, below 1 inside
+//   env space = proximity(radius: 0.5);
+//     space.distance(p, id)      distance from p to the nearest segment of another axis than the
+//                                one the module `id` belongs to (its branching point excluded);
+//                                `radius` when none is that close
+//   env scene = obstacles(sphere: vec3(0, 2, 0), sphere_radius: 1, box_min: ..., box_max: ...,
+//                          plane_point: ..., plane_normal: ...);
+//     scene.distance(p)          signed distance to the nearest shape (negative inside)
+//     scene.inside(p)            p inside some shape
+#pragma once
+
+#include "plant/environment.hpp"
+#include "plant/skeleton.hpp"
+
+namespace plant {
+
+// An environment that sees the plant: the turtle pass calls update() before each step.
+class SkeletonEnvironment : public Environment {
+public:
+    virtual void update(const Skeleton& skeleton) = 0;
+};
+
+EnvironmentFactory runtime_environments();
+
+} // namespace plant

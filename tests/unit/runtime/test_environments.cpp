@@ -1,0 +1,95 @@
+// Environment objects against hand-computed values.
+#include "helpers.hpp"
+#include "plant/environments.hpp"
+
+#include <catch2/catch.hpp>
+
+using namespace plant;
+
+namespace {
+
+std::unique_ptr<Environment> make(const std::string& kind, std::vector<EnvArg> args) {
+    std::string error;
+    auto env = runtime_environments()(kind, args, error);
+    INFO(error);
+    REQUIRE(env);
+    return env;
+}
+EnvArg vec_arg(const char* key, double x, double y, double z) {
+    EnvArg a;
+    a.key = key;
+    a.type = ValueType::Vec3;
+    a.v[0] = x, a.v[1] = y, a.v[2] = z;
+    return a;
+}
+EnvArg num_arg(const char* key, double v) {
+    EnvArg a;
+    a.key = key;
+    a.v[0] = v;
+    return a;
+}
+double ask(const Environment& e, std::size_t method, std::vector<double> args) {
+    double r[3] = {0, 0, 0};
+    e.call(method, args.data(), r);
+    return r[0];
+}
+
+} // namespace
+
+TEST_CASE("ellipsoid: containment, scaled containment, level", "[environments]") {
+    auto e = make("ellipsoid", {vec_arg("center", 0, 4, 0), vec_arg("radii", 3, 2, 3)});
+    CHECK(ask(*e, 0, {0, 5.9, 0}) == 1);          // inside: 1.9 / 2 < 1
+    CHECK(ask(*e, 0, {0, 6.1, 0}) == 0);          // outside the top
+    CHECK(ask(*e, 0, {2.9, 4, 0}) == 1);
+    CHECK(ask(*e, 1, {2.5, 4, 0, 0.8}) == 0);     // 2.5 / 3 = 0.83 > 0.8: outside the shrunk one
+    CHECK(ask(*e, 1, {2.3, 4, 0, 0.8}) == 1);
+    CHECK(ask(*e, 2, {3, 4, 0}) == Approx(1.0));  // on the surface
+    CHECK(ask(*e, 2, {1.5, 5, 0}) == Approx(std::sqrt(0.25 + 0.25)));
+}
+
+TEST_CASE("proximity: distance to other stems, the asking stem and its branching point excluded", "[environments]") {
+    auto c = test::compile("module S(x); axiom: S(1) F F [ +(90) S(2) F F ] F;");
+    REQUIRE(c->program);
+    Derivation d(*c->program, {});
+    d.run();
+    Skeleton sk = build_skeleton(*c->program, d.string(), TurtleOptions{});
+    REQUIRE(sk.axes.size() == 2);
+    auto env = make("proximity", {num_arg("radius", 1.5)});
+    auto* prox = dynamic_cast<SkeletonEnvironment*>(env.get());
+    REQUIRE(prox);
+    prox->update(sk);
+    // the branch goes from (0, 2, 0) to (-2, 2, 0); the main stem from (0, 0, 0) to (0, 3, 0)
+    const ModuleId branch_module = sk.axes[1].points[2].id; // the branch's second F
+    const ModuleId main_module = sk.axes[0].points[1].id;
+    // a point beside the main stem, asked for by the branch: 0.5 from the main stem
+    CHECK(ask(*env, 0, {0.5, 1, 0, double(branch_module)}) == Approx(0.5));
+    // asked for by the main stem, its own segments do not count: the branch is 1 away
+    CHECK(ask(*env, 0, {-1, 1, 0, double(main_module)}) == Approx(1.0));
+    // asked for by the branch near its base: the main stem's segments meeting at the branching
+    // point (0, 2, 0) do not count, so the nearest is (0, 0)-(0, 1), sqrt(0.25 + 1) away
+    CHECK(ask(*env, 0, {-0.5, 2, 0, double(branch_module)}) == Approx(std::sqrt(1.25)));
+    // nothing within the radius: the radius comes back
+    CHECK(ask(*env, 0, {10, 10, 0, 0}) == Approx(1.5));
+}
+
+TEST_CASE("obstacles: signed distances to spheres, boxes and planes", "[environments]") {
+    auto e = make("obstacles", {vec_arg("sphere", 0, 0, 0), num_arg("sphere_radius", 1), vec_arg("box_min", 4, 0, 0),
+                                vec_arg("box_max", 6, 2, 2), vec_arg("plane_point", 0, -3, 0),
+                                vec_arg("plane_normal", 0, 1, 0)});
+    CHECK(ask(*e, 0, {0, 2, 0}) == Approx(1.0));      // 1 above the sphere
+    CHECK(ask(*e, 0, {0, 0.5, 0}) == Approx(-0.5));   // inside the sphere
+    CHECK(ask(*e, 0, {5, 1, 1}) == Approx(-1.0));     // at the box's center, 1 from each face
+    CHECK(ask(*e, 0, {7, 1, 1}) == Approx(1.0));      // 1 beside the box
+    CHECK(ask(*e, 0, {20, -2.5, 20}) == Approx(0.5)); // above the plane y = -3
+    CHECK(ask(*e, 1, {0, 0.5, 0}) == 1);
+    CHECK(ask(*e, 1, {20, 20, 20}) == 0);
+}
+
+TEST_CASE("environment arguments are checked", "[environments]") {
+    std::string error;
+    CHECK(!runtime_environments()("ellipsoid", {vec_arg("radii", 1, 0, 1)}, error));
+    CHECK(error == "ellipsoid: radii must be positive");
+    error.clear();
+    CHECK(!runtime_environments()("proximity", {num_arg("range", 1)}, error));
+    CHECK(error == "proximity: unknown argument 'range' (known: radius)");
+}
