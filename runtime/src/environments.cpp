@@ -106,48 +106,75 @@ public:
     }
     void update(const Skeleton& sk) override {
         segments_.clear();
-        cells_.clear();
         axis_of_.clear();
         base_.clear();
+        lo_ = glm::dvec3(std::numeric_limits<double>::max());
+        glm::dvec3 hi(-std::numeric_limits<double>::max());
         for (std::size_t a = 0; a < sk.axes.size(); ++a) {
             const auto& pts = sk.axes[a].points;
             base_.push_back(pts.empty() ? glm::dvec3(0.0) : pts[0].position);
             for (std::size_t k = 0; k < pts.size(); ++k) {
                 if (pts[k].id) axis_of_[pts[k].id] = static_cast<int>(a);
-                if (k == 0) continue;
-                Segment s{pts[k - 1].position, pts[k].position, static_cast<int>(a)};
-                auto index = static_cast<std::uint32_t>(segments_.size());
-                segments_.push_back(s);
-                // register in every cell the segment's bounding box touches
-                glm::ivec3 lo = cell(glm::min(s.a, s.b)), hi = cell(glm::max(s.a, s.b));
-                for (int x = lo.x; x <= hi.x; ++x)
-                    for (int y = lo.y; y <= hi.y; ++y)
-                        for (int z = lo.z; z <= hi.z; ++z) cells_[key({x, y, z})].push_back(index);
+                lo_ = glm::min(lo_, pts[k].position);
+                hi = glm::max(hi, pts[k].position);
+                if (k > 0) segments_.push_back(Segment{pts[k - 1].position, pts[k].position, static_cast<int>(a)});
             }
         }
+        // a dense grid over the plant's box, cells at least one radius wide (wider when the box
+        // would need more than 8 million cells), stored as offsets into one index array
+        cell_ = radius_;
+        if (segments_.empty()) {
+            dims_ = glm::ivec3(0);
+            return;
+        }
+        for (;;) {
+            glm::dvec3 n = glm::floor((hi - lo_) / cell_) + 1.0;
+            if (n.x * n.y * n.z <= 8e6) {
+                dims_ = glm::ivec3(n);
+                break;
+            }
+            cell_ *= 2;
+        }
+        const std::size_t cells = static_cast<std::size_t>(dims_.x) * dims_.y * dims_.z;
+        offsets_.assign(cells + 1, 0);
+        auto each_cell = [&](const Segment& s, auto&& f) {
+            glm::ivec3 a = cell(glm::min(s.a, s.b)), b = cell(glm::max(s.a, s.b));
+            for (int z = a.z; z <= b.z; ++z)
+                for (int y = a.y; y <= b.y; ++y)
+                    for (int x = a.x; x <= b.x; ++x) f(index(x, y, z));
+        };
+        for (const auto& s : segments_) each_cell(s, [&](std::size_t c) { ++offsets_[c + 1]; });
+        for (std::size_t c = 0; c < cells; ++c) offsets_[c + 1] += offsets_[c];
+        entries_.assign(offsets_[cells], 0);
+        std::vector<std::uint32_t> fill(offsets_.begin(), offsets_.end() - 1);
+        for (std::uint32_t i = 0; i < segments_.size(); ++i)
+            each_cell(segments_[i], [&](std::size_t c) { entries_[fill[c]++] = i; });
     }
     void call(std::size_t, const double* a, double* r) const override {
         const glm::dvec3 p = vec(a);
-        auto it = axis_of_.find(static_cast<ModuleId>(a[3]));
-        const int own = it == axis_of_.end() ? -1 : it->second;
-        double best = radius_;
-        glm::ivec3 c = cell(p);
-        for (int x = -1; x <= 1; ++x)
-            for (int y = -1; y <= 1; ++y)
-                for (int z = -1; z <= 1; ++z) {
-                    auto found = cells_.find(key(c + glm::ivec3(x, y, z)));
-                    if (found == cells_.end()) continue;
-                    for (std::uint32_t i : found->second) {
-                        const Segment& s = segments_[i];
-                        if (s.axis == own) continue;
-                        if (own >= 0) { // the stem's branching point
-                            const glm::dvec3& base = base_[static_cast<std::size_t>(own)];
-                            if (glm::length(s.a - base) < 1e-9 || glm::length(s.b - base) < 1e-9) continue;
+        int own = -1;
+        if (a[3] > 0) {
+            auto it = axis_of_.find(static_cast<ModuleId>(a[3]));
+            if (it != axis_of_.end()) own = it->second;
+        }
+        const glm::dvec3 base = own >= 0 ? base_[static_cast<std::size_t>(own)] : glm::dvec3(0.0);
+        double best2 = radius_ * radius_;
+        if (dims_.x > 0) {
+            glm::ivec3 c = cell(p);
+            const int reach = 1; // cells are at least one radius wide
+            for (int z = std::max(0, c.z - reach); z <= std::min(dims_.z - 1, c.z + reach); ++z)
+                for (int y = std::max(0, c.y - reach); y <= std::min(dims_.y - 1, c.y + reach); ++y)
+                    for (int x = std::max(0, c.x - reach); x <= std::min(dims_.x - 1, c.x + reach); ++x) {
+                        const std::size_t k = index(x, y, z);
+                        for (std::uint32_t e = offsets_[k]; e < offsets_[k + 1]; ++e) {
+                            const Segment& s = segments_[entries_[e]];
+                            if (s.axis == own) continue;
+                            if (own >= 0 && (same(s.a, base) || same(s.b, base))) continue; // its branching point
+                            best2 = std::min(best2, distance2(p, s));
                         }
-                        best = std::min(best, distance(p, s));
                     }
-                }
-        r[0] = best;
+        }
+        r[0] = std::sqrt(best2);
     }
 
 private:
@@ -155,22 +182,33 @@ private:
         glm::dvec3 a, b;
         int axis;
     };
-    static double distance(const glm::dvec3& p, const Segment& s) {
+    static bool same(const glm::dvec3& a, const glm::dvec3& b) {
+        glm::dvec3 d = a - b;
+        return glm::dot(d, d) < 1e-18;
+    }
+    static double distance2(const glm::dvec3& p, const Segment& s) {
         glm::dvec3 d = s.b - s.a;
         double len2 = glm::dot(d, d);
         double t = len2 > 0 ? std::clamp(glm::dot(p - s.a, d) / len2, 0.0, 1.0) : 0.0;
-        return glm::length(p - (s.a + d * t));
+        glm::dvec3 q = p - (s.a + d * t);
+        return glm::dot(q, q);
     }
     glm::ivec3 cell(const glm::dvec3& p) const {
-        return glm::ivec3(glm::floor(p / radius_));
+        glm::dvec3 c = glm::floor((p - lo_) / cell_);
+        // points outside the box map to just outside the grid, which the loops clip
+        return glm::ivec3(glm::clamp(c, glm::dvec3(-2.0), glm::dvec3(dims_) + 1.0));
     }
-    static std::uint64_t key(glm::ivec3 c) {
-        auto u = [](int v) { return static_cast<std::uint64_t>(static_cast<std::uint32_t>(v) & 0x1fffff); };
-        return u(c.x) | (u(c.y) << 21) | (u(c.z) << 42);
+    std::size_t index(int x, int y, int z) const {
+        return (static_cast<std::size_t>(z) * static_cast<std::size_t>(dims_.y) + static_cast<std::size_t>(y)) *
+                   static_cast<std::size_t>(dims_.x) +
+               static_cast<std::size_t>(x);
     }
     double radius_;
+    double cell_ = 1;
+    glm::dvec3 lo_{0.0};
+    glm::ivec3 dims_{0};
     std::vector<Segment> segments_;
-    std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> cells_;
+    std::vector<std::uint32_t> offsets_, entries_;
     std::unordered_map<ModuleId, int> axis_of_;
     std::vector<glm::dvec3> base_; // where each axis starts
 };
