@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <unordered_map>
 
 namespace plant {
@@ -258,6 +259,144 @@ public:
     }
 };
 
+// ---- envelope ------------------------------------------------------------------------------
+
+// Cescatti's asymmetric crown envelope (as used by Boudon et al. 2003, Fig. 6): P1 the top, P2
+// the bottom, P3 and P5 the widest points on the +x and -x sides, P4 and P6 on the +z and -z
+// sides (each at its own height), C1 and C2 the shapes above and below the peripheral line.
+// Between two neighbouring peripheral points the line is a quarter ellipse; above it the crown
+// is the superellipse (r/R)^C1 + ((y - Y)/(top - Y))^C1 = 1, below it the same with C2.
+class Envelope : public Environment {
+public:
+    glm::dvec3 top, bottom;
+    double radius[4];  // +x, +z, -x, -z, from the axis through the bottom point
+    double height[4];
+    double c_top = 2, c_bottom = 2;
+
+    const std::vector<EnvMethod>& methods() const override {
+        static const std::vector<EnvMethod> m = {
+            {"contains", {V}, B, "p inside the envelope"},
+            {"level", {V}, N, "how far out p is: below 1 inside, 1 on the surface"},
+        };
+        return m;
+    }
+    double level(const glm::dvec3& p) const {
+        const double dx = p.x - bottom.x, dz = p.z - bottom.z;
+        const double r = std::hypot(dx, dz);
+        double theta = std::atan2(dz, dx);
+        if (theta < 0) theta += 2 * std::numbers::pi;
+        const int q = std::min(3, static_cast<int>(theta / (std::numbers::pi / 2)));
+        const double phi = theta - q * std::numbers::pi / 2; // angle within the quadrant
+        const double a = radius[q], b = radius[(q + 1) % 4];
+        const double c = std::cos(phi), s = std::sin(phi);
+        const double R = a * b / std::sqrt((b * c) * (b * c) + (a * s) * (a * s)); // quarter ellipse
+        const double Y = height[q] * c * c + height[(q + 1) % 4] * s * s;
+        if (p.y >= Y) {
+            if (p.y > top.y) return 1e300;
+            double h = std::max(top.y - Y, 1e-12);
+            return std::pow(std::pow(r / R, c_top) + std::pow((p.y - Y) / h, c_top), 1 / c_top);
+        }
+        if (p.y < bottom.y) return 1e300;
+        double h = std::max(Y - bottom.y, 1e-12);
+        return std::pow(std::pow(r / R, c_bottom) + std::pow((Y - p.y) / h, c_bottom), 1 / c_bottom);
+    }
+    void call(std::size_t method, const double* a, double* r) const override {
+        double l = level(vec(a));
+        r[0] = method == 0 ? (l <= 1.0 ? 1.0 : 0.0) : l;
+    }
+};
+
+// ---- light ---------------------------------------------------------------------------------
+
+// Occlusion by the plant itself: the plant's box is cut into resolution^3 cells; a cell a
+// segment passes through (or an organ sits in) is occupied. A point's exposure is the fraction
+// of light left after the occupied cells between it and the light, each keeping (1 - opacity).
+class Light : public SkeletonEnvironment {
+public:
+    Light(glm::dvec3 toward_light, int resolution, double opacity)
+        : dir_(glm::normalize(toward_light)), res_(resolution), opacity_(opacity) {}
+    const std::vector<EnvMethod>& methods() const override {
+        static const std::vector<EnvMethod> m = {
+            {"exposure", {V}, N, "fraction of the light reaching p, from 0 (shaded) to 1"},
+            {"occlusion", {V}, N, "occupied cells between p and the light"},
+        };
+        return m;
+    }
+    void update(const Skeleton& sk) override {
+        lo_ = glm::dvec3(std::numeric_limits<double>::max());
+        glm::dvec3 hi(-std::numeric_limits<double>::max());
+        for (const auto& a : sk.axes)
+            for (const auto& p : a.points) {
+                lo_ = glm::min(lo_, p.position);
+                hi = glm::max(hi, p.position);
+            }
+        for (const auto& o : sk.organs) {
+            glm::dvec3 p(o.transform[3]);
+            lo_ = glm::min(lo_, p);
+            hi = glm::max(hi, p);
+        }
+        occupied_.assign(static_cast<std::size_t>(res_) * res_ * res_, 0);
+        if (lo_.x > hi.x) return;
+        cell_ = std::max({hi.x - lo_.x, hi.y - lo_.y, hi.z - lo_.z, 1e-9}) / res_ * 1.0001;
+        for (const auto& a : sk.axes)
+            for (std::size_t k = 1; k < a.points.size(); ++k) {
+                glm::dvec3 from = a.points[k - 1].position, to = a.points[k].position;
+                int n = std::max(1, static_cast<int>(std::ceil(glm::length(to - from) / (cell_ * 0.5))));
+                for (int j = 0; j <= n; ++j) mark(from + (to - from) * (double(j) / n));
+            }
+        for (const auto& o : sk.organs) mark(glm::dvec3(o.transform[3]));
+    }
+    void call(std::size_t method, const double* a, double* r) const override {
+        int count = occlusion(vec(a));
+        r[0] = method == 0 ? std::pow(1 - opacity_, count) : count;
+    }
+
+private:
+    bool inside(const glm::ivec3& c) const {
+        return c.x >= 0 && c.y >= 0 && c.z >= 0 && c.x < res_ && c.y < res_ && c.z < res_;
+    }
+    glm::ivec3 cell(const glm::dvec3& p) const { return glm::ivec3(glm::floor((p - lo_) / cell_)); }
+    std::size_t index(const glm::ivec3& c) const {
+        return (static_cast<std::size_t>(c.z) * res_ + static_cast<std::size_t>(c.y)) * res_ + static_cast<std::size_t>(c.x);
+    }
+    void mark(const glm::dvec3& p) {
+        glm::ivec3 c = cell(p);
+        if (inside(c)) occupied_[index(c)] = 1;
+    }
+    // Occupied cells met walking from p toward the light, p's own cell excluded, in steps of
+    // half a cell (each cell counted once).
+    int occlusion(const glm::dvec3& p) const {
+        if (occupied_.empty() || lo_.x > 1e300) return 0;
+        glm::ivec3 start = cell(p), last = start;
+        int count = 0;
+        const double step = cell_ * 0.5;
+        const int max_steps = 4 * res_ + 8;
+        for (int k = 1; k < max_steps; ++k) {
+            glm::ivec3 c = cell(p + dir_ * (step * k));
+            if (c == last) continue;
+            last = c;
+            if (!inside(c)) {
+                // outside the box now: nothing more can be in the way unless we are still
+                // approaching it from outside
+                glm::dvec3 q = (p + dir_ * (step * k) - lo_) / cell_;
+                bool leaving = (q.x < 0 && dir_.x <= 0) || (q.y < 0 && dir_.y <= 0) || (q.z < 0 && dir_.z <= 0) ||
+                               (q.x >= res_ && dir_.x >= 0) || (q.y >= res_ && dir_.y >= 0) ||
+                               (q.z >= res_ && dir_.z >= 0);
+                if (leaving) break;
+                continue;
+            }
+            if (c != start && occupied_[index(c)]) ++count;
+        }
+        return count;
+    }
+    glm::dvec3 dir_;
+    int res_;
+    double opacity_;
+    glm::dvec3 lo_{1e301};
+    double cell_ = 1;
+    std::vector<std::uint8_t> occupied_;
+};
+
 } // namespace
 
 EnvironmentFactory runtime_environments() {
@@ -323,7 +462,53 @@ EnvironmentFactory runtime_environments() {
             }
             return o;
         }
-        error = fmt::format("unknown environment kind '{}': this version has ellipsoid, proximity and obstacles",
+        if (kind == "envelope") {
+            if (!a.only({"top", "bottom", "px", "pz", "nx", "nz", "top_shape", "bottom_shape"})) return nullptr;
+            auto e = std::make_unique<Envelope>();
+            const EnvArg *t = a.find("top", V), *b = a.find("bottom", V);
+            const EnvArg* side[4] = {a.find("px", V), a.find("pz", V), a.find("nx", V), a.find("nz", V)};
+            const EnvArg *ct = a.find("top_shape", N), *cb = a.find("bottom_shape", N);
+            if (!a.ok()) return nullptr;
+            if (!t || !b || !side[0] || !side[1] || !side[2] || !side[3]) {
+                error = "envelope: needs top, bottom and the four widest points px, pz, nx, nz";
+                return nullptr;
+            }
+            e->top = vec(*t);
+            e->bottom = vec(*b);
+            const double rad[4] = {side[0]->v[0] - e->bottom.x, side[1]->v[2] - e->bottom.z,
+                                   e->bottom.x - side[2]->v[0], e->bottom.z - side[3]->v[2]};
+            for (int k = 0; k < 4; ++k) {
+                e->radius[k] = rad[k];
+                e->height[k] = side[k]->v[1];
+                if (!(rad[k] > 0) || e->height[k] >= e->top.y || e->height[k] <= e->bottom.y) {
+                    error = "envelope: each widest point lies on its own side of the axis through the bottom point, "
+                            "between the bottom and the top";
+                    return nullptr;
+                }
+            }
+            e->c_top = ct ? ct->v[0] : 2.0;
+            e->c_bottom = cb ? cb->v[0] : 2.0;
+            if (!(e->c_top > 0) || !(e->c_bottom > 0)) {
+                error = "envelope: the shape coefficients must be positive";
+                return nullptr;
+            }
+            return e;
+        }
+        if (kind == "light") {
+            if (!a.only({"direction", "resolution", "opacity"})) return nullptr;
+            const EnvArg *d = a.find("direction", V), *res = a.find("resolution", N), *op = a.find("opacity", N);
+            if (!a.ok()) return nullptr;
+            glm::dvec3 dir = d ? vec(*d) : glm::dvec3(0, 1, 0);
+            int resolution = res ? static_cast<int>(res->v[0]) : 32;
+            double opacity = op ? op->v[0] : 0.3;
+            if (glm::length(dir) == 0 || resolution < 1 || resolution > 512 || !(opacity >= 0 && opacity <= 1)) {
+                error = "light: direction must not be zero, resolution 1 to 512, opacity 0 to 1";
+                return nullptr;
+            }
+            return std::make_unique<Light>(dir, resolution, opacity);
+        }
+        error = fmt::format("unknown environment kind '{}': this version has ellipsoid, envelope, proximity, light "
+                            "and obstacles",
                             kind);
         return nullptr;
     };

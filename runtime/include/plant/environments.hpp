@@ -9,6 +9,10 @@
 //     space.distance(p, id)      distance from p to the nearest segment of another axis than the
 //                                one the module `id` belongs to (its branching point excluded);
 //                                `radius` when none is that close
+//   env crown = envelope(top: ..., bottom: ..., px: ..., pz: ..., nx: ..., nz: ..., top_shape: 2);
+//     crown.contains(p), crown.level(p)   Cescatti's asymmetric crown
+//   env sun = light(direction: vec3(-1, 1, 0), resolution: 32, opacity: 0.3);
+//     sun.exposure(p), sun.occlusion(p)   self-shading by the plant's segments and organs
 //   env scene = obstacles(sphere: vec3(0, 2, 0), sphere_radius: 1, box_min: ..., box_max: ...,
 //                          plane_point: ..., plane_normal: ...);
 //     scene.distance(p)          signed distance to the nearest shape (negative inside)

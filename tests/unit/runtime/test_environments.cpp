@@ -4,6 +4,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <cmath>
+#include <numbers>
+
 using namespace plant;
 
 namespace {
@@ -92,4 +95,39 @@ TEST_CASE("environment arguments are checked", "[environments]") {
     error.clear();
     CHECK(!runtime_environments()("proximity", {num_arg("range", 1)}, error));
     CHECK(error == "proximity: unknown argument 'range' (known: radius)");
+}
+
+TEST_CASE("envelope: Cescatti's crown, asymmetric sides and shape coefficients", "[environments]") {
+    // top at y = 10, bottom at y = 2 on the axis x = z = 0; widest at y = 6 with radii 4 (+x),
+    // 2 (+z), 3 (-x), 2 (-z); C1 = C2 = 2 (ellipse-like above and below)
+    auto e = make("envelope", {vec_arg("top", 0, 10, 0), vec_arg("bottom", 0, 2, 0), vec_arg("px", 4, 6, 0),
+                               vec_arg("pz", 0, 6, 2), vec_arg("nx", -3, 6, 0), vec_arg("nz", 0, 6, -2)});
+    CHECK(ask(*e, 1, {4, 6, 0}) == Approx(1.0));                 // on the peripheral line at +x
+    CHECK(ask(*e, 1, {-3, 6, 0}) == Approx(1.0));                // at -x, a different radius
+    CHECK(ask(*e, 1, {0, 10, 0}) == Approx(1.0));                // the top
+    CHECK(ask(*e, 1, {2, 8, 0}) == Approx(std::sqrt(0.25 + 0.25))); // (2/4)^2 + (2/4)^2 above the line
+    CHECK(ask(*e, 1, {0, 4, 1}) == Approx(std::sqrt(0.25 + 0.25))); // (1/2)^2 + (2/4)^2 below it
+    CHECK(ask(*e, 0, {3.9, 6, 0}) == 1);
+    CHECK(ask(*e, 0, {-3.1, 6, 0}) == 0);
+    CHECK(ask(*e, 0, {0, 11, 0}) == 0);
+    // halfway between +x and +z the peripheral line is the quarter ellipse with semi-axes 4 and 2
+    double c = std::cos(std::numbers::pi / 4), R = 4 * 2 / std::sqrt((2 * c) * (2 * c) + (4 * c) * (4 * c));
+    CHECK(ask(*e, 1, {R * c, 6, R * c}) == Approx(1.0));
+}
+
+TEST_CASE("light: exposure falls behind occupied cells toward the light", "[environments]") {
+    // a horizontal layer of branches at y = 5 over a stem; light from above
+    auto c = test::compile(R"(
+        axiom: F(5) [ +(90) F(2) ] [ -(90) F(2) ] [ &(90) F(2) ] [ ^(90) F(2) ] F(5);
+    )");
+    REQUIRE(c->program);
+    Derivation d(*c->program, {});
+    d.run();
+    Skeleton sk = build_skeleton(*c->program, d.string(), TurtleOptions{});
+    auto env = make("light", {vec_arg("direction", 0, 1, 0), num_arg("resolution", 10), num_arg("opacity", 0.5)});
+    dynamic_cast<SkeletonEnvironment&>(*env).update(sk);
+    CHECK(ask(*env, 0, {0, 10.5, 0}) == Approx(1.0));     // above the plant: full light
+    CHECK(ask(*env, 1, {1.5, 3, 0}) >= 1);                // under the +x... layer at y = 5
+    CHECK(ask(*env, 0, {1.5, 3, 0}) < 1.0);
+    CHECK(ask(*env, 0, {1.5, 3, 0}) == Approx(std::pow(0.5, ask(*env, 1, {1.5, 3, 0}))));
 }
