@@ -73,15 +73,20 @@ public:
             {"contains", {V}, B, "p inside the ellipsoid"},
             {"contains_scaled", {V, N}, B, "p inside the ellipsoid scaled by g about its center"},
             {"level", {V}, N, "|(p - center) / radii|: below 1 inside, 1 on the surface"},
+            {"distance", {V}, N, "signed distance to the surface along the ray from the center (negative inside)"},
         };
         return m;
     }
     void call(std::size_t method, const double* a, double* r) const override {
-        double level = glm::length((vec(a) - center_) / radii_);
+        const glm::dvec3 p = vec(a);
+        double level = glm::length((p - center_) / radii_);
         switch (method) {
         case 0: r[0] = level <= 1.0; break;
         case 1: r[0] = a[3] > 0 && level <= a[3]; break;
-        default: r[0] = level; break;
+        case 2: r[0] = level; break;
+        default: // the surface point on the ray from the center through p is center + (p - center) / level
+            r[0] = level > 0 ? glm::length(p - center_) * (1 - 1 / level) : -std::min({radii_.x, radii_.y, radii_.z});
+            break;
         }
     }
 

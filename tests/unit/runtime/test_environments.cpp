@@ -48,6 +48,9 @@ TEST_CASE("ellipsoid: containment, scaled containment, level", "[environments]")
     CHECK(ask(*e, 1, {2.3, 4, 0, 0.8}) == 1);
     CHECK(ask(*e, 2, {3, 4, 0}) == Approx(1.0));  // on the surface
     CHECK(ask(*e, 2, {1.5, 5, 0}) == Approx(std::sqrt(0.25 + 0.25)));
+    CHECK(ask(*e, 3, {0, 7, 0}) == Approx(1.0));  // 1 above the top (y = 6)
+    CHECK(ask(*e, 3, {0, 5, 0}) == Approx(-1.0)); // 1 below it, inside
+    CHECK(ask(*e, 3, {0, 4, 0}) == Approx(-2.0)); // the center
 }
 
 TEST_CASE("proximity: distance to other stems, the asking stem and its branching point excluded", "[environments]") {
