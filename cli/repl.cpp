@@ -599,6 +599,9 @@ std::vector<std::string> Session::completions() const {
         for (const auto& s : program_->symbols.all())
             if (s.arity >= 0 && !s.name.empty()) out.push_back(s.name);
         for (const auto& g : program_->groups) out.push_back(g.name);
+        for (const auto& e : program_->environment_names) out.push_back(e);
+        for (const auto& c : program_->curves) out.push_back(c.name);
+        for (const auto& f : program_->functions) out.push_back(f.name);
     }
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
