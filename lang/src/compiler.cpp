@@ -933,7 +933,25 @@ void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list, Span span)
                 continue;
             }
             std::vector<Span> arg_spans;
+            const bool communication = info.query && info.name == "?E";
             for (std::size_t i = 0; i < nargs; ++i) {
+                // ?E(env, slots...): the first argument names an environment, which is kept as its index
+                if (communication && i == 0) {
+                    const ast::Expr& a = *m.args[0];
+                    std::size_t env = P_.environment_names.size();
+                    if (a.kind == ast::ExprKind::Name)
+                        for (std::size_t e = 0; e < P_.environment_names.size(); ++e)
+                            if (P_.environment_names[e] == a.text) env = e;
+                    if (env == P_.environment_names.size()) {
+                        diags_->error(a.span, "the first argument of ?E names an environment, as in ?E(sun, 0)");
+                        emit_const(c, -1, a.span);
+                    } else {
+                        emit_const(c, static_cast<double>(env), a.span);
+                    }
+                    arg_spans.push_back(a.span);
+                    width += 1;
+                    continue;
+                }
                 ValueType t = compile_expr(c, *m.args[i]);
                 for (int w = 0; w < std::max(1, value_width(t)); ++w) arg_spans.push_back(m.args[i]->span);
                 if (t == ValueType::String) t = ValueType::Number;

@@ -71,7 +71,7 @@ public:
     const std::vector<EnvMethod>& methods() const override {
         static const std::vector<EnvMethod> m = {
             {"contains", {V}, B, "p inside the ellipsoid"},
-            {"contains_scaled", {V, N}, B, "p inside the ellipsoid scaled by g about its center"},
+            {"contains_scaled", {V, N}, B, "p inside the ellipsoid scaled by g about its center", false},
             {"level", {V}, N, "|(p - center) / radii|: below 1 inside, 1 on the surface"},
             {"distance", {V}, N, "signed distance to the surface along the ray from the center (negative inside)"},
         };

@@ -17,9 +17,14 @@ public:
     QuerySink(const Program& p, const ModuleString& s) : program_(p), string_(s) {}
     void query(std::size_t module, const TurtleState& t) override {
         const std::string& name = program_.symbols[string_.sym[module]].name;
+        if (name == "?E") { // communication modules: answered after the environments see the plant
+            positions[string_.ids[module]] = t.position;
+            return;
+        }
         glm::dvec3 v = name == "?P" ? t.position : name == "?H" ? t.heading : name == "?U" ? t.up : t.left;
         found[string_.ids[module]] = v;
     }
+    std::unordered_map<ModuleId, glm::dvec3> positions;
     std::unordered_map<ModuleId, glm::dvec3> found;
 
 private:
@@ -68,6 +73,17 @@ void TurtleQueryPass::fill_queries(const Derivation& d, ModuleString& string) {
         Skeleton sk = skeleton->take();
         for (const auto& env : p.environments)
             if (auto* seeing = dynamic_cast<SkeletonEnvironment*>(env.get())) seeing->update(sk);
+    }
+    // ?E(env, slots...): the named environment answers at the module's position (LANGUAGE.md
+    // section 8, open L-systems' communication modules)
+    const auto e_symbol = p.symbols.find("?E");
+    for (std::size_t i = 0; e_symbol && i < string.size(); ++i) {
+        if (string.sym[i] != *e_symbol || string.arity(i) < 2) continue;
+        auto it = sink.positions.find(string.ids[i]);
+        double* a = string.params.data() + string.poff[i];
+        const auto env = static_cast<std::size_t>(a[0]);
+        if (it == sink.positions.end() || a[0] < 0 || env >= p.environments.size() || !p.environments[env]) continue;
+        p.environments[env]->communicate(it->second, string.ids[i], a + 1, string.arity(i) - 1);
     }
     for (std::size_t i = 0; i < string.size(); ++i) {
         if (!p.symbols[string.sym[i]].query || string.arity(i) != 3) continue;

@@ -66,7 +66,7 @@ struct Symbols {
     SymbolId F = ~0u, f = ~0u, G = ~0u, plus = ~0u, minus = ~0u, amp = ~0u, caret = ~0u, back = ~0u, slash = ~0u,
              pipe = ~0u, dollar = ~0u, open = ~0u, close = ~0u, bang = ~0u, semi = ~0u, sphere = ~0u, set_head = ~0u,
              set_head2 = ~0u, move_to = ~0u, tropism = ~0u, elasticity = ~0u, set_color = ~0u, qP = ~0u, qH = ~0u,
-             qU = ~0u, qL = ~0u;
+             qU = ~0u, qL = ~0u, qE = ~0u;
     explicit Symbols(const SymbolTable& st) {
         auto get = [&](const char* n, SymbolId& out) {
             if (auto id = st.find(n)) out = *id;
@@ -75,7 +75,7 @@ struct Symbols {
         get("\\", back), get("/", slash), get("|", pipe), get("$", dollar), get("[", open), get("]", close);
         get("!", bang), get(";", semi), get("@O", sphere), get("@R", set_head), get("SetHead", set_head2);
         get("@M", move_to), get("@Tp", tropism), get("@Ts", elasticity), get("SetColor", set_color);
-        get("?P", qP), get("?H", qH), get("?U", qU), get("?L", qL);
+        get("?P", qP), get("?H", qH), get("?U", qU), get("?L", qL), get("?E", qE);
     }
 };
 
@@ -207,7 +207,7 @@ void interpret(const Program& program, const ModuleString& s, const TurtleOption
             if (s.arity(i) >= 3) t.tropism = vec_arg(i, 0);
         } else if (sym == y.elasticity) {
             t.elasticity = arg(i, 0, 0);
-        } else if (sym == y.qP || sym == y.qH || sym == y.qU || sym == y.qL) {
+        } else if (sym == y.qP || sym == y.qH || sym == y.qU || sym == y.qL || sym == y.qE) {
             sink.query(i, t);
         } else {
             const std::string& name = program.symbols[sym].name;

@@ -7,6 +7,8 @@
 
 #include "plant/program.hpp"
 
+#include <glm/glm.hpp>
+
 #include <functional>
 #include <memory>
 #include <string>
@@ -27,6 +29,8 @@ struct EnvMethod {
     std::vector<ValueType> args;
     ValueType result = ValueType::Number;
     const char* doc = "";
+    // Answers ?E(env, slots...) modules: methods taking (p) or (p, id) fill the slots in order.
+    bool communicates = true;
 };
 
 class Environment {
@@ -37,6 +41,22 @@ public:
     // up to three. Called from many threads at once while a step is rewritten: it must not
     // change the object.
     virtual void call(std::size_t method, const double* args, double* result) const = 0;
+
+    // Fills the slots of a ?E module at `position` with the answers of the methods that take
+    // the point (and, for a second number, the module's identity), in their order.
+    virtual void communicate(const glm::dvec3& position, ModuleId id, double* slots, std::size_t n) const {
+        std::size_t slot = 0;
+        const auto& ms = methods();
+        for (std::size_t m = 0; m < ms.size() && slot < n; ++m) {
+            const auto& a = ms[m].args;
+            bool point = !a.empty() && a[0] == ValueType::Vec3;
+            if (!ms[m].communicates || !point || a.size() > 2 || (a.size() == 2 && a[1] == ValueType::Vec3)) continue;
+            double args[4] = {position.x, position.y, position.z, static_cast<double>(id)};
+            double result[3] = {0, 0, 0};
+            call(m, args, result);
+            slots[slot++] = result[0];
+        }
+    }
 };
 
 // Makes an environment of `kind`. Returns null and explains why in `error` when the kind is
