@@ -463,6 +463,17 @@ void Compiler::compile_environment(const ast::ShapeDecl& s) {
     if (!opts_.environments) return; // no runtime: using it is reported where it is used
     std::vector<EnvArg> args;
     for (std::size_t i = 0; i < s.args.size(); ++i) {
+        if (s.args[i]->kind == ast::ExprKind::String) { // a file, relative to the grammar
+            EnvArg a;
+            a.key = s.keys[i];
+            a.type = ValueType::String;
+            fs::path path(s.args[i]->text);
+            if (path.is_relative()) path = fs::path(sm_.file(s.span.file).name()).parent_path() / path;
+            a.text = path.lexically_normal().string();
+            a.span = s.args[i]->span;
+            args.push_back(a);
+            continue;
+        }
         auto v = eval_const(*s.args[i], "an environment's argument");
         if (!v) return;
         EnvArg a;

@@ -19,8 +19,9 @@ namespace plant {
 // One evaluated constructor argument: `key: value` (key empty when positional).
 struct EnvArg {
     std::string key;
-    ValueType type = ValueType::Number;
+    ValueType type = ValueType::Number; // String for a quoted file name, in `text`
     double v[3] = {0, 0, 0};
+    std::string text;                   // a string argument; a file path resolved against the grammar
     Span span;
 };
 

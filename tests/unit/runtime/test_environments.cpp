@@ -134,3 +134,19 @@ TEST_CASE("light: exposure falls behind occupied cells toward the light", "[envi
     CHECK(ask(*env, 0, {1.5, 3, 0}) < 1.0);
     CHECK(ask(*env, 0, {1.5, 3, 0}) == Approx(std::pow(0.5, ask(*env, 1, {1.5, 3, 0}))));
 }
+
+TEST_CASE("obstacles: signed distance to a loaded mesh", "[environments]") {
+    EnvArg mesh;
+    mesh.key = "mesh";
+    mesh.type = ValueType::String;
+    mesh.text = std::string(PLANT_TEST_DATA) + "/cube.obj";
+    auto e = make("obstacles", {mesh});
+    CHECK(ask(*e, 0, {0.5, 0.5, 2}) == Approx(1.0));    // 1 above the top face
+    CHECK(ask(*e, 0, {0.5, 0.5, 0.5}) == Approx(-0.5)); // the center, 0.5 from every face
+    CHECK(ask(*e, 0, {2, 2, 0.5}) == Approx(std::sqrt(2.0))); // nearest to the edge x = y = 1
+    CHECK(ask(*e, 1, {0.2, 0.3, 0.4}) == 1);
+    std::string error;
+    mesh.text = "/nonexistent.obj";
+    CHECK(!runtime_environments()("obstacles", {mesh}, error));
+    CHECK(error == "obstacles: cannot load the mesh '/nonexistent.obj'");
+}
