@@ -1,0 +1,92 @@
+// Oriented-particle plant dynamics after Hädrich et al. 2017 (climbing-plants-particles.txt,
+// section 4.1 and the appendix), usable from C++ without the language. This is the first part of
+// the climber runtime: particles, shape matching with ellipsoid moments, goals, age-dependent
+// stiffness, a fixed root and damping. Growth, anchors, obstacles, breaking and wind come next.
+//
+// Particles are stored one array per field (PositionBasedDynamics' habit); a particle is named by
+// a {index, generation} handle (Box2D's), and a parent's index is always below its children's.
+#pragma once
+
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace plant::physics {
+
+struct Handle {
+    std::uint32_t index = ~0u;
+    std::uint32_t generation = 0;
+    bool valid() const { return index != ~0u; }
+};
+
+struct Settings {
+    glm::dvec3 gravity{0.0, -9.81, 0.0};
+    double dt = 0.025;           // the paper's step, 25 ms
+    double density = 700.0;      // kg/m^3, for masses (Eq. 2)
+    double damping = 0.02;       // fraction of velocity removed per step
+    double stiffening_time = 10; // t_m: a particle reaches full stiffness at this age (s = t_l / t_m)
+    double fixed_stiffness = -1; // >= 0: every particle has this stiffness instead (tests, tools)
+    int iterations = 8;          // shape-matching passes per step
+};
+
+// The least-squares rotation of a moment matrix A, by Müller et al. 2016 ("A robust method to
+// extract the rotational part of deformations"): iterations on a quaternion, warm-started with
+// `q`. Always a proper rotation; zero, rank-deficient and reflected input leave q as it is or
+// turn it the best it can.
+glm::dquat extract_rotation(const glm::dmat3& A, glm::dquat q, int iterations = 20);
+
+class World {
+public:
+    explicit World(Settings s = {}) : settings_(s) {}
+
+    // A root: fixed where it is, with effectively infinite mass in its groups (or, with
+    // fixed = false, the free first particle of a loose branch).
+    Handle add_root(const glm::dvec3& position, const glm::dquat& orientation, const glm::dvec3& radii,
+                    bool fixed = true);
+    // A particle attached to `parent`, at `position` in the rest state (now).
+    Handle add_particle(Handle parent, const glm::dvec3& position, const glm::dquat& orientation,
+                        const glm::dvec3& radii);
+
+    // One step of Δt: predict (Eq. 1), match shapes (Eq. 3, 4, 14, 15), move toward the goals by
+    // the stiffness, integrate (Eq. 17-20), damp.
+    void step();
+
+    bool alive(Handle h) const;
+    glm::dvec3 position(Handle h) const { return x_[h.index]; }
+    glm::dvec3 rest_position(Handle h) const { return rest_x_[h.index]; }
+    glm::dquat orientation(Handle h) const { return q_[h.index]; }
+    glm::dvec3 velocity(Handle h) const { return v_[h.index]; }
+    double mass(Handle h) const { return m_[h.index]; }
+    std::size_t size() const { return x_.size(); }
+    Settings& settings() { return settings_; }
+
+    // Moves a particle (dragging, tests); its rest state stays.
+    void set_position(Handle h, const glm::dvec3& p) { x_[h.index] = p; }
+    void set_orientation(Handle h, const glm::dquat& q) { q_[h.index] = q; }
+
+    // The goal positions the shape matching gives for the current positions (Eq. 4), without
+    // stepping: what a rigid motion must leave unchanged.
+    std::vector<glm::dvec3> goals() const;
+    // The rotation of particle i's own group (parent, itself, children).
+    glm::dquat group_rotation(std::uint32_t i) const;
+
+    // A hash of the whole state, for determinism tests.
+    std::uint64_t state_hash() const;
+
+private:
+    std::vector<std::uint32_t> group(std::uint32_t i) const; // parent, self, children
+    double group_mass(std::uint32_t i) const;
+    double stiffness(std::uint32_t i) const;
+
+    Settings settings_;
+    std::vector<glm::dvec3> x_, v_, rest_x_, radii_;
+    std::vector<glm::dquat> q_, rest_q_;
+    std::vector<double> m_, age_;
+    std::vector<std::uint32_t> parent_, generation_;
+    std::vector<std::vector<std::uint32_t>> children_;
+    std::vector<std::uint8_t> fixed_, alive_;
+};
+
+} // namespace plant::physics

@@ -1,0 +1,119 @@
+// The particle runtime's checks from PLANTS.md (climber section) that its first part supports.
+#include "plant/physics/world.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+using namespace plant::physics;
+
+namespace {
+
+bool proper_rotation(const glm::dquat& q) {
+    glm::dmat3 R = glm::mat3_cast(q);
+    if (!std::isfinite(R[0][0])) return false;
+    glm::dmat3 I = glm::transpose(R) * R;
+    for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b)
+            if (std::fabs(I[a][b] - (a == b ? 1.0 : 0.0)) > 1e-9) return false;
+    return std::fabs(glm::determinant(R) - 1.0) < 1e-9;
+}
+
+double angle_between(const glm::dquat& a, const glm::dquat& b) {
+    return 2 * std::acos(std::min(1.0, std::fabs(glm::dot(glm::normalize(a), glm::normalize(b)))));
+}
+
+// A clamped cantilever: a fixed root and nine particles along +x, 10 cm apart.
+struct Cantilever {
+    World world;
+    std::vector<Handle> p;
+    explicit Cantilever(double stiffness) {
+        world.settings().fixed_stiffness = stiffness;
+        glm::dvec3 r(0.06, 0.02, 0.02);
+        p.push_back(world.add_root({0, 0, 0}, glm::dquat(1, 0, 0, 0), r));
+        for (int k = 1; k < 10; ++k) p.push_back(world.add_particle(p.back(), {0.1 * k, 0, 0}, glm::dquat(1, 0, 0, 0), r));
+    }
+    double tip_sag() const { return world.rest_position(p.back()).y - world.position(p.back()).y; }
+    void run(double seconds) {
+        int steps = static_cast<int>(std::lround(seconds / world.settings().dt));
+        for (int k = 0; k < steps; ++k) world.step();
+    }
+};
+
+} // namespace
+
+TEST_CASE("rotation extraction gives a proper rotation, also on degenerate input", "[physics]") {
+    // a known rotation is found again, from a cold start
+    glm::dquat truth = glm::normalize(glm::angleAxis(1.1, glm::normalize(glm::dvec3(1, 2, -0.5))));
+    glm::dquat q = extract_rotation(glm::mat3_cast(truth), glm::dquat(1, 0, 0, 0), 50);
+    CHECK(proper_rotation(q));
+    CHECK(angle_between(q, truth) < 1e-6);
+    // a rotation times a stretch: the rotation part
+    glm::dmat3 S(1.0);
+    S[0][0] = 3, S[1][1] = 0.5, S[2][2] = 2;
+    q = extract_rotation(glm::mat3_cast(truth) * S, glm::dquat(1, 0, 0, 0), 100);
+    CHECK(angle_between(q, truth) < 1e-6);
+    // zero, rank one and a reflection: still proper rotations, no NaN
+    CHECK(proper_rotation(extract_rotation(glm::dmat3(0.0), truth)));
+    CHECK(proper_rotation(extract_rotation(glm::dmat3(glm::dvec3(1, 0, 0), glm::dvec3(2, 0, 0), glm::dvec3(0.5, 0, 0)), truth)));
+    glm::dmat3 reflect(1.0);
+    reflect[0][0] = -1;
+    CHECK(proper_rotation(extract_rotation(reflect, glm::dquat(1, 0, 0, 0))));
+    CHECK(proper_rotation(extract_rotation(glm::dmat3(std::nan("")), truth)));
+}
+
+TEST_CASE("one rotated particle gives its own rotation", "[physics]") {
+    // a single particle: the ellipsoid moment alone (Eq. 15 as R D R̄ᵀ) carries the orientation
+    glm::dquat turn = glm::angleAxis(0.7, glm::dvec3(0, 0, 1));
+    World w;
+    Handle h = w.add_root({0, 0, 0}, glm::dquat(1, 0, 0, 0), {0.3, 0.1, 0.05});
+    w.set_orientation(h, turn);
+    CHECK(angle_between(w.group_rotation(h.index), turn) < 1e-6);
+}
+
+TEST_CASE("a rigid motion leaves the goals where the particles are", "[physics]") {
+    // a free branch (its first particle not fixed) with a side shoot, moved and turned as a whole
+    World w;
+    glm::dvec3 r(0.05, 0.03, 0.02);
+    Handle a = w.add_root({0, 0, 0}, glm::dquat(1, 0, 0, 0), r, false);
+    Handle b = w.add_particle(a, {0, 0.1, 0}, glm::dquat(1, 0, 0, 0), r);
+    Handle c = w.add_particle(b, {0, 0.2, 0}, glm::dquat(1, 0, 0, 0), r);
+    Handle d = w.add_particle(b, {0.1, 0.15, 0}, glm::angleAxis(0.3, glm::dvec3(0, 0, 1)), r);
+    glm::dquat turn = glm::angleAxis(0.5, glm::normalize(glm::dvec3(0.3, 0, 1)));
+    glm::dvec3 shift(1, 2, 3);
+    for (Handle h : {a, b, c, d}) {
+        w.set_position(h, glm::mat3_cast(turn) * w.rest_position(h) + shift);
+        w.set_orientation(h, turn * w.orientation(h));
+    }
+    auto goals = w.goals();
+    for (Handle h : {a, b, c, d}) CHECK(glm::length(goals[h.index] - w.position(h)) < 1e-6);
+    // and without any motion the goals are the rest positions
+    World still;
+    Handle r0 = still.add_root({0, 0, 0}, glm::dquat(1, 0, 0, 0), r);
+    Handle s0 = still.add_particle(r0, {0, 0.1, 0}, glm::dquat(1, 0, 0, 0), r);
+    CHECK(glm::length(still.goals()[s0.index] - still.position(s0)) < 1e-12);
+}
+
+TEST_CASE("a clamped cantilever sags more when soft and returns to rest without gravity", "[physics]") {
+    Cantilever soft(0.2), stiff(1.0);
+    soft.run(10);
+    stiff.run(10);
+    INFO("sag soft " << soft.tip_sag() << " stiff " << stiff.tip_sag());
+    CHECK(soft.tip_sag() > 0);
+    CHECK(soft.tip_sag() > 1.5 * stiff.tip_sag());
+    // gravity off: back to the rest shape within 1 mm after 30 s
+    soft.world.settings().gravity = glm::dvec3(0.0);
+    soft.run(30);
+    CHECK(std::fabs(soft.tip_sag()) < 0.001);
+    CHECK(glm::length(soft.world.position(soft.p.back()) - soft.world.rest_position(soft.p.back())) < 0.001);
+}
+
+TEST_CASE("the same setup gives the same state, bit for bit", "[physics]") {
+    Cantilever a(0.3), b(0.3);
+    a.run(5);
+    b.run(5);
+    CHECK(a.world.state_hash() == b.world.state_hash());
+    Cantilever c(0.4);
+    c.run(5);
+    CHECK(a.world.state_hash() != c.world.state_hash());
+}
