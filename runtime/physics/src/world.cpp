@@ -19,6 +19,67 @@ glm::dmat3 outer(const glm::dvec3& a, const glm::dvec3& b) {
 
 } // namespace
 
+glm::dvec3 surface_adaption(const glm::dvec3& forward, const glm::dvec3& to_surface, double tau, double dt) {
+    glm::dvec3 f = glm::normalize(forward), s = glm::normalize(to_surface);
+    // Eq. 6: about v_s x v_f by (v_s . v_f) tau dt: a forward vector leaning into the surface
+    // turns away from it, toward the tangent plane, and one parallel to it stays
+    glm::dvec3 axis = glm::cross(s, f);
+    double len = glm::length(axis);
+    if (len < 1e-12) return f;
+    double angle = glm::dot(s, f) * tau * dt;
+    return glm::normalize(glm::angleAxis(angle, axis / len) * f);
+}
+
+glm::dvec3 phototropism(const glm::dvec3& forward, const glm::dvec3& to_light, double occlusion, double eta, double dt) {
+    glm::dvec3 f = glm::normalize(forward), l = glm::normalize(to_light);
+    glm::dvec3 axis = glm::cross(f, l); // toward the light (PLANTS.md pitfall)
+    double len = glm::length(axis);
+    if (len < 1e-12) return f;
+    // Eq. 7, and never past the light direction itself
+    double angle = std::min((1 - std::clamp(occlusion, 0.0, 1.0)) * eta * dt, std::acos(std::clamp(glm::dot(f, l), -1.0, 1.0)));
+    return glm::normalize(glm::angleAxis(angle, axis / len) * f);
+}
+
+double Obstacle::distance(const glm::dvec3& p) const {
+    switch (kind) {
+    case Sphere: return glm::length(p - a) - b.x;
+    case Box: {
+        glm::dvec3 c = (a + b) * 0.5, h = (b - a) * 0.5, q = glm::abs(p - c) - h;
+        return glm::length(glm::max(q, glm::dvec3(0.0))) + std::min(std::max(q.x, std::max(q.y, q.z)), 0.0);
+    }
+    case Plane: return glm::dot(p - a, glm::normalize(b));
+    }
+    return 1e300;
+}
+
+glm::dvec3 Obstacle::normal(const glm::dvec3& p) const {
+    if (kind == Plane) return glm::normalize(b);
+    // central differences of the distance
+    const double e = 1e-6;
+    glm::dvec3 g(distance(p + glm::dvec3(e, 0, 0)) - distance(p - glm::dvec3(e, 0, 0)),
+                 distance(p + glm::dvec3(0, e, 0)) - distance(p - glm::dvec3(0, e, 0)),
+                 distance(p + glm::dvec3(0, 0, e)) - distance(p - glm::dvec3(0, 0, e)));
+    double l = glm::length(g);
+    return l > 0 ? g / l : glm::dvec3(0, 1, 0);
+}
+
+void World::add_anchor(Handle h, const glm::dvec3& point, double phi, double release) {
+    anchors_.push_back({h.index, point, std::clamp(phi, 0.0, 1.0), release});
+}
+
+bool World::anchored(Handle h) const {
+    for (const auto& a : anchors_)
+        if (a.particle == h.index) return true;
+    return false;
+}
+
+std::size_t World::components() const {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < x_.size(); ++i)
+        if (alive_[i] && parent_[i] == kNone) ++n;
+    return n;
+}
+
 glm::dquat extract_rotation(const glm::dmat3& A, glm::dquat q, int iterations) {
     // Müller et al. 2016, Eq. 10-12: turn R toward the columns of A about omega
     for (int k = 0; k < iterations; ++k) {
@@ -146,6 +207,16 @@ void World::step() {
     // Eq. 1: predicted positions (no fluid acceleration yet)
     for (std::size_t i = 0; i < n; ++i)
         if (alive_[i] && !fixed_[i]) x_[i] = x_[i] + v_[i] * dt + settings_.gravity * (dt * dt / 2);
+    // Eq. 5: anchors pull their particles in; one too far away lets go
+    for (std::size_t k = 0; k < anchors_.size();) {
+        Anchor& a = anchors_[k];
+        if (glm::length(x_[a.particle] - a.point) > a.release) {
+            anchors_.erase(anchors_.begin() + static_cast<std::ptrdiff_t>(k));
+            continue;
+        }
+        x_[a.particle] += a.phi * (a.point - x_[a.particle]);
+        ++k;
+    }
     // shape matching on the predictions; small overlapping groups pass a correction on by one
     // particle per iteration, so a chain needs several to hold its shape
     std::vector<glm::dquat> rot(n);
@@ -162,13 +233,42 @@ void World::step() {
             x_[i] = x_[i] + stiffness(i) * (goal[i] - x_[i]);
             q_[i] = glm::normalize(glm::slerp(q_[i], glm::normalize(rot[i] * rest_q_[i]), stiffness(i)));
         }
+        for (const auto& [i, target] : pulls_) x_[i] = target; // a dragged particle goes where it is dragged
     }
-    // Eq. 17-18, with damping
+    // Eq. 17-18, with damping; then obstacles: a particle inside one is put back on its surface
+    // (its radius off it), its velocity losing the normal part (or bouncing by the elasticity)
+    // and some of the tangential part (friction)
     for (std::uint32_t i = 0; i < n; ++i) {
         if (!alive_[i]) continue;
         v_[i] = fixed_[i] ? glm::dvec3(0.0) : (x_[i] - old[i]) / dt * (1.0 - settings_.damping);
         age_[i] += dt;
+        if (fixed_[i]) continue;
+        const double r = std::min({radii_[i].x, radii_[i].y, radii_[i].z});
+        for (const auto& o : obstacles_) {
+            double d = o.distance(x_[i]) - r;
+            if (d >= 0) continue;
+            glm::dvec3 nrm = o.normal(x_[i]);
+            x_[i] -= nrm * d;
+            double vn = glm::dot(v_[i], nrm);
+            glm::dvec3 tangential = v_[i] - nrm * vn;
+            v_[i] = tangential * (1 - o.friction) + (vn < 0 ? -vn * o.elasticity : vn) * nrm;
+        }
     }
+    // breaking: a connection stretched past the threshold lets its child go (section 4.3)
+    if (break_threshold_ > 0) {
+        for (std::uint32_t i = 0; i < n; ++i) {
+            const std::uint32_t p = parent_[i];
+            if (!alive_[i] || p == kNone) continue;
+            double rest = glm::length(rest_x_[i] - rest_x_[p]);
+            double now = glm::length(x_[i] - x_[p]);
+            if (rest > 0 && std::fabs(now - rest) / rest > break_threshold_) {
+                auto& siblings = children_[p];
+                siblings.erase(std::remove(siblings.begin(), siblings.end(), i), siblings.end());
+                parent_[i] = kNone; // the loose part keeps its own shape and falls
+            }
+        }
+    }
+    pulls_.clear();
 }
 
 std::uint64_t World::state_hash() const {

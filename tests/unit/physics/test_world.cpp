@@ -117,3 +117,84 @@ TEST_CASE("the same setup gives the same state, bit for bit", "[physics]") {
     c.run(5);
     CHECK(a.world.state_hash() != c.world.state_hash());
 }
+
+TEST_CASE("phototropism turns toward the light, and not at all when occluded", "[physics]") {
+    glm::dvec3 f(0, 1, 0), light(1, 1, 0);
+    glm::dvec3 g = phototropism(f, light, 0.0, 1.0, 0.1);
+    CHECK(glm::dot(g, glm::normalize(light)) > glm::dot(f, glm::normalize(light))); // closer to the light
+    CHECK(glm::length(g) == Approx(1.0));
+    CHECK(glm::length(phototropism(f, light, 1.0, 1.0, 0.1) - f) < 1e-12); // fully occluded
+    // many steps end facing the light, without overshooting it
+    for (int k = 0; k < 200; ++k) f = phototropism(f, light, 0.0, 1.0, 0.1);
+    CHECK(glm::dot(f, glm::normalize(light)) == Approx(1.0));
+}
+
+TEST_CASE("surface adaption turns an apex leaning into a wall parallel to it", "[physics]") {
+    glm::dvec3 to_wall(1, 0, 0); // the wall is at +x
+    glm::dvec3 f = glm::normalize(glm::dvec3(1, 1, 0));
+    for (int k = 0; k < 400; ++k) f = surface_adaption(f, to_wall, 1.0, 0.025);
+    CHECK(std::fabs(glm::dot(f, to_wall)) < 0.05); // parallel to the wall
+    CHECK(f.y > 0.99);                              // still growing upward
+    CHECK(glm::length(surface_adaption(glm::dvec3(0, 1, 0), to_wall, 1.0, 0.025) - glm::dvec3(0, 1, 0)) < 1e-12);
+}
+
+TEST_CASE("anchors pull in by (1 - phi) each step and let go past their distance", "[physics]") {
+    Settings s;
+    s.gravity = glm::dvec3(0.0);
+    s.damping = 1.0; // no momentum: Eq. 5 alone
+    World w(s);
+    Handle p = w.add_root({1, 0, 0}, glm::dquat(1, 0, 0, 0), {0.05, 0.05, 0.05}, false);
+    w.add_anchor(p, {0, 0, 0}, 0.3, 2.0);
+    w.step();
+    CHECK(glm::length(w.position(p)) == Approx(0.7));
+    w.step();
+    CHECK(glm::length(w.position(p)) == Approx(0.49));
+    CHECK(w.anchored(p));
+    World far(s);
+    Handle q = far.add_root({1, 0, 0}, glm::dquat(1, 0, 0, 0), {0.05, 0.05, 0.05}, false);
+    far.add_anchor(q, {0, 0, 0}, 0.3, 0.5); // already too far: released, not pulled
+    far.step();
+    CHECK(!far.anchored(q));
+    CHECK(glm::length(far.position(q)) == Approx(1.0));
+}
+
+TEST_CASE("no particle ends inside an obstacle", "[physics]") {
+    World w;
+    Obstacle ground;
+    ground.kind = Obstacle::Plane;
+    ground.a = glm::dvec3(0, 0, 0);
+    ground.b = glm::dvec3(0, 1, 0);
+    w.add_obstacle(ground);
+    Obstacle ball;
+    ball.kind = Obstacle::Sphere;
+    ball.a = glm::dvec3(0.3, 0.3, 0);
+    ball.b = glm::dvec3(0.2, 0, 0);
+    w.add_obstacle(ball);
+    // a loose branch dropped from 1 m onto the ground and the ball
+    Handle a = w.add_root({0, 1, 0}, glm::dquat(1, 0, 0, 0), {0.03, 0.03, 0.03}, false);
+    std::vector<Handle> p{a};
+    for (int k = 1; k < 6; ++k) p.push_back(w.add_particle(p.back(), {0.1 * k, 1, 0}, glm::dquat(1, 0, 0, 0), {0.03, 0.03, 0.03}));
+    for (int step = 0; step < 200; ++step) {
+        w.step();
+        for (Handle h : p) {
+            REQUIRE(ground.distance(w.position(h)) >= 0.03 - 1e-9);
+            REQUIRE(ball.distance(w.position(h)) >= 0.03 - 1e-9);
+        }
+    }
+    CHECK(w.position(p[0]).y < 0.2); // it did fall
+}
+
+TEST_CASE("pulling a tip past the threshold breaks the branch and the loose part falls", "[physics]") {
+    Cantilever c(1.0);
+    c.world.set_break_threshold(0.2);
+    CHECK(c.world.components() == 1);
+    // drag the tip down, further each step, until something gives
+    for (int k = 1; k <= 10 && c.world.components() == 1; ++k) {
+        c.world.pull(c.p.back(), c.world.rest_position(c.p.back()) + glm::dvec3(0, -0.1 * k, 0));
+        c.world.step();
+    }
+    CHECK(c.world.components() == 2);
+    double y0 = c.world.position(c.p.back()).y;
+    c.run(1);
+    CHECK(c.world.position(c.p.back()).y < y0 - 1.0); // a second of free fall
+}

@@ -31,6 +31,26 @@ struct Settings {
     int iterations = 8;          // shape-matching passes per step
 };
 
+// Growth directions (Hädrich et al., section 4.2). Each returns the apex's forward vector turned
+// by the response, as an axis and an angle would (Eq. 6, 7) applied to it.
+// Surface adaption, Eq. 6: toward being parallel to a nearby surface; `to_surface` points to the
+// closest surface point, tau in [0, 1].
+glm::dvec3 surface_adaption(const glm::dvec3& forward, const glm::dvec3& to_surface, double tau, double dt);
+// Phototropism, Eq. 7: toward the light by (1 - O) eta dt, O the occlusion in [0, 1]. The axis is
+// forward x to_light, so the apex turns toward the light (the printed v_l x v_f turns it away:
+// PLANTS.md lists that pitfall).
+glm::dvec3 phototropism(const glm::dvec3& forward, const glm::dvec3& to_light, double occlusion, double eta, double dt);
+
+// Obstacles for particles: signed distance fields.
+struct Obstacle {
+    enum Kind { Sphere, Box, Plane } kind = Plane;
+    glm::dvec3 a{0.0}, b{0.0, 1.0, 0.0}; // sphere: center, (radius in b.x); box: min, max; plane: point, normal
+    double friction = 0.5;   // fraction of the tangential velocity removed on contact
+    double elasticity = 0.0; // fraction of the normal velocity kept, reversed, on contact
+    double distance(const glm::dvec3& p) const;
+    glm::dvec3 normal(const glm::dvec3& p) const; // gradient of the distance
+};
+
 // The least-squares rotation of a moment matrix A, by Müller et al. 2016 ("A robust method to
 // extract the rotational part of deformations"): iterations on a quaternion, warm-started with
 // `q`. Always a proper rotation; zero, rank-deficient and reflected input leave q as it is or
@@ -49,9 +69,22 @@ public:
     Handle add_particle(Handle parent, const glm::dvec3& position, const glm::dquat& orientation,
                         const glm::dvec3& radii);
 
-    // One step of Δt: predict (Eq. 1), match shapes (Eq. 3, 4, 14, 15), move toward the goals by
-    // the stiffness, integrate (Eq. 17-20), damp.
+    // One step of Δt: predict (Eq. 1), pull anchored particles in (Eq. 5), match shapes (Eq. 3,
+    // 4, 14, 15), move toward the goals by the stiffness, keep particles out of obstacles,
+    // integrate (Eq. 17-20), damp, break overstretched connections.
     void step();
+
+    // Eq. 5: each step the particle's predicted position moves a fraction phi of the way to the
+    // anchor; past `release` from it, the anchor lets go.
+    void add_anchor(Handle h, const glm::dvec3& point, double phi, double release);
+    bool anchored(Handle h) const;
+    void add_obstacle(const Obstacle& o) { obstacles_.push_back(o); }
+    // Connections whose length differs from the rest length by more than this fraction break
+    // (0: never); the child's part becomes a loose branch.
+    void set_break_threshold(double t) { break_threshold_ = t; }
+    // Number of connected parts (a broken-off branch is one more).
+    std::size_t components() const;
+    std::uint32_t parent(Handle h) const { return parent_[h.index]; }
 
     bool alive(Handle h) const;
     glm::dvec3 position(Handle h) const { return x_[h.index]; }
@@ -62,8 +95,10 @@ public:
     std::size_t size() const { return x_.size(); }
     Settings& settings() { return settings_; }
 
-    // Moves a particle (dragging, tests); its rest state stays.
+    // Moves a particle (tests); its rest state stays.
     void set_position(Handle h, const glm::dvec3& p) { x_[h.index] = p; }
+    // Holds a particle at `target` through the next step, as a user dragging it would.
+    void pull(Handle h, const glm::dvec3& target) { pulls_.push_back({h.index, target}); }
     void set_orientation(Handle h, const glm::dquat& q) { q_[h.index] = q; }
 
     // The goal positions the shape matching gives for the current positions (Eq. 4), without
@@ -87,6 +122,15 @@ private:
     std::vector<std::uint32_t> parent_, generation_;
     std::vector<std::vector<std::uint32_t>> children_;
     std::vector<std::uint8_t> fixed_, alive_;
+    struct Anchor {
+        std::uint32_t particle;
+        glm::dvec3 point;
+        double phi, release;
+    };
+    std::vector<Anchor> anchors_;
+    std::vector<Obstacle> obstacles_;
+    std::vector<std::pair<std::uint32_t, glm::dvec3>> pulls_;
+    double break_threshold_ = 0;
 };
 
 } // namespace plant::physics
