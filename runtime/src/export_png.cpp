@@ -176,6 +176,19 @@ inline std::int64_t edge_bias(std::int64_t ax, std::int64_t ay, std::int64_t bx,
     return (dy > 0 || (dy == 0 && dx < 0)) ? 0 : -1;
 }
 
+// Narrows [kmin, kmax] to the k with w + a * k >= 0; false if that leaves nothing.
+inline bool clip_span(std::int64_t w, std::int64_t a, std::int64_t& kmin, std::int64_t& kmax) {
+    if (a > 0) {
+        if (w < 0) kmin = std::max(kmin, ceil_div(-w, a));
+    } else if (a < 0) {
+        if (w < 0) return false;
+        kmax = std::min(kmax, floor_div(w, -a));
+    } else if (w < 0) {
+        return false;
+    }
+    return kmin <= kmax;
+}
+
 struct ShadedVertex {
     std::int64_t x, y;
     float z, t; // depth, light intensity
@@ -223,31 +236,35 @@ void fill_triangle(Raster& r, ShadedVertex a, ShadedVertex b, ShadedVertex c,
 
     const float cr = color_lut_scale[0], cg = color_lut_scale[1], cb = color_lut_scale[2];
     const std::uint8_t* lut = r.encode.data();
+    const std::int64_t last = x1 - x0;
     for (std::int64_t y = y0; y <= y1; ++y) {
-        std::int64_t w0 = w0row, w1 = w1row, w2 = w2row;
-        const double dy = double(y - y0);
-        float z = float(zrow0 + dzdy * dy);
-        float t = float(trow0 + dtdy * dy);
-        float* zline = r.depth.data() + y * r.width;
-        std::uint8_t* cline = r.rgb.data() + y * r.width * 3;
-        for (std::int64_t x = x0; x <= x1; ++x) {
-            if ((w0 | w1 | w2) >= 0 && z > zline[x]) {
-                zline[x] = z;
+        const std::int64_t w0 = w0row, w1 = w1row, w2 = w2row;
+        w0row += b0;
+        w1row += b1;
+        w2row += b2;
+        // The samples k = 0..last of this row where every edge function is >= 0, solved exactly
+        // rather than tested one by one (long slivers have huge, nearly empty bounding boxes).
+        std::int64_t kmin = 0, kmax = last;
+        if (!clip_span(w0, a0, kmin, kmax) || !clip_span(w1, a1, kmin, kmax) ||
+            !clip_span(w2, a2, kmin, kmax))
+            continue;
+        const double dx = double(kmin), dy = double(y - y0);
+        float z = float(zrow0 + dzdx * dx + dzdy * dy);
+        float t = float(trow0 + dtdx * dx + dtdy * dy);
+        float* zline = r.depth.data() + y * r.width + x0;
+        std::uint8_t* cline = r.rgb.data() + (y * r.width + x0) * 3;
+        for (std::int64_t k = kmin; k <= kmax; ++k) {
+            if (z > zline[k]) {
+                zline[k] = z;
                 const float tt = std::clamp(t, 0.0f, 1.0f);
-                std::uint8_t* px3 = cline + x * 3;
+                std::uint8_t* px3 = cline + k * 3;
                 px3[0] = lut[int(cr * tt + 0.5f)];
                 px3[1] = lut[int(cg * tt + 0.5f)];
                 px3[2] = lut[int(cb * tt + 0.5f)];
             }
-            w0 += a0;
-            w1 += a1;
-            w2 += a2;
             z += fdzdx;
             t += fdtdx;
         }
-        w0row += b0;
-        w1row += b1;
-        w2row += b2;
     }
 }
 

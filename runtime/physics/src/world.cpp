@@ -1,9 +1,12 @@
+#define GLM_ENABLE_EXPERIMENTAL // glm::rotation (gtx/quaternion)
 #include "plant/physics/world.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <numbers>
+
+#include <glm/gtx/quaternion.hpp>
 
 namespace plant::physics {
 
@@ -94,8 +97,11 @@ glm::dquat extract_rotation(const glm::dmat3& A, glm::dquat q, int iterations) {
     return q;
 }
 
-Handle World::add_root(const glm::dvec3& position, const glm::dquat& orientation, const glm::dvec3& radii,
+Handle World::add_root(const glm::dvec3& position_in, const glm::dquat& orientation_in, const glm::dvec3& radii_in,
                        bool fixed) {
+    // copies first: the arguments may refer into the arrays that grow below
+    const glm::dvec3 position = position_in, radii = radii_in;
+    const glm::dquat orientation = orientation_in;
     Handle h{static_cast<std::uint32_t>(x_.size()), 0};
     x_.push_back(position);
     v_.emplace_back(0.0);
@@ -106,6 +112,8 @@ Handle World::add_root(const glm::dvec3& position, const glm::dquat& orientation
     // Hädrich et al., Eq. 2: the mass of an ellipsoid
     m_.push_back(4.0 * std::numbers::pi * radii.x * radii.y * radii.z * settings_.density / 3.0);
     age_.push_back(0);
+    length_.push_back(0);
+    laterals_.push_back(0);
     parent_.push_back(kNone);
     generation_.push_back(0);
     children_.emplace_back();
@@ -116,7 +124,7 @@ Handle World::add_root(const glm::dvec3& position, const glm::dquat& orientation
 
 Handle World::add_particle(Handle parent, const glm::dvec3& position, const glm::dquat& orientation,
                            const glm::dvec3& radii) {
-    Handle h = add_root(position, orientation, radii, false);
+    Handle h = add_root(position, orientation, radii, false); // copies its arguments before growing
     parent_[h.index] = parent.index;
     children_[parent.index].push_back(h.index);
     return h;
@@ -269,6 +277,68 @@ void World::step() {
         }
     }
     pulls_.clear();
+}
+
+namespace {
+
+// Counter-based random numbers, as the language's: a draw depends on (seed, particle, draw).
+double random_unit(std::uint64_t seed, std::uint64_t particle, std::uint64_t draw) {
+    auto mix = [](std::uint64_t z) {
+        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+        z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+        return z ^ (z >> 31);
+    };
+    std::uint64_t h = mix(seed + 0x9e3779b97f4a7c15ULL);
+    h = mix(h ^ (particle * 0xd1b54a32d192ed03ULL));
+    h = mix(h ^ (draw * 0x8cb92ba72f3d8dd7ULL + 0x2545f4914f6cdd1dULL));
+    return static_cast<double>(h >> 11) * 0x1.0p-53;
+}
+
+glm::dquat heading_to(const glm::dvec3& forward) {
+    return glm::rotation(glm::dvec3(0, 1, 0), glm::normalize(forward));
+}
+
+} // namespace
+
+void World::grow() {
+    const Growth& g = settings_.growth;
+    const std::size_t n = x_.size();
+    for (std::uint32_t i = 0; i < n && x_.size() < g.max_particles; ++i) {
+        if (!alive_[i] || !children_[i].empty()) continue;
+        length_[i] += g.speed * settings_.dt;
+        if (length_[i] < g.segment_length) continue;
+        length_[i] = 0;
+        glm::dvec3 f = q_[i] * glm::dvec3(0, 1, 0);
+        // Eq. 6: the nearest obstacle in range steers the apex parallel to its surface
+        if (g.adaption > 0) {
+            double best = g.adaption_range;
+            const Obstacle* near = nullptr;
+            for (const auto& o : obstacles_) {
+                double d = o.distance(x_[i]);
+                if (d < best) best = d, near = &o;
+            }
+            if (near) f = surface_adaption(f, -near->normal(x_[i]), g.adaption, settings_.dt * 40);
+        }
+        // Eq. 7 (occlusion by other plants is not modelled yet: O = 0)
+        if (g.phototropism > 0) f = phototropism(f, g.to_light, 0.0, g.phototropism, settings_.dt * 40);
+        glm::dvec3 pos = x_[i] + f * g.segment_length;
+        for (const auto& o : obstacles_) // never grow into an obstacle
+            if (o.distance(pos) < radii_[i].x) pos -= o.normal(pos) * (o.distance(pos) - radii_[i].x);
+        Handle parent{i, generation_[i]};
+        add_particle(parent, pos, heading_to(f), radii_[i]);
+        // lateral branching with probability BP, at most B buds per particle
+        for (int b = 0; b < g.max_lateral && x_.size() < g.max_particles; ++b) {
+            if (random_unit(g.seed, i, 3 * static_cast<std::uint64_t>(b)) >= g.branch_probability) continue;
+            double angle = random_unit(g.seed, i, 3 * static_cast<std::uint64_t>(b) + 1) * g.branch_variance *
+                           std::numbers::pi / 2;
+            double around = random_unit(g.seed, i, 3 * static_cast<std::uint64_t>(b) + 2) * 2 * std::numbers::pi;
+            glm::dvec3 side = glm::normalize(glm::cross(f, std::fabs(f.y) < 0.9 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0)));
+            glm::dvec3 axis = glm::angleAxis(around, f) * side;
+            glm::dvec3 lf = glm::angleAxis(angle, axis) * f;
+            add_particle(parent, x_[i] + lf * g.segment_length, heading_to(lf), radii_[i] * g.falloff);
+            ++laterals_[i];
+        }
+    }
 }
 
 std::uint64_t World::state_hash() const {

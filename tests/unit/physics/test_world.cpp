@@ -1,9 +1,14 @@
 // The particle runtime's checks from PLANTS.md (climber section) that its first part supports.
+#define GLM_ENABLE_EXPERIMENTAL
 #include "plant/physics/world.hpp"
+
+#include <glm/gtx/quaternion.hpp>
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <numbers>
 
 using namespace plant::physics;
 
@@ -197,4 +202,99 @@ TEST_CASE("pulling a tip past the threshold breaks the branch and the loose part
     double y0 = c.world.position(c.p.back()).y;
     c.run(1);
     CHECK(c.world.position(c.p.back()).y < y0 - 1.0); // a second of free fall
+}
+
+namespace {
+// A seed particle growing upward for `seconds`.
+World grown(Growth g, double seconds, glm::dvec3 start_forward = {0, 1, 0}) {
+    Settings s;
+    s.gravity = glm::dvec3(0.0); // growth alone
+    s.growth = g;
+    World w(s);
+    w.add_root({0, 0, 0}, glm::rotation(glm::dvec3(0, 1, 0), glm::normalize(start_forward)), {0.02, 0.05, 0.02});
+    int steps = static_cast<int>(seconds / s.dt);
+    for (int k = 0; k < steps; ++k) {
+        w.step();
+        w.grow();
+    }
+    return w;
+}
+} // namespace
+
+TEST_CASE("lateral branching: rate within 3 sigma of BP, angles within V * 90 degrees", "[physics]") {
+    Growth g;
+    g.branch_probability = 0.3;
+    g.branch_variance = 0.4;
+    g.speed = 1.0;
+    g.max_particles = 400;
+    std::size_t particles = 0, with_lateral = 0;
+    double worst = 0;
+    for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+        g.seed = seed;
+        World w = grown(g, 3.0);
+        for (std::uint32_t i = 0; i < w.size(); ++i) {
+            Handle h{i, 0};
+            if (w.parent(h) == ~0u) continue;
+            Handle parent{w.parent(h), 0};
+            // the particles that grew a continuation could grow a lateral
+            if (w.laterals(parent) > 0 && w.forward(h) != w.forward(parent)) {
+                glm::dvec3 a = w.forward(parent), b = w.forward(h);
+                worst = std::max(worst, std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0)));
+            }
+        }
+        for (std::uint32_t i = 0; i < w.size(); ++i) {
+            Handle h{i, 0};
+            bool has_children = false;
+            for (std::uint32_t j = 0; j < w.size(); ++j)
+                if (w.parent(Handle{j, 0}) == i) has_children = true;
+            if (!has_children) continue; // an apex has not had its chance yet
+            ++particles;
+            with_lateral += w.laterals(h) > 0;
+        }
+    }
+    double n = double(particles), p = 0.3;
+    INFO(with_lateral << " of " << particles);
+    CHECK(std::fabs(with_lateral - n * p) < 3 * std::sqrt(n * p * (1 - p)));
+    CHECK(worst <= 0.4 * std::numbers::pi / 2 + 1e-9);
+}
+
+TEST_CASE("an apex growing toward a wall turns parallel to it and never enters it", "[physics]") {
+    Growth g;
+    g.adaption = 1.0;
+    g.adaption_range = 0.4;
+    g.speed = 1.0;
+    g.max_particles = 60;
+    Settings s;
+    s.gravity = glm::dvec3(0.0);
+    s.growth = g;
+    World w(s);
+    Obstacle wall; // the plane x = 0.3, facing -x
+    wall.kind = Obstacle::Plane;
+    wall.a = glm::dvec3(0.3, 0, 0);
+    wall.b = glm::dvec3(-1, 0, 0);
+    w.add_obstacle(wall);
+    w.add_root({0, 0, 0}, glm::rotation(glm::dvec3(0, 1, 0), glm::normalize(glm::dvec3(1, 1, 0))), {0.02, 0.05, 0.02});
+    Handle apex{0, 0};
+    for (int k = 0; k < 400 && w.size() < 60; ++k) {
+        w.step();
+        w.grow();
+        for (std::uint32_t i = 0; i < w.size(); ++i) REQUIRE(wall.distance(w.position(Handle{i, 0})) >= 0.02 - 1e-9);
+    }
+    apex = Handle{static_cast<std::uint32_t>(w.size() - 1), 0};
+    CHECK(std::fabs(glm::dot(w.forward(apex), glm::dvec3(1, 0, 0))) < 0.2); // parallel to the wall
+    CHECK(w.forward(apex).y > 0.9);                                         // and still climbing
+}
+
+TEST_CASE("growth is deterministic for a seed", "[physics]") {
+    Growth g;
+    g.branch_probability = 0.5;
+    g.speed = 1.0;
+    g.max_particles = 200;
+    g.seed = 7;
+    World a = grown(g, 2.0), b = grown(g, 2.0);
+    CHECK(a.size() == b.size());
+    CHECK(a.state_hash() == b.state_hash());
+    g.seed = 8;
+    World c = grown(g, 2.0);
+    CHECK(c.state_hash() != a.state_hash());
 }

@@ -21,6 +21,22 @@ struct Handle {
     bool valid() const { return index != ~0u; }
 };
 
+// Growth and branching (section 4.2, 4.3; Table 2's parameters).
+struct Growth {
+    double segment_length = 0.1;    // a new particle every this much of growth
+    double speed = 0.05;            // apical growth, m/s
+    std::size_t max_particles = 25000;
+    double branch_probability = 0;  // BP: chance that a new particle carries a lateral bud
+    double branch_variance = 0.5;   // V in [0, 1]: a lateral turns up to V * 90 degrees away
+    int max_lateral = 1;            // B: lateral buds per particle
+    double falloff = 0.8;           // thickness of a lateral relative to its parent
+    glm::dvec3 to_light{0, 1, 0};
+    double phototropism = 0;        // eta (Eq. 7)
+    double adaption = 0;            // tau (Eq. 6)
+    double adaption_range = 0.3;    // obstacles nearer than this steer the apex
+    std::uint64_t seed = 1;
+};
+
 struct Settings {
     glm::dvec3 gravity{0.0, -9.81, 0.0};
     double dt = 0.025;           // the paper's step, 25 ms
@@ -28,6 +44,7 @@ struct Settings {
     double damping = 0.02;       // fraction of velocity removed per step
     double stiffening_time = 10; // t_m: a particle reaches full stiffness at this age (s = t_l / t_m)
     double fixed_stiffness = -1; // >= 0: every particle has this stiffness instead (tests, tools)
+    Growth growth;
     int iterations = 8;          // shape-matching passes per step
 };
 
@@ -74,6 +91,15 @@ public:
     // integrate (Eq. 17-20), damp, break overstretched connections.
     void step();
 
+    // Apical growth: every apex (a particle without children) lengthens; each segment_length a
+    // new particle continues it, turned by surface adaption and phototropism (Eq. 6-8), and with
+    // probability BP a lateral bud starts beside it, turned by up to V * 90 degrees. Random draws
+    // depend on the seed and the particles' indices only.
+    void grow();
+    // The unit forward vector of a particle (its orientation's +y).
+    glm::dvec3 forward(Handle h) const { return q_[h.index] * glm::dvec3(0, 1, 0); }
+    std::size_t laterals(Handle h) const { return laterals_[h.index]; }
+
     // Eq. 5: each step the particle's predicted position moves a fraction phi of the way to the
     // anchor; past `release` from it, the anchor lets go.
     void add_anchor(Handle h, const glm::dvec3& point, double phi, double release);
@@ -118,7 +144,8 @@ private:
     Settings settings_;
     std::vector<glm::dvec3> x_, v_, rest_x_, radii_;
     std::vector<glm::dquat> q_, rest_q_;
-    std::vector<double> m_, age_;
+    std::vector<double> m_, age_, length_;
+    std::vector<std::uint32_t> laterals_;
     std::vector<std::uint32_t> parent_, generation_;
     std::vector<std::vector<std::uint32_t>> children_;
     std::vector<std::uint8_t> fixed_, alive_;
