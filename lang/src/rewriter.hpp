@@ -162,8 +162,10 @@ public:
                 check_holes(t, values);
             }
             const std::size_t m = t.syms.size();
-            std::memcpy(S, t.syms.data(), m * sizeof(SymbolId));
-            std::memcpy(PA, t.params.data(), t.params.size() * sizeof(double));
+            if (m != 0) std::memcpy(S, t.syms.data(), m * sizeof(SymbolId));
+            // An erasing or parameterless successor has no parameter storage;
+            // memcpy with a null source is undefined even for zero bytes.
+            if (!t.params.empty()) std::memcpy(PA, t.params.data(), t.params.size() * sizeof(double));
             for (std::size_t h = 0; h < t.holes.size(); ++h) PA[t.holes[h]] = values[h];
             for (std::size_t j = 0; j < m; ++j) {
                 PO[j] = static_cast<std::uint32_t>(p + t.param_end[j]);
