@@ -134,78 +134,87 @@ bool World::alive(Handle h) const {
     return h.index < x_.size() && generation_[h.index] == h.generation && alive_[h.index];
 }
 
-std::vector<std::uint32_t> World::group(std::uint32_t i) const {
-    std::vector<std::uint32_t> g;
-    if (parent_[i] != kNone) g.push_back(parent_[i]);
-    g.push_back(i);
-    for (std::uint32_t c : children_[i]) g.push_back(c);
-    return g;
-}
-
 double World::stiffness(std::uint32_t i) const {
     if (settings_.fixed_stiffness >= 0) return std::min(1.0, settings_.fixed_stiffness);
     // s = t_l / t_m, clamped to [0, 1]; t_l starts at 0.2 (section 4.3)
     return std::clamp((0.2 + age_[i]) / settings_.stiffening_time, 0.0, 1.0);
 }
 
-glm::dquat World::group_rotation(std::uint32_t i) const {
-    const auto g = group(i);
+glm::dmat3 World::ellipsoid_moment(std::uint32_t j) const {
+    // Eq. 15's term for one member, written R D R̄ᵀ (PLANTS.md pitfall)
+    const double m = fixed_[j] ? kFixedMass : m_[j];
+    const glm::dvec3& r = radii_[j];
+    glm::dmat3 D(0.0);
+    D[0][0] = r.x * r.x, D[1][1] = r.y * r.y, D[2][2] = r.z * r.z;
+    return 0.2 * m * glm::mat3_cast(q_[j]) * D * glm::transpose(glm::mat3_cast(rest_q_[j]));
+}
+
+World::Frame World::group_frame(std::uint32_t i, const glm::dquat& warm, const glm::dmat3* moments) const {
     double M = 0;
     glm::dvec3 c(0.0), rc(0.0);
-    for (std::uint32_t j : g) {
-        double m = fixed_[j] ? kFixedMass : m_[j];
+    for_group(i, [&](std::uint32_t j) {
+        const double m = fixed_[j] ? kFixedMass : m_[j];
         M += m;
         c += m * x_[j];
         rc += m * rest_x_[j];
-    }
+    });
     c /= M;
     rc /= M;
-    // Eq. 14 with Eq. 15's ellipsoid moment written R D R̄ᵀ (PLANTS.md pitfall), positions
-    // relative to the centers to keep the sums well conditioned
+    // Eq. 14 with Eq. 15's ellipsoid moments (precomputed per pass when `moments` is given),
+    // positions relative to the centers to keep the sums well conditioned
     glm::dmat3 A(0.0);
-    for (std::uint32_t j : g) {
-        double m = fixed_[j] ? kFixedMass : m_[j];
-        const glm::dvec3& r = radii_[j];
-        glm::dmat3 D(0.0);
-        D[0][0] = r.x * r.x, D[1][1] = r.y * r.y, D[2][2] = r.z * r.z;
-        A += 0.2 * m * glm::mat3_cast(q_[j]) * D * glm::transpose(glm::mat3_cast(rest_q_[j]));
+    for_group(i, [&](std::uint32_t j) {
+        const double m = fixed_[j] ? kFixedMass : m_[j];
+        A += moments ? moments[j] : ellipsoid_moment(j);
         A += m * outer(x_[j] - c, rest_x_[j] - rc);
-    }
+    });
+    return {c, rc, extract_rotation(A, warm), true};
+}
+
+glm::dquat World::group_rotation(std::uint32_t i) const {
     // warm start: the particle's own rotation from rest
-    glm::dquat warm = glm::normalize(q_[i] * glm::inverse(rest_q_[i]));
-    return extract_rotation(A, warm);
+    return group_frame(i, glm::normalize(q_[i] * glm::inverse(rest_q_[i])), nullptr).R;
+}
+
+void World::match_shapes(std::vector<Frame>& frames, std::vector<glm::dvec3>& goal, std::vector<double>& weight,
+                         std::vector<glm::dmat3>& moments) const {
+    const std::size_t n = x_.size();
+    frames.resize(n);
+    moments.resize(n);
+    for (std::uint32_t j = 0; j < n; ++j)
+        if (alive_[j]) moments[j] = ellipsoid_moment(j);
+    goal.assign(n, glm::dvec3(0.0));
+    weight.assign(n, 0.0);
+    for (std::uint32_t i = 0; i < n; ++i) {
+        if (!alive_[i]) continue;
+        // warm start from the last pass's rotation when there is one, else from the particle's
+        // own rotation from rest
+        const glm::dquat warm = frames[i].valid ? frames[i].R : glm::normalize(q_[i] * glm::inverse(rest_q_[i]));
+        frames[i] = group_frame(i, warm, moments.data());
+    }
+    for (std::uint32_t i = 0; i < n; ++i) {
+        if (!alive_[i]) continue;
+        const Frame& f = frames[i];
+        const glm::dmat3 R = glm::mat3_cast(f.R);
+        for_group(i, [&](std::uint32_t j) {
+            // Eq. 3: the target of member j in group i; Eq. 4: weighted by mass, the group of a
+            // particle's parent counting twice as much as its own, its children's half
+            const glm::dvec3 target = R * (rest_x_[j] - f.rc) + f.c;
+            const double w = m_[j] * (j == i ? 1.0 : (i == parent_[j] ? 2.0 : 0.5));
+            goal[j] += w * target;
+            weight[j] += w;
+        });
+    }
+    for (std::size_t j = 0; j < n; ++j) goal[j] = weight[j] > 0 ? goal[j] / weight[j] : x_[j];
 }
 
 std::vector<glm::dvec3> World::goals() const {
-    const std::size_t n = x_.size();
-    std::vector<glm::dvec3> sum(n, glm::dvec3(0.0));
-    std::vector<double> weight(n, 0.0);
-    for (std::uint32_t i = 0; i < n; ++i) {
-        if (!alive_[i]) continue;
-        const auto g = group(i);
-        double M = 0;
-        glm::dvec3 c(0.0), rc(0.0);
-        for (std::uint32_t j : g) {
-            double m = fixed_[j] ? kFixedMass : m_[j];
-            M += m;
-            c += m * x_[j];
-            rc += m * rest_x_[j];
-        }
-        c /= M;
-        rc /= M;
-        glm::dmat3 R = glm::mat3_cast(group_rotation(i));
-        for (std::uint32_t j : g) {
-            // Eq. 3: the target of member j in group i; Eq. 4: weighted by mass, the group of a
-            // particle's parent counting twice as much as its own, its children's half
-            glm::dvec3 target = R * (rest_x_[j] - rc) + c;
-            double w = m_[j] * (j == i ? 1.0 : (i == parent_[j] ? 2.0 : 0.5));
-            sum[j] += w * target;
-            weight[j] += w;
-        }
-    }
-    std::vector<glm::dvec3> out(n);
-    for (std::size_t j = 0; j < n; ++j) out[j] = weight[j] > 0 ? sum[j] / weight[j] : x_[j];
-    return out;
+    std::vector<Frame> frames;
+    std::vector<glm::dvec3> goal;
+    std::vector<double> weight;
+    std::vector<glm::dmat3> moments;
+    match_shapes(frames, goal, weight, moments);
+    return goal;
 }
 
 void World::step() {
@@ -227,10 +236,12 @@ void World::step() {
     }
     // shape matching on the predictions; small overlapping groups pass a correction on by one
     // particle per iteration, so a chain needs several to hold its shape
-    std::vector<glm::dquat> rot(n);
+    std::vector<Frame> frames;
+    std::vector<glm::dvec3> goal;
+    std::vector<double> weight;
+    std::vector<glm::dmat3> moments;
     for (int it = 0; it < settings_.iterations; ++it) {
-        std::vector<glm::dvec3> goal = goals();
-        for (std::uint32_t i = 0; i < n; ++i) rot[i] = alive_[i] ? group_rotation(i) : q_[i];
+        match_shapes(frames, goal, weight, moments);
         for (std::uint32_t i = 0; i < n; ++i) {
             if (!alive_[i]) continue;
             if (fixed_[i]) {
@@ -239,7 +250,7 @@ void World::step() {
             }
             // x'_g = x_p + s (x_g - x_p) (section 4.3)
             x_[i] = x_[i] + stiffness(i) * (goal[i] - x_[i]);
-            q_[i] = glm::normalize(glm::slerp(q_[i], glm::normalize(rot[i] * rest_q_[i]), stiffness(i)));
+            q_[i] = glm::normalize(glm::slerp(q_[i], glm::normalize(frames[i].R * rest_q_[i]), stiffness(i)));
         }
         for (const auto& [i, target] : pulls_) x_[i] = target; // a dragged particle goes where it is dragged
     }

@@ -137,7 +137,26 @@ public:
     std::uint64_t state_hash() const;
 
 private:
-    std::vector<std::uint32_t> group(std::uint32_t i) const; // parent, self, children
+    // The shape-matching group of particle i: its parent, itself, its children.
+    template <class F> void for_group(std::uint32_t i, F&& f) const {
+        if (parent_[i] != kNoParent) f(parent_[i]);
+        f(i);
+        for (std::uint32_t c : children_[i]) f(c);
+    }
+    static constexpr std::uint32_t kNoParent = ~0u;
+    // A group's mass centers now and at rest, and its rotation (Eq. 14-15).
+    struct Frame {
+        glm::dvec3 c{0.0}, rc{0.0};
+        glm::dquat R{1, 0, 0, 0};
+        bool valid = false;
+    };
+    glm::dmat3 ellipsoid_moment(std::uint32_t j) const;
+    // `moments`: every particle's ellipsoid_moment, or null to compute them here.
+    Frame group_frame(std::uint32_t i, const glm::dquat& warm, const glm::dmat3* moments) const;
+    // One shape-matching pass: every group's frame (warm-started from `frames`) and every
+    // particle's goal (Eq. 3-4); `weight` and `moments` are scratch.
+    void match_shapes(std::vector<Frame>& frames, std::vector<glm::dvec3>& goal, std::vector<double>& weight,
+                      std::vector<glm::dmat3>& moments) const;
     double group_mass(std::uint32_t i) const;
     double stiffness(std::uint32_t i) const;
 
