@@ -7,8 +7,8 @@
 // plane, so the collision stage has contacts to resolve. Every step runs growth (the T + 1 apices
 // lengthen and branch) and then the physics step, which includes the obstacle pass; the two are
 // timed separately.
-//   plant_physics_bench [PARTICLES] [STEPS]
-// Prints one line: particles=N steps=S physics_ms=... growth_ms=... total_ms=...
+//   plant_physics_bench [PARTICLES] [STEPS] [THREADS]
+// Prints one line: particles=N threads=T steps=S physics_ms=... growth_ms=... total_ms=...
 #include "plant/physics/world.hpp"
 
 #include <glm/gtc/quaternion.hpp>
@@ -25,14 +25,16 @@ using namespace plant::physics;
 int main(int argc, char** argv) {
     const long want = argc > 1 ? std::atol(argv[1]) : 25000;
     const int steps = argc > 2 ? std::atoi(argv[2]) : 40;
-    if (want < 100 || steps < 1) {
-        std::fprintf(stderr, "usage: plant_physics_bench [PARTICLES >= 100] [STEPS >= 1]\n");
+    const int threads = argc > 3 ? std::atoi(argv[3]) : 1;
+    if (want < 100 || steps < 1 || threads < 1) {
+        std::fprintf(stderr, "usage: plant_physics_bench [PARTICLES >= 100] [STEPS >= 1] [THREADS >= 1]\n");
         return 64;
     }
     const long lateral = 99;
     const long trunk = want / (lateral + 1);
 
     Settings s;
+    s.threads = threads;
     s.growth.speed = 0.05;
     s.growth.segment_length = 0.05;
     s.growth.max_particles = static_cast<std::size_t>(want) + 2000; // room to grow during the run
@@ -71,8 +73,8 @@ int main(int argc, char** argv) {
         growth += std::chrono::duration<double, std::milli>(t1 - t0).count();
         physics += std::chrono::duration<double, std::milli>(t2 - t1).count();
     }
-    std::printf("particles=%zu grown=%zu steps=%d physics_ms=%.3f growth_ms=%.3f total_ms=%.3f hash=%016llx\n",
-                start, w.size() - start, steps, physics / steps, growth / steps, (physics + growth) / steps,
+    std::printf("particles=%zu threads=%d grown=%zu steps=%d physics_ms=%.3f growth_ms=%.3f total_ms=%.3f hash=%016llx\n",
+                start, threads, w.size() - start, steps, physics / steps, growth / steps, (physics + growth) / steps,
                 static_cast<unsigned long long>(w.state_hash()));
     return 0;
 }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <thread>
 
 #include <glm/gtx/quaternion.hpp>
 
@@ -176,36 +177,71 @@ glm::dquat World::group_rotation(std::uint32_t i) const {
     return group_frame(i, glm::normalize(q_[i] * glm::inverse(rest_q_[i])), nullptr).R;
 }
 
+namespace {
+
+// Runs f(begin, end) over [0, n) split into `threads` contiguous ranges. Each index is handled
+// by exactly one call and writes only its own slots, so the result does not depend on the
+// thread count.
+template <class F> void parallel_ranges(std::size_t n, int threads, F&& f) {
+    const std::size_t t = std::clamp<std::size_t>(static_cast<std::size_t>(std::max(threads, 1)), 1, n / 2048 + 1);
+    if (t == 1) {
+        f(std::size_t{0}, n);
+        return;
+    }
+    std::vector<std::thread> pool;
+    pool.reserve(t - 1);
+    for (std::size_t k = 1; k < t; ++k) pool.emplace_back([&f, k, t, n] { f(n * k / t, n * (k + 1) / t); });
+    f(std::size_t{0}, n / t);
+    for (auto& th : pool) th.join();
+}
+
+} // namespace
+
 void World::match_shapes(std::vector<Frame>& frames, std::vector<glm::dvec3>& goal, std::vector<double>& weight,
                          std::vector<glm::dmat3>& moments) const {
     const std::size_t n = x_.size();
     frames.resize(n);
     moments.resize(n);
-    for (std::uint32_t j = 0; j < n; ++j)
-        if (alive_[j]) moments[j] = ellipsoid_moment(j);
-    goal.assign(n, glm::dvec3(0.0));
-    weight.assign(n, 0.0);
-    for (std::uint32_t i = 0; i < n; ++i) {
-        if (!alive_[i]) continue;
-        // warm start from the last pass's rotation when there is one, else from the particle's
-        // own rotation from rest
-        const glm::dquat warm = frames[i].valid ? frames[i].R : glm::normalize(q_[i] * glm::inverse(rest_q_[i]));
-        frames[i] = group_frame(i, warm, moments.data());
-    }
-    for (std::uint32_t i = 0; i < n; ++i) {
-        if (!alive_[i]) continue;
-        const Frame& f = frames[i];
-        const glm::dmat3 R = glm::mat3_cast(f.R);
-        for_group(i, [&](std::uint32_t j) {
-            // Eq. 3: the target of member j in group i; Eq. 4: weighted by mass, the group of a
-            // particle's parent counting twice as much as its own, its children's half
-            const glm::dvec3 target = R * (rest_x_[j] - f.rc) + f.c;
-            const double w = m_[j] * (j == i ? 1.0 : (i == parent_[j] ? 2.0 : 0.5));
-            goal[j] += w * target;
-            weight[j] += w;
-        });
-    }
-    for (std::size_t j = 0; j < n; ++j) goal[j] = weight[j] > 0 ? goal[j] / weight[j] : x_[j];
+    goal.resize(n);
+    weight.resize(n);
+    const int threads = settings_.threads;
+    parallel_ranges(n, threads, [&](std::size_t b, std::size_t e) {
+        for (std::size_t j = b; j < e; ++j)
+            if (alive_[j]) moments[j] = ellipsoid_moment(static_cast<std::uint32_t>(j));
+    });
+    parallel_ranges(n, threads, [&](std::size_t b, std::size_t e) {
+        for (std::size_t k = b; k < e; ++k) {
+            const auto i = static_cast<std::uint32_t>(k);
+            if (!alive_[i]) continue;
+            // warm start from the last pass's rotation when there is one, else from the
+            // particle's own rotation from rest
+            const glm::dquat warm =
+                frames[i].valid ? frames[i].R : glm::normalize(q_[i] * glm::inverse(rest_q_[i]));
+            frames[i] = group_frame(i, warm, moments.data());
+        }
+    });
+    // Eq. 3: the target of particle j in group i is R_i (x̄_j - c̄_i) + c_i; Eq. 4: j's goal is
+    // their mass-weighted mean over the groups j belongs to (its own, its parent's, its
+    // children's), its parent's group counting twice as much as its own and its children's half.
+    // Gathered per particle, so each slot is written by one thread.
+    parallel_ranges(n, threads, [&](std::size_t b, std::size_t e) {
+        for (std::size_t k = b; k < e; ++k) {
+            const auto j = static_cast<std::uint32_t>(k);
+            glm::dvec3 sum(0.0);
+            double wsum = 0;
+            auto add = [&](std::uint32_t i, double w) {
+                if (!alive_[i]) return;
+                const Frame& f = frames[i];
+                sum += w * (f.R * (rest_x_[j] - f.rc) + f.c);
+                wsum += w;
+            };
+            add(j, m_[j]);
+            if (parent_[j] != kNone) add(parent_[j], 2.0 * m_[j]);
+            for (std::uint32_t c : children_[j]) add(c, 0.5 * m_[j]);
+            weight[j] = wsum;
+            goal[j] = wsum > 0 ? sum / wsum : x_[j];
+        }
+    });
 }
 
 std::vector<glm::dvec3> World::goals() const {

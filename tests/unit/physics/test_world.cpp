@@ -298,3 +298,26 @@ TEST_CASE("growth is deterministic for a seed", "[physics]") {
     World c = grown(g, 2.0);
     CHECK(c.state_hash() != a.state_hash());
 }
+
+TEST_CASE("the state after growth and gravity does not depend on the thread count", "[physics]") {
+    // enough particles (over 4,096) that two threads really split the shape-matching passes
+    auto run = [](int threads) {
+        Settings s;
+        s.threads = threads;
+        s.growth.branch_probability = 0.5;
+        s.growth.speed = 4.0;
+        s.growth.max_particles = 5000;
+        s.growth.seed = 11;
+        World w(s);
+        w.add_root({0, 0, 0}, glm::dquat(1, 0, 0, 0), {0.02, 0.05, 0.02});
+        for (int k = 0; k < 40; ++k) {
+            w.grow();
+            w.step();
+        }
+        return std::pair{w.size(), w.state_hash()};
+    };
+    const auto one = run(1), two = run(2);
+    CHECK(one.first > 4096);
+    CHECK(one.first == two.first);
+    CHECK(one.second == two.second);
+}

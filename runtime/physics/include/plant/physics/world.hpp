@@ -46,6 +46,7 @@ struct Settings {
     double fixed_stiffness = -1; // >= 0: every particle has this stiffness instead (tests, tools)
     Growth growth;
     int iterations = 8;          // shape-matching passes per step
+    int threads = 1;             // threads for the shape-matching passes (results do not depend on it)
 };
 
 // Growth directions (Hädrich et al., section 4.2). Each returns the apex's forward vector turned
