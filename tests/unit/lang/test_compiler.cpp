@@ -88,7 +88,7 @@ TEST_CASE("letter runs split by longest match over declared names", "[compiler]"
     CHECK(test::derive("module Fb; axiom: F b;") == "F b");
 }
 
-TEST_CASE("a -D value overrides a param with an expression; unknown params are reported", "[compiler]") {
+TEST_CASE("a -D value overrides a param with an expression, and unknown params are reported", "[compiler]") {
     CompileOptions o;
     o.defines = {{"r", "2 * 3"}};
     auto c = compile("param r = 1; axiom: F(r);", o);

@@ -95,7 +95,7 @@ TEST_CASE("context parts of a production are sorted by their operators", "[parse
     CHECK(!prods[2].has_right);
 }
 
-TEST_CASE("turtle symbols, @-names, queries and ';' with arguments are modules", "[parser]") {
+TEST_CASE("turtle symbols, @-names, queries and the color symbol with arguments are modules", "[parser]") {
     auto p = parse(R"(axiom: F(1)+(30)-&^\/|$!(2);(3)~leaf(1)%@O(1)?P(0,0,0)[G]f//;)");
     REQUIRE(p->errors().empty());
     std::vector<std::string> names;

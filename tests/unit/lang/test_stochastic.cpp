@@ -44,7 +44,7 @@ TEST_CASE("10,000 draws of a 0.3/0.7 rule land within 3 sigma", "[stochastic]") 
     CHECK(std::fabs(double(xs) - mean) < 3 * sigma);
 }
 
-TEST_CASE("the counter-based generator is uniform in [0, 1)", "[stochastic]") {
+TEST_CASE("the counter-based generator is uniform over 0 <= u < 1", "[stochastic]") {
     int bins[10] = {};
     const int n = 100000;
     for (int i = 0; i < n; ++i) {
@@ -56,7 +56,7 @@ TEST_CASE("the counter-based generator is uniform in [0, 1)", "[stochastic]") {
     for (int b : bins) CHECK(std::abs(b - n / 10) < 4 * std::sqrt(n * 0.1 * 0.9));
 }
 
-TEST_CASE("same seed, same string; different seeds, different strings", "[stochastic]") {
+TEST_CASE("same seed, same string, and different seeds, different strings", "[stochastic]") {
     std::string a = run_with(kBushy, 1, 1);
     CHECK(a == run_with(kBushy, 1, 1));
     CHECK(a != run_with(kBushy, 2, 1));

@@ -84,7 +84,7 @@ TEST_CASE("the frame stays orthonormal and right-handed after many rotations", "
     CHECK(t.left.y == Approx(0.0).margin(1e-12)); // '$' made L horizontal
 }
 
-TEST_CASE("branches: '[' saves and ']' restores the state; a branch is a new axis", "[turtle]") {
+TEST_CASE("a branch saves and restores the turtle state and is a new axis", "[turtle]") {
     auto r = draw("F [ +(90) F ] F");
     REQUIRE(r.ends.size() == 3);
     near(r.ends[1], {-1, 1, 0});
@@ -139,7 +139,7 @@ TEST_CASE("query modules read the turtle after interpretation rules (the L-Py ca
     CHECK(format_string(*c->program, d.string()) == "I(10)R(0,10,0)");
 }
 
-TEST_CASE("?H ?U ?L read the frame; a vec3 binding reads all three numbers", "[turtle][query]") {
+TEST_CASE("?H ?U ?L read the frame, and a vec3 binding reads all three numbers", "[turtle][query]") {
     auto c = test::compile(R"(
         module R(v: vec3);
         axiom: +(90) ?H(0, 0, 0) ?L(0, 0, 0) ?U(0, 0, 0);
@@ -160,7 +160,7 @@ TEST_CASE("?H ?U ?L read the frame; a vec3 binding reads all three numbers", "[t
     near(v(3), {0, 0, 1});  // up
 }
 
-TEST_CASE("G draws like F; colors come from ;(c) and SetColor", "[turtle]") {
+TEST_CASE("G draws like F, and colors come from the color module and SetColor", "[turtle]") {
     near(draw("G(2)").ends[0], {0, 2, 0});
     Drawn drawn = skeleton_of("axiom: F ;(1) F SetColor(255, 0, 0) F SetColor(0, 0.5, 1) F @R(1, 0, 0) F;");
     const Skeleton& sk = drawn.skeleton;
