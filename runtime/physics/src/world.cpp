@@ -150,7 +150,8 @@ glm::dmat3 World::ellipsoid_moment(std::uint32_t j) const {
     return 0.2 * m * glm::mat3_cast(q_[j]) * D * glm::transpose(glm::mat3_cast(rest_q_[j]));
 }
 
-World::Frame World::group_frame(std::uint32_t i, const glm::dquat& warm, const glm::dmat3* moments) const {
+World::Frame World::group_frame(std::uint32_t i, const glm::dquat& warm, const glm::dmat3* moments,
+                                int iterations) const {
     double M = 0;
     glm::dvec3 c(0.0), rc(0.0);
     for_group(i, [&](std::uint32_t j) {
@@ -169,12 +170,12 @@ World::Frame World::group_frame(std::uint32_t i, const glm::dquat& warm, const g
         A += moments ? moments[j] : ellipsoid_moment(j);
         A += m * outer(x_[j] - c, rest_x_[j] - rc);
     });
-    return {c, rc, extract_rotation(A, warm), true};
+    return {c, rc, extract_rotation(A, warm, iterations), true};
 }
 
 glm::dquat World::group_rotation(std::uint32_t i) const {
     // warm start: the particle's own rotation from rest
-    return group_frame(i, glm::normalize(q_[i] * glm::inverse(rest_q_[i])), nullptr).R;
+    return group_frame(i, glm::normalize(q_[i] * glm::inverse(rest_q_[i])), nullptr, 20).R;
 }
 
 namespace {
@@ -198,7 +199,7 @@ template <class F> void parallel_ranges(std::size_t n, int threads, F&& f) {
 } // namespace
 
 void World::match_shapes(std::vector<Frame>& frames, std::vector<glm::dvec3>& goal, std::vector<double>& weight,
-                         std::vector<glm::dmat3>& moments) const {
+                         std::vector<glm::dmat3>& moments, int iterations) const {
     const std::size_t n = x_.size();
     frames.resize(n);
     moments.resize(n);
@@ -217,7 +218,7 @@ void World::match_shapes(std::vector<Frame>& frames, std::vector<glm::dvec3>& go
             // particle's own rotation from rest
             const glm::dquat warm =
                 frames[i].valid ? frames[i].R : glm::normalize(q_[i] * glm::inverse(rest_q_[i]));
-            frames[i] = group_frame(i, warm, moments.data());
+            frames[i] = group_frame(i, warm, moments.data(), iterations);
         }
     });
     // Eq. 3: the target of particle j in group i is R_i (x̄_j - c̄_i) + c_i; Eq. 4: j's goal is
@@ -249,7 +250,7 @@ std::vector<glm::dvec3> World::goals() const {
     std::vector<glm::dvec3> goal;
     std::vector<double> weight;
     std::vector<glm::dmat3> moments;
-    match_shapes(frames, goal, weight, moments);
+    match_shapes(frames, goal, weight, moments, 20);
     return goal;
 }
 
@@ -277,7 +278,7 @@ void World::step() {
     std::vector<double> weight;
     std::vector<glm::dmat3> moments;
     for (int it = 0; it < settings_.iterations; ++it) {
-        match_shapes(frames, goal, weight, moments);
+        match_shapes(frames, goal, weight, moments, settings_.rotation_iterations);
         for (std::uint32_t i = 0; i < n; ++i) {
             if (!alive_[i]) continue;
             if (fixed_[i]) {

@@ -47,6 +47,10 @@ struct Settings {
     Growth growth;
     int iterations = 8;          // shape-matching passes per step
     int threads = 1;             // threads for the shape-matching passes (results do not depend on it)
+    // Rotation-extraction iterations per group and pass. Each pass warm-starts from the last
+    // one's rotation, so the iterations add up over a step's passes, as Müller et al. 2016
+    // suggest for simulations; a cold solve (goals(), group_rotation()) runs up to 20.
+    int rotation_iterations = 2;
 };
 
 // Growth directions (Hädrich et al., section 4.2). Each returns the apex's forward vector turned
@@ -153,11 +157,12 @@ private:
     };
     glm::dmat3 ellipsoid_moment(std::uint32_t j) const;
     // `moments`: every particle's ellipsoid_moment, or null to compute them here.
-    Frame group_frame(std::uint32_t i, const glm::dquat& warm, const glm::dmat3* moments) const;
+    Frame group_frame(std::uint32_t i, const glm::dquat& warm, const glm::dmat3* moments, int iterations) const;
     // One shape-matching pass: every group's frame (warm-started from `frames`) and every
-    // particle's goal (Eq. 3-4); `weight` and `moments` are scratch.
+    // particle's goal (Eq. 3-4), with at most `iterations` rotation-extraction iterations per
+    // group; `weight` and `moments` are scratch.
     void match_shapes(std::vector<Frame>& frames, std::vector<glm::dvec3>& goal, std::vector<double>& weight,
-                      std::vector<glm::dmat3>& moments) const;
+                      std::vector<glm::dmat3>& moments, int iterations) const;
     double group_mass(std::uint32_t i) const;
     double stiffness(std::uint32_t i) const;
 
