@@ -279,16 +279,19 @@ void World::step() {
     std::vector<glm::dmat3> moments;
     for (int it = 0; it < settings_.iterations; ++it) {
         match_shapes(frames, goal, weight, moments, settings_.rotation_iterations);
-        for (std::uint32_t i = 0; i < n; ++i) {
-            if (!alive_[i]) continue;
-            if (fixed_[i]) {
-                x_[i] = rest_x_[i];
-                continue;
+        parallel_ranges(n, settings_.threads, [&](std::size_t b, std::size_t e) {
+            for (std::size_t i = b; i < e; ++i) {
+                if (!alive_[i]) continue;
+                if (fixed_[i]) {
+                    x_[i] = rest_x_[i];
+                    continue;
+                }
+                // x'_g = x_p + s (x_g - x_p) (section 4.3)
+                const double st = stiffness(static_cast<std::uint32_t>(i));
+                x_[i] = x_[i] + st * (goal[i] - x_[i]);
+                q_[i] = glm::normalize(glm::slerp(q_[i], glm::normalize(frames[i].R * rest_q_[i]), st));
             }
-            // x'_g = x_p + s (x_g - x_p) (section 4.3)
-            x_[i] = x_[i] + stiffness(i) * (goal[i] - x_[i]);
-            q_[i] = glm::normalize(glm::slerp(q_[i], glm::normalize(frames[i].R * rest_q_[i]), stiffness(i)));
-        }
+        });
         for (const auto& [i, target] : pulls_) x_[i] = target; // a dragged particle goes where it is dragged
     }
     // Eq. 17-18, with damping; then obstacles: a particle inside one is put back on its surface
