@@ -257,7 +257,8 @@ std::vector<glm::dvec3> World::goals() const {
 void World::step() {
     const double dt = settings_.dt;
     const std::size_t n = x_.size();
-    std::vector<glm::dvec3> old = x_;
+    std::vector<glm::dvec3>& old = scratch_.old;
+    old = x_;
     // Eq. 1: predicted positions (no fluid acceleration yet)
     for (std::size_t i = 0; i < n; ++i)
         if (alive_[i] && !fixed_[i]) x_[i] = x_[i] + v_[i] * dt + settings_.gravity * (dt * dt / 2);
@@ -273,10 +274,12 @@ void World::step() {
     }
     // shape matching on the predictions; small overlapping groups pass a correction on by one
     // particle per iteration, so a chain needs several to hold its shape
-    std::vector<Frame> frames;
-    std::vector<glm::dvec3> goal;
-    std::vector<double> weight;
-    std::vector<glm::dmat3> moments;
+    // scratch kept across steps: no allocation in a step, and each group's rotation is
+    // warm-started from the last pass, also the previous step's
+    auto& frames = scratch_.frames;
+    auto& goal = scratch_.goal;
+    auto& weight = scratch_.weight;
+    auto& moments = scratch_.moments;
     for (int it = 0; it < settings_.iterations; ++it) {
         match_shapes(frames, goal, weight, moments, settings_.rotation_iterations);
         parallel_ranges(n, settings_.threads, [&](std::size_t b, std::size_t e) {
@@ -289,7 +292,12 @@ void World::step() {
                 // x'_g = x_p + s (x_g - x_p) (section 4.3)
                 const double st = stiffness(static_cast<std::uint32_t>(i));
                 x_[i] = x_[i] + st * (goal[i] - x_[i]);
-                q_[i] = glm::normalize(glm::slerp(q_[i], glm::normalize(frames[i].R * rest_q_[i]), st));
+                // normalized linear blend toward the goal orientation, on the short arc: the
+                // steps are small, where it and slerp agree to second order, and it needs no
+                // trigonometry
+                glm::dquat target = glm::normalize(frames[i].R * rest_q_[i]);
+                if (glm::dot(q_[i], target) < 0) target = -target;
+                q_[i] = glm::normalize(q_[i] * (1.0 - st) + target * st);
             }
         });
         for (const auto& [i, target] : pulls_) x_[i] = target; // a dragged particle goes where it is dragged

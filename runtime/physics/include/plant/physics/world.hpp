@@ -183,6 +183,13 @@ private:
     std::vector<Obstacle> obstacles_;
     std::vector<std::pair<std::uint32_t, glm::dvec3>> pulls_;
     double break_threshold_ = 0;
+    struct Scratch {
+        std::vector<Frame> frames;
+        std::vector<glm::dvec3> goal;
+        std::vector<double> weight;
+        std::vector<glm::dmat3> moments;
+        std::vector<glm::dvec3> old;
+    } scratch_;
 };
 
 } // namespace plant::physics
