@@ -14,7 +14,6 @@ namespace plant::physics {
 namespace {
 
 constexpr double kFixedMass = 1e12; // "effectively infinite" inside group sums (PLANTS.md pitfall)
-constexpr std::uint32_t kNone = ~0u;
 
 glm::dmat3 outer(const glm::dvec3& a, const glm::dvec3& b) {
     // glm is column-major: column j is a * b[j]
@@ -141,9 +140,13 @@ double World::stiffness(std::uint32_t i) const {
     return std::clamp((0.2 + age_[i]) / settings_.stiffening_time, 0.0, 1.0);
 }
 
+double World::matching_mass(std::uint32_t j) const {
+    return fixed_[j] ? kFixedMass : m_[j];
+}
+
 glm::dmat3 World::ellipsoid_moment(std::uint32_t j) const {
     // Eq. 15's term for one member, written R D R̄ᵀ (PLANTS.md pitfall)
-    const double m = fixed_[j] ? kFixedMass : m_[j];
+    const double m = matching_mass(j);
     const glm::dvec3& r = radii_[j];
     glm::dmat3 D(0.0);
     D[0][0] = r.x * r.x, D[1][1] = r.y * r.y, D[2][2] = r.z * r.z;
@@ -155,7 +158,7 @@ World::Frame World::group_frame(std::uint32_t i, const glm::dquat& warm, const g
     double M = 0;
     glm::dvec3 c(0.0), rc(0.0);
     for_group(i, [&](std::uint32_t j) {
-        const double m = fixed_[j] ? kFixedMass : m_[j];
+        const double m = matching_mass(j);
         M += m;
         c += m * x_[j];
         rc += m * rest_x_[j];
@@ -166,7 +169,7 @@ World::Frame World::group_frame(std::uint32_t i, const glm::dquat& warm, const g
     // positions relative to the centers to keep the sums well conditioned
     glm::dmat3 A(0.0);
     for_group(i, [&](std::uint32_t j) {
-        const double m = fixed_[j] ? kFixedMass : m_[j];
+        const double m = matching_mass(j);
         A += moments ? moments[j] : ellipsoid_moment(j);
         A += m * outer(x_[j] - c, rest_x_[j] - rc);
     });
@@ -174,8 +177,7 @@ World::Frame World::group_frame(std::uint32_t i, const glm::dquat& warm, const g
 }
 
 glm::dquat World::group_rotation(std::uint32_t i) const {
-    // warm start: the particle's own rotation from rest
-    return group_frame(i, glm::normalize(q_[i] * glm::inverse(rest_q_[i])), nullptr, 20).R;
+    return group_frame(i, rotation_from_rest(i), nullptr, 20).R;
 }
 
 namespace {
@@ -198,13 +200,12 @@ template <class F> void parallel_ranges(std::size_t n, int threads, F&& f) {
 
 } // namespace
 
-void World::match_shapes(std::vector<Frame>& frames, std::vector<glm::dvec3>& goal, std::vector<double>& weight,
-                         std::vector<glm::dmat3>& moments, int iterations) const {
+void World::match_shapes(std::vector<Frame>& frames, std::vector<glm::dvec3>& goal, std::vector<glm::dmat3>& moments,
+                         int iterations) const {
     const std::size_t n = x_.size();
     frames.resize(n);
     moments.resize(n);
     goal.resize(n);
-    weight.resize(n);
     const int threads = settings_.threads;
     parallel_ranges(n, threads, [&](std::size_t b, std::size_t e) {
         for (std::size_t j = b; j < e; ++j)
@@ -216,9 +217,7 @@ void World::match_shapes(std::vector<Frame>& frames, std::vector<glm::dvec3>& go
             if (!alive_[i]) continue;
             // warm start from the last pass's rotation when there is one, else from the
             // particle's own rotation from rest
-            const glm::dquat warm =
-                frames[i].valid ? frames[i].R : glm::normalize(q_[i] * glm::inverse(rest_q_[i]));
-            frames[i] = group_frame(i, warm, moments.data(), iterations);
+            frames[i] = group_frame(i, frames[i].valid ? frames[i].R : rotation_from_rest(i), moments.data(), iterations);
         }
     });
     // Eq. 3: the target of particle j in group i is R_i (x̄_j - c̄_i) + c_i; Eq. 4: j's goal is
@@ -239,7 +238,6 @@ void World::match_shapes(std::vector<Frame>& frames, std::vector<glm::dvec3>& go
             add(j, m_[j]);
             if (parent_[j] != kNone) add(parent_[j], 2.0 * m_[j]);
             for (std::uint32_t c : children_[j]) add(c, 0.5 * m_[j]);
-            weight[j] = wsum;
             goal[j] = wsum > 0 ? sum / wsum : x_[j];
         }
     });
@@ -248,9 +246,8 @@ void World::match_shapes(std::vector<Frame>& frames, std::vector<glm::dvec3>& go
 std::vector<glm::dvec3> World::goals() const {
     std::vector<Frame> frames;
     std::vector<glm::dvec3> goal;
-    std::vector<double> weight;
     std::vector<glm::dmat3> moments;
-    match_shapes(frames, goal, weight, moments, 20);
+    match_shapes(frames, goal, moments, 20);
     return goal;
 }
 
@@ -273,15 +270,14 @@ void World::step() {
         ++k;
     }
     // shape matching on the predictions; small overlapping groups pass a correction on by one
-    // particle per iteration, so a chain needs several to hold its shape
-    // scratch kept across steps: no allocation in a step, and each group's rotation is
-    // warm-started from the last pass, also the previous step's
+    // particle per iteration, so a chain needs several to hold its shape. The scratch is kept
+    // across steps: no allocation in a step, and each group's rotation is warm-started from the
+    // last pass, also the previous step's.
     auto& frames = scratch_.frames;
     auto& goal = scratch_.goal;
-    auto& weight = scratch_.weight;
     auto& moments = scratch_.moments;
     for (int it = 0; it < settings_.iterations; ++it) {
-        match_shapes(frames, goal, weight, moments, settings_.rotation_iterations);
+        match_shapes(frames, goal, moments, settings_.rotation_iterations);
         parallel_ranges(n, settings_.threads, [&](std::size_t b, std::size_t e) {
             for (std::size_t i = b; i < e; ++i) {
                 if (!alive_[i]) continue;

@@ -144,26 +144,29 @@ public:
 private:
     // The shape-matching group of particle i: its parent, itself, its children.
     template <class F> void for_group(std::uint32_t i, F&& f) const {
-        if (parent_[i] != kNoParent) f(parent_[i]);
+        if (parent_[i] != kNone) f(parent_[i]);
         f(i);
         for (std::uint32_t c : children_[i]) f(c);
     }
-    static constexpr std::uint32_t kNoParent = ~0u;
+    static constexpr std::uint32_t kNone = ~0u; // no parent
+    // The particle's own rotation from rest: a warm start for its group's rotation.
+    glm::dquat rotation_from_rest(std::uint32_t i) const { return glm::normalize(q_[i] * glm::inverse(rest_q_[i])); }
     // A group's mass centers now and at rest, and its rotation (Eq. 14-15).
     struct Frame {
         glm::dvec3 c{0.0}, rc{0.0};
         glm::dquat R{1, 0, 0, 0};
         bool valid = false;
     };
+    // A particle's mass inside group sums: a fixed root's is effectively infinite.
+    double matching_mass(std::uint32_t j) const;
     glm::dmat3 ellipsoid_moment(std::uint32_t j) const;
     // `moments`: every particle's ellipsoid_moment, or null to compute them here.
     Frame group_frame(std::uint32_t i, const glm::dquat& warm, const glm::dmat3* moments, int iterations) const;
     // One shape-matching pass: every group's frame (warm-started from `frames`) and every
     // particle's goal (Eq. 3-4), with at most `iterations` rotation-extraction iterations per
-    // group; `weight` and `moments` are scratch.
-    void match_shapes(std::vector<Frame>& frames, std::vector<glm::dvec3>& goal, std::vector<double>& weight,
-                      std::vector<glm::dmat3>& moments, int iterations) const;
-    double group_mass(std::uint32_t i) const;
+    // group; `moments` is scratch.
+    void match_shapes(std::vector<Frame>& frames, std::vector<glm::dvec3>& goal, std::vector<glm::dmat3>& moments,
+                      int iterations) const;
     double stiffness(std::uint32_t i) const;
 
     Settings settings_;
@@ -186,7 +189,6 @@ private:
     struct Scratch {
         std::vector<Frame> frames;
         std::vector<glm::dvec3> goal;
-        std::vector<double> weight;
         std::vector<glm::dmat3> moments;
         std::vector<glm::dvec3> old;
     } scratch_;
