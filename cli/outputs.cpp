@@ -71,7 +71,7 @@ OutputSummary write_outputs(const Program& program, const Derivation& d, const s
     Scene scene;
     if (need_skeleton)
         skeleton = build_skeleton(program, d.interpreted(d.string()),
-                                  TurtleOptions{d.default_angle(), d.default_step(), d.default_width()});
+                                  turtle_options(d));
     if (need_scene) {
         MeshOptions mo;
         mo.sides = options.sides;

@@ -30,7 +30,7 @@ int main(int argc, char** argv) {
     o.steps = steps;
     Derivation d(*program, o);
     d.run();
-    Skeleton sk = build_skeleton(*program, d.interpreted(d.string()), TurtleOptions{});
+    Skeleton sk = build_skeleton(*program, d.interpreted(d.string()), turtle_options(d));
     std::size_t segments = 0;
     glm::dvec3 lo(1e300), hi(-1e300);
     for (const auto& a : sk.axes) {

@@ -33,7 +33,7 @@ int main(int argc, char** argv) {
     Derivation d(*program, o);
     d.run();
     Skeleton sk = build_skeleton(*program, d.interpreted(d.string()),
-                                 TurtleOptions{d.default_angle(), d.default_step(), d.default_width()});
+                                 turtle_options(d));
     MeshOptions mo;
     mo.sides = sides;
     double best = 1e300;

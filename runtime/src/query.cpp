@@ -67,8 +67,7 @@ void TurtleQueryPass::fill_queries(const Derivation& d, ModuleString& string) {
     std::optional<SkeletonBuilder> skeleton;
     if (!p.environments.empty()) skeleton.emplace(p, interpreted);
     BothSinks both(sink, skeleton ? &*skeleton : nullptr);
-    TurtleOptions o{d.default_angle(), d.default_step(), d.default_width()};
-    interpret(p, interpreted, o, both);
+    interpret(p, interpreted, turtle_options(d), both);
     if (skeleton) {
         Skeleton sk = skeleton->take();
         for (const auto& env : p.environments)

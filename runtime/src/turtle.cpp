@@ -2,6 +2,7 @@
 // frame (H, L, U with U = H x L), so that '+' turns H toward L, '&' pitches H toward -U and
 // '/' rolls L toward U.
 #include "plant/turtle.hpp"
+#include "plant/derive.hpp"
 
 #include <fmt/format.h>
 #include <glm/gtc/matrix_transform.hpp>
@@ -217,6 +218,10 @@ void interpret(const Program& program, const ModuleString& s, const TurtleOption
             }
         }
     }
+}
+
+TurtleOptions turtle_options(const Derivation& d) {
+    return {d.default_angle(), d.default_step(), d.default_width()};
 }
 
 } // namespace plant

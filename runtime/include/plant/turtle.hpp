@@ -64,6 +64,9 @@ struct TurtleOptions {
     double step = 1.0;   // the grammar's `step`
     double width = 0.1;  // the grammar's `width`
 };
+class Derivation;
+// The grammar's own `angle`, `step` and `width`, as the derivation read them.
+TurtleOptions turtle_options(const Derivation& d);
 
 // Interprets `s` (already passed through the interpretation rules). Throws RuntimeError for a
 // ']' without '[' (naming its place in the string) and for non-finite results.

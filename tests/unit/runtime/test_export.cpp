@@ -18,7 +18,7 @@ Scene scene_of(const std::string& grammar) {
     Derivation d(*c->program, {});
     d.run();
     Skeleton sk = build_skeleton(*c->program, d.interpreted(d.string()),
-                                 TurtleOptions{d.default_angle(), d.default_step(), d.default_width()});
+                                 turtle_options(d));
     return build_scene(*c->program, sk, MeshOptions{});
 }
 

@@ -24,7 +24,7 @@ Skeleton skeleton_of(const std::string& grammar, int steps) {
     Derivation d(*c->program, o);
     d.run();
     return build_skeleton(*c->program, d.interpreted(d.string()),
-                          TurtleOptions{d.default_angle(), d.default_step(), d.default_width()});
+                          turtle_options(d));
 }
 
 MeshPart tube_of(const SkeletonAxis& axis, const MeshOptions& o) {

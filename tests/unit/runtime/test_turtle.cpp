@@ -26,7 +26,7 @@ Recorder draw(const std::string& axiom, const std::string& head = "") {
     Derivation d(*c->program, {});
     d.run();
     Recorder r;
-    interpret(*c->program, d.string(), TurtleOptions{d.default_angle(), d.default_step(), d.default_width()}, r);
+    interpret(*c->program, d.string(), turtle_options(d), r);
     return r;
 }
 
