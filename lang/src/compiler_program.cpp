@@ -540,11 +540,16 @@ void Compiler::compile_surface(const ast::ShapeDecl& s) {
     def.name = s.name;
     def.kind = s.kind;
     def.span = s.span;
-    for (const auto& other : P_.surfaces) {
-        if (other.name == s.name) {
-            duplicate("surface", s.name, s.span, other.span);
+    // a surface in an importing file replaces the library's (libraries are compiled first), so a
+    // user swaps a default leaf for load("my_leaf.obj"); twice in one file is an error
+    std::size_t replace = P_.surfaces.size();
+    for (std::size_t i = 0; i < P_.surfaces.size(); ++i) {
+        if (P_.surfaces[i].name != s.name) continue;
+        if (P_.surfaces[i].span.file == s.span.file) {
+            duplicate("surface", s.name, s.span, P_.surfaces[i].span);
             return;
         }
+        replace = i;
     }
     if (s.kind == "polygon") {
         for (const auto& a : s.args) {
@@ -572,7 +577,8 @@ void Compiler::compile_surface(const ast::ShapeDecl& s) {
         diags_->error(s.kind_span, fmt::format("unknown surface kind '{}': expected polygon(...) or load(\"file\")", s.kind));
         return;
     }
-    P_.surfaces.push_back(std::move(def));
+    if (replace < P_.surfaces.size()) P_.surfaces[replace] = std::move(def);
+    else P_.surfaces.push_back(std::move(def));
 }
 
 // Splits an arrow-form body (argument code, Emit, argument code, Emit, ..., ProduceEnd) into a

@@ -113,6 +113,8 @@ public:
         static const std::vector<EnvMethod> m = {
             {"distance", {V, N}, N,
              "distance from p to the nearest segment of another stem than module id's (at most radius)"},
+            {"clearance", {N}, N,
+             "smallest distance from a node of module id's stem to an older stem (at most radius)"},
         };
         return m;
     }
@@ -120,11 +122,17 @@ public:
         segments_.clear();
         axis_of_.clear();
         base_.clear();
+        first_id_.clear();
+        nodes_.clear();
+        node_off_.assign(1, 0);
         lo_ = glm::dvec3(std::numeric_limits<double>::max());
         glm::dvec3 hi(-std::numeric_limits<double>::max());
         for (std::size_t a = 0; a < sk.axes.size(); ++a) {
             const auto& pts = sk.axes[a].points;
             base_.push_back(pts.empty() ? glm::dvec3(0.0) : pts[0].position);
+            first_id_.push_back(pts.size() > 1 ? pts[1].id : std::numeric_limits<ModuleId>::max());
+            for (std::size_t k = 1; k < pts.size(); ++k) nodes_.push_back(pts[k].position);
+            node_off_.push_back(static_cast<std::uint32_t>(nodes_.size()));
             for (std::size_t k = 0; k < pts.size(); ++k) {
                 if (pts[k].id) axis_of_[pts[k].id] = static_cast<int>(a);
                 lo_ = glm::min(lo_, pts[k].position);
@@ -162,34 +170,61 @@ public:
         for (std::uint32_t i = 0; i < segments_.size(); ++i)
             each_cell(segments_[i], [&](std::size_t c) { entries_[fill[c]++] = i; });
     }
-    void call(std::size_t, const double* a, double* r) const override {
-        const glm::dvec3 p = vec(a);
-        int own = -1;
-        if (a[3] > 0) {
-            auto it = axis_of_.find(static_cast<ModuleId>(a[3]));
-            if (it != axis_of_.end()) own = it->second;
+    void call(std::size_t method, const double* a, double* r) const override {
+        if (method == 0) {
+            r[0] = distance(vec(a), axis_of(a[3]), false);
+            return;
         }
-        const glm::dvec3 base = own >= 0 ? base_[static_cast<std::size_t>(own)] : glm::dvec3(0.0);
-        double best2 = radius_ * radius_;
-        if (dims_.x > 0) {
-            glm::ivec3 c = cell(p);
-            const int reach = 1; // cells are at least one radius wide
-            for (int z = std::max(0, c.z - reach); z <= std::min(dims_.z - 1, c.z + reach); ++z)
-                for (int y = std::max(0, c.y - reach); y <= std::min(dims_.y - 1, c.y + reach); ++y)
-                    for (int x = std::max(0, c.x - reach); x <= std::min(dims_.x - 1, c.x + reach); ++x) {
-                        const std::size_t k = index(x, y, z);
-                        for (std::uint32_t e = offsets_[k]; e < offsets_[k + 1]; ++e) {
-                            const Segment& s = segments_[entries_[e]];
-                            if (s.axis == own) continue;
-                            if (own >= 0 && (same(s.a, base) || same(s.b, base))) continue; // its branching point
-                            best2 = std::min(best2, distance2(p, s));
-                        }
-                    }
-        }
-        r[0] = std::sqrt(best2);
+        r[0] = clearance(axis_of(a[0]));
+    }
+    // ?E(space, distance, clearance): the asking stem is the axis the turtle was drawing there
+    // (a ?E module is not a segment, so its own identity names no stem).
+    void communicate(const glm::dvec3& p, ModuleId, int axis, double* slots, std::size_t n) const override {
+        if (axis >= static_cast<int>(base_.size())) axis = -1;
+        if (n > 0) slots[0] = distance(p, axis, false);
+        if (n > 1) slots[1] = clearance(axis);
     }
 
 private:
+    int axis_of(double id) const {
+        if (!(id > 0)) return -1;
+        auto it = axis_of_.find(static_cast<ModuleId>(id));
+        return it == axis_of_.end() ? -1 : it->second;
+    }
+    // Distance from p to the nearest segment of an axis other than `own`, skipping segments that
+    // touch own's branching point; with `older_only`, only axes whose first segment was drawn by
+    // a module with a smaller identity (made in an earlier step, or earlier in the string).
+    double distance(const glm::dvec3& p, int own, bool older_only) const {
+        const glm::dvec3 base = own >= 0 ? base_[static_cast<std::size_t>(own)] : glm::dvec3(0.0);
+        const ModuleId own_id = own >= 0 ? first_id_[static_cast<std::size_t>(own)] : 0;
+        double best2 = radius_ * radius_;
+        if (dims_.x == 0) return radius_;
+        glm::ivec3 c = cell(p);
+        const int reach = 1; // cells are at least one radius wide
+        for (int z = std::max(0, c.z - reach); z <= std::min(dims_.z - 1, c.z + reach); ++z)
+            for (int y = std::max(0, c.y - reach); y <= std::min(dims_.y - 1, c.y + reach); ++y)
+                for (int x = std::max(0, c.x - reach); x <= std::min(dims_.x - 1, c.x + reach); ++x) {
+                    const std::size_t k = index(x, y, z);
+                    for (std::uint32_t e = offsets_[k]; e < offsets_[k + 1]; ++e) {
+                        const Segment& s = segments_[entries_[e]];
+                        if (s.axis == own) continue;
+                        if (older_only && first_id_[static_cast<std::size_t>(s.axis)] >= own_id) continue;
+                        if (own >= 0 && (same(s.a, base) || same(s.b, base))) continue; // its branching point
+                        best2 = std::min(best2, distance2(p, s));
+                    }
+                }
+        return std::sqrt(best2);
+    }
+    // Umezawa & Mukai, Eq. 3, read sequentially: the smallest distance from a node of the stem
+    // (its branching point excluded) to a segment of an older stem. A new stem closer than
+    // delta_min to one is removed; younger stems answer for themselves.
+    double clearance(int own) const {
+        if (own < 0) return radius_;
+        double best = radius_;
+        for (std::uint32_t k = node_off_[static_cast<std::size_t>(own)]; k < node_off_[static_cast<std::size_t>(own) + 1]; ++k)
+            best = std::min(best, distance(nodes_[k], own, true));
+        return best;
+    }
     struct Segment {
         glm::dvec3 a, b;
         int axis;
@@ -223,6 +258,9 @@ private:
     std::vector<std::uint32_t> offsets_, entries_;
     std::unordered_map<ModuleId, int> axis_of_;
     std::vector<glm::dvec3> base_; // where each axis starts
+    std::vector<ModuleId> first_id_; // identity of the module that drew each axis's first segment
+    std::vector<glm::dvec3> nodes_;  // every axis's points after its first, axis after axis
+    std::vector<std::uint32_t> node_off_;
 };
 
 // ---- obstacles -----------------------------------------------------------------------------

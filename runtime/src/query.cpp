@@ -18,13 +18,17 @@ public:
     void query(std::size_t module, const TurtleState& t) override {
         const std::string& name = program_.symbols[string_.sym[module]].name;
         if (name == "?E") { // communication modules: answered after the environments see the plant
-            positions[string_.ids[module]] = t.position;
+            positions[string_.ids[module]] = Place{t.position, t.axis};
             return;
         }
         glm::dvec3 v = name == "?P" ? t.position : name == "?H" ? t.heading : name == "?U" ? t.up : t.left;
         found[string_.ids[module]] = v;
     }
-    std::unordered_map<ModuleId, glm::dvec3> positions;
+    struct Place {
+        glm::dvec3 position;
+        int axis;
+    };
+    std::unordered_map<ModuleId, Place> positions;
     std::unordered_map<ModuleId, glm::dvec3> found;
 
 private:
@@ -82,7 +86,7 @@ void TurtleQueryPass::fill_queries(const Derivation& d, ModuleString& string) {
         double* a = string.params.data() + string.poff[i];
         const auto env = static_cast<std::size_t>(a[0]);
         if (it == sink.positions.end() || a[0] < 0 || env >= p.environments.size() || !p.environments[env]) continue;
-        p.environments[env]->communicate(it->second, string.ids[i], a + 1, string.arity(i) - 1);
+        p.environments[env]->communicate(it->second.position, string.ids[i], it->second.axis, a + 1, string.arity(i) - 1);
     }
     for (std::size_t i = 0; i < string.size(); ++i) {
         if (!p.symbols[string.sym[i]].query || string.arity(i) != 3) continue;

@@ -44,8 +44,11 @@ public:
     virtual void call(std::size_t method, const double* args, double* result) const = 0;
 
     // Fills the slots of a ?E module at `position` with the answers of the methods that take
-    // the point (and, for a second number, the module's identity), in their order.
-    virtual void communicate(const glm::dvec3& position, ModuleId id, double* slots, std::size_t n) const {
+    // the point (and, for a second number, the module's identity), in their order. `axis` is the
+    // index of the axis the turtle was drawing at the module (-1 when none); environments that
+    // know axes (proximity) use it to tell which stem is asking.
+    virtual void communicate(const glm::dvec3& position, ModuleId id, int axis, double* slots, std::size_t n) const {
+        (void)axis;
         std::size_t slot = 0;
         const auto& ms = methods();
         for (std::size_t m = 0; m < ms.size() && slot < n; ++m) {

@@ -9,6 +9,10 @@
 //     space.distance(p, id)      distance from p to the nearest segment of another axis than the
 //                                one the module `id` belongs to (its branching point excluded);
 //                                `radius` when none is that close
+//     space.clearance(id)        smallest distance from a node of module id's stem (its first
+//                                point excluded) to an older stem, one whose first segment has
+//                                a smaller identity; `radius` when none is that close.
+//                                ?E(space, d, c) receives both for the stem it stands on
 //   env crown = envelope(top: ..., bottom: ..., px: ..., pz: ..., nx: ..., nz: ..., top_shape: 2);
 //     crown.contains(p), crown.level(p)   Cescatti's asymmetric crown
 //   env sun = light(direction: vec3(-1, 1, 0), resolution: 32, opacity: 0.3);
