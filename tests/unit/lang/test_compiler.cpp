@@ -107,3 +107,24 @@ TEST_CASE("types: vectors, members and mismatches", "[compiler]") {
     CHECK(!c->program);
     CHECK(messages(*c, Severity::Error)[0] == "operator '+' cannot be applied to vec3 and number");
 }
+
+TEST_CASE("a surface in an importing file replaces the library's, but twice in one file is an error", "[compiler]") {
+    CompileOptions opts;
+    opts.file_texts["/virtual/lib.plant"] = "surface leaf = polygon(vec3(0, 0, 0), vec3(1, 0, 0), vec3(0, 1, 0));";
+    SourceManager sources;
+    Diagnostics diags;
+    std::uint32_t id = sources.add("/virtual/main.plant",
+                                   "import \"lib.plant\";\n"
+                                   "surface leaf = polygon(vec3(0, 0, 0), vec3(2, 0, 0), vec3(2, 2, 0), vec3(0, 2, 0));\n"
+                                   "axiom: ~leaf(1);");
+    auto program = compile_source(sources, id, opts, diags);
+    INFO(render_all(diags, sources));
+    REQUIRE(program);
+    REQUIRE(program->surfaces.size() == 1);
+    CHECK(program->surfaces[0].points.size() == 4);
+
+    auto twice = test::compile("surface leaf = polygon(vec3(0, 0, 0), vec3(1, 0, 0), vec3(0, 1, 0));\n"
+                               "surface leaf = polygon(vec3(0, 0, 0), vec3(1, 0, 0), vec3(0, 1, 0));\naxiom: F;");
+    CHECK(!twice->program);
+    CHECK(twice->rendered().find("surface 'leaf'") != std::string::npos);
+}

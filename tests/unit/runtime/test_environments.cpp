@@ -78,6 +78,25 @@ TEST_CASE("proximity: distance to other stems, the asking stem and its branching
     CHECK(ask(*env, 0, {10, 10, 0, 0}) == Approx(1.5));
 }
 
+TEST_CASE("proximity: clearance of a stem from older stems only", "[environments]") {
+    // main stem (0,0)-(0,4); branch A from (0,1) and branch B from (0,1.5), both to x = -2
+    auto c = test::compile("axiom: F [ +(90) F(2) ] F(0.5) [ +(90) F(2) ] F(2.5);");
+    REQUIRE(c->program);
+    Derivation d(*c->program, {});
+    d.run();
+    Skeleton sk = build_skeleton(*c->program, d.string(), TurtleOptions{});
+    REQUIRE(sk.axes.size() == 3);
+    auto env = make("proximity", {num_arg("radius", 1.5)});
+    dynamic_cast<SkeletonEnvironment&>(*env).update(sk);
+    const double main_id = double(sk.axes[0].points[1].id), a_id = double(sk.axes[1].points[1].id),
+                 b_id = double(sk.axes[2].points[1].id);
+    REQUIRE(a_id < b_id);
+    CHECK(ask(*env, 1, {main_id}) == Approx(1.5)); // nothing is older than the main stem
+    CHECK(ask(*env, 1, {a_id}) == Approx(1.5));    // the main stem is 2 from A's tip; B is younger
+    CHECK(ask(*env, 1, {b_id}) == Approx(0.5));    // B's tip is 0.5 from the older A
+    CHECK(ask(*env, 1, {12345}) == Approx(1.5));   // an identity that drew nothing
+}
+
 TEST_CASE("obstacles: signed distances to spheres, boxes and planes", "[environments]") {
     auto e = make("obstacles", {vec_arg("sphere", 0, 0, 0), num_arg("sphere_radius", 1), vec_arg("box_min", 4, 0, 0),
                                 vec_arg("box_max", 6, 2, 2), vec_arg("plane_point", 0, -3, 0),
