@@ -424,6 +424,10 @@ ValueType Compiler::compile_env_call(Ctx& c, const ast::Expr& e, std::size_t env
         return ValueType::Number;
     }
     const EnvMethod& method = methods[m];
+    if (method.hook_only && c.kind != CtxKind::Hook)
+        diags_->error(e.span, fmt::format("'{}.{}' changes the environment and can be called only in hooks "
+                                          "(on start, on before_step, on after_step, on end)",
+                                          env_name, e.text));
     const std::size_t given = e.args.size() - 1;
     if (given != method.args.size()) {
         diags_->error(e.span, fmt::format("'{}.{}' takes {} argument{}, given {}", env_name, e.text, method.args.size(),

@@ -715,6 +715,19 @@ std::unique_ptr<Program> Compiler::compile(std::uint32_t main_file) {
     }
     for (const ast::ShapeDecl* s : P_.deferred.curves) compile_curve(*s); // before the code that calls them
     for (const ast::ShapeDecl* s : P_.deferred.envs) compile_environment(*s);
+    // `module Seg(len, r) bound ivy;` needs ivy to be a climber
+    for (const auto& info : P_.symbols.all()) {
+        if (info.bound_to.empty()) continue;
+        auto it = env_names_.find(info.bound_to);
+        if (it == env_names_.end())
+            diags_->error(info.decl_span, fmt::format("module '{}' is bound to '{}', which is not an environment; "
+                                                      "declare it first, as in env {} = climber(...);",
+                                                      info.name, info.bound_to, info.bound_to));
+        else if (it->second != "climber")
+            diags_->error(info.decl_span, fmt::format("module '{}' is bound to '{}', a {} environment; only a climber "
+                                                      "can hold segments",
+                                                      info.name, info.bound_to, it->second));
+    }
     for (std::uint32_t i = 0; i < P_.functions.size(); ++i) ensure_function_compiled(i);
     for (const ast::ShapeDecl* s : P_.deferred.surfaces) compile_surface(*s);
     for (const auto& lf : order_) {

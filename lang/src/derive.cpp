@@ -7,6 +7,7 @@
 // by prefix sums. Random draws are keyed by the module's position in the old string and new
 // identities are numbered in string order, so the result is the same for any number of threads.
 #include "plant/derive.hpp"
+#include "plant/environment.hpp"
 
 #include "plant/random.hpp"
 #include "plant/vm.hpp"
@@ -349,6 +350,8 @@ void Derivation::run_hook(HookKind kind) {
 }
 
 void Derivation::start() {
+    for (const auto& env : prog_.environments)
+        if (env) env->reset();
     EvalEnv env;
     env.prog = &prog_;
     env.globals = globals_.data();

@@ -2,6 +2,8 @@
 // skeleton's segments) and obstacles (signed distances to boxes, spheres and planes).
 #include "plant/environments.hpp"
 
+#include "plant/climber.hpp"
+
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #include <OpenMesh/Core/IO/MeshIO.hh>
@@ -632,8 +634,9 @@ EnvironmentFactory runtime_environments() {
             }
             return std::make_unique<Light>(dir, resolution, opacity);
         }
-        error = fmt::format("unknown environment kind '{}': this version has ellipsoid, envelope, proximity, light "
-                            "and obstacles",
+        if (kind == "climber") return make_climber(args, error);
+        error = fmt::format("unknown environment kind '{}': this version has ellipsoid, envelope, proximity, light, "
+                            "obstacles and climber",
                             kind);
         return nullptr;
     };

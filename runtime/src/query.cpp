@@ -1,10 +1,12 @@
 #include "plant/query.hpp"
 
+#include "plant/climber.hpp"
 #include "plant/environments.hpp"
 #include "plant/skeleton.hpp"
 #include "plant/turtle.hpp"
 
 #include <optional>
+#include <set>
 
 #include <unordered_map>
 
@@ -36,6 +38,77 @@ private:
     const ModuleString& string_;
 };
 
+// Shows each climber the segments of the modules bound to it, in string order.
+class ClimberSink : public TurtleSink {
+public:
+    ClimberSink(const ModuleString& s, const std::vector<Climber*>& by_symbol) : string_(s), by_symbol_(by_symbol) {}
+    void segment(const TurtleSegment& seg) override {
+        const SymbolId sym = string_.sym[seg.module];
+        Climber* c = sym < by_symbol_.size() ? by_symbol_[sym] : nullptr;
+        if (!c) return;
+        const TurtleState& t = *seg.state;
+        const double len = string_.arity(seg.module) > 0 ? string_.args(seg.module)[0] : t.step;
+        c->observe(seg.id, t.bound_parent, seg.from, seg.to, glm::dmat3(-t.left, t.heading, t.up), t.width / 2, len);
+    }
+
+private:
+    const ModuleString& string_;
+    const std::vector<Climber*>& by_symbol_;
+};
+
+// Removes each module in `ids` and the rest of its branch (the ']' stays), as '%' would.
+void cut_modules(ModuleString& s, const Program& p, const std::set<ModuleId>& ids) {
+    const SymbolId open = p.symbols.open_bracket, close = p.symbols.close_bracket;
+    ModuleString out;
+    std::size_t i = 0;
+    while (i < s.size()) {
+        if (!ids.count(s.ids[i])) {
+            out.append_range(s, i, i + 1);
+            ++i;
+            continue;
+        }
+        int depth = 0;
+        ++i;
+        while (i < s.size()) {
+            if (s.sym[i] == open) ++depth;
+            else if (s.sym[i] == close) {
+                if (depth == 0) break;
+                --depth;
+            }
+            ++i;
+        }
+    }
+    s.swap(out);
+}
+
+// The climbers' part of a step (climber.hpp): place new bound modules' particles, run the
+// physics, and cut what broke off out of the string.
+void advance_climbers(const Derivation& d, ModuleString& string) {
+    const Program& p = d.program();
+    std::vector<Climber*> by_symbol(p.symbols.size(), nullptr);
+    std::vector<Climber*> climbers;
+    for (std::size_t k = 0; k < p.symbols.size(); ++k) {
+        const std::string& env = p.symbols.all()[k].bound_to;
+        if (env.empty()) continue;
+        for (std::size_t e = 0; e < p.environments.size(); ++e)
+            if (p.environment_names[e] == env)
+                if (auto* c = dynamic_cast<Climber*>(p.environments[e].get())) by_symbol[k] = c;
+    }
+    for (const auto& env : p.environments)
+        if (auto* c = dynamic_cast<Climber*>(env.get())) climbers.push_back(c);
+    if (climbers.empty()) return;
+    ModuleString interpreted = d.interpreted(string);
+    for (Climber* c : climbers) c->begin_sync();
+    ClimberSink sink(interpreted, by_symbol);
+    interpret(p, interpreted, turtle_options(d), sink);
+    std::set<ModuleId> gone;
+    for (Climber* c : climbers) {
+        c->advance();
+        gone.insert(c->detached().begin(), c->detached().end());
+    }
+    if (!gone.empty()) cut_modules(string, p, gone);
+}
+
 } // namespace
 
 // Feeds one turtle pass to the query sink and, when environments want the plant, a skeleton.
@@ -66,6 +139,7 @@ private:
 
 void TurtleQueryPass::fill_queries(const Derivation& d, ModuleString& string) {
     const Program& p = d.program();
+    advance_climbers(d, string);
     ModuleString interpreted = d.interpreted(string);
     QuerySink sink(p, interpreted);
     std::optional<SkeletonBuilder> skeleton;

@@ -3,6 +3,7 @@
 // '/' rolls L toward U.
 #include "plant/turtle.hpp"
 #include "plant/derive.hpp"
+#include "plant/environment.hpp"
 
 #include <fmt/format.h>
 #include <glm/gtc/matrix_transform.hpp>
@@ -132,9 +133,41 @@ void interpret(const Program& program, const ModuleString& s, const TurtleOption
         orthonormalize(t);
     };
 
+    // modules bound to a climber: drawn like F, ending where their particle is
+    std::vector<char> bound(program.symbols.size(), 0);
+    for (std::size_t k = 0; k < bound.size(); ++k) bound[k] = !program.symbols.all()[k].bound_to.empty();
+
     for (std::size_t i = 0; i < s.size(); ++i) {
         const SymbolId sym = s.sym[i];
-        if (sym == y.F || sym == y.G) {
+        if (sym < bound.size() && bound[sym]) {
+            // Seg(len, r): length and radius; with a particle, the segment ends at its position
+            double len = arg(i, 0, t.step);
+            if (s.arity(i) > 1) t.width = 2 * s.args(i)[1];
+            if (t.axis < 0) {
+                t.axis = next_axis++;
+                sink.axis_begin(t.axis, parent_axis, t);
+            }
+            glm::dvec3 from = t.position;
+            glm::dvec3 p;
+            glm::dmat3 frame;
+            bool placed = false;
+            for (const BoundPoses* bp : options.poses)
+                if (bp && bp->pose(s.ids[i], p, frame)) {
+                    placed = true;
+                    break;
+                }
+            if (placed) {
+                t.position = p;
+                t.heading = frame[1];
+                t.left = -frame[0];
+                t.up = frame[2];
+            } else {
+                t.position += t.heading * len;
+            }
+            check(i);
+            sink.segment(TurtleSegment{from, t.position, &t, i, s.ids[i]});
+            t.bound_parent = s.ids[i];
+        } else if (sym == y.F || sym == y.G) {
             double len = arg(i, 0, t.step);
             if (s.arity(i) > 1) t.width = s.args(i)[1];
             if (t.axis < 0) {
@@ -221,7 +254,10 @@ void interpret(const Program& program, const ModuleString& s, const TurtleOption
 }
 
 TurtleOptions turtle_options(const Derivation& d) {
-    return {d.default_angle(), d.default_step(), d.default_width()};
+    TurtleOptions o{d.default_angle(), d.default_step(), d.default_width(), {}};
+    for (const auto& env : d.program().environments)
+        if (const auto* p = dynamic_cast<const BoundPoses*>(env.get())) o.poses.push_back(p);
+    return o;
 }
 
 } // namespace plant

@@ -32,12 +32,18 @@ struct EnvMethod {
     const char* doc = "";
     // Answers ?E(env, slots...) modules: methods taking (p) or (p, id) fill the slots in order.
     bool communicates = true;
+    // Changes the environment (pulling a branch, cutting one, switching wind): callable only from
+    // hooks, which run on one thread between steps.
+    bool hook_only = false;
 };
 
 class Environment {
 public:
     virtual ~Environment() = default;
     virtual const std::vector<EnvMethod>& methods() const = 0;
+    // Back to the state it was declared with: a derivation starting again (the REPL's :set, a
+    // second run of one compiled program) must not see the last one's plant.
+    virtual void reset() {}
     // Answers a query. `args` holds the arguments' numbers (three for a vec3), `result` receives
     // up to three. Called from many threads at once while a step is rewritten: it must not
     // change the object.

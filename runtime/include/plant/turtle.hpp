@@ -27,6 +27,7 @@ struct TurtleState {
     glm::dvec3 tropism{0.0, -1.0, 0.0}; // @Tp
     double elasticity = 0.0;           // @Ts; 0: no tropism
     int axis = -1;                     // axis being drawn, -1 when the next F starts a new one
+    ModuleId bound_parent = 0;         // the last module bound to a climber on this path (0: none)
 };
 
 // A drawn segment: from the state before an F to the state after it.
@@ -59,13 +60,24 @@ public:
     virtual void query(std::size_t /*module*/, const TurtleState&) {}
 };
 
+// Where a physics environment holds the segments of modules bound to it (`module Seg(len, r)
+// bound ivy;`): the turtle draws such a module's segment from where it stands to the particle's
+// position and takes the particle's frame. A module without a particle yet is drawn like F(len).
+class BoundPoses {
+public:
+    virtual ~BoundPoses() = default;
+    // The particle of module `id`: its position and its frame (+y heading, -x left, +z up).
+    virtual bool pose(ModuleId id, glm::dvec3& position, glm::dmat3& frame) const = 0;
+};
+
 struct TurtleOptions {
     double angle = 90.0; // the grammar's `angle`
     double step = 1.0;   // the grammar's `step`
     double width = 0.1;  // the grammar's `width`
+    std::vector<const BoundPoses*> poses; // the program's climbers: poses of bound modules
 };
 class Derivation;
-// The grammar's own `angle`, `step` and `width`, as the derivation read them.
+// The grammar's own `angle`, `step` and `width`, as the derivation read them, and its climbers.
 TurtleOptions turtle_options(const Derivation& d);
 
 // Interprets `s` (already passed through the interpretation rules). Throws RuntimeError for a

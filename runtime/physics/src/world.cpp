@@ -130,6 +130,46 @@ Handle World::add_particle(Handle parent, const glm::dvec3& position, const glm:
     return h;
 }
 
+Handle World::add_grown(Handle parent, const glm::dvec3& position_in, const glm::dquat& orientation_in,
+                        const glm::dvec3& radii) {
+    const glm::dvec3 position = position_in;
+    const glm::dquat orientation = orientation_in;
+    Handle h = add_particle(parent, position, orientation, radii);
+    // Hädrich et al., Eq. 9-10: growth enters the rest state too. The turn taking the parent's
+    // current frame to its rest frame carries the new particle's offset and orientation over.
+    const std::uint32_t p = parent.index, i = h.index;
+    const glm::dquat back = glm::normalize(rest_q_[p] * glm::inverse(q_[p]));
+    rest_x_[i] = rest_x_[p] + back * (position - x_[p]);
+    rest_q_[i] = glm::normalize(back * orientation);
+    return h;
+}
+
+void World::remove(Handle h) {
+    if (!alive(h)) return;
+    std::vector<std::uint32_t> todo{h.index};
+    if (parent_[h.index] != kNone) {
+        auto& siblings = children_[parent_[h.index]];
+        siblings.erase(std::remove(siblings.begin(), siblings.end(), h.index), siblings.end());
+        parent_[h.index] = kNone;
+    }
+    while (!todo.empty()) {
+        std::uint32_t i = todo.back();
+        todo.pop_back();
+        alive_[i] = 0;
+        ++generation_[i];
+        for (std::uint32_t c : children_[i]) todo.push_back(c);
+        children_[i].clear();
+    }
+    std::erase_if(anchors_, [&](const Anchor& a) { return !alive_[a.particle]; });
+}
+
+bool World::attached(Handle h) const {
+    if (!alive(h)) return false;
+    std::uint32_t i = h.index;
+    while (parent_[i] != kNone) i = parent_[i];
+    return fixed_[i] != 0;
+}
+
 bool World::alive(Handle h) const {
     return h.index < x_.size() && generation_[h.index] == h.generation && alive_[h.index];
 }
@@ -256,9 +296,9 @@ void World::step() {
     const std::size_t n = x_.size();
     std::vector<glm::dvec3>& old = scratch_.old;
     old = x_;
-    // Eq. 1: predicted positions (no fluid acceleration yet)
+    // Eq. 1: predicted positions; a_e is the steady wind (SPH is not coupled yet)
     for (std::size_t i = 0; i < n; ++i)
-        if (alive_[i] && !fixed_[i]) x_[i] = x_[i] + v_[i] * dt + settings_.gravity * (dt * dt / 2);
+        if (alive_[i] && !fixed_[i]) x_[i] = x_[i] + v_[i] * dt + (settings_.gravity + wind_) * (dt * dt / 2);
     // Eq. 5: anchors pull their particles in; one too far away lets go
     for (std::size_t k = 0; k < anchors_.size();) {
         Anchor& a = anchors_[k];

@@ -96,6 +96,18 @@ public:
     // integrate (Eq. 17-20), damp, break overstretched connections.
     void step();
 
+    // A particle placed next to a parent that may have moved or bent since it was made: its rest
+    // state is taken relative to the parent's rest state as its current state is to the parent's
+    // current state, so growth becomes part of the shape the plant returns to (Eq. 9-10).
+    Handle add_grown(Handle parent, const glm::dvec3& position, const glm::dquat& orientation, const glm::dvec3& radii);
+    // Removes h and everything attached below it (cutting a branch).
+    void remove(Handle h);
+    // Whether h still hangs from a fixed root (false once its branch broke off or was cut).
+    bool attached(Handle h) const;
+    // External acceleration a_e of Eq. 1 on every free particle (a steady wind).
+    void set_wind(const glm::dvec3& a) { wind_ = a; }
+    const std::vector<Obstacle>& obstacles() const { return obstacles_; }
+
     // Apical growth: every apex (a particle without children) lengthens; each segment_length a
     // new particle continues it, turned by surface adaption and phototropism (Eq. 6-8), and with
     // probability BP a lateral bud starts beside it, turned by up to V * 90 degrees. Random draws
@@ -125,6 +137,7 @@ public:
     double mass(Handle h) const { return m_[h.index]; }
     std::size_t size() const { return x_.size(); }
     Settings& settings() { return settings_; }
+    const Settings& settings() const { return settings_; }
 
     // Moves a particle (tests); its rest state stays.
     void set_position(Handle h, const glm::dvec3& p) { x_[h.index] = p; }
@@ -186,6 +199,7 @@ private:
     std::vector<Obstacle> obstacles_;
     std::vector<std::pair<std::uint32_t, glm::dvec3>> pulls_;
     double break_threshold_ = 0;
+    glm::dvec3 wind_{0.0};
     struct Scratch {
         std::vector<Frame> frames;
         std::vector<glm::dvec3> goal;

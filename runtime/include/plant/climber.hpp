@@ -1,0 +1,114 @@
+// The `climber` environment: the particle runtime (runtime/physics/) behind a grammar
+// (LANGUAGE.md sections 8 and 10; Hädrich et al. 2017).
+//
+//   env ivy = climber(gravity: vec3(0, -9.81, 0), substeps: 4, stiffness: 1, break_threshold: 0.5,
+//                     light: vec3(-1, 1, 0), phototropism: 0.5, adaption: 0.5, anchor: 0.3,
+//                     box_min: ..., box_max: ..., attractor: vec3(...), attractor_radius: 0.3);
+//   module Seg(len, r) bound ivy;
+//
+// Before every step the string is drawn once by the turtle: each bound module without a particle
+// gets one where the turtle put its segment's end, child of the particle of the bound module
+// before it on its path (a plant's first one hangs from a fixed root at its segment's start).
+// Particles whose modules left the string are removed. Then the world runs `substeps` steps of
+// 25 ms. A part that broke off (or was cut) leaves the string, from its first module to the end
+// of its branch. Every turtle pass (queries, skeleton, meshes) draws bound modules at their
+// particles.
+//
+// Methods: grow_dir(p, h) (h turned by surface adaption, Eq. 6, by painted attractors and by
+// phototropism weighted by occlusion, Eq. 7), occlusion(p), anchored(id), particles(); in hooks
+// only: pull(id, target), cut(id), wind(a).
+#pragma once
+
+#include "plant/environment.hpp"
+#include "plant/physics/world.hpp"
+#include "plant/turtle.hpp"
+
+#include <glm/glm.hpp>
+
+#include <map>
+#include <optional>
+#include <memory>
+#include <set>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace plant {
+
+class Climber : public Environment, public BoundPoses {
+public:
+    struct Attractor {
+        glm::dvec3 point;
+        double radius, strength;
+    };
+    struct Config {
+        int substeps = 4;           // physics steps of dt per derivation step
+        glm::dvec3 light{0, 1, 0};  // toward the light
+        double phototropism = 0;    // eta, Eq. 7
+        double adaption = 0.5;      // tau, Eq. 6
+        double adaption_range = 0.3;
+        double response = 10;       // growth responses act over substeps * dt * response seconds
+        double anchor = 0;          // phi of Eq. 5 for new particles near a surface (0: no anchors)
+        double anchor_range = 0.05; // how near (beyond the particle's radius)
+        double anchor_release = 0.3;
+        double light_cell = 0.1;    // occupancy grid for occlusion
+        double opacity = 0.15;      // occlusion 1 - exp(-opacity * particles between p and the light)
+        std::vector<Attractor> attractors;
+    };
+
+    Climber(physics::Settings settings, Config config) : world_(settings), config_(std::move(config)) {}
+    // Keeps the world as it is now (settings and obstacles) for reset().
+    void remember_initial() { initial_ = world_; }
+    void reset() override;
+
+    // Environment
+    const std::vector<EnvMethod>& methods() const override;
+    void call(std::size_t method, const double* args, double* result) const override;
+    // BoundPoses
+    bool pose(ModuleId id, glm::dvec3& position, glm::dmat3& frame) const override;
+
+    // The step's sync, driven by the query pass: begin, observe every bound module the turtle
+    // drew (in string order), advance.
+    void begin_sync();
+    void observe(ModuleId id, ModuleId parent, const glm::dvec3& from, const glm::dvec3& to, const glm::dmat3& frame,
+                 double radius, double length);
+    void advance();
+    // Modules whose particles broke off or were cut in the last advance.
+    const std::set<ModuleId>& detached() const { return detached_; }
+
+    physics::World& world() { return world_; }
+    const physics::World& world() const { return world_; }
+    physics::Handle particle(ModuleId id) const;
+
+private:
+    double occlusion(const glm::dvec3& p) const;
+    glm::dvec3 grow_dir(const glm::dvec3& p, const glm::dvec3& h) const;
+    void rebuild_occupancy();
+
+    physics::World world_, initial_;
+    Config config_;
+    std::map<ModuleId, physics::Handle> particle_of_; // ordered: removals happen in id order
+    std::set<ModuleId> seen_, detached_;
+    struct Pending {
+        ModuleId id, parent;
+        glm::dvec3 from, to;
+        glm::dmat3 frame;
+        double radius, length;
+    };
+    std::vector<Pending> pending_;
+    // edits asked for by hooks (call() is const: hooks are the only callers, one at a time)
+    mutable std::vector<std::pair<ModuleId, glm::dvec3>> pulls_;
+    mutable std::vector<ModuleId> cuts_;
+    mutable glm::dvec3 wind_{0.0};
+    mutable bool wind_changed_ = false;
+    // occupancy grid of particles for occlusion
+    glm::dvec3 grid_lo_{0.0};
+    double grid_cell_ = 0.1;
+    glm::ivec3 grid_n_{0};
+    std::vector<std::uint32_t> grid_;
+};
+
+// Makes a climber from `env name = climber(key: value, ...)`; null and a message on bad input.
+std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::string& error);
+
+} // namespace plant

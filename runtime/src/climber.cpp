@@ -1,0 +1,386 @@
+// The climber environment: a physics::World driven by the grammar's bound modules.
+#include "plant/climber.hpp"
+
+#include <fmt/format.h>
+#include <glm/gtc/quaternion.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace plant {
+
+namespace {
+
+constexpr ValueType N = ValueType::Number;
+constexpr ValueType V = ValueType::Vec3;
+
+glm::dvec3 vec(const double* a) { return {a[0], a[1], a[2]}; }
+
+// The frame's columns are the particle's axes: x = -left, y = heading, z = up.
+glm::dquat quat_of(const glm::dmat3& frame) { return glm::normalize(glm::quat_cast(frame)); }
+
+} // namespace
+
+const std::vector<EnvMethod>& Climber::methods() const {
+    static const std::vector<EnvMethod> m = [] {
+        std::vector<EnvMethod> v = {
+            {"grow_dir", {V, V}, V,
+             "heading h at p turned by surface adaption (Eq. 6), attractors and phototropism (Eq. 7)", false},
+            {"occlusion", {V}, N, "light occlusion at p by the plant's particles, 0 to 1", true},
+            {"anchored", {N}, N, "1 when module id's particle is anchored to a surface", false},
+            {"particles", {}, N, "particles in the world", false},
+            {"pull", {N, V}, N, "hold module id's particle at a point through the next step's physics", false},
+            {"cut", {N}, N, "cut the branch at module id: it leaves the string", false},
+            {"wind", {V}, N, "set the steady wind acceleration (vec3(0, 0, 0): off)", false},
+        };
+        for (std::size_t k = 4; k < v.size(); ++k) v[k].hook_only = true;
+        return v;
+    }();
+    return m;
+}
+
+physics::Handle Climber::particle(ModuleId id) const {
+    auto it = particle_of_.find(id);
+    return it == particle_of_.end() ? physics::Handle{} : it->second;
+}
+
+void Climber::call(std::size_t method, const double* a, double* r) const {
+    switch (method) {
+    case 0: {
+        glm::dvec3 g = grow_dir(vec(a), vec(a + 3));
+        r[0] = g.x, r[1] = g.y, r[2] = g.z;
+        return;
+    }
+    case 1: r[0] = occlusion(vec(a)); return;
+    case 2: {
+        physics::Handle h = particle(static_cast<ModuleId>(a[0]));
+        r[0] = h.valid() && world_.alive(h) && world_.anchored(h) ? 1 : 0;
+        return;
+    }
+    case 3: r[0] = static_cast<double>(particle_of_.size()); return;
+    case 4: pulls_.emplace_back(static_cast<ModuleId>(a[0]), vec(a + 1)); return;
+    case 5: cuts_.push_back(static_cast<ModuleId>(a[0])); return;
+    case 6:
+        wind_ = vec(a);
+        wind_changed_ = true;
+        return;
+    default: r[0] = 0;
+    }
+}
+
+bool Climber::pose(ModuleId id, glm::dvec3& position, glm::dmat3& frame) const {
+    physics::Handle h = particle(id);
+    if (!h.valid() || !world_.alive(h)) return false;
+    position = world_.position(h);
+    frame = glm::mat3_cast(world_.orientation(h));
+    return true;
+}
+
+void Climber::reset() {
+    world_ = initial_;
+    particle_of_.clear();
+    seen_.clear();
+    detached_.clear();
+    pending_.clear();
+    pulls_.clear();
+    cuts_.clear();
+    wind_changed_ = false;
+    grid_.clear();
+    grid_n_ = glm::ivec3(0);
+}
+
+void Climber::begin_sync() {
+    seen_.clear();
+    pending_.clear();
+}
+
+void Climber::observe(ModuleId id, ModuleId parent, const glm::dvec3& from, const glm::dvec3& to,
+                      const glm::dmat3& frame, double radius, double length) {
+    if (particle_of_.count(id)) {
+        seen_.insert(id);
+        return;
+    }
+    pending_.push_back(Pending{id, parent, from, to, frame, radius, length});
+}
+
+void Climber::advance() {
+    // particles whose modules the grammar removed go too
+    for (auto it = particle_of_.begin(); it != particle_of_.end();) {
+        if (seen_.count(it->first)) {
+            ++it;
+            continue;
+        }
+        world_.remove(it->second);
+        it = particle_of_.erase(it);
+    }
+    // new bound modules become particles where the turtle drew them
+    for (const Pending& p : pending_) {
+        const double r = std::max(p.radius, 1e-4);
+        const glm::dvec3 radii(r, std::max(p.length / 2, r), r);
+        const glm::dquat q = quat_of(p.frame);
+        physics::Handle parent = particle(p.parent);
+        if (!parent.valid() || !world_.alive(parent)) parent = world_.add_root(p.from, q, radii, true);
+        physics::Handle h = world_.add_grown(parent, p.to, q, radii);
+        particle_of_[p.id] = h;
+        // Eq. 5: a particle born near a surface holds on to it
+        if (config_.anchor > 0) {
+            const physics::Obstacle* nearest = nullptr;
+            double best = r + config_.anchor_range;
+            for (const auto& o : world_.obstacles()) {
+                double d = o.distance(p.to);
+                if (d < best) best = d, nearest = &o;
+            }
+            if (nearest) {
+                glm::dvec3 n = nearest->normal(p.to);
+                glm::dvec3 point = p.to - n * (nearest->distance(p.to) - r);
+                world_.add_anchor(h, point, config_.anchor, config_.anchor_release);
+            }
+        }
+    }
+    pending_.clear();
+    // edits from hooks
+    detached_.clear();
+    for (ModuleId id : cuts_) {
+        physics::Handle h = particle(id);
+        if (h.valid() && world_.alive(h)) world_.remove(h);
+    }
+    cuts_.clear();
+    if (wind_changed_) world_.set_wind(wind_), wind_changed_ = false;
+    for (int k = 0; k < config_.substeps; ++k) {
+        for (const auto& [id, target] : pulls_) {
+            physics::Handle h = particle(id);
+            if (h.valid() && world_.alive(h)) world_.pull(h, target);
+        }
+        world_.step();
+    }
+    pulls_.clear();
+    // broken-off and cut parts leave the string (and the world)
+    for (auto it = particle_of_.begin(); it != particle_of_.end();) {
+        if (world_.attached(it->second)) {
+            ++it;
+            continue;
+        }
+        detached_.insert(it->first);
+        it = particle_of_.erase(it);
+    }
+    rebuild_occupancy();
+}
+
+void Climber::rebuild_occupancy() {
+    grid_.clear();
+    grid_n_ = glm::ivec3(0);
+    if (particle_of_.empty()) return;
+    glm::dvec3 lo(1e300), hi(-1e300);
+    for (const auto& [id, h] : particle_of_) {
+        lo = glm::min(lo, world_.position(h));
+        hi = glm::max(hi, world_.position(h));
+    }
+    double cell = config_.light_cell;
+    glm::dvec3 n = glm::floor((hi - lo) / cell) + 1.0;
+    while (n.x * n.y * n.z > 4e6) {
+        cell *= 2;
+        n = glm::floor((hi - lo) / cell) + 1.0;
+    }
+    grid_cell_ = cell;
+    grid_lo_ = lo;
+    grid_n_ = glm::ivec3(n);
+    grid_.assign(static_cast<std::size_t>(grid_n_.x) * grid_n_.y * grid_n_.z, 0);
+    for (const auto& [id, h] : particle_of_) {
+        glm::ivec3 c = glm::ivec3(glm::floor((world_.position(h) - lo) / cell));
+        c = glm::clamp(c, glm::ivec3(0), grid_n_ - 1);
+        ++grid_[(static_cast<std::size_t>(c.z) * grid_n_.y + c.y) * grid_n_.x + c.x];
+    }
+}
+
+double Climber::occlusion(const glm::dvec3& p) const {
+    // particles in the cells between p and the light (Eq. 7's O), its own cell excluded
+    if (grid_.empty()) return 0;
+    const glm::dvec3 dir = glm::normalize(config_.light);
+    const double cell = grid_cell_;
+    glm::dvec3 q = p;
+    glm::ivec3 own = glm::ivec3(glm::floor((p - grid_lo_) / cell));
+    double count = 0;
+    glm::ivec3 last = own;
+    const glm::dvec3 extent = glm::dvec3(grid_n_) * cell;
+    for (int k = 0; k < 4 * (grid_n_.x + grid_n_.y + grid_n_.z); ++k) {
+        q += dir * (cell * 0.5);
+        glm::dvec3 rel = q - grid_lo_;
+        if (rel.x < 0 || rel.y < 0 || rel.z < 0 || rel.x >= extent.x || rel.y >= extent.y || rel.z >= extent.z) {
+            // outside the grid: nothing more in the way once moving away from it
+            bool leaving = (rel.x < 0 && dir.x <= 0) || (rel.y < 0 && dir.y <= 0) || (rel.z < 0 && dir.z <= 0) ||
+                           (rel.x >= extent.x && dir.x >= 0) || (rel.y >= extent.y && dir.y >= 0) ||
+                           (rel.z >= extent.z && dir.z >= 0);
+            if (leaving) break;
+            continue;
+        }
+        glm::ivec3 c = glm::ivec3(glm::floor(rel / cell));
+        if (c == own || c == last) continue;
+        last = c;
+        count += grid_[(static_cast<std::size_t>(c.z) * grid_n_.y + c.y) * grid_n_.x + c.x];
+    }
+    return 1.0 - std::exp(-config_.opacity * count);
+}
+
+glm::dvec3 Climber::grow_dir(const glm::dvec3& p, const glm::dvec3& h) const {
+    const double time = config_.substeps * world_.settings().dt * config_.response;
+    glm::dvec3 f = glm::length(h) > 0 ? glm::normalize(h) : glm::dvec3(0, 1, 0);
+    // Eq. 6: parallel to the nearest surface in range
+    if (config_.adaption > 0) {
+        const physics::Obstacle* nearest = nullptr;
+        double best = config_.adaption_range;
+        for (const auto& o : world_.obstacles()) {
+            double d = o.distance(p);
+            if (d < best) best = d, nearest = &o;
+        }
+        if (nearest) {
+            // section 4.2: a plant searches for a support nearby and grows toward it (stronger the
+            // farther it is within range), then turns parallel to it (Eq. 6)
+            const glm::dvec3 to_surface = -nearest->normal(p);
+            const double reach = std::clamp(best / config_.adaption_range, 0.0, 1.0);
+            f = glm::normalize(f + to_surface * (config_.adaption * time * reach));
+            f = physics::surface_adaption(f, to_surface, config_.adaption, time);
+        }
+    }
+    // painted attractors (section 5.1): toward their weighted average within their radii
+    glm::dvec3 pull(0.0);
+    for (const auto& a : config_.attractors) {
+        glm::dvec3 d = a.point - p;
+        double len = glm::length(d);
+        if (len >= a.radius || len < 1e-12) continue;
+        pull += d / len * (a.strength * (1 - len / a.radius));
+    }
+    if (glm::length(pull) > 0) f = glm::normalize(f + pull * time);
+    // Eq. 7: toward the light, less where the plant shades itself
+    if (config_.phototropism > 0)
+        f = physics::phototropism(f, glm::normalize(config_.light), occlusion(p), config_.phototropism, time);
+    return f;
+}
+
+std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::string& error) {
+    physics::Settings s;
+    s.fixed_stiffness = 1.0; // the paper used s = 1 for most results
+    Climber::Config c;
+    std::vector<glm::dvec3> sphere, box_min, box_max, plane_p, plane_n, attract;
+    std::vector<double> sphere_r, attract_r, attract_s;
+    double friction = 0.5, elasticity = 0.0, break_threshold = 0;
+    glm::dvec3 wind(0.0);
+    std::vector<std::string> meshes;
+    static const char* numbers[] = {"substeps", "iterations", "stiffness", "stiffening_time", "break_threshold",
+                                    "damping", "density", "phototropism", "adaption", "adaption_range", "response",
+                                    "anchor", "anchor_range", "anchor_release", "friction", "elasticity",
+                                    "sphere_radius", "attractor_radius", "attractor_strength", "threads",
+                                    "light_cell", "opacity"};
+    static const char* vectors[] = {"gravity", "light", "wind", "sphere", "box_min", "box_max", "plane_point",
+                                    "plane_normal", "attractor"};
+    for (const auto& a : args) {
+        if (a.key == "mesh") {
+            if (a.type != ValueType::String) {
+                error = "climber: 'mesh' is a quoted file name, as in mesh: \"rock.obj\"";
+                return nullptr;
+            }
+            meshes.push_back(a.text);
+            continue;
+        }
+        bool is_number = std::any_of(std::begin(numbers), std::end(numbers), [&](const char* k) { return a.key == k; });
+        bool is_vector = std::any_of(std::begin(vectors), std::end(vectors), [&](const char* k) { return a.key == k; });
+        if (!is_number && !is_vector) {
+            error = a.key.empty() ? "climber: arguments are named, as in climber(gravity: vec3(0, -9.81, 0))"
+                                  : fmt::format("climber: unknown argument '{}'", a.key);
+            return nullptr;
+        }
+        if (is_vector != (a.type == ValueType::Vec3)) {
+            error = fmt::format("climber: '{}' must be a {}", a.key, is_vector ? "vec3" : "number");
+            return nullptr;
+        }
+        const double x = a.v[0];
+        const glm::dvec3 v(a.v[0], a.v[1], a.v[2]);
+        if (a.key == "substeps") c.substeps = static_cast<int>(std::clamp(x, 0.0, 1000.0));
+        else if (a.key == "iterations") s.iterations = static_cast<int>(std::clamp(x, 1.0, 100.0));
+        else if (a.key == "stiffness") s.fixed_stiffness = x; // negative: grows with age, s = t_l / t_m
+        else if (a.key == "stiffening_time") s.stiffening_time = std::max(x, 1e-6);
+        else if (a.key == "break_threshold") break_threshold = std::max(x, 0.0);
+        else if (a.key == "damping") s.damping = std::clamp(x, 0.0, 1.0);
+        else if (a.key == "density") s.density = std::max(x, 1e-9);
+        else if (a.key == "phototropism") c.phototropism = std::max(x, 0.0);
+        else if (a.key == "adaption") c.adaption = std::clamp(x, 0.0, 1.0);
+        else if (a.key == "adaption_range") c.adaption_range = std::max(x, 0.0);
+        else if (a.key == "response") c.response = std::max(x, 0.0);
+        else if (a.key == "anchor") c.anchor = std::clamp(x, 0.0, 1.0);
+        else if (a.key == "anchor_range") c.anchor_range = std::max(x, 0.0);
+        else if (a.key == "anchor_release") c.anchor_release = std::max(x, 0.0);
+        else if (a.key == "friction") friction = std::clamp(x, 0.0, 1.0);
+        else if (a.key == "elasticity") elasticity = std::clamp(x, 0.0, 1.0);
+        else if (a.key == "sphere_radius") sphere_r.push_back(x);
+        else if (a.key == "attractor_radius") attract_r.push_back(x);
+        else if (a.key == "attractor_strength") attract_s.push_back(x);
+        else if (a.key == "threads") s.threads = static_cast<int>(std::clamp(x, 1.0, 256.0));
+        else if (a.key == "light_cell") c.light_cell = std::max(x, 1e-3);
+        else if (a.key == "opacity") c.opacity = std::max(x, 0.0);
+        else if (a.key == "gravity") s.gravity = v;
+        else if (a.key == "light") c.light = v;
+        else if (a.key == "wind") wind = v;
+        else if (a.key == "sphere") sphere.push_back(v);
+        else if (a.key == "box_min") box_min.push_back(v);
+        else if (a.key == "box_max") box_max.push_back(v);
+        else if (a.key == "plane_point") plane_p.push_back(v);
+        else if (a.key == "plane_normal") plane_n.push_back(v);
+        else if (a.key == "attractor") attract.push_back(v);
+    }
+    if (sphere.size() != sphere_r.size() || box_min.size() != box_max.size() || plane_p.size() != plane_n.size()) {
+        error = "climber: give each sphere a sphere_radius, each box_min a box_max and each plane_point a plane_normal";
+        return nullptr;
+    }
+    if (attract_r.size() > attract.size() || attract_s.size() > attract.size()) {
+        error = "climber: an attractor_radius or attractor_strength without an attractor";
+        return nullptr;
+    }
+    if (glm::length(c.light) == 0) {
+        error = "climber: 'light' must not be zero";
+        return nullptr;
+    }
+    if (!meshes.empty()) {
+        error = "climber: mesh obstacles are not supported yet; use boxes, spheres and planes";
+        return nullptr;
+    }
+    for (std::size_t i = 0; i < attract.size(); ++i)
+        c.attractors.push_back(
+            {attract[i], i < attract_r.size() ? attract_r[i] : 0.3, i < attract_s.size() ? attract_s[i] : 1.0});
+    auto climber = std::make_unique<Climber>(s, c);
+    physics::World& w = climber->world();
+    w.set_break_threshold(break_threshold);
+    w.set_wind(wind);
+    auto add = [&](physics::Obstacle o) {
+        o.friction = friction;
+        o.elasticity = elasticity;
+        w.add_obstacle(o);
+    };
+    for (std::size_t i = 0; i < sphere.size(); ++i) {
+        physics::Obstacle o;
+        o.kind = physics::Obstacle::Sphere;
+        o.a = sphere[i];
+        o.b = glm::dvec3(sphere_r[i], 0, 0);
+        add(o);
+    }
+    for (std::size_t i = 0; i < box_min.size(); ++i) {
+        physics::Obstacle o;
+        o.kind = physics::Obstacle::Box;
+        o.a = glm::min(box_min[i], box_max[i]);
+        o.b = glm::max(box_min[i], box_max[i]);
+        add(o);
+    }
+    for (std::size_t i = 0; i < plane_p.size(); ++i) {
+        if (glm::length(plane_n[i]) == 0) {
+            error = "climber: a plane_normal must not be zero";
+            return nullptr;
+        }
+        physics::Obstacle o;
+        o.kind = physics::Obstacle::Plane;
+        o.a = plane_p[i];
+        o.b = glm::normalize(plane_n[i]);
+        add(o);
+    }
+    climber->remember_initial();
+    return climber;
+}
+
+} // namespace plant
