@@ -224,21 +224,21 @@ double Climber::occlusion(const glm::dvec3& p) const {
 glm::dvec3 Climber::grow_dir(const glm::dvec3& p, const glm::dvec3& h) const {
     const double time = config_.substeps * world_.settings().dt * config_.response;
     glm::dvec3 f = glm::length(h) > 0 ? glm::normalize(h) : glm::dvec3(0, 1, 0);
-    // Eq. 6: parallel to the nearest surface in range
+    // Eq. 6: parallel to the nearest surface in range; before that, a plant searches for the
+    // support and grows toward it (section 4.2), more the farther it still is
+    const physics::Obstacle* nearest = nullptr;
+    glm::dvec3 normal(0.0);
     if (config_.adaption > 0) {
-        const physics::Obstacle* nearest = nullptr;
         double best = config_.adaption_range;
         for (const auto& o : world_.obstacles()) {
             double d = o.distance(p);
             if (d < best) best = d, nearest = &o;
         }
         if (nearest) {
-            // section 4.2: a plant searches for a support nearby and grows toward it (stronger the
-            // farther it is within range), then turns parallel to it (Eq. 6)
-            const glm::dvec3 to_surface = -nearest->normal(p);
+            normal = nearest->normal(p);
+            f = physics::surface_adaption(f, -normal, config_.adaption, time);
             const double reach = std::clamp(best / config_.adaption_range, 0.0, 1.0);
-            f = glm::normalize(f + to_surface * (config_.adaption * time * reach));
-            f = physics::surface_adaption(f, to_surface, config_.adaption, time);
+            f = glm::normalize(f - normal * (config_.adaption * time * reach));
         }
     }
     // painted attractors (section 5.1): toward their weighted average within their radii
@@ -250,9 +250,16 @@ glm::dvec3 Climber::grow_dir(const glm::dvec3& p, const glm::dvec3& h) const {
         pull += d / len * (a.strength * (1 - len / a.radius));
     }
     if (glm::length(pull) > 0) f = glm::normalize(f + pull * time);
-    // Eq. 7: toward the light, less where the plant shades itself
-    if (config_.phototropism > 0)
-        f = physics::phototropism(f, glm::normalize(config_.light), occlusion(p), config_.phototropism, time);
+    // Eq. 7: toward the light, less where the plant shades itself. On a support the shoot follows
+    // the light along it: the turn does not lift it off the surface.
+    if (config_.phototropism > 0) {
+        glm::dvec3 g = physics::phototropism(f, glm::normalize(config_.light), occlusion(p), config_.phototropism, time);
+        if (nearest) {
+            glm::dvec3 kept = g + normal * (glm::dot(f, normal) - glm::dot(g, normal));
+            if (glm::length(kept) > 1e-9) g = glm::normalize(kept);
+        }
+        f = g;
+    }
     return f;
 }
 

@@ -1,0 +1,156 @@
+// The climber environment end to end: grammars whose bound modules are particles.
+#include "helpers.hpp"
+#include "plant/climber.hpp"
+#include "plant/environments.hpp"
+#include "plant/query.hpp"
+#include "plant/skeleton.hpp"
+#include "plant/turtle.hpp"
+
+#include <catch2/catch.hpp>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <string>
+
+using namespace plant;
+
+namespace {
+
+struct Grown {
+    std::unique_ptr<test::Compiled> compiled;
+    std::string string;
+    Skeleton skeleton;
+    std::size_t particles = 0;
+};
+
+Grown grow(const std::string& text, int threads = 1) {
+    Grown g;
+    CompileOptions opts;
+    opts.environments = runtime_environments();
+    g.compiled = test::compile(text, opts);
+    INFO(g.compiled->rendered());
+    REQUIRE(g.compiled->program);
+    TurtleQueryPass queries;
+    DeriveOptions o;
+    o.queries = &queries;
+    o.threads = threads;
+    Derivation d(*g.compiled->program, o);
+    d.run();
+    g.string = format_string(*g.compiled->program, d.string(), false);
+    g.skeleton = build_skeleton(*g.compiled->program, d.interpreted(d.string()), turtle_options(d));
+    for (const auto& env : g.compiled->program->environments)
+        if (auto* c = dynamic_cast<Climber*>(env.get())) g.particles = c->world().size();
+    return g;
+}
+
+std::size_t count(const std::string& s, const std::string& what) {
+    std::size_t n = 0;
+    for (std::size_t at = s.find(what); at != std::string::npos; at = s.find(what, at + 1)) ++n;
+    return n;
+}
+
+// A horizontal cantilever of four bound segments, 0.1 long, growing along +x from the origin.
+std::string cantilever(const std::string& climber_args, const std::string& extra = "") {
+    return "env ivy = climber(" + climber_args + ");\n"
+           "module Seg(len, r) bound ivy;\n" + extra +
+           "derive 6;\n"
+           "axiom: -(90) Seg(0.1, 0.01) Seg(0.1, 0.01) Seg(0.1, 0.01) Seg(0.1, 0.01) ?P(0, 0, 0);\n";
+}
+
+} // namespace
+
+TEST_CASE("climber: bound segments sag under gravity and the turtle draws them where the particles are", "[climber]") {
+    Grown soft = grow(cantilever("stiffness: 0.3, substeps: 10"));
+    Grown still = grow(cantilever("stiffness: 0.3, substeps: 10, gravity: vec3(0, 0, 0)"));
+    REQUIRE(soft.skeleton.axes.size() == 1);
+    const auto& tip = soft.skeleton.axes[0].points.back().position;
+    const auto& straight = still.skeleton.axes[0].points.back().position;
+    CHECK(tip.y < -0.02);                           // it sagged
+    CHECK(straight.y == Approx(0.0).margin(1e-9));  // without gravity it keeps its shape
+    CHECK(straight.x == Approx(0.4).margin(1e-9));
+    // the query module after the tip reads the physical position
+    CHECK(soft.string.find("?P(" + fmt::format("{}", tip.x)) != std::string::npos);
+    CHECK(soft.particles == 5); // a fixed root and one particle per segment
+}
+
+TEST_CASE("climber: a pulled tip past the break threshold leaves the string, and so does a cut branch", "[climber]") {
+    // ids in the axiom: -(90) is 1, the segments 2 to 5
+    Grown pulled = grow(cantilever("stiffness: 1, substeps: 4, break_threshold: 0.3",
+                                   "on before_step { if step() == 2 { ivy.pull(5, vec3(1, 1, 0)); } }\n"));
+    CHECK(count(pulled.string, "Seg(") < 4);
+    CHECK(count(pulled.string, "Seg(") >= 1);
+    CHECK(pulled.string.find("?P") == std::string::npos); // it followed the broken tip out
+    Grown whole = grow(cantilever("stiffness: 1, substeps: 4, break_threshold: 0.3"));
+    CHECK(count(whole.string, "Seg(") == 4);
+
+    Grown cut = grow(cantilever("stiffness: 1, substeps: 4", "on before_step { if step() == 3 { ivy.cut(4); } }\n"));
+    CHECK(cut.string == "-(90)Seg(0.1,0.01)Seg(0.1,0.01)");
+    CHECK(cut.particles == 5); // the world keeps its slots; the cut ones are dead
+}
+
+TEST_CASE("climber: a plant beside a wall climbs it without entering, parallel to its face", "[climber]") {
+    const std::string g = R"(
+env ivy = climber(box_min: vec3(-1, 0, -0.2), box_max: vec3(1, 3, 0), adaption: 0.8, adaption_range: 0.2,
+                  anchor: 0.5, anchor_range: 0.03, light: vec3(0, 1, 0.3), phototropism: 0.2);
+module Seg(len, r) bound ivy;
+module Apex(k);
+derive 30;
+axiom: @M(0, 0, 0.1) SetHead(0, 0.8, -0.6) Seg(0.05, 0.006) Apex(0) ?P(0, 0, 0) ?H(0, 1, 0);
+rules {
+  Apex(k) > ?P(p) ?H(h) : k < 30 { let g = ivy.grow_dir(p, h); produce SetHead(g.x, g.y, g.z) Seg(0.05, 0.006) Apex(k + 1); }
+}
+)";
+    Grown r = grow(g);
+    const auto& pts = r.skeleton.axes.at(0).points;
+    REQUIRE(pts.size() > 25);
+    double lowest_z = 1e9;
+    for (const auto& p : pts) lowest_z = std::min(lowest_z, p.position.z);
+    CHECK(lowest_z >= 0.0);                        // never inside the wall (z < 0)
+    CHECK(pts.back().position.y > 0.8);            // it climbed
+    CHECK(std::abs(pts.back().heading.z) < 0.15);  // along the face, not away from it
+}
+
+TEST_CASE("climber: grow_dir turns a free shoot toward the light, and not when there is none to follow", "[climber]") {
+    auto shoot = [](double eta) {
+        return grow(fmt::format(R"(
+env ivy = climber(gravity: vec3(0, 0, 0), light: vec3(1, 1, 0), phototropism: {});
+module Seg(len, r) bound ivy;
+module Apex(k);
+derive 12;
+axiom: Seg(0.05, 0.006) Apex(0) ?P(0, 0, 0) ?H(0, 1, 0);
+rules {{
+  Apex(k) > ?P(p) ?H(h) {{ let g = ivy.grow_dir(p, h); produce SetHead(g.x, g.y, g.z) Seg(0.05, 0.006) Apex(k + 1); }}
+}}
+)",
+                                eta));
+    };
+    Grown lit = shoot(0.3), blind = shoot(0);
+    CHECK(lit.skeleton.axes[0].points.back().heading.x > 0.3);
+    CHECK(blind.skeleton.axes[0].points.back().heading.x == Approx(0.0).margin(1e-9));
+}
+
+TEST_CASE("climber: a grammar grows the same plant for a seed, on any thread count and when derived again", "[climber]") {
+    // the library with a wall scene, through the stdlib search path
+    const std::string text = "import climber with { N = 3, BP = 0.3, steps = 20, shoot_length = 20 };\n"
+                             "env ivy = climber(box_min: vec3(-1, 0, -0.2), box_max: vec3(1, 3, 0), adaption: 0.8, "
+                             "anchor: 0.5, phototropism: 0.3);\nseed 5;\n";
+    Grown a = grow(text, 1), b = grow(text, 2);
+    CHECK(a.string == b.string);
+    CHECK(count(a.string, "Seg(") > 60);
+    // one compiled program derived twice: the climber starts over (Environment::reset)
+    CompileOptions opts;
+    opts.environments = runtime_environments();
+    auto c = test::compile(text, opts);
+    REQUIRE(c->program);
+    TurtleQueryPass queries;
+    DeriveOptions o;
+    o.queries = &queries;
+    std::string first, second;
+    for (std::string* out : {&first, &second}) {
+        Derivation d(*c->program, o);
+        d.run();
+        *out = format_string(*c->program, d.string(), false);
+    }
+    CHECK(first == second);
+    CHECK(first == a.string);
+}
