@@ -724,8 +724,8 @@ std::unique_ptr<Program> Compiler::compile(std::uint32_t main_file) {
                                                       "declare it first, as in env {} = climber(...);",
                                                       info.name, info.bound_to, info.bound_to));
         else if (it->second != "climber")
-            diags_->error(info.decl_span, fmt::format("module '{}' is bound to '{}', a {} environment; only a climber "
-                                                      "can hold segments",
+            diags_->error(info.decl_span, fmt::format("module '{}' is bound to '{}', which is not a climber (it is "
+                                                      "'{}'); only a climber can hold segments",
                                                       info.name, info.bound_to, it->second));
     }
     for (std::uint32_t i = 0; i < P_.functions.size(); ++i) ensure_function_compiled(i);
