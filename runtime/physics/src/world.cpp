@@ -296,9 +296,12 @@ void World::step() {
     const std::size_t n = x_.size();
     std::vector<glm::dvec3>& old = scratch_.old;
     old = x_;
-    // Eq. 1: predicted positions; a_e is the steady wind (SPH is not coupled yet)
+    // Eq. 1: predicted positions; a_e is the steady wind plus what the fluid pushed (Fluid::step)
+    if (external_.size() < n) external_.resize(n, glm::dvec3(0.0));
     for (std::size_t i = 0; i < n; ++i)
-        if (alive_[i] && !fixed_[i]) x_[i] = x_[i] + v_[i] * dt + (settings_.gravity + wind_) * (dt * dt / 2);
+        if (alive_[i] && !fixed_[i])
+            x_[i] = x_[i] + v_[i] * dt + (settings_.gravity + wind_ + external_[i]) * (dt * dt / 2);
+    std::fill(external_.begin(), external_.end(), glm::dvec3(0.0));
     // Eq. 5: anchors pull their particles in; one too far away lets go
     for (std::size_t k = 0; k < anchors_.size();) {
         Anchor& a = anchors_[k];

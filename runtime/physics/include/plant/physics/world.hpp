@@ -107,6 +107,17 @@ public:
     // External acceleration a_e of Eq. 1 on every free particle (a steady wind).
     void set_wind(const glm::dvec3& a) { wind_ = a; }
     const std::vector<Obstacle>& obstacles() const { return obstacles_; }
+    // Adds to a particle's external acceleration (Eq. 1's a_e) for the next step only: the
+    // fluid's push on a branch.
+    void add_external(Handle h, const glm::dvec3& a) {
+        if (external_.size() < x_.size()) external_.resize(x_.size(), glm::dvec3(0.0));
+        external_[h.index] += a;
+    }
+    // The handle of the particle in slot i (alive or not).
+    Handle handle(std::uint32_t i) const { return {i, generation_[i]}; }
+    // Full grown: at full stiffness (with a fixed stiffness, always). Only these meet the fluid.
+    bool full_grown(Handle h) const { return stiffness(h.index) >= 1.0 || settings_.fixed_stiffness >= 0; }
+    glm::dvec3 radii(Handle h) const { return radii_[h.index]; }
 
     // Apical growth: every apex (a particle without children) lengthens; each segment_length a
     // new particle continues it, turned by surface adaption and phototropism (Eq. 6-8), and with
@@ -200,6 +211,7 @@ private:
     std::vector<std::pair<std::uint32_t, glm::dvec3>> pulls_;
     double break_threshold_ = 0;
     glm::dvec3 wind_{0.0};
+    std::vector<glm::dvec3> external_; // per particle, cleared after each step
     struct Scratch {
         std::vector<Frame> frames;
         std::vector<glm::dvec3> goal;
