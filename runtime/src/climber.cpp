@@ -78,6 +78,7 @@ bool Climber::pose(ModuleId id, glm::dvec3& position, glm::dmat3& frame) const {
 
 void Climber::reset() {
     world_ = initial_;
+    fluid_ = initial_fluid_;
     particle_of_.clear();
     seen_.clear();
     detached_.clear();
@@ -145,12 +146,18 @@ void Climber::advance() {
         if (h.valid() && world_.alive(h)) world_.remove(h);
     }
     cuts_.clear();
-    if (wind_changed_) world_.set_wind(wind_), wind_changed_ = false;
+    if (wind_changed_) {
+        if (config_.air) fluid_.settings().wind = wind_;
+        else world_.set_wind(wind_);
+        wind_changed_ = false;
+    }
+    const int air_steps = config_.air ? std::max(1, static_cast<int>(std::lround(world_.settings().dt / config_.fluid.dt))) : 0;
     for (int k = 0; k < config_.substeps; ++k) {
         for (const auto& [id, target] : pulls_) {
             physics::Handle h = particle(id);
             if (h.valid() && world_.alive(h)) world_.pull(h, target);
         }
+        for (int a = 0; a < air_steps; ++a) fluid_.step(&world_);
         world_.step();
     }
     pulls_.clear();
@@ -276,9 +283,11 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
                                     "damping", "density", "phototropism", "adaption", "adaption_range", "response",
                                     "anchor", "anchor_range", "anchor_release", "friction", "elasticity",
                                     "sphere_radius", "attractor_radius", "attractor_strength", "threads",
-                                    "light_cell", "opacity"};
+                                    "light_cell", "opacity", "air_spacing", "air_density", "air_viscosity",
+                                    "air_stiffness", "air_coupling"};
     static const char* vectors[] = {"gravity", "light", "wind", "sphere", "box_min", "box_max", "plane_point",
-                                    "plane_normal", "attractor"};
+                                    "plane_normal", "attractor", "air_min", "air_max"};
+    bool air_min = false, air_max = false;
     for (const auto& a : args) {
         if (a.key == "mesh") {
             if (a.type != ValueType::String) {
@@ -332,6 +341,13 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
         else if (a.key == "plane_point") plane_p.push_back(v);
         else if (a.key == "plane_normal") plane_n.push_back(v);
         else if (a.key == "attractor") attract.push_back(v);
+        else if (a.key == "air_min") c.fluid.domain_lo = v, air_min = true;
+        else if (a.key == "air_max") c.fluid.domain_hi = v, air_max = true;
+        else if (a.key == "air_spacing") c.fluid.spacing = std::max(x, 1e-3), c.fluid.support = 2 * c.fluid.spacing;
+        else if (a.key == "air_density") c.fluid.rest_density = std::max(x, 1e-6);
+        else if (a.key == "air_viscosity") c.fluid.viscosity = std::max(x, 0.0);
+        else if (a.key == "air_stiffness") c.fluid.stiffness = std::max(x, 1e-6);
+        else if (a.key == "air_coupling") c.fluid.coupling = std::max(x, 0.0);
     }
     if (sphere.size() != sphere_r.size() || box_min.size() != box_max.size() || plane_p.size() != plane_n.size()) {
         error = "climber: give each sphere a sphere_radius, each box_min a box_max and each plane_point a plane_normal";
@@ -340,6 +356,24 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
     if (attract_r.size() > attract.size() || attract_s.size() > attract.size()) {
         error = "climber: an attractor_radius or attractor_strength without an attractor";
         return nullptr;
+    }
+    if (air_min != air_max) {
+        error = "climber: give both air_min and air_max for SPH air, or neither";
+        return nullptr;
+    }
+    if (air_min) {
+        c.air = true;
+        c.fluid.domain_lo = glm::min(c.fluid.domain_lo, c.fluid.domain_hi);
+        c.fluid.domain_hi = glm::max(c.fluid.domain_lo, c.fluid.domain_hi);
+        glm::dvec3 cells = (c.fluid.domain_hi - c.fluid.domain_lo) / c.fluid.spacing;
+        if (cells.x * cells.y * cells.z > 200000) {
+            error = "climber: the air box holds more than 200,000 particles at this air_spacing";
+            return nullptr;
+        }
+        c.fluid.wind = wind;
+        c.fluid.threads = s.threads;
+        c.fluid.dt = s.dt / 10;
+        wind = glm::dvec3(0.0); // the air carries the wind
     }
     if (glm::length(c.light) == 0) {
         error = "climber: 'light' must not be zero";

@@ -17,9 +17,15 @@
 // Methods: grow_dir(p, h) (h turned by surface adaption, Eq. 6, by painted attractors and by
 // phototropism weighted by occlusion, Eq. 7), occlusion(p), anchored(id), particles(); in hooks
 // only: pull(id, target), cut(id), wind(a).
+//
+// With air_min and air_max the climber also runs SPH air in that box (section 5.3): each 25 ms
+// physics step runs ten 2.5 ms air steps coupled both ways with the full-grown particles, and
+// `wind` (argument and hook method) is the air's inflow velocity in m/s instead of a steady
+// acceleration.
 #pragma once
 
 #include "plant/environment.hpp"
+#include "plant/physics/fluid.hpp"
 #include "plant/physics/world.hpp"
 #include "plant/turtle.hpp"
 
@@ -54,11 +60,21 @@ public:
         double light_cell = 0.1;    // occupancy grid for occlusion
         double opacity = 0.15;      // occlusion 1 - exp(-opacity * particles between p and the light)
         std::vector<Attractor> attractors;
+        bool air = false;           // SPH air fills [air_min, air_max] (section 5.3)
+        physics::FluidSettings fluid;
     };
 
     Climber(physics::Settings settings, Config config) : world_(settings), config_(std::move(config)) {}
     // Keeps the world as it is now (settings and obstacles) for reset().
-    void remember_initial() { initial_ = world_; }
+    void remember_initial() {
+        initial_ = world_;
+        if (config_.air) {
+            fluid_ = physics::Fluid(config_.fluid);
+            fluid_.fill(config_.fluid.domain_lo, config_.fluid.domain_hi);
+        }
+        initial_fluid_ = fluid_;
+    }
+    const physics::Fluid& fluid() const { return fluid_; }
     void reset() override;
 
     // Environment
@@ -86,6 +102,7 @@ private:
     void rebuild_occupancy();
 
     physics::World world_, initial_;
+    physics::Fluid fluid_, initial_fluid_;
     Config config_;
     std::map<ModuleId, physics::Handle> particle_of_; // ordered: removals happen in id order
     std::set<ModuleId> seen_, detached_;

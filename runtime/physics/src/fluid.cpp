@@ -314,6 +314,9 @@ void Fluid::step(World* plant) {
     const glm::dvec3 lo = s_.domain_lo, hi = s_.domain_hi;
     const bool windy = glm::length(s_.wind) > 0;
     for (std::size_t i = 0; i < x_.size(); ++i) {
+        // the fan: a wind draws the air toward its velocity (and the air keeps moving once it
+        // is switched off, until viscosity and the walls stop it)
+        if (windy) a_[i] += (s_.wind - v_[i]) * s_.drive;
         v_[i] += a_[i] * dt;
         x_[i] += v_[i] * dt;
         for (int k = 0; k < 3; ++k) {

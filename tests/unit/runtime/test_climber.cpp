@@ -154,3 +154,22 @@ TEST_CASE("climber: a grammar grows the same plant for a seed, on any thread cou
     CHECK(first == second);
     CHECK(first == a.string);
 }
+
+TEST_CASE("climber: SPH air blowing past a stem pushes it downwind", "[climber]") {
+    auto stem = [](double coupling) {
+        return grow(fmt::format(R"(
+env ivy = climber(stiffness: 0.3, gravity: vec3(0, 0, 0), substeps: 4, wind: vec3(3, 0, 0),
+                  air_min: vec3(-0.3, 0, -0.3), air_max: vec3(0.5, 0.6, 0.3), air_spacing: 0.05,
+                  air_coupling: {});
+module Seg(len, r) bound ivy;
+derive 6;
+axiom: Seg(0.1, 0.02) Seg(0.1, 0.02) Seg(0.1, 0.02) Seg(0.1, 0.02) Seg(0.1, 0.02) ?P(0, 0, 0);
+)",
+                                coupling));
+    };
+    Grown calm = stem(0), blown = stem(1);
+    const auto& still = calm.skeleton.axes.at(0).points.back().position;
+    const auto& bent = blown.skeleton.axes.at(0).points.back().position;
+    CHECK(still.x == Approx(0.0).margin(1e-9)); // uncoupled, the air passes through
+    CHECK(bent.x > 0.005);                      // coupled, it bends the stem downwind
+}

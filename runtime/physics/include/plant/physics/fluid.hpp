@@ -26,7 +26,8 @@ struct FluidSettings {
     double viscosity = 0.02;      // mu
     double dt = 0.0025;           // a fluid step; the plant's 25 ms step runs several
     glm::dvec3 domain_lo{-1, 0, -1}, domain_hi{1, 2, 1};
-    glm::dvec3 wind{0.0};         // emitter velocity: particles leaving the domain re-enter upwind
+    glm::dvec3 wind{0.0};         // the wind's velocity: particles leaving the domain re-enter upwind
+    double drive = 5.0;           // 1/s: how fast a wind brings the air to its velocity
     double coupling = 1.0;        // scales the forces between air and plant
     int threads = 1;
 };
