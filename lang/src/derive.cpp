@@ -282,28 +282,7 @@ void Derivation::apply_cut(ModuleString& s) const {
             break;
         }
     if (!any) return;
-    ModuleString out;
-    const std::size_t n = s.size();
-    std::size_t i = 0;
-    while (i < n) {
-        if (s.sym[i] != cut) {
-            out.append_range(s, i, i + 1);
-            ++i;
-            continue;
-        }
-        // skip to the ']' closing the current branch (kept) or to the end
-        int depth = 0;
-        ++i;
-        while (i < n) {
-            if (s.sym[i] == open) ++depth;
-            else if (s.sym[i] == close) {
-                if (depth == 0) break;
-                --depth;
-            }
-            ++i;
-        }
-    }
-    s.swap(out);
+    cut_branches(s, open, close, [&](std::size_t i) { return s.sym[i] == cut; });
 }
 
 ModuleString Derivation::interpreted(const ModuleString& s) const {

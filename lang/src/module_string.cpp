@@ -102,4 +102,29 @@ std::string format_string(const Program& program, const ModuleString& s, bool wi
     return out;
 }
 
+void cut_branches(ModuleString& s, SymbolId open, SymbolId close, const std::function<bool(std::size_t)>& cuts) {
+    ModuleString out;
+    const std::size_t n = s.size();
+    std::size_t i = 0;
+    while (i < n) {
+        if (!cuts(i)) {
+            out.append_range(s, i, i + 1);
+            ++i;
+            continue;
+        }
+        // skip to the ']' closing the current branch (kept) or to the end
+        int depth = 0;
+        ++i;
+        while (i < n) {
+            if (s.sym[i] == open) ++depth;
+            else if (s.sym[i] == close) {
+                if (depth == 0) break;
+                --depth;
+            }
+            ++i;
+        }
+    }
+    s.swap(out);
+}
+
 } // namespace plant

@@ -76,6 +76,16 @@ bool Climber::pose(ModuleId id, glm::dvec3& position, glm::dmat3& frame) const {
     return true;
 }
 
+const physics::Obstacle* Climber::nearest_obstacle(const glm::dvec3& p, double within, double& distance) const {
+    const physics::Obstacle* nearest = nullptr;
+    distance = within;
+    for (const auto& o : world_.obstacles()) {
+        double d = o.distance(p);
+        if (d < distance) distance = d, nearest = &o;
+    }
+    return nearest;
+}
+
 void Climber::reset() {
     world_ = initial_;
     fluid_ = initial_fluid_;
@@ -125,13 +135,8 @@ void Climber::advance() {
         particle_of_[p.id] = h;
         // Eq. 5: a particle born near a surface holds on to it
         if (config_.anchor > 0) {
-            const physics::Obstacle* nearest = nullptr;
-            double best = r + config_.anchor_range;
-            for (const auto& o : world_.obstacles()) {
-                double d = o.distance(p.to);
-                if (d < best) best = d, nearest = &o;
-            }
-            if (nearest) {
+            double best = 0;
+            if (const physics::Obstacle* nearest = nearest_obstacle(p.to, r + config_.anchor_range, best)) {
                 glm::dvec3 n = nearest->normal(p.to);
                 glm::dvec3 point = p.to - n * (nearest->distance(p.to) - r);
                 world_.add_anchor(h, point, config_.anchor, config_.anchor_release);
@@ -236,11 +241,8 @@ glm::dvec3 Climber::grow_dir(const glm::dvec3& p, const glm::dvec3& h) const {
     const physics::Obstacle* nearest = nullptr;
     glm::dvec3 normal(0.0);
     if (config_.adaption > 0) {
-        double best = config_.adaption_range;
-        for (const auto& o : world_.obstacles()) {
-            double d = o.distance(p);
-            if (d < best) best = d, nearest = &o;
-        }
+        double best = 0;
+        nearest = nearest_obstacle(p, config_.adaption_range, best);
         if (nearest) {
             normal = nearest->normal(p);
             f = physics::surface_adaption(f, -normal, config_.adaption, time);

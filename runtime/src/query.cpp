@@ -56,30 +56,6 @@ private:
     const std::vector<Climber*>& by_symbol_;
 };
 
-// Removes each module in `ids` and the rest of its branch (the ']' stays), as '%' would.
-void cut_modules(ModuleString& s, const Program& p, const std::set<ModuleId>& ids) {
-    const SymbolId open = p.symbols.open_bracket, close = p.symbols.close_bracket;
-    ModuleString out;
-    std::size_t i = 0;
-    while (i < s.size()) {
-        if (!ids.count(s.ids[i])) {
-            out.append_range(s, i, i + 1);
-            ++i;
-            continue;
-        }
-        int depth = 0;
-        ++i;
-        while (i < s.size()) {
-            if (s.sym[i] == open) ++depth;
-            else if (s.sym[i] == close) {
-                if (depth == 0) break;
-                --depth;
-            }
-            ++i;
-        }
-    }
-    s.swap(out);
-}
 
 // The climbers' part of a step (climber.hpp): place new bound modules' particles, run the
 // physics, and cut what broke off out of the string.
@@ -106,7 +82,9 @@ void advance_climbers(const Derivation& d, ModuleString& string) {
         c->advance();
         gone.insert(c->detached().begin(), c->detached().end());
     }
-    if (!gone.empty()) cut_modules(string, p, gone);
+    if (!gone.empty())
+        cut_branches(string, p.symbols.open_bracket, p.symbols.close_bracket,
+                     [&](std::size_t i) { return gone.count(string.ids[i]) > 0; });
 }
 
 } // namespace

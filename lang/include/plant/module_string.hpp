@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <span>
+#include <functional>
 #include <vector>
 
 namespace plant {
@@ -58,5 +59,10 @@ struct ModuleString {
 // unused. Unbalanced brackets map to size() (no partner). Built once per step, only when some
 // production has context.
 std::vector<std::uint32_t> bracket_table(const ModuleString& s, SymbolId open, SymbolId close);
+
+// Removes every module for which `cuts(i)` holds together with the rest of its branch, up to the
+// ']' that closes it (kept) or the string's end: what '%' does, and what a climber does to a
+// part that broke off.
+void cut_branches(ModuleString& s, SymbolId open, SymbolId close, const std::function<bool(std::size_t)>& cuts);
 
 } // namespace plant

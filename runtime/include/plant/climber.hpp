@@ -98,6 +98,8 @@ public:
 
 private:
     double occlusion(const glm::dvec3& p) const;
+    // The obstacle nearest to p if one is nearer than `within`, and its distance.
+    const physics::Obstacle* nearest_obstacle(const glm::dvec3& p, double within, double& distance) const;
     glm::dvec3 grow_dir(const glm::dvec3& p, const glm::dvec3& h) const;
     void rebuild_occupancy();
 

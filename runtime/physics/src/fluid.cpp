@@ -1,5 +1,7 @@
 #include "plant/physics/fluid.hpp"
 
+#include "parallel.hpp"
+
 #include <glm/gtc/quaternion.hpp>
 
 #include <algorithm>
@@ -12,18 +14,6 @@ namespace plant::physics {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-
-template <class F> void parallel_ranges(std::size_t n, int threads, F&& f) {
-    const std::size_t t = std::clamp<std::size_t>(static_cast<std::size_t>(std::max(threads, 1)), 1, n / 1024 + 1);
-    if (t == 1) {
-        f(std::size_t{0}, n);
-        return;
-    }
-    std::vector<std::thread> pool;
-    for (std::size_t k = 1; k < t; ++k) pool.emplace_back([&f, k, t, n] { f(n * k / t, n * (k + 1) / t); });
-    f(std::size_t{0}, n / t);
-    for (auto& th : pool) th.join();
-}
 
 } // namespace
 
@@ -172,7 +162,7 @@ void Fluid::compute_densities(const World* plant) {
     const std::size_t n = x_.size();
     nbr_count_.assign(n, 0);
     nbr_.resize(n * kNeighbours);
-    parallel_ranges(n, s_.threads, [&](std::size_t b, std::size_t e) {
+    parallel_ranges(n, s_.threads, 1024, [&](std::size_t b, std::size_t e) {
         for (std::size_t k = b; k < e; ++k) {
             const std::uint32_t i = order_[k];
             std::uint32_t* list = nbr_.data() + static_cast<std::size_t>(i) * kNeighbours;
@@ -242,7 +232,7 @@ void Fluid::step(World* plant) {
     const double h = s_.support, m = mass_, dt = s_.dt;
     compute_densities(plant);
     // Eq. 11: a = (-grad p + mu lap v) / rho, pressure symmetrised as in Müller et al. 2003
-    parallel_ranges(x_.size(), s_.threads, [&](std::size_t b, std::size_t e) {
+    parallel_ranges(x_.size(), s_.threads, 1024, [&](std::size_t b, std::size_t e) {
         for (std::size_t k = b; k < e; ++k) {
             const std::uint32_t i = order_[k];
             glm::dvec3 f(0.0);

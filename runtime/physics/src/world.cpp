@@ -1,6 +1,8 @@
 #define GLM_ENABLE_EXPERIMENTAL // glm::rotation (gtx/quaternion)
 #include "plant/physics/world.hpp"
 
+#include "parallel.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -220,25 +222,6 @@ glm::dquat World::group_rotation(std::uint32_t i) const {
     return group_frame(i, rotation_from_rest(i), nullptr, 20).R;
 }
 
-namespace {
-
-// Runs f(begin, end) over [0, n) split into `threads` contiguous ranges. Each index is handled
-// by exactly one call and writes only its own slots, so the result does not depend on the
-// thread count.
-template <class F> void parallel_ranges(std::size_t n, int threads, F&& f) {
-    const std::size_t t = std::clamp<std::size_t>(static_cast<std::size_t>(std::max(threads, 1)), 1, n / 2048 + 1);
-    if (t == 1) {
-        f(std::size_t{0}, n);
-        return;
-    }
-    std::vector<std::thread> pool;
-    pool.reserve(t - 1);
-    for (std::size_t k = 1; k < t; ++k) pool.emplace_back([&f, k, t, n] { f(n * k / t, n * (k + 1) / t); });
-    f(std::size_t{0}, n / t);
-    for (auto& th : pool) th.join();
-}
-
-} // namespace
 
 void World::match_shapes(std::vector<Frame>& frames, std::vector<glm::dvec3>& goal, std::vector<glm::dmat3>& moments,
                          int iterations) const {
@@ -247,11 +230,11 @@ void World::match_shapes(std::vector<Frame>& frames, std::vector<glm::dvec3>& go
     moments.resize(n);
     goal.resize(n);
     const int threads = settings_.threads;
-    parallel_ranges(n, threads, [&](std::size_t b, std::size_t e) {
+    parallel_ranges(n, threads, 2048, [&](std::size_t b, std::size_t e) {
         for (std::size_t j = b; j < e; ++j)
             if (alive_[j]) moments[j] = ellipsoid_moment(static_cast<std::uint32_t>(j));
     });
-    parallel_ranges(n, threads, [&](std::size_t b, std::size_t e) {
+    parallel_ranges(n, threads, 2048, [&](std::size_t b, std::size_t e) {
         for (std::size_t k = b; k < e; ++k) {
             const auto i = static_cast<std::uint32_t>(k);
             if (!alive_[i]) continue;
@@ -264,7 +247,7 @@ void World::match_shapes(std::vector<Frame>& frames, std::vector<glm::dvec3>& go
     // their mass-weighted mean over the groups j belongs to (its own, its parent's, its
     // children's), its parent's group counting twice as much as its own and its children's half.
     // Gathered per particle, so each slot is written by one thread.
-    parallel_ranges(n, threads, [&](std::size_t b, std::size_t e) {
+    parallel_ranges(n, threads, 2048, [&](std::size_t b, std::size_t e) {
         for (std::size_t k = b; k < e; ++k) {
             const auto j = static_cast<std::uint32_t>(k);
             glm::dvec3 sum(0.0);
@@ -321,7 +304,7 @@ void World::step() {
     auto& moments = scratch_.moments;
     for (int it = 0; it < settings_.iterations; ++it) {
         match_shapes(frames, goal, moments, settings_.rotation_iterations);
-        parallel_ranges(n, settings_.threads, [&](std::size_t b, std::size_t e) {
+        parallel_ranges(n, settings_.threads, 2048, [&](std::size_t b, std::size_t e) {
             for (std::size_t i = b; i < e; ++i) {
                 if (!alive_[i]) continue;
                 if (fixed_[i]) {
