@@ -156,40 +156,57 @@ void Fluid::compute_densities(const World* plant) {
     if (plant) gather_boundary(*plant);
     else boundary_.clear();
     const double h = s_.support, m = mass_, h2 = h * h;
-    // neighbour lists (within h, itself included), kNeighbours slots per particle: a particle
-    // with more (air squeezed hard) searches again in the force pass. Particles are visited in
-    // cell order, which keeps the lookups local.
+    // Neighbour lists (within h, not itself), kNeighbours slots per particle; a particle with
+    // more (air squeezed hard) searches again where its list is needed. One pass on one thread
+    // visits each pair once, from a half stencil: the rows of cells after the particle's own row
+    // and, in its own row, the particles after it (the particles are in cell order). Doing it
+    // once halves the distance tests of the densities; doing it on one thread keeps the sums'
+    // order, and so the results, the same for every thread count.
     const std::size_t n = x_.size();
+    const double cell = h / 2;
+    const float reject = static_cast<float>(h2) * 1.001f; // single precision rejects, double decides
     nbr_count_.assign(n, 0);
     nbr_.resize(n * kNeighbours);
-    parallel_ranges(n, s_.threads, 1024, [&](std::size_t b, std::size_t e) {
-        for (std::size_t k = b; k < e; ++k) {
-            const std::uint32_t i = order_[k];
-            std::uint32_t* list = nbr_.data() + static_cast<std::size_t>(i) * kNeighbours;
-            std::uint32_t c = 0;
-            double rho = 0;
-            const glm::dvec3 xi = x_[i];
-            const glm::vec3 xif = xf_[i];
-            const float reject = static_cast<float>(h2) * 1.001f; // single precision rejects, double decides
-            for_neighbours(xi, h, [&](std::uint32_t j, const glm::dvec3& xj) {
-                const glm::vec3 df = xif - xf_[j];
-                if (glm::dot(df, df) > reject) return;
-                glm::dvec3 d = xi - xj;
-                double r2 = glm::dot(d, d);
-                if (r2 < h2) {
-                    if (c < kNeighbours) list[c] = j;
-                    ++c;
-                    double w = h2 - r2;
-                    rho += w * w * w;
+    std::vector<double>& sum = rho_;
+    sum.assign(n, 0.0);
+    auto link = [&](std::uint32_t i, std::uint32_t j) {
+        if (nbr_count_[i] < kNeighbours) nbr_[static_cast<std::size_t>(i) * kNeighbours + nbr_count_[i]] = j;
+        ++nbr_count_[i];
+    };
+    for (std::uint32_t i = 0; i < n; ++i) {
+        const glm::dvec3 xi = x_[i];
+        const glm::vec3 xif = xf_[i];
+        const glm::ivec3 c = glm::clamp(glm::ivec3(glm::floor((xi - lo_) / cell)), glm::ivec3(0), n_ - 1);
+        const int x0 = std::max(c.x - 2, 0), x1 = std::min(c.x + 2, n_.x - 1);
+        for (int z = c.z; z <= std::min(c.z + 2, n_.z - 1); ++z)
+            for (int y = z == c.z ? c.y : std::max(c.y - 2, 0); y <= std::min(c.y + 2, n_.y - 1); ++y) {
+                const std::size_t row = (static_cast<std::size_t>(z) * n_.y + y) * n_.x;
+                const std::uint32_t begin = z == c.z && y == c.y ? i + 1 : cell_start_[row + x0];
+                for (std::uint32_t j = begin; j < cell_start_[row + x1 + 1]; ++j) {
+                    const glm::vec3 df = xif - xf_[j];
+                    if (glm::dot(df, df) > reject) continue;
+                    const glm::dvec3 d = xi - x_[j];
+                    const double r2 = glm::dot(d, d);
+                    if (r2 >= h2) continue;
+                    const double w = h2 - r2, w3 = w * w * w;
+                    sum[i] += w3;
+                    sum[j] += w3;
+                    link(i, j);
+                    link(j, i);
                 }
-            });
-            nbr_count_[i] = c;
+            }
+    }
+    parallel_ranges(n, s_.threads, 1024, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) {
+            const std::uint32_t count = nbr_count_[i];
+            const std::uint32_t* list = nbr_.data() + i * kNeighbours;
+            double rho = sum[i] + h2 * h2 * h2; // and itself, at distance 0
             // the walls: the air mirrored across a wall within reach stands in for the missing
             // neighbours, so air at a wall is not thinner than inside. A particle within h of
-            // i's mirror q is within h of i too (reflection only moves it away), so i's own list
-            // holds every candidate.
+            // i's mirror q is within h of i too (reflection only moves it away), so i and its
+            // list hold every candidate.
             for_mirrors(x_[i], [&](const glm::dvec3& q, int) {
-                auto add = [&](std::uint32_t j) {
+                auto add = [&](std::size_t j) {
                     glm::dvec3 d = q - x_[j];
                     double r2 = glm::dot(d, d);
                     if (r2 < h2) {
@@ -197,10 +214,13 @@ void Fluid::compute_densities(const World* plant) {
                         rho += w * w * w;
                     }
                 };
-                if (c <= kNeighbours)
-                    for (std::uint32_t t = 0; t < c; ++t) add(list[t]);
+                add(i);
+                if (count <= kNeighbours)
+                    for (std::uint32_t t = 0; t < count; ++t) add(list[t]);
                 else
-                    for_neighbours(q, h, [&](std::uint32_t j, const glm::dvec3&) { add(j); });
+                    for_neighbours(q, h, [&](std::uint32_t j, const glm::dvec3&) {
+                        if (j != i) add(j);
+                    });
             });
             rho_[i] = rho * m * poly6_c_;
         }
@@ -264,11 +284,14 @@ void Fluid::step(World* plant) {
                         if (axes & (1 << a)) d[a] = -d[a];
                     f += d * ((p_[i] + p_[j]) * 0.5 * vol_[j] * grad_c_ * hr * hr / r);
                 };
+                mirrored(i); // its own image too
                 if (nbr_count_[i] <= kNeighbours) {
                     const std::uint32_t* list = nbr_.data() + static_cast<std::size_t>(i) * kNeighbours;
                     for (std::uint32_t t = 0; t < nbr_count_[i]; ++t) mirrored(list[t]);
                 } else {
-                    for_neighbours(q, h, [&](std::uint32_t j, const glm::dvec3&) { mirrored(j); });
+                    for_neighbours(q, h, [&](std::uint32_t j, const glm::dvec3&) {
+                        if (j != i) mirrored(j);
+                    });
                 }
             });
             a_[i] = f / rho_[i];
