@@ -324,6 +324,7 @@ void World::step() {
         });
         for (const auto& [i, target] : pulls_) x_[i] = target; // a dragged particle goes where it is dragged
     }
+    if (settings_.collisions) separate_particles();
     // Eq. 17-18, with damping; then obstacles: a particle inside one is put back on its surface
     // (its radius off it), its velocity losing the normal part (or bouncing by the elasticity)
     // and some of the tangential part (friction)
@@ -420,6 +421,78 @@ void World::grow() {
             ++laterals_[i];
         }
     }
+}
+
+// Section 5.2: plants collide with each other and with themselves. Particles are spheres of
+// their thinnest radius; two that overlap and are not joined (parent and child, or children of
+// one parent) move apart along the line between them, half each (all of it when the other is a
+// fixed root), as Müller and Chentanez 2011 resolve contacts. The pushes are gathered per
+// particle from the positions before any moves, so the result does not depend on the order or
+// the thread count.
+void World::separate_particles() {
+    const std::size_t n = x_.size();
+    double reach = 0;
+    for (std::size_t i = 0; i < n; ++i)
+        if (alive_[i]) reach = std::max(reach, 2 * std::min({radii_[i].x, radii_[i].y, radii_[i].z}));
+    if (reach <= 0 || n < 2) return;
+    const double cell = 2 * reach; // twice the widest contact: a 2 x 2 x 2 block of cells holds every partner
+    // particles sorted by cell, and an open-addressing table from a cell to its run of them
+    auto cell_of = [&](const glm::dvec3& p) { return glm::i64vec3(glm::floor(p / cell)); };
+    auto hash = [](const glm::i64vec3& c) {
+        return static_cast<std::uint64_t>(c.x * 73856093) ^ static_cast<std::uint64_t>(c.y * 19349663) ^
+               static_cast<std::uint64_t>(c.z * 83492791);
+    };
+    auto& grid = scratch_.grid;
+    grid.clear();
+    for (std::uint32_t i = 0; i < n; ++i)
+        if (alive_[i]) grid.emplace_back(hash(cell_of(x_[i])), i);
+    std::sort(grid.begin(), grid.end());
+    std::size_t size = 16;
+    while (size < 2 * grid.size()) size *= 2;
+    auto& table = scratch_.table; // (key, first index in grid) or empty
+    table.assign(size, {0, ~0u});
+    for (std::uint32_t k = 0; k < grid.size(); ++k) {
+        if (k > 0 && grid[k].first == grid[k - 1].first) continue;
+        std::size_t slot = grid[k].first & (size - 1);
+        while (table[slot].second != ~0u) slot = (slot + 1) & (size - 1);
+        table[slot] = {grid[k].first, k};
+    }
+    auto& push = scratch_.push;
+    push.assign(n, glm::dvec3(0.0));
+    auto joined = [&](std::uint32_t a, std::uint32_t b) {
+        return parent_[a] == b || parent_[b] == a || (parent_[a] != kNone && parent_[a] == parent_[b]);
+    };
+    parallel_ranges(n, settings_.threads, 2048, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) {
+            if (!alive_[i] || fixed_[i]) continue;
+            const double ri = std::min({radii_[i].x, radii_[i].y, radii_[i].z});
+            // only the 2 x 2 x 2 block of cells on the side of each axis the particle is nearer
+            // to can hold a partner
+            const glm::dvec3 u = x_[i] / cell;
+            const glm::i64vec3 c = glm::i64vec3(glm::floor(u));
+            const glm::dvec3 frac = u - glm::floor(u);
+            const glm::i64vec3 side(frac.x < 0.5 ? -1 : 1, frac.y < 0.5 ? -1 : 1, frac.z < 0.5 ? -1 : 1);
+            for (int dz = 0; dz <= 1; ++dz)
+                for (int dy = 0; dy <= 1; ++dy)
+                    for (int dx = 0; dx <= 1; ++dx) {
+                        const std::uint64_t k = hash(c + glm::i64vec3(dx, dy, dz) * side);
+                        std::size_t slot = k & (size - 1);
+                        while (table[slot].second != ~0u && table[slot].first != k) slot = (slot + 1) & (size - 1);
+                        if (table[slot].second == ~0u) continue;
+                        for (std::uint32_t at = table[slot].second; at < grid.size() && grid[at].first == k; ++at) {
+                            const std::uint32_t j = grid[at].second;
+                            if (j == i || joined(static_cast<std::uint32_t>(i), j)) continue;
+                            const double rj = std::min({radii_[j].x, radii_[j].y, radii_[j].z});
+                            glm::dvec3 d = x_[i] - x_[j];
+                            const double dist2 = glm::dot(d, d), want = ri + rj;
+                            if (dist2 >= want * want || dist2 < 1e-24) continue;
+                            const double dist = std::sqrt(dist2);
+                            push[i] += d / dist * ((want - dist) * (fixed_[j] ? 1.0 : 0.5));
+                        }
+                    }
+        }
+    });
+    for (std::size_t i = 0; i < n; ++i) x_[i] += push[i];
 }
 
 std::uint64_t World::state_hash() const {

@@ -208,7 +208,8 @@ namespace {
 // A seed particle growing upward for `seconds`.
 World grown(Growth g, double seconds, glm::dvec3 start_forward = {0, 1, 0}) {
     Settings s;
-    s.gravity = glm::dvec3(0.0); // growth alone
+    s.gravity = glm::dvec3(0.0); // growth alone: no gravity, and no contacts pushing laterals about
+    s.collisions = false;
     s.growth = g;
     World w(s);
     w.add_root({0, 0, 0}, glm::rotation(glm::dvec3(0, 1, 0), glm::normalize(start_forward)), {0.02, 0.05, 0.02});
@@ -333,4 +334,28 @@ TEST_CASE("two warm-started rotation iterations a pass settle where a full solve
     INFO("sag with 2 iterations " << fast.tip_sag() << ", with 20 " << exact.tip_sag());
     CHECK(exact.tip_sag() > 0);
     CHECK(std::fabs(fast.tip_sag() - exact.tip_sag()) < 0.02 * exact.tip_sag());
+}
+
+TEST_CASE("plant-plant collision: crossing branches of two plants end apart, and overlap without it", "[physics]") {
+    auto closest = [](bool collisions) {
+        Settings s;
+        s.gravity = glm::dvec3(0.0);
+        s.fixed_stiffness = 0.5;
+        s.collisions = collisions;
+        World w(s);
+        const glm::dvec3 r(0.02, 0.025, 0.02);
+        const glm::dquat along_x = glm::rotation(glm::dvec3(0, 1, 0), glm::dvec3(1, 0, 0));
+        std::vector<Handle> a, b;
+        a.push_back(w.add_root({0, 0, 0}, along_x, r));
+        for (int k = 1; k <= 10; ++k) a.push_back(w.add_particle(a.back(), {0.05 * k, 0, 0}, along_x, r));
+        b.push_back(w.add_root({0.25, -0.25, 0.01}, glm::dquat(1, 0, 0, 0), r));
+        for (int k = 1; k <= 10; ++k) b.push_back(w.add_particle(b.back(), {0.25, -0.25 + 0.05 * k, 0.01}, glm::dquat(1, 0, 0, 0), r));
+        for (int step = 0; step < 20; ++step) w.step();
+        double gap = 1e9; // distance between surfaces, negative when they overlap
+        for (Handle p : a)
+            for (Handle q : b) gap = std::min(gap, glm::distance(w.position(p), w.position(q)) - 0.04);
+        return gap;
+    };
+    CHECK(closest(false) < -0.02);  // the branches run through each other
+    CHECK(closest(true) > -0.004);  // they end (nearly) apart: within a tenth of the contact distance
 }

@@ -51,6 +51,8 @@ struct Settings {
     // one's rotation, so the iterations add up over a step's passes, as Müller et al. 2016
     // suggest for simulations; a cold solve (goals(), group_rotation()) runs up to 20.
     int rotation_iterations = 2;
+    // Plant-plant and self collision between particles not joined to each other (section 5.2).
+    bool collisions = true;
 };
 
 // Growth directions (Hädrich et al., section 4.2). Each returns the apex's forward vector turned
@@ -192,6 +194,7 @@ private:
     void match_shapes(std::vector<Frame>& frames, std::vector<glm::dvec3>& goal, std::vector<glm::dmat3>& moments,
                       int iterations) const;
     double stiffness(std::uint32_t i) const;
+    void separate_particles();
 
     Settings settings_;
     std::vector<glm::dvec3> x_, v_, rest_x_, radii_;
@@ -217,6 +220,9 @@ private:
         std::vector<glm::dvec3> goal;
         std::vector<glm::dmat3> moments;
         std::vector<glm::dvec3> old;
+        std::vector<std::pair<std::uint64_t, std::uint32_t>> grid;  // (cell key, particle), sorted
+        std::vector<std::pair<std::uint64_t, std::uint32_t>> table; // cell key -> first in grid
+        std::vector<glm::dvec3> push;
     } scratch_;
 };
 
