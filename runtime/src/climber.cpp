@@ -1,6 +1,8 @@
 // The climber environment: a physics::World driven by the grammar's bound modules.
 #include "plant/climber.hpp"
 
+#include "triangle_mesh.hpp"
+
 #include <fmt/format.h>
 #include <glm/gtc/quaternion.hpp>
 
@@ -31,7 +33,8 @@ const std::vector<EnvMethod>& Climber::methods() const {
             {"particles", {}, N, "particles in the world", false},
             {"pull", {N, V}, N, "hold module id's particle at a point through the next step's physics", false},
             {"cut", {N}, N, "cut the branch at module id: it leaves the string", false},
-            {"wind", {V}, N, "set the steady wind acceleration (vec3(0, 0, 0): off)", false},
+            {"wind", {V}, N, "set the wind (vec3(0, 0, 0): off)", false},
+            {"move", {N, V}, N, "move obstacle k (in the order declared: spheres, boxes, planes, meshes) by a vector", false},
         };
         for (std::size_t k = 4; k < v.size(); ++k) v[k].hook_only = true;
         return v;
@@ -64,6 +67,7 @@ void Climber::call(std::size_t method, const double* a, double* r) const {
         wind_ = vec(a);
         wind_changed_ = true;
         return;
+    case 7: moves_.emplace_back(static_cast<std::size_t>(std::max(a[0], 0.0)), vec(a + 1)); return;
     default: r[0] = 0;
     }
 }
@@ -95,6 +99,7 @@ void Climber::reset() {
     pending_.clear();
     pulls_.clear();
     cuts_.clear();
+    moves_.clear();
     wind_changed_ = false;
     grid_.clear();
     grid_n_ = glm::ivec3(0);
@@ -151,6 +156,8 @@ void Climber::advance() {
         if (h.valid() && world_.alive(h)) world_.remove(h);
     }
     cuts_.clear();
+    for (const auto& [k, delta] : moves_) world_.move_obstacle(k, delta);
+    moves_.clear();
     if (wind_changed_) {
         if (config_.air) fluid_.settings().wind = wind_;
         else world_.set_wind(wind_);
@@ -281,12 +288,13 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
     double friction = 0.5, elasticity = 0.0, break_threshold = 0;
     glm::dvec3 wind(0.0);
     std::vector<std::string> meshes;
+    double mesh_cell = 0.05;
     static const char* numbers[] = {"substeps", "iterations", "stiffness", "stiffening_time", "break_threshold",
                                     "damping", "density", "phototropism", "adaption", "adaption_range", "response",
                                     "anchor", "anchor_range", "anchor_release", "friction", "elasticity",
                                     "sphere_radius", "attractor_radius", "attractor_strength", "threads",
                                     "light_cell", "opacity", "air_spacing", "air_density", "air_viscosity",
-                                    "air_stiffness", "air_coupling"};
+                                    "air_stiffness", "air_coupling", "mesh_cell"};
     static const char* vectors[] = {"gravity", "light", "wind", "sphere", "box_min", "box_max", "plane_point",
                                     "plane_normal", "attractor", "air_min", "air_max"};
     bool air_min = false, air_max = false;
@@ -350,6 +358,7 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
         else if (a.key == "air_viscosity") c.fluid.viscosity = std::max(x, 0.0);
         else if (a.key == "air_stiffness") c.fluid.stiffness = std::max(x, 1e-6);
         else if (a.key == "air_coupling") c.fluid.coupling = std::max(x, 0.0);
+        else if (a.key == "mesh_cell") mesh_cell = std::max(x, 1e-3);
     }
     if (sphere.size() != sphere_r.size() || box_min.size() != box_max.size() || plane_p.size() != plane_n.size()) {
         error = "climber: give each sphere a sphere_radius, each box_min a box_max and each plane_point a plane_normal";
@@ -379,10 +388,6 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
     }
     if (glm::length(c.light) == 0) {
         error = "climber: 'light' must not be zero";
-        return nullptr;
-    }
-    if (!meshes.empty()) {
-        error = "climber: mesh obstacles are not supported yet; use boxes, spheres and planes";
         return nullptr;
     }
     for (std::size_t i = 0; i < attract.size(); ++i)
@@ -420,6 +425,14 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
         o.kind = physics::Obstacle::Plane;
         o.a = plane_p[i];
         o.b = glm::normalize(plane_n[i]);
+        add(o);
+    }
+    for (const auto& path : meshes) {
+        std::vector<Triangle> mesh;
+        if (!load_triangles(path, mesh, "climber", error)) return nullptr;
+        physics::Obstacle o;
+        o.kind = physics::Obstacle::Grid;
+        o.grid = distance_grid(mesh, mesh_cell, 4 * mesh_cell + c.adaption_range);
         add(o);
     }
     climber->remember_initial();

@@ -4,11 +4,8 @@
 
 #include "plant/climber.hpp"
 
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <OpenMesh/Core/IO/MeshIO.hh>
-#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
-#pragma GCC diagnostic pop
+#include "triangle_mesh.hpp"
+
 
 #include <fmt/format.h>
 #include <glm/glm.hpp>
@@ -279,9 +276,6 @@ public:
     struct Plane {
         glm::dvec3 p, n;
     };
-    struct Triangle {
-        glm::dvec3 a, b, c, n;
-    };
     std::vector<Sphere> spheres;
     std::vector<Box> boxes;
     std::vector<Plane> planes;
@@ -306,42 +300,8 @@ public:
             d = std::min(d, outside + inside);
         }
         for (const auto& pl : planes) d = std::min(d, glm::dot(p - pl.p, pl.n));
-        if (!triangles.empty()) {
-            // the nearest triangle gives the distance; the side of its face, the sign
-            double best = std::numeric_limits<double>::infinity();
-            double sign = 1;
-            for (const auto& t : triangles) {
-                glm::dvec3 q = closest_on_triangle(p, t);
-                double dist = glm::length(p - q);
-                if (dist < best - 1e-12) {
-                    best = dist;
-                    sign = glm::dot(p - q, t.n) < 0 ? -1 : 1;
-                }
-            }
-            d = std::min(d, sign * best);
-        }
+        if (!triangles.empty()) d = std::min(d, signed_distance(triangles, p));
         return d;
-    }
-    // Ericson, Real-Time Collision Detection, 5.1.5: the point of a triangle nearest to p.
-    static glm::dvec3 closest_on_triangle(const glm::dvec3& p, const Triangle& t) {
-        const glm::dvec3 ab = t.b - t.a, ac = t.c - t.a, ap = p - t.a;
-        double d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
-        if (d1 <= 0 && d2 <= 0) return t.a;
-        const glm::dvec3 bp = p - t.b;
-        double d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
-        if (d3 >= 0 && d4 <= d3) return t.b;
-        double vc = d1 * d4 - d3 * d2;
-        if (vc <= 0 && d1 >= 0 && d3 <= 0) return t.a + ab * (d1 / (d1 - d3));
-        const glm::dvec3 cp = p - t.c;
-        double d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
-        if (d6 >= 0 && d5 <= d6) return t.c;
-        double vb = d5 * d2 - d1 * d6;
-        if (vb <= 0 && d2 >= 0 && d6 <= 0) return t.a + ac * (d2 / (d2 - d6));
-        double va = d3 * d6 - d5 * d4;
-        if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
-            return t.b + (t.c - t.b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-        double denom = 1 / (va + vb + vc);
-        return t.a + ab * (vb * denom) + ac * (vc * denom);
     }
     void call(std::size_t method, const double* a, double* r) const override {
         double d = distance(vec(a));
@@ -487,34 +447,6 @@ private:
     std::vector<std::uint8_t> occupied_;
 };
 
-bool load_triangles(const std::string& path, std::vector<Obstacles::Triangle>& out, std::string& error) {
-    using Mesh = OpenMesh::TriMesh_ArrayKernelT<>;
-    Mesh mesh;
-    omlog().disable();
-    omerr().disable();
-    if (!OpenMesh::IO::read_mesh(mesh, path)) {
-        error = fmt::format("obstacles: cannot load the mesh '{}'", path);
-        return false;
-    }
-    mesh.triangulate();
-    for (auto f : mesh.faces()) {
-        glm::dvec3 v[3];
-        int k = 0;
-        for (auto vh : mesh.fv_range(f)) {
-            auto p = mesh.point(vh);
-            if (k < 3) v[k++] = glm::dvec3(p[0], p[1], p[2]);
-        }
-        glm::dvec3 n = glm::cross(v[1] - v[0], v[2] - v[0]);
-        if (glm::length(n) == 0) continue;
-        out.push_back({v[0], v[1], v[2], glm::normalize(n)});
-    }
-    if (out.empty()) {
-        error = fmt::format("obstacles: the mesh '{}' has no faces", path);
-        return false;
-    }
-    return true;
-}
-
 } // namespace
 
 EnvironmentFactory runtime_environments() {
@@ -556,7 +488,7 @@ EnvironmentFactory runtime_environments() {
                         error = "obstacles: 'mesh' is a quoted file name, as in mesh: \"rock.obj\"";
                         return nullptr;
                     }
-                    if (!load_triangles(arg.text, o->triangles, error)) return nullptr;
+                    if (!load_triangles(arg.text, o->triangles, "obstacles", error)) return nullptr;
                     continue;
                 }
                 bool is_vec = arg.type == V;

@@ -16,7 +16,7 @@
 //
 // Methods: grow_dir(p, h) (h turned by surface adaption, Eq. 6, by painted attractors and by
 // phototropism weighted by occlusion, Eq. 7), occlusion(p), anchored(id), particles(); in hooks
-// only: pull(id, target), cut(id), wind(a).
+// only: pull(id, target), cut(id), wind(a), move(k, delta).
 //
 // With air_min and air_max the climber also runs SPH air in that box (section 5.3): each 25 ms
 // physics step runs ten 2.5 ms air steps coupled both ways with the full-grown particles, and
@@ -118,6 +118,7 @@ private:
     // edits asked for by hooks (call() is const: hooks are the only callers, one at a time)
     mutable std::vector<std::pair<ModuleId, glm::dvec3>> pulls_;
     mutable std::vector<ModuleId> cuts_;
+    mutable std::vector<std::pair<std::size_t, glm::dvec3>> moves_;
     mutable glm::dvec3 wind_{0.0};
     mutable bool wind_changed_ = false;
     // occupancy grid of particles for occlusion

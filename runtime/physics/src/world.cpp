@@ -53,14 +53,35 @@ double Obstacle::distance(const glm::dvec3& p) const {
         return glm::length(glm::max(q, glm::dvec3(0.0))) + std::min(std::max(q.x, std::max(q.y, q.z)), 0.0);
     }
     case Plane: return glm::dot(p - a, glm::normalize(b));
+    case Grid: return grid ? grid->sample(p - a) : 1e300;
     }
     return 1e300;
 }
 
+double DistanceGrid::sample(const glm::dvec3& p) const {
+    if (d.empty()) return 1e300;
+    const glm::dvec3 hi = lo + glm::dvec3(n - 1) * cell;
+    const glm::dvec3 q = glm::clamp(p, lo, hi);
+    const double outside = glm::length(p - q);
+    const glm::dvec3 u = (q - lo) / cell;
+    const glm::ivec3 c = glm::clamp(glm::ivec3(glm::floor(u)), glm::ivec3(0), glm::max(n - 2, glm::ivec3(0)));
+    const glm::dvec3 f = glm::clamp(u - glm::dvec3(c), 0.0, 1.0);
+    auto at = [&](int x, int y, int z) {
+        x = std::min(x, n.x - 1), y = std::min(y, n.y - 1), z = std::min(z, n.z - 1);
+        return d[(static_cast<std::size_t>(z) * n.y + y) * n.x + x];
+    };
+    auto lerp = [](double a0, double a1, double t) { return a0 + (a1 - a0) * t; };
+    const double x00 = lerp(at(c.x, c.y, c.z), at(c.x + 1, c.y, c.z), f.x);
+    const double x10 = lerp(at(c.x, c.y + 1, c.z), at(c.x + 1, c.y + 1, c.z), f.x);
+    const double x01 = lerp(at(c.x, c.y, c.z + 1), at(c.x + 1, c.y, c.z + 1), f.x);
+    const double x11 = lerp(at(c.x, c.y + 1, c.z + 1), at(c.x + 1, c.y + 1, c.z + 1), f.x);
+    return lerp(lerp(x00, x10, f.y), lerp(x01, x11, f.y), f.z) + outside;
+}
+
 glm::dvec3 Obstacle::normal(const glm::dvec3& p) const {
     if (kind == Plane) return glm::normalize(b);
-    // central differences of the distance
-    const double e = 1e-6;
+    // central differences of the distance (over half a cell for a sampled grid)
+    const double e = kind == Grid && grid ? grid->cell / 2 : 1e-6;
     glm::dvec3 g(distance(p + glm::dvec3(e, 0, 0)) - distance(p - glm::dvec3(e, 0, 0)),
                  distance(p + glm::dvec3(0, e, 0)) - distance(p - glm::dvec3(0, e, 0)),
                  distance(p + glm::dvec3(0, 0, e)) - distance(p - glm::dvec3(0, 0, e)));

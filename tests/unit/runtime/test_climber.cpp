@@ -173,3 +173,74 @@ axiom: Seg(0.1, 0.02) Seg(0.1, 0.02) Seg(0.1, 0.02) Seg(0.1, 0.02) Seg(0.1, 0.02
     CHECK(still.x == Approx(0.0).margin(1e-9)); // uncoupled, the air passes through
     CHECK(bent.x > 0.005);                      // coupled, it bends the stem downwind
 }
+
+TEST_CASE("climber: a mesh obstacle (a distance grid of a loaded cube) is climbed and never entered", "[climber]") {
+    // the unit cube [0, 1]^3 from tests/data/cube.obj, scaled by nothing: a plant starts in front
+    // of its +z face and leans into it
+    const std::string cube = std::string(PLANT_TEST_DATA) + "/cube.obj";
+    Grown r = grow(fmt::format(R"(
+env ivy = climber(mesh: "{}", mesh_cell: 0.05, adaption: 0.8, adaption_range: 0.2, anchor: 0.5, anchor_range: 0.03);
+module Seg(len, r) bound ivy;
+module Apex(k);
+derive 24;
+axiom: @M(0.5, 0, 1.08) SetHead(0, 0.8, -0.6) Seg(0.05, 0.006) Apex(0) ?P(0, 0, 0) ?H(0, 1, 0);
+rules {{
+  Apex(k) > ?P(p) ?H(h) {{ let g = ivy.grow_dir(p, h); produce SetHead(g.x, g.y, g.z) Seg(0.05, 0.006) Apex(k + 1); }}
+}}
+)",
+                               cube));
+    const auto& pts = r.skeleton.axes.at(0).points;
+    REQUIRE(pts.size() > 20);
+    for (const auto& p : pts) {
+        const glm::dvec3& x = p.position;
+        const bool inside = x.x > 0.01 && x.x < 0.99 && x.y > 0.01 && x.y < 0.99 && x.z > 0.01 && x.z < 0.99;
+        CHECK(!inside);
+    }
+    CHECK(pts.back().position.y > 0.7);      // it went up the face
+    CHECK(pts.back().position.z < 1.1);      // staying on it
+}
+
+TEST_CASE("distance grid: trilinear samples of a box's distance", "[climber]") {
+    plant::physics::DistanceGrid g;
+    g.lo = glm::dvec3(-1.0);
+    g.cell = 0.25;
+    g.n = glm::ivec3(9);
+    g.d.resize(9 * 9 * 9);
+    plant::physics::Obstacle box;
+    box.kind = plant::physics::Obstacle::Box;
+    box.a = glm::dvec3(-0.5);
+    box.b = glm::dvec3(0.5);
+    for (int z = 0; z < 9; ++z)
+        for (int y = 0; y < 9; ++y)
+            for (int x = 0; x < 9; ++x)
+                g.d[(static_cast<std::size_t>(z) * 9 + y) * 9 + x] = box.distance(g.lo + glm::dvec3(x, y, z) * 0.25);
+    CHECK(g.sample(glm::dvec3(0.75, 0, 0)) == Approx(0.25));     // a grid point
+    CHECK(g.sample(glm::dvec3(0.625, 0, 0)) == Approx(0.125));   // between two, along a linear stretch
+    CHECK(g.sample(glm::dvec3(0, 0, 0)) == Approx(-0.5));        // the centre
+    CHECK(g.sample(glm::dvec3(3, 0, 0)) == Approx(2.5));         // outside the grid: 2 beyond it plus 0.5
+}
+
+TEST_CASE("climber: a box moved by a hook pushes the plant along, which never ends inside it", "[climber]") {
+    auto run = [](bool move) {
+        return grow(fmt::format(R"(
+env ivy = climber(box_min: vec3(-1, 0, -0.2), box_max: vec3(1, 3, 0), adaption: 0.8, adaption_range: 0.2,
+                  anchor: 0.5, anchor_range: 0.03);
+module Seg(len, r) bound ivy;
+module Apex(k);
+derive 24;
+axiom: @M(0, 0, 0.02) Seg(0.05, 0.006) Apex(0) ?P(0, 0, 0) ?H(0, 1, 0);
+on before_step {{ if {} && step() >= 16 && step() < 20 {{ ivy.move(0, vec3(0, 0, 0.02)); }} }}
+rules {{
+  Apex(k) > ?P(p) ?H(h) {{ let g = ivy.grow_dir(p, h); produce SetHead(g.x, g.y, g.z) Seg(0.05, 0.006) Apex(k + 1); }}
+}}
+)",
+                                move ? "true" : "false"));
+    };
+    Grown still = run(false), moved = run(true);
+    double still_z = 1e9, moved_z = 1e9;
+    for (const auto& p : still.skeleton.axes.at(0).points) still_z = std::min(still_z, p.position.z);
+    for (const auto& p : moved.skeleton.axes.at(0).points)
+        if (p.position.y > 0.1) moved_z = std::min(moved_z, p.position.z); // above the fixed root
+    CHECK(still_z < 0.03);
+    CHECK(moved_z >= 0.08 - 1e-6); // the wall's face went from z = 0 to 0.08; the plant is in front
+}

@@ -11,6 +11,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace plant::physics {
@@ -66,9 +67,21 @@ glm::dvec3 surface_adaption(const glm::dvec3& forward, const glm::dvec3& to_surf
 glm::dvec3 phototropism(const glm::dvec3& forward, const glm::dvec3& to_light, double occlusion, double eta, double dt);
 
 // Obstacles for particles: signed distance fields.
+// A signed distance sampled on a regular grid (a triangle mesh's, say): trilinear inside the
+// grid; outside it, the distance to the grid's box plus the value at the nearest grid point.
+struct DistanceGrid {
+    glm::dvec3 lo{0.0};
+    double cell = 1;
+    glm::ivec3 n{0};
+    std::vector<double> d; // x fastest
+    double sample(const glm::dvec3& p) const;
+};
+
 struct Obstacle {
-    enum Kind { Sphere, Box, Plane } kind = Plane;
-    glm::dvec3 a{0.0}, b{0.0, 1.0, 0.0}; // sphere: center, (radius in b.x); box: min, max; plane: point, normal
+    enum Kind { Sphere, Box, Plane, Grid } kind = Plane;
+    glm::dvec3 a{0.0}, b{0.0, 1.0, 0.0}; // sphere: center, (radius in b.x); box: min, max; plane: point, normal;
+                                         // grid: a is its offset from where it was sampled
+    std::shared_ptr<const DistanceGrid> grid{}; // Grid: the sampled distance (shared, never changed)
     double friction = 0.5;   // fraction of the tangential velocity removed on contact
     double elasticity = 0.0; // fraction of the normal velocity kept, reversed, on contact
     double distance(const glm::dvec3& p) const;
@@ -135,6 +148,13 @@ public:
     void add_anchor(Handle h, const glm::dvec3& point, double phi, double release);
     bool anchored(Handle h) const;
     void add_obstacle(const Obstacle& o) { obstacles_.push_back(o); }
+    // Moves obstacle k by `delta` (section 5.2: the user moves objects and the plants adapt).
+    void move_obstacle(std::size_t k, const glm::dvec3& delta) {
+        if (k >= obstacles_.size()) return;
+        Obstacle& o = obstacles_[k];
+        o.a += delta;
+        if (o.kind == Obstacle::Box) o.b += delta;
+    }
     // Connections whose length differs from the rest length by more than this fraction break
     // (0: never); the child's part becomes a loose branch.
     void set_break_threshold(double t) { break_threshold_ = t; }

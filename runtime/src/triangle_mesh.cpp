@@ -1,0 +1,107 @@
+#include "triangle_mesh.hpp"
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#include <OpenMesh/Core/IO/MeshIO.hh>
+#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+#pragma GCC diagnostic pop
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace plant {
+
+bool load_triangles(const std::string& path, std::vector<Triangle>& out, const char* who, std::string& error) {
+    using Mesh = OpenMesh::TriMesh_ArrayKernelT<>;
+    Mesh mesh;
+    omlog().disable();
+    omerr().disable();
+    if (!OpenMesh::IO::read_mesh(mesh, path)) {
+        error = fmt::format("{}: cannot load the mesh '{}'", who, path);
+        return false;
+    }
+    mesh.triangulate();
+    for (auto f : mesh.faces()) {
+        glm::dvec3 v[3];
+        int k = 0;
+        for (auto vh : mesh.fv_range(f)) {
+            auto p = mesh.point(vh);
+            if (k < 3) v[k++] = glm::dvec3(p[0], p[1], p[2]);
+        }
+        glm::dvec3 n = glm::cross(v[1] - v[0], v[2] - v[0]);
+        if (glm::length(n) == 0) continue;
+        out.push_back({v[0], v[1], v[2], glm::normalize(n)});
+    }
+    if (out.empty()) {
+        error = fmt::format("{}: the mesh '{}' has no faces", who, path);
+        return false;
+    }
+    return true;
+}
+
+glm::dvec3 closest_on_triangle(const glm::dvec3& p, const Triangle& t) {
+    const glm::dvec3 ab = t.b - t.a, ac = t.c - t.a, ap = p - t.a;
+    double d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
+    if (d1 <= 0 && d2 <= 0) return t.a;
+    const glm::dvec3 bp = p - t.b;
+    double d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
+    if (d3 >= 0 && d4 <= d3) return t.b;
+    double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) return t.a + ab * (d1 / (d1 - d3));
+    const glm::dvec3 cp = p - t.c;
+    double d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
+    if (d6 >= 0 && d5 <= d6) return t.c;
+    double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) return t.a + ac * (d2 / (d2 - d6));
+    double va = d3 * d6 - d5 * d4;
+    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+        return t.b + (t.c - t.b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    double denom = 1 / (va + vb + vc);
+    return t.a + ab * (vb * denom) + ac * (vc * denom);
+}
+
+double signed_distance(const std::vector<Triangle>& mesh, const glm::dvec3& p) {
+    // the nearest triangle gives the distance; the side of its face, the sign
+    double best = std::numeric_limits<double>::infinity();
+    double sign = 1;
+    for (const auto& t : mesh) {
+        glm::dvec3 q = closest_on_triangle(p, t);
+        double dist = glm::length(p - q);
+        if (dist < best - 1e-12) {
+            best = dist;
+            sign = glm::dot(p - q, t.n) < 0 ? -1 : 1;
+        }
+    }
+    return sign * best;
+}
+
+std::shared_ptr<const physics::DistanceGrid> distance_grid(const std::vector<Triangle>& mesh, double cell, double margin,
+                                                           std::size_t max_points) {
+    glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+    for (const auto& t : mesh)
+        for (const glm::dvec3& v : {t.a, t.b, t.c}) lo = glm::min(lo, v), hi = glm::max(hi, v);
+    lo -= glm::dvec3(margin);
+    hi += glm::dvec3(margin);
+    auto points = [&](double c) { return glm::ivec3(glm::ceil((hi - lo) / c)) + 1; };
+    while (true) {
+        glm::ivec3 n = points(cell);
+        if (static_cast<double>(n.x) * n.y * n.z <= static_cast<double>(max_points)) break;
+        cell *= 1.25;
+    }
+    auto g = std::make_shared<physics::DistanceGrid>();
+    g->lo = lo;
+    g->cell = cell;
+    g->n = points(cell);
+    g->d.resize(static_cast<std::size_t>(g->n.x) * g->n.y * g->n.z);
+    for (int z = 0; z < g->n.z; ++z)
+        for (int y = 0; y < g->n.y; ++y)
+            for (int x = 0; x < g->n.x; ++x)
+                g->d[(static_cast<std::size_t>(z) * g->n.y + y) * g->n.x + x] =
+                    signed_distance(mesh, lo + glm::dvec3(x, y, z) * cell);
+    return g;
+}
+
+} // namespace plant

@@ -1,0 +1,32 @@
+// Closed triangle meshes as obstacles: loading (any format OpenMesh reads) and signed distance.
+// Shared by the `obstacles` and `climber` environments (internal to plant_runtime).
+#pragma once
+
+#include "plant/physics/world.hpp"
+
+#include <glm/glm.hpp>
+
+#include <string>
+#include <vector>
+
+namespace plant {
+
+struct Triangle {
+    glm::dvec3 a, b, c, n; // corners and unit normal (outward for a closed mesh wound outward)
+};
+
+// Reads a mesh and triangulates it. `who` prefixes the error ("obstacles", "climber").
+bool load_triangles(const std::string& path, std::vector<Triangle>& out, const char* who, std::string& error);
+
+// Ericson, Real-Time Collision Detection, 5.1.5: the point of a triangle nearest to p.
+glm::dvec3 closest_on_triangle(const glm::dvec3& p, const Triangle& t);
+
+// Distance from p to the nearest triangle, negative on the inner side of that triangle's face.
+double signed_distance(const std::vector<Triangle>& mesh, const glm::dvec3& p);
+
+// Samples signed_distance on a grid of `cell` spacing over the mesh's box grown by `margin`
+// (at most `max_points` samples: the cell grows to fit), for the particle runtime.
+std::shared_ptr<const physics::DistanceGrid> distance_grid(const std::vector<Triangle>& mesh, double cell, double margin,
+                                                           std::size_t max_points = 1u << 20);
+
+} // namespace plant
