@@ -7,8 +7,13 @@
 // plane, so the collision stage has contacts to resolve. Every step runs growth (the T + 1 apices
 // lengthen and branch) and then the physics step, which includes the obstacle pass; the two are
 // timed separately.
-//   plant_physics_bench [PARTICLES] [STEPS] [THREADS]
-// Prints one line: particles=N threads=T steps=S physics_ms=... growth_ms=... total_ms=...
+// With AIR > 0, that many SPH air particles blow past the plant, coupled both ways (section 5.3),
+// ten 2.5 ms air steps per 25 ms plant step.
+//   plant_physics_bench [PARTICLES] [STEPS] [THREADS] [AIR] [--per-step]
+// Prints, per step with --per-step, the paper's stages (physics, growth, collision, SPH), then
+// one line: particles=N threads=T steps=S physics_ms=... growth_ms=... collision_ms=... sph_ms=...
+// total_ms=... (physics includes collision; total is physics + growth)
+#include "plant/physics/fluid.hpp"
 #include "plant/physics/world.hpp"
 
 #include <glm/gtc/quaternion.hpp>
@@ -19,6 +24,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <numbers>
+#include <string>
 
 using namespace plant::physics;
 
@@ -26,8 +32,11 @@ int main(int argc, char** argv) {
     const long want = argc > 1 ? std::atol(argv[1]) : 25000;
     const int steps = argc > 2 ? std::atoi(argv[2]) : 40;
     const int threads = argc > 3 ? std::atoi(argv[3]) : 1;
-    if (want < 100 || steps < 1 || threads < 1) {
-        std::fprintf(stderr, "usage: plant_physics_bench [PARTICLES >= 100] [STEPS >= 1] [THREADS >= 1]\n");
+    const long air = argc > 4 ? std::atol(argv[4]) : 0;
+    const bool per_step = argc > 5 && std::string(argv[5]) == "--per-step";
+    if (want < 100 || steps < 1 || threads < 1 || air < 0) {
+        std::fprintf(stderr, "usage: plant_physics_bench [PARTICLES >= 100] [STEPS >= 1] [THREADS >= 1] [AIR >= 0] "
+                             "[--per-step]\n");
         return 64;
     }
     const long lateral = 99;
@@ -61,20 +70,39 @@ int main(int argc, char** argv) {
         prev = trunk_h;
     }
 
+    // air around the lower trunk and its laterals, blowing along x
+    FluidSettings fs;
+    fs.threads = threads;
+    fs.wind = glm::dvec3(3, 0, 0);
+    const double side = std::cbrt(static_cast<double>(std::max(air, 1L))) * fs.spacing;
+    fs.domain_lo = glm::dvec3(-side / 2, 0.0, -side / 2);
+    fs.domain_hi = glm::dvec3(side / 2, side, side / 2);
+    Fluid fluid(fs);
+    if (air > 0) fluid.fill(fs.domain_lo, fs.domain_hi);
+
     using clock = std::chrono::steady_clock;
-    double physics = 0, growth = 0;
+    double physics = 0, growth = 0, collision = 0, sph = 0;
     const std::size_t start = w.size();
     for (int i = 0; i < steps; ++i) {
         auto t0 = clock::now();
         w.grow();
         auto t1 = clock::now();
-        w.step();
+        if (air > 0)
+            for (int k = 0; k < 10; ++k) fluid.step(&w);
         auto t2 = clock::now();
-        growth += std::chrono::duration<double, std::milli>(t1 - t0).count();
-        physics += std::chrono::duration<double, std::milli>(t2 - t1).count();
+        w.step();
+        auto t3 = clock::now();
+        const double g = std::chrono::duration<double, std::milli>(t1 - t0).count();
+        const double a = std::chrono::duration<double, std::milli>(t2 - t1).count();
+        const double p = std::chrono::duration<double, std::milli>(t3 - t2).count();
+        growth += g, sph += a, physics += p, collision += w.last_step_times().collision;
+        if (per_step)
+            std::printf("step %d: physics %.3f ms (collision %.3f), growth %.3f ms, sph %.3f ms\n", i + 1, p,
+                        w.last_step_times().collision, g, a);
     }
-    std::printf("particles=%zu threads=%d grown=%zu steps=%d physics_ms=%.3f growth_ms=%.3f total_ms=%.3f hash=%016llx\n",
-                start, threads, w.size() - start, steps, physics / steps, growth / steps, (physics + growth) / steps,
-                static_cast<unsigned long long>(w.state_hash()));
+    std::printf("particles=%zu air=%zu threads=%d grown=%zu steps=%d physics_ms=%.3f growth_ms=%.3f collision_ms=%.3f "
+                "sph_ms=%.3f total_ms=%.3f hash=%016llx\n",
+                start, fluid.size(), threads, w.size() - start, steps, physics / steps, growth / steps, collision / steps,
+                sph / steps, (physics + growth) / steps, static_cast<unsigned long long>(w.state_hash()));
     return 0;
 }

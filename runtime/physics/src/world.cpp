@@ -4,6 +4,7 @@
 #include "parallel.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <numbers>
@@ -296,6 +297,9 @@ std::vector<glm::dvec3> World::goals() const {
 }
 
 void World::step() {
+    using clock = std::chrono::steady_clock;
+    const auto t_start = clock::now();
+    double collision_ms = 0;
     const double dt = settings_.dt;
     const std::size_t n = x_.size();
     std::vector<glm::dvec3>& old = scratch_.old;
@@ -345,10 +349,13 @@ void World::step() {
         });
         for (const auto& [i, target] : pulls_) x_[i] = target; // a dragged particle goes where it is dragged
     }
+    auto t0 = clock::now();
     if (settings_.collisions) separate_particles();
+    collision_ms += std::chrono::duration<double, std::milli>(clock::now() - t0).count();
     // Eq. 17-18, with damping; then obstacles: a particle inside one is put back on its surface
     // (its radius off it), its velocity losing the normal part (or bouncing by the elasticity)
     // and some of the tangential part (friction)
+    t0 = clock::now();
     for (std::uint32_t i = 0; i < n; ++i) {
         if (!alive_[i]) continue;
         v_[i] = fixed_[i] ? glm::dvec3(0.0) : (x_[i] - old[i]) / dt * (1.0 - settings_.damping);
@@ -365,6 +372,7 @@ void World::step() {
             v_[i] = tangential * (1 - o.friction) + (vn < 0 ? -vn * o.elasticity : vn) * nrm;
         }
     }
+    collision_ms += std::chrono::duration<double, std::milli>(clock::now() - t0).count();
     // breaking: a connection stretched past the threshold lets its child go (section 4.3)
     if (break_threshold_ > 0) {
         for (std::uint32_t i = 0; i < n; ++i) {
@@ -380,6 +388,8 @@ void World::step() {
         }
     }
     pulls_.clear();
+    times_.collision = collision_ms;
+    times_.dynamics = std::chrono::duration<double, std::milli>(clock::now() - t_start).count() - collision_ms;
 }
 
 namespace {

@@ -184,6 +184,13 @@ public:
     // The rotation of particle i's own group (parent, itself, children).
     glm::dquat group_rotation(std::uint32_t i) const;
 
+    // Where the last step's time went (milliseconds): shape matching and integration, and the
+    // collisions with obstacles and between particles.
+    struct StepTimes {
+        double dynamics = 0, collision = 0;
+    };
+    const StepTimes& last_step_times() const { return times_; }
+
     // A hash of the whole state, for determinism tests.
     std::uint64_t state_hash() const;
 
@@ -234,6 +241,7 @@ private:
     std::vector<std::pair<std::uint32_t, glm::dvec3>> pulls_;
     double break_threshold_ = 0;
     glm::dvec3 wind_{0.0};
+    StepTimes times_;
     std::vector<glm::dvec3> external_; // per particle, cleared after each step
     struct Scratch {
         std::vector<Frame> frames;
