@@ -31,12 +31,14 @@ const std::vector<EnvMethod>& Climber::methods() const {
             {"occlusion", {V}, N, "light occlusion at p by the plant's particles, 0 to 1", true},
             {"anchored", {N}, N, "1 when module id's particle is anchored to a surface", false},
             {"particles", {}, N, "particles in the world", false},
+            {"seeded", {N}, N, "1 in the step after a hook seeded a branch at module id (ivy.seed(id))", false},
             {"pull", {N, V}, N, "hold module id's particle at a point through the next step's physics", false},
             {"cut", {N}, N, "cut the branch at module id: it leaves the string", false},
             {"wind", {V}, N, "set the wind (vec3(0, 0, 0): off)", false},
             {"move", {N, V}, N, "move obstacle k (in the order declared: spheres, boxes, planes, meshes) by a vector", false},
+            {"seed", {N}, N, "seed a new branch at module id: ivy.seeded(id) holds in the next step", false},
         };
-        for (std::size_t k = 4; k < v.size(); ++k) v[k].hook_only = true;
+        for (std::size_t k = 5; k < v.size(); ++k) v[k].hook_only = true;
         return v;
     }();
     return m;
@@ -61,13 +63,15 @@ void Climber::call(std::size_t method, const double* a, double* r) const {
         return;
     }
     case 3: r[0] = static_cast<double>(particle_of_.size()); return;
-    case 4: pulls_.emplace_back(static_cast<ModuleId>(a[0]), vec(a + 1)); return;
-    case 5: cuts_.push_back(static_cast<ModuleId>(a[0])); return;
-    case 6:
+    case 4: r[0] = seeded_.count(static_cast<ModuleId>(a[0])) ? 1 : 0; return;
+    case 5: pulls_.emplace_back(static_cast<ModuleId>(a[0]), vec(a + 1)); return;
+    case 6: cuts_.push_back(static_cast<ModuleId>(a[0])); return;
+    case 7:
         wind_ = vec(a);
         wind_changed_ = true;
         return;
-    case 7: moves_.emplace_back(static_cast<std::size_t>(std::max(a[0], 0.0)), vec(a + 1)); return;
+    case 8: moves_.emplace_back(static_cast<std::size_t>(std::max(a[0], 0.0)), vec(a + 1)); return;
+    case 9: seed_requests_.push_back(static_cast<ModuleId>(a[0])); return;
     default: r[0] = 0;
     }
 }
@@ -100,6 +104,8 @@ void Climber::reset() {
     pulls_.clear();
     cuts_.clear();
     moves_.clear();
+    seed_requests_.clear();
+    seeded_.clear();
     wind_changed_ = false;
     grid_.clear();
     grid_n_ = glm::ivec3(0);
@@ -156,6 +162,10 @@ void Climber::advance() {
         if (h.valid() && world_.alive(h)) world_.remove(h);
     }
     cuts_.clear();
+    // seeds asked for since the last step are visible to this step's productions
+    seeded_.clear();
+    seeded_.insert(seed_requests_.begin(), seed_requests_.end());
+    seed_requests_.clear();
     for (const auto& [k, delta] : moves_) world_.move_obstacle(k, delta);
     moves_.clear();
     if (wind_changed_) {

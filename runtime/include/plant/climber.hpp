@@ -15,8 +15,8 @@
 // particles.
 //
 // Methods: grow_dir(p, h) (h turned by surface adaption, Eq. 6, by painted attractors and by
-// phototropism weighted by occlusion, Eq. 7), occlusion(p), anchored(id), particles(); in hooks
-// only: pull(id, target), cut(id), wind(a), move(k, delta).
+// phototropism weighted by occlusion, Eq. 7), occlusion(p), anchored(id), particles(), seeded(id);
+// in hooks only: pull(id, target), cut(id), wind(a), move(k, delta), seed(id).
 //
 // With air_min and air_max the climber also runs SPH air in that box (section 5.3): each 25 ms
 // physics step runs ten 2.5 ms air steps coupled both ways with the full-grown particles, and
@@ -119,6 +119,8 @@ private:
     mutable std::vector<std::pair<ModuleId, glm::dvec3>> pulls_;
     mutable std::vector<ModuleId> cuts_;
     mutable std::vector<std::pair<std::size_t, glm::dvec3>> moves_;
+    mutable std::vector<ModuleId> seed_requests_;
+    std::set<ModuleId> seeded_;
     mutable glm::dvec3 wind_{0.0};
     mutable bool wind_changed_ = false;
     // occupancy grid of particles for occlusion

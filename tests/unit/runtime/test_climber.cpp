@@ -244,3 +244,20 @@ rules {{
     CHECK(still_z < 0.03);
     CHECK(moved_z >= 0.08 - 1e-6); // the wall's face went from z = 0 to 0.08; the plant is in front
 }
+
+TEST_CASE("climber: a hook seeds a new branch at a segment, and it grows from there", "[climber]") {
+    // stdlib/climber.plant with one unbranched plant; #12 is its second segment
+    auto plant = [](const std::string& hook) {
+        return grow("import climber with { N = 1, BP = 0, steps = 12, leaf_size = 0 };\n"
+                    "env ivy = climber(box_min: vec3(-1, 0, -0.2), box_max: vec3(1, 3, 0), adaption: 0.8, anchor: 0.5);\n" +
+                    hook);
+    };
+    Grown plain = plant(""), seeded = plant("on before_step { if step() == 4 { ivy.seed(12); } }\n");
+    CHECK(count(plain.string, "Apex(") == 1);
+    CHECK(count(seeded.string, "Apex(") == 2);
+    CHECK(count(seeded.string, "Seg(") > count(plain.string, "Seg(") + 4); // the new shoot grew on
+    REQUIRE(seeded.skeleton.axes.size() == 2);
+    // it starts where the second segment ends
+    const auto& base = seeded.skeleton.axes[1].points.front().position;
+    CHECK(glm::distance(base, seeded.skeleton.axes[0].points[2].position) < 1e-9);
+}
