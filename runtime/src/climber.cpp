@@ -49,7 +49,19 @@ physics::Handle Climber::particle(ModuleId id) const {
     return it == particle_of_.end() ? physics::Handle{} : it->second;
 }
 
+namespace {
+
+// A module identity from a number, or 0 (no module) for anything that is not one.
+ModuleId id_of(double v) {
+    return std::isfinite(v) && v > 0 && v < 9.0e15 ? static_cast<ModuleId>(v) : 0;
+}
+bool finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+} // namespace
+
 void Climber::call(std::size_t method, const double* a, double* r) const {
+    // editing calls with a non-finite vector or index are ignored: they would poison the world
+    if (method >= 5 && method != 6 && method != 9 && !finite(vec(method == 7 ? a : a + 1))) return;
     switch (method) {
     case 0: {
         glm::dvec3 g = grow_dir(vec(a), vec(a + 3));
@@ -58,20 +70,22 @@ void Climber::call(std::size_t method, const double* a, double* r) const {
     }
     case 1: r[0] = occlusion(vec(a)); return;
     case 2: {
-        physics::Handle h = particle(static_cast<ModuleId>(a[0]));
+        physics::Handle h = particle(id_of(a[0]));
         r[0] = h.valid() && world_.alive(h) && world_.anchored(h) ? 1 : 0;
         return;
     }
     case 3: r[0] = static_cast<double>(particle_of_.size()); return;
-    case 4: r[0] = seeded_.count(static_cast<ModuleId>(a[0])) ? 1 : 0; return;
-    case 5: pulls_.emplace_back(static_cast<ModuleId>(a[0]), vec(a + 1)); return;
-    case 6: cuts_.push_back(static_cast<ModuleId>(a[0])); return;
+    case 4: r[0] = seeded_.count(id_of(a[0])) ? 1 : 0; return;
+    case 5: pulls_.emplace_back(id_of(a[0]), vec(a + 1)); return;
+    case 6: cuts_.push_back(id_of(a[0])); return;
     case 7:
         wind_ = vec(a);
         wind_changed_ = true;
         return;
-    case 8: moves_.emplace_back(static_cast<std::size_t>(std::max(a[0], 0.0)), vec(a + 1)); return;
-    case 9: seed_requests_.push_back(static_cast<ModuleId>(a[0])); return;
+    case 8:
+        if (std::isfinite(a[0]) && a[0] >= 0 && a[0] < 1e9) moves_.emplace_back(static_cast<std::size_t>(a[0]), vec(a + 1));
+        return;
+    case 9: seed_requests_.push_back(id_of(a[0])); return;
     default: r[0] = 0;
     }
 }
@@ -98,6 +112,7 @@ void Climber::reset() {
     world_ = initial_;
     fluid_ = initial_fluid_;
     particle_of_.clear();
+    roots_.clear();
     seen_.clear();
     detached_.clear();
     pending_.clear();
@@ -137,11 +152,15 @@ void Climber::advance() {
     }
     // new bound modules become particles where the turtle drew them
     for (const Pending& p : pending_) {
-        const double r = std::max(p.radius, 1e-4);
-        const glm::dvec3 radii(r, std::max(p.length / 2, r), r);
+        const double r = std::isfinite(p.radius) ? std::clamp(p.radius, 1e-4, 1e6) : 1e-4;
+        const double length = std::isfinite(p.length) ? std::clamp(p.length, 0.0, 1e6) : 0.0;
+        const glm::dvec3 radii(r, std::max(length / 2, r), r);
         const glm::dquat q = quat_of(p.frame);
         physics::Handle parent = particle(p.parent);
-        if (!parent.valid() || !world_.alive(parent)) parent = world_.add_root(p.from, q, radii, true);
+        if (!parent.valid() || !world_.alive(parent)) {
+            parent = world_.add_root(p.from, q, radii, true);
+            roots_.push_back(parent);
+        }
         physics::Handle h = world_.add_grown(parent, p.to, q, radii);
         particle_of_[p.id] = h;
         // Eq. 5: a particle born near a surface holds on to it
@@ -190,7 +209,17 @@ void Climber::advance() {
             continue;
         }
         detached_.insert(it->first);
+        world_.remove(it->second); // a broken-off part is no longer drawn, so no longer simulated
         it = particle_of_.erase(it);
+    }
+    // a fixed root whose plant is gone would only be in the way of the next one planted there
+    for (auto it = roots_.begin(); it != roots_.end();) {
+        if (world_.has_children(*it)) {
+            ++it;
+            continue;
+        }
+        world_.remove(*it);
+        it = roots_.erase(it);
     }
     rebuild_occupancy();
 }
@@ -201,20 +230,24 @@ void Climber::rebuild_occupancy() {
     if (particle_of_.empty()) return;
     glm::dvec3 lo(1e300), hi(-1e300);
     for (const auto& [id, h] : particle_of_) {
+        if (!finite(world_.position(h))) continue;
         lo = glm::min(lo, world_.position(h));
         hi = glm::max(hi, world_.position(h));
     }
+    if (!(lo.x <= hi.x)) return; // no particle with a finite position
     double cell = config_.light_cell;
     glm::dvec3 n = glm::floor((hi - lo) / cell) + 1.0;
     while (n.x * n.y * n.z > 4e6) {
         cell *= 2;
         n = glm::floor((hi - lo) / cell) + 1.0;
     }
+    if (!finite(n)) return;
     grid_cell_ = cell;
     grid_lo_ = lo;
     grid_n_ = glm::ivec3(n);
     grid_.assign(static_cast<std::size_t>(grid_n_.x) * grid_n_.y * grid_n_.z, 0);
     for (const auto& [id, h] : particle_of_) {
+        if (!finite(world_.position(h))) continue;
         glm::ivec3 c = glm::ivec3(glm::floor((world_.position(h) - lo) / cell));
         c = glm::clamp(c, glm::ivec3(0), grid_n_ - 1);
         ++grid_[(static_cast<std::size_t>(c.z) * grid_n_.y + c.y) * grid_n_.x + c.x];
@@ -223,7 +256,7 @@ void Climber::rebuild_occupancy() {
 
 double Climber::occlusion(const glm::dvec3& p) const {
     // particles in the cells between p and the light (Eq. 7's O), its own cell excluded
-    if (grid_.empty()) return 0;
+    if (grid_.empty() || !finite(p)) return 0;
     const glm::dvec3 dir = glm::normalize(config_.light);
     const double cell = grid_cell_;
     glm::dvec3 q = p;
@@ -242,7 +275,7 @@ double Climber::occlusion(const glm::dvec3& p) const {
             if (leaving) break;
             continue;
         }
-        glm::ivec3 c = glm::ivec3(glm::floor(rel / cell));
+        glm::ivec3 c = glm::clamp(glm::ivec3(glm::floor(rel / cell)), glm::ivec3(0), grid_n_ - 1);
         if (c == own || c == last) continue;
         last = c;
         count += grid_[(static_cast<std::size_t>(c.z) * grid_n_.y + c.y) * grid_n_.x + c.x];
@@ -252,7 +285,8 @@ double Climber::occlusion(const glm::dvec3& p) const {
 
 glm::dvec3 Climber::grow_dir(const glm::dvec3& p, const glm::dvec3& h) const {
     const double time = config_.substeps * world_.settings().dt * config_.response;
-    glm::dvec3 f = glm::length(h) > 0 ? glm::normalize(h) : glm::dvec3(0, 1, 0);
+    glm::dvec3 f = finite(h) && glm::length(h) > 0 ? glm::normalize(h) : glm::dvec3(0, 1, 0);
+    if (!finite(p)) return f;
     // Eq. 6: parallel to the nearest surface in range; before that, a plant searches for the
     // support and grows toward it (section 4.2), more the farther it still is
     const physics::Obstacle* nearest = nullptr;
@@ -384,9 +418,15 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
     }
     if (air_min) {
         c.air = true;
-        c.fluid.domain_lo = glm::min(c.fluid.domain_lo, c.fluid.domain_hi);
-        c.fluid.domain_hi = glm::max(c.fluid.domain_lo, c.fluid.domain_hi);
-        glm::dvec3 cells = (c.fluid.domain_hi - c.fluid.domain_lo) / c.fluid.spacing;
+        const glm::dvec3 lo = glm::min(c.fluid.domain_lo, c.fluid.domain_hi), hi = glm::max(c.fluid.domain_lo, c.fluid.domain_hi);
+        c.fluid.domain_lo = lo;
+        c.fluid.domain_hi = hi;
+        if (!finite(lo) || !finite(hi)) {
+            error = "climber: air_min and air_max must be finite";
+            return nullptr;
+        }
+        // counted as Fluid::fill will fill it: at least one particle along each axis
+        glm::dvec3 cells = glm::max(glm::floor((hi - lo) / c.fluid.spacing + 1e-9), glm::dvec3(1.0));
         if (cells.x * cells.y * cells.z > 200000) {
             error = "climber: the air box holds more than 200,000 particles at this air_spacing";
             return nullptr;

@@ -9,6 +9,7 @@
 #include <set>
 
 #include <unordered_map>
+#include <unordered_set>
 
 namespace plant {
 
@@ -41,11 +42,12 @@ private:
 // Shows each climber the segments of the modules bound to it, in string order.
 class ClimberSink : public TurtleSink {
 public:
-    ClimberSink(const ModuleString& s, const std::vector<Climber*>& by_symbol) : string_(s), by_symbol_(by_symbol) {}
+    ClimberSink(const ModuleString& s, const std::vector<Climber*>& by_symbol, const std::unordered_set<ModuleId>& own)
+        : string_(s), by_symbol_(by_symbol), own_(own) {}
     void segment(const TurtleSegment& seg) override {
         const SymbolId sym = string_.sym[seg.module];
         Climber* c = sym < by_symbol_.size() ? by_symbol_[sym] : nullptr;
-        if (!c) return;
+        if (!c || !own_.count(seg.id)) return;
         const TurtleState& t = *seg.state;
         const double len = string_.arity(seg.module) > 0 ? string_.args(seg.module)[0] : t.step;
         c->observe(seg.id, t.bound_parent, seg.from, seg.to, glm::dmat3(-t.left, t.heading, t.up), t.width / 2, len);
@@ -54,6 +56,7 @@ public:
 private:
     const ModuleString& string_;
     const std::vector<Climber*>& by_symbol_;
+    const std::unordered_set<ModuleId>& own_;
 };
 
 
@@ -75,7 +78,12 @@ void advance_climbers(const Derivation& d, ModuleString& string) {
     if (climbers.empty()) return;
     ModuleString interpreted = d.interpreted(string);
     for (Climber* c : climbers) c->begin_sync();
-    ClimberSink sink(interpreted, by_symbol);
+    // only modules of the string itself hold particles: one an interpretation rule made has an
+    // identity that the next step may give to another module
+    std::unordered_set<ModuleId> own;
+    for (std::size_t i = 0; i < string.size(); ++i)
+        if (string.sym[i] < by_symbol.size() && by_symbol[string.sym[i]]) own.insert(string.ids[i]);
+    ClimberSink sink(interpreted, by_symbol, own);
     interpret(p, interpreted, turtle_options(d), sink);
     std::set<ModuleId> gone;
     for (Climber* c : climbers) {

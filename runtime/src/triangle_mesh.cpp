@@ -32,7 +32,7 @@ bool load_triangles(const std::string& path, std::vector<Triangle>& out, const c
             if (k < 3) v[k++] = glm::dvec3(p[0], p[1], p[2]);
         }
         glm::dvec3 n = glm::cross(v[1] - v[0], v[2] - v[0]);
-        if (glm::length(n) == 0) continue;
+        if (!(glm::length(n) > 0) || !std::isfinite(glm::length(n))) continue; // degenerate or not finite
         out.push_back({v[0], v[1], v[2], glm::normalize(n)});
     }
     if (out.empty()) {
@@ -85,16 +85,16 @@ std::shared_ptr<const physics::DistanceGrid> distance_grid(const std::vector<Tri
         for (const glm::dvec3& v : {t.a, t.b, t.c}) lo = glm::min(lo, v), hi = glm::max(hi, v);
     lo -= glm::dvec3(margin);
     hi += glm::dvec3(margin);
-    auto points = [&](double c) { return glm::ivec3(glm::ceil((hi - lo) / c)) + 1; };
+    auto points = [&](double c) { return glm::ceil((hi - lo) / c) + 1.0; }; // in double: no overflow
     while (true) {
-        glm::ivec3 n = points(cell);
-        if (static_cast<double>(n.x) * n.y * n.z <= static_cast<double>(max_points)) break;
+        glm::dvec3 n = points(cell);
+        if (n.x * n.y * n.z <= static_cast<double>(max_points)) break;
         cell *= 1.25;
     }
     auto g = std::make_shared<physics::DistanceGrid>();
     g->lo = lo;
     g->cell = cell;
-    g->n = points(cell);
+    g->n = glm::ivec3(points(cell));
     g->d.resize(static_cast<std::size_t>(g->n.x) * g->n.y * g->n.z);
     for (int z = 0; z < g->n.z; ++z)
         for (int y = 0; y < g->n.y; ++y)

@@ -107,6 +107,7 @@ private:
     physics::Fluid fluid_, initial_fluid_;
     Config config_;
     std::map<ModuleId, physics::Handle> particle_of_; // ordered: removals happen in id order
+    std::vector<physics::Handle> roots_;              // the fixed roots made for plants' first segments
     std::set<ModuleId> seen_, detached_;
     struct Pending {
         ModuleId id, parent;

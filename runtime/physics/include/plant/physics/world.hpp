@@ -161,6 +161,7 @@ public:
     // Number of connected parts (a broken-off branch is one more).
     std::size_t components() const;
     std::uint32_t parent(Handle h) const { return parent_[h.index]; }
+    bool has_children(Handle h) const { return alive(h) && !children_[h.index].empty(); }
 
     bool alive(Handle h) const;
     glm::dvec3 position(Handle h) const { return x_[h.index]; }
