@@ -252,9 +252,15 @@ void World::match_shapes(std::vector<Frame>& frames, std::vector<glm::dvec3>& go
     moments.resize(n);
     goal.resize(n);
     const int threads = settings_.threads;
+    // Eq. 15's moment R D R̄ᵀ: the rest part D R̄ᵀ (with the mass) is fixed within a step and
+    // computed once in step(); here only the current rotation changes
+    const bool cached = scratch_.rest_moment.size() == n;
     parallel_ranges(n, threads, 2048, [&](std::size_t b, std::size_t e) {
-        for (std::size_t j = b; j < e; ++j)
-            if (alive_[j]) moments[j] = ellipsoid_moment(static_cast<std::uint32_t>(j));
+        for (std::size_t j = b; j < e; ++j) {
+            if (!alive_[j]) continue;
+            moments[j] = cached ? glm::mat3_cast(q_[j]) * scratch_.rest_moment[j]
+                                : ellipsoid_moment(static_cast<std::uint32_t>(j));
+        }
     });
     parallel_ranges(n, threads, 2048, [&](std::size_t b, std::size_t e) {
         for (std::size_t k = b; k < e; ++k) {
@@ -327,6 +333,15 @@ void World::step() {
     auto& frames = scratch_.frames;
     auto& goal = scratch_.goal;
     auto& moments = scratch_.moments;
+    auto& rest_moment = scratch_.rest_moment;
+    rest_moment.resize(n);
+    for (std::size_t j = 0; j < n; ++j) {
+        if (!alive_[j]) continue;
+        const glm::dvec3& r = radii_[j];
+        glm::dmat3 D(0.0);
+        D[0][0] = r.x * r.x, D[1][1] = r.y * r.y, D[2][2] = r.z * r.z;
+        rest_moment[j] = 0.2 * matching_mass(static_cast<std::uint32_t>(j)) * D * glm::transpose(glm::mat3_cast(rest_q_[j]));
+    }
     for (int it = 0; it < settings_.iterations; ++it) {
         match_shapes(frames, goal, moments, settings_.rotation_iterations);
         parallel_ranges(n, settings_.threads, 2048, [&](std::size_t b, std::size_t e) {
@@ -388,6 +403,7 @@ void World::step() {
         }
     }
     pulls_.clear();
+    rest_moment.clear(); // only valid within this step
     times_.collision = collision_ms;
     times_.dynamics = std::chrono::duration<double, std::milli>(clock::now() - t_start).count() - collision_ms;
 }
@@ -462,44 +478,58 @@ void World::grow() {
 // the thread count.
 void World::separate_particles() {
     const std::size_t n = x_.size();
+    auto& thin = scratch_.thin;
+    thin.assign(n, 0.0);
     double reach = 0;
     for (std::size_t i = 0; i < n; ++i)
-        if (alive_[i]) reach = std::max(reach, 2 * std::min({radii_[i].x, radii_[i].y, radii_[i].z}));
+        if (alive_[i]) {
+            thin[i] = std::min({radii_[i].x, radii_[i].y, radii_[i].z});
+            reach = std::max(reach, 2 * thin[i]);
+        }
     if (reach <= 0 || n < 2) return;
     const double cell = 2 * reach; // twice the widest contact: a 2 x 2 x 2 block of cells holds every partner
-    // particles sorted by cell, and an open-addressing table from a cell to its run of them
-    auto cell_of = [&](const glm::dvec3& p) { return glm::i64vec3(glm::floor(p / cell)); };
     auto hash = [](const glm::i64vec3& c) {
         return static_cast<std::uint64_t>(c.x * 73856093) ^ static_cast<std::uint64_t>(c.y * 19349663) ^
                static_cast<std::uint64_t>(c.z * 83492791);
     };
-    auto& grid = scratch_.grid;
-    grid.clear();
-    for (std::uint32_t i = 0; i < n; ++i)
-        if (alive_[i]) grid.emplace_back(hash(cell_of(x_[i])), i);
-    std::sort(grid.begin(), grid.end());
+    // an open-addressing table from a cell's key to its run of particles in `members` (in index
+    // order), built by counting: no sort
     std::size_t size = 16;
-    while (size < 2 * grid.size()) size *= 2;
-    auto& table = scratch_.table; // (key, first index in grid) or empty
-    table.assign(size, {0, ~0u});
-    for (std::uint32_t k = 0; k < grid.size(); ++k) {
-        if (k > 0 && grid[k].first == grid[k - 1].first) continue;
-        std::size_t slot = grid[k].first & (size - 1);
-        while (table[slot].second != ~0u) slot = (slot + 1) & (size - 1);
-        table[slot] = {grid[k].first, k};
+    while (size < 4 * n) size *= 2; // a quarter full at most: short probes
+    auto& table = scratch_.table; // (key, count) per slot; count 0: empty
+    table.assign(size, {0, 0});
+    auto& slot_of = scratch_.slot_of;
+    slot_of.assign(n, ~0u);
+    for (std::uint32_t i = 0; i < n; ++i) {
+        if (!alive_[i]) continue;
+        const std::uint64_t k = hash(glm::i64vec3(glm::floor(x_[i] / cell)));
+        std::size_t slot = k & (size - 1);
+        while (table[slot].second != 0 && table[slot].first != k) slot = (slot + 1) & (size - 1);
+        table[slot].first = k;
+        ++table[slot].second;
+        slot_of[i] = static_cast<std::uint32_t>(slot);
+    }
+    auto& start = scratch_.start;
+    start.assign(size + 1, 0);
+    for (std::size_t t = 0; t < size; ++t) start[t + 1] = start[t] + table[t].second;
+    auto& members = scratch_.members;
+    members.resize(start[size]);
+    {
+        std::vector<std::uint32_t>& fill = scratch_.fill;
+        fill.assign(start.begin(), start.end() - 1);
+        for (std::uint32_t i = 0; i < n; ++i)
+            if (slot_of[i] != ~0u) members[fill[slot_of[i]]++] = i;
     }
     auto& push = scratch_.push;
     push.assign(n, glm::dvec3(0.0));
-    auto joined = [&](std::uint32_t a, std::uint32_t b) {
-        return parent_[a] == b || parent_[b] == a || (parent_[a] != kNone && parent_[a] == parent_[b]);
-    };
     parallel_ranges(n, settings_.threads, 2048, [&](std::size_t b, std::size_t e) {
         for (std::size_t i = b; i < e; ++i) {
             if (!alive_[i] || fixed_[i]) continue;
-            const double ri = std::min({radii_[i].x, radii_[i].y, radii_[i].z});
+            const double ri = thin[i];
+            const glm::dvec3 xi = x_[i];
             // only the 2 x 2 x 2 block of cells on the side of each axis the particle is nearer
             // to can hold a partner
-            const glm::dvec3 u = x_[i] / cell;
+            const glm::dvec3 u = xi / cell;
             const glm::i64vec3 c = glm::i64vec3(glm::floor(u));
             const glm::dvec3 frac = u - glm::floor(u);
             const glm::i64vec3 side(frac.x < 0.5 ? -1 : 1, frac.y < 0.5 ? -1 : 1, frac.z < 0.5 ? -1 : 1);
@@ -508,15 +538,15 @@ void World::separate_particles() {
                     for (int dx = 0; dx <= 1; ++dx) {
                         const std::uint64_t k = hash(c + glm::i64vec3(dx, dy, dz) * side);
                         std::size_t slot = k & (size - 1);
-                        while (table[slot].second != ~0u && table[slot].first != k) slot = (slot + 1) & (size - 1);
-                        if (table[slot].second == ~0u) continue;
-                        for (std::uint32_t at = table[slot].second; at < grid.size() && grid[at].first == k; ++at) {
-                            const std::uint32_t j = grid[at].second;
-                            if (j == i || joined(static_cast<std::uint32_t>(i), j)) continue;
-                            const double rj = std::min({radii_[j].x, radii_[j].y, radii_[j].z});
-                            glm::dvec3 d = x_[i] - x_[j];
-                            const double dist2 = glm::dot(d, d), want = ri + rj;
-                            if (dist2 >= want * want || dist2 < 1e-24) continue;
+                        while (table[slot].second != 0 && table[slot].first != k) slot = (slot + 1) & (size - 1);
+                        for (std::uint32_t at = start[slot]; at < start[slot + 1]; ++at) {
+                            const std::uint32_t j = members[at];
+                            const glm::dvec3 d = xi - x_[j];
+                            const double dist2 = glm::dot(d, d), want = ri + thin[j];
+                            if (dist2 >= want * want || dist2 < 1e-24) continue; // apart, or itself
+                            // joined particles (parent and child, children of one parent) do not collide
+                            const std::uint32_t pi = parent_[i], pj = parent_[j];
+                            if (pi == j || pj == i || (pi != kNone && pi == pj)) continue;
                             const double dist = std::sqrt(dist2);
                             push[i] += d / dist * ((want - dist) * (fixed_[j] ? 1.0 : 0.5));
                         }

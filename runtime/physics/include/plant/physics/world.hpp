@@ -46,7 +46,7 @@ struct Settings {
     double stiffening_time = 10; // t_m: a particle reaches full stiffness at this age (s = t_l / t_m)
     double fixed_stiffness = -1; // >= 0: every particle has this stiffness instead (tests, tools)
     Growth growth;
-    int iterations = 8;          // shape-matching passes per step
+    int iterations = 4;          // shape-matching passes per step
     int threads = 1;             // threads for the shape-matching passes (results do not depend on it)
     // Rotation-extraction iterations per group and pass. Each pass warm-starts from the last
     // one's rotation, so the iterations add up over a step's passes, as Müller et al. 2016
@@ -249,8 +249,10 @@ private:
         std::vector<glm::dvec3> goal;
         std::vector<glm::dmat3> moments;
         std::vector<glm::dvec3> old;
-        std::vector<std::pair<std::uint64_t, std::uint32_t>> grid;  // (cell key, particle), sorted
-        std::vector<std::pair<std::uint64_t, std::uint32_t>> table; // cell key -> first in grid
+        std::vector<std::pair<std::uint64_t, std::uint32_t>> table; // cell key and its particle count
+        std::vector<std::uint32_t> slot_of, start, members, fill;   // particles grouped by table slot
+        std::vector<double> thin;                                   // each particle's thinnest radius
+        std::vector<glm::dmat3> rest_moment;                        // 0.2 m D R̄ᵀ, during a step
         std::vector<glm::dvec3> push;
     } scratch_;
 };
