@@ -24,6 +24,7 @@ struct RunCmd {
     GrammarOptions g;
     std::vector<std::string> outputs;
     int sides = 8;
+    bool no_obstacles = false;
     std::string size = "800x800";
 };
 
@@ -70,6 +71,7 @@ int run_main(RunCmd& c) {
     try {
         OutputOptions oo;
         oo.sides = c.sides;
+        oo.obstacles = !c.no_obstacles;
         oo.width = width;
         oo.height = height;
         OutputSummary summary = write_outputs(*program, d, c.outputs, oo);
@@ -99,6 +101,8 @@ void setup_run(CLI::App& app, int& exit_code) {
         ->type_name("FILE");
     cmd->add_option("--sides", c->sides, "Vertices around each ring of a branch")->check(CLI::Range(3, 64));
     cmd->add_option("--size", c->size, "Size of PNG previews")->type_name("WxH");
+    cmd->add_flag("--no-obstacles", c->no_obstacles,
+                  "Leave the environments' obstacles (a climber's walls, say) out of meshes and images");
     cmd->callback([c, &exit_code] { exit_code = run_main(*c); });
 }
 

@@ -1,5 +1,7 @@
 #include "outputs.hpp"
 
+#include "plant/environment.hpp"
+
 #include "plant/export.hpp"
 #include "plant/export_text.hpp"
 #include "plant/mesh.hpp"
@@ -54,6 +56,38 @@ std::optional<Format> format_of(const std::string& given) {
 
 const char* known_extensions() { return ".glb .gltf .obj .ply .off .png .svg .txt .skel.json or .mesh.txt"; }
 
+// The environments' obstacles as one more prototype, placed once where it is: flat-shaded
+// triangles in a stone grey.
+static void add_environments(const Program& program, Scene& scene) {
+    std::vector<glm::dvec3> tris;
+    const glm::dvec3 lo(scene.bounds_min), hi(scene.bounds_max);
+    for (const auto& env : program.environments)
+        if (env) env->geometry(tris, lo, hi);
+    if (tris.size() < 3) return;
+    MeshPart part;
+    for (std::size_t k = 0; k + 2 < tris.size(); k += 3) {
+        const glm::vec3 a(tris[k]), b(tris[k + 1]), c(tris[k + 2]);
+        glm::vec3 n = glm::cross(b - a, c - a);
+        if (!(glm::length(n) > 0)) continue;
+        n = glm::normalize(n);
+        const auto base = static_cast<std::uint32_t>(part.positions.size());
+        for (const glm::vec3& p : {a, b, c}) {
+            part.positions.push_back(p);
+            part.normals.push_back(n);
+            part.uvs.emplace_back(0.0f);
+        }
+        part.indices.insert(part.indices.end(), {base, base + 1, base + 2});
+    }
+    if (part.empty()) return;
+    const auto material = static_cast<std::uint32_t>(scene.materials.size());
+    scene.materials.push_back(Material{glm::vec3(0.62f, 0.6f, 0.56f)});
+    part.primitives.push_back(Primitive{0, static_cast<std::uint32_t>(part.indices.size()), material});
+    scene.prototypes.push_back(std::move(part));
+    scene.prototype_names.push_back("obstacles");
+    scene.instances.push_back(Instance{static_cast<std::uint32_t>(scene.prototypes.size() - 1), glm::mat4(1.0f)});
+    scene.update_bounds();
+}
+
 OutputSummary write_outputs(const Program& program, const Derivation& d, const std::vector<std::string>& paths,
                             const OutputOptions& options) {
     std::vector<Format> formats;
@@ -76,6 +110,7 @@ OutputSummary write_outputs(const Program& program, const Derivation& d, const s
         MeshOptions mo;
         mo.sides = options.sides;
         scene = build_scene(program, skeleton, mo);
+        if (options.obstacles) add_environments(program, scene);
     }
     // All or nothing: every file is first written under a temporary name beside its target
     // (same extension, which the writers go by); only when all succeeded are they renamed.

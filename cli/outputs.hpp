@@ -18,6 +18,7 @@ const char* known_extensions();
 struct OutputOptions {
     int sides = 8;
     int width = 800, height = 800;
+    bool obstacles = true; // the environments' geometry (walls, boxes) goes into meshes and images
 };
 
 // Interprets, meshes (when some output needs it) and writes every path. Throws RuntimeError or

@@ -108,6 +108,15 @@ const physics::Obstacle* Climber::nearest_obstacle(const glm::dvec3& p, double w
     return nearest;
 }
 
+void Climber::geometry(std::vector<glm::dvec3>& triangles, const glm::dvec3& lo, const glm::dvec3& hi) const {
+    const auto& obstacles = world_.obstacles();
+    for (const auto& o : obstacles) obstacle_triangles(o, lo, hi, triangles);
+    for (const auto& [k, mesh] : meshes_) {
+        const glm::dvec3 offset = k < obstacles.size() ? obstacles[k].a : glm::dvec3(0.0); // moved since loaded
+        for (const auto& v : mesh) triangles.push_back(v + offset);
+    }
+}
+
 void Climber::reset() {
     world_ = initial_;
     fluid_ = initial_fluid_;
@@ -483,6 +492,9 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
         physics::Obstacle o;
         o.kind = physics::Obstacle::Grid;
         o.grid = distance_grid(mesh, mesh_cell, 4 * mesh_cell + c.adaption_range);
+        std::vector<glm::dvec3> shown;
+        for (const auto& t : mesh) shown.insert(shown.end(), {t.a, t.b, t.c});
+        climber->show_mesh(w.obstacles().size(), std::move(shown));
         add(o);
     }
     climber->remember_initial();

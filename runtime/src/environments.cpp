@@ -303,6 +303,24 @@ public:
         if (!triangles.empty()) d = std::min(d, signed_distance(triangles, p));
         return d;
     }
+    void geometry(std::vector<glm::dvec3>& out, const glm::dvec3& lo, const glm::dvec3& hi) const override {
+        for (const auto& sp : spheres) {
+            physics::Obstacle o;
+            o.kind = physics::Obstacle::Sphere, o.a = sp.c, o.b = glm::dvec3(sp.r, 0, 0);
+            obstacle_triangles(o, lo, hi, out);
+        }
+        for (const auto& b : boxes) {
+            physics::Obstacle o;
+            o.kind = physics::Obstacle::Box, o.a = b.lo, o.b = b.hi;
+            obstacle_triangles(o, lo, hi, out);
+        }
+        for (const auto& pl : planes) {
+            physics::Obstacle o;
+            o.kind = physics::Obstacle::Plane, o.a = pl.p, o.b = pl.n;
+            obstacle_triangles(o, lo, hi, out);
+        }
+        for (const auto& t : triangles) out.insert(out.end(), {t.a, t.b, t.c});
+    }
     void call(std::size_t method, const double* a, double* r) const override {
         double d = distance(vec(a));
         r[0] = method == 0 ? (std::isfinite(d) ? d : 1e300) : (d < 0 ? 1.0 : 0.0);

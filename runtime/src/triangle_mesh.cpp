@@ -104,4 +104,46 @@ std::shared_ptr<const physics::DistanceGrid> distance_grid(const std::vector<Tri
     return g;
 }
 
+void obstacle_triangles(const physics::Obstacle& o, const glm::dvec3& lo, const glm::dvec3& hi,
+                        std::vector<glm::dvec3>& out) {
+    auto quad = [&](const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, const glm::dvec3& d) {
+        out.insert(out.end(), {a, b, c, a, c, d});
+    };
+    switch (o.kind) {
+    case physics::Obstacle::Box: {
+        const glm::dvec3 a = o.a, b = o.b;
+        auto p = [&](int x, int y, int z) { return glm::dvec3(x ? b.x : a.x, y ? b.y : a.y, z ? b.z : a.z); };
+        quad(p(0, 0, 0), p(0, 1, 0), p(1, 1, 0), p(1, 0, 0)); // -z
+        quad(p(0, 0, 1), p(1, 0, 1), p(1, 1, 1), p(0, 1, 1)); // +z
+        quad(p(0, 0, 0), p(0, 0, 1), p(0, 1, 1), p(0, 1, 0)); // -x
+        quad(p(1, 0, 0), p(1, 1, 0), p(1, 1, 1), p(1, 0, 1)); // +x
+        quad(p(0, 0, 0), p(1, 0, 0), p(1, 0, 1), p(0, 0, 1)); // -y
+        quad(p(0, 1, 0), p(0, 1, 1), p(1, 1, 1), p(1, 1, 0)); // +y
+        break;
+    }
+    case physics::Obstacle::Sphere: {
+        const int rings = 12, segments = 24;
+        const double r = o.b.x;
+        auto at = [&](int i, int j) {
+            const double t = 3.14159265358979323846 * i / rings, f = 2 * 3.14159265358979323846 * j / segments;
+            return o.a + r * glm::dvec3(std::sin(t) * std::cos(f), std::cos(t), std::sin(t) * std::sin(f));
+        };
+        for (int i = 0; i < rings; ++i)
+            for (int j = 0; j < segments; ++j) quad(at(i, j), at(i, j + 1), at(i + 1, j + 1), at(i + 1, j));
+        break;
+    }
+    case physics::Obstacle::Plane: {
+        const glm::dvec3 n = glm::normalize(o.b);
+        const glm::dvec3 centre = (lo + hi) * 0.5;
+        const double half = std::max(0.4 * glm::length(hi - lo), 1e-3); // a little wider than the plant
+        const glm::dvec3 c = centre - n * glm::dot(centre - o.a, n); // the plant's centre on the plane
+        const glm::dvec3 u = glm::normalize(std::abs(n.y) < 0.9 ? glm::cross(n, glm::dvec3(0, 1, 0)) : glm::cross(n, glm::dvec3(1, 0, 0)));
+        const glm::dvec3 v = glm::cross(n, u);
+        quad(c - u * half - v * half, c + u * half - v * half, c + u * half + v * half, c - u * half + v * half);
+        break;
+    }
+    case physics::Obstacle::Grid: break;
+    }
+}
+
 } // namespace plant

@@ -29,4 +29,9 @@ double signed_distance(const std::vector<Triangle>& mesh, const glm::dvec3& p);
 std::shared_ptr<const physics::DistanceGrid> distance_grid(const std::vector<Triangle>& mesh, double cell, double margin,
                                                            std::size_t max_points = 1u << 20);
 
+// Appends triangles showing an obstacle: a box's six faces, a sphere, a plane as a square around
+// the plant's box [lo, hi] (0.8 of its diagonal across). A sampled grid shows nothing here (its mesh does).
+void obstacle_triangles(const physics::Obstacle& o, const glm::dvec3& lo, const glm::dvec3& hi,
+                        std::vector<glm::dvec3>& out);
+
 } // namespace plant

@@ -77,6 +77,14 @@ done
 contains "PNG signature" "$tmp/a.png" "PNG"
 contains "string output" "$tmp/a.txt" "F[+F~leaf(1)]F"
 contains "mesh summary" "$tmp/a.mesh.txt" "instances 1"
+
+# an environment's obstacles go into meshes and images as one more prototype, unless left out
+printf 'env wall = obstacles(box_min: vec3(-1, 0, -1), box_max: vec3(1, 1, -0.5));\naxiom: F;\n' >"$tmp/wall.plant"
+check "run with obstacles" 0 "$plant" run "$tmp/wall.plant" -o "$tmp/w.mesh.txt"
+contains "obstacles are shown" "$tmp/w.mesh.txt" "prototypes 1"
+contains "obstacles are shown as a box" "$tmp/w.mesh.txt" "triangles 28"
+check "run --no-obstacles" 0 "$plant" run "$tmp/wall.plant" --no-obstacles -o "$tmp/n.mesh.txt"
+contains "--no-obstacles leaves them out" "$tmp/n.mesh.txt" "prototypes 0"
 check "unknown output format" 64 "$plant" run "$tmp/plant.plant" -o "$tmp/a.xyz"
 contains "format message" "$tmp/stderr" "cannot tell the format of"
 check "bad --size" 64 "$plant" run "$tmp/plant.plant" --size 10 -o "$tmp/b.png"

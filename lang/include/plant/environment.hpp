@@ -44,6 +44,12 @@ public:
     // Back to the state it was declared with: a derivation starting again (the REPL's :set, a
     // second run of one compiled program) must not see the last one's plant.
     virtual void reset() {}
+    // Triangles (world space, consecutive corners, wound outward) that show the environment in
+    // meshes and previews: the wall a climber clings to, say. `lo` and `hi` bound the plant, for
+    // giving an unbounded shape (a plane) a size.
+    virtual void geometry(std::vector<glm::dvec3>& triangles, const glm::dvec3& lo, const glm::dvec3& hi) const {
+        (void)triangles, (void)lo, (void)hi;
+    }
     // Answers a query. `args` holds the arguments' numbers (three for a vec3), `result` receives
     // up to three. Called from many threads at once while a step is rewritten: it must not
     // change the object.

@@ -76,6 +76,9 @@ public:
     }
     const physics::Fluid& fluid() const { return fluid_; }
     void reset() override;
+    void geometry(std::vector<glm::dvec3>& triangles, const glm::dvec3& lo, const glm::dvec3& hi) const override;
+    // A loaded mesh's triangles for obstacle k (a sampled grid), to show it.
+    void show_mesh(std::size_t k, std::vector<glm::dvec3> triangles) { meshes_.emplace_back(k, std::move(triangles)); }
 
     // Environment
     const std::vector<EnvMethod>& methods() const override;
@@ -108,6 +111,7 @@ private:
     Config config_;
     std::map<ModuleId, physics::Handle> particle_of_; // ordered: removals happen in id order
     std::vector<physics::Handle> roots_;              // the fixed roots made for plants' first segments
+    std::vector<std::pair<std::size_t, std::vector<glm::dvec3>>> meshes_; // obstacle index, its triangles
     std::set<ModuleId> seen_, detached_;
     struct Pending {
         ModuleId id, parent;
