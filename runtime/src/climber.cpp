@@ -119,6 +119,7 @@ void Climber::geometry(std::vector<glm::dvec3>& triangles, const glm::dvec3& lo,
 
 void Climber::reset() {
     world_ = initial_;
+    attractors_ = config_.attractors;
     fluid_ = initial_fluid_;
     particle_of_.clear();
     roots_.clear();
@@ -181,6 +182,16 @@ void Climber::advance() {
                 world_.add_anchor(h, point, config_.anchor, config_.anchor_release);
             }
         }
+    }
+    // painted samples a new particle reached are used up, so shoots move on across the region
+    // instead of circling a sample (as a space-colonization attractor is removed once reached)
+    if (!attractors_.empty()) {
+        const double reach2 = config_.attractor_reach * config_.attractor_reach;
+        for (const Pending& p : pending_)
+            std::erase_if(attractors_, [&](const Attractor& a) {
+                const glm::dvec3 d = a.point - p.to;
+                return glm::dot(d, d) < reach2;
+            });
     }
     pending_.clear();
     // edits from hooks
@@ -312,7 +323,7 @@ glm::dvec3 Climber::grow_dir(const glm::dvec3& p, const glm::dvec3& h) const {
     }
     // painted attractors (section 5.1): toward their weighted average within their radii
     glm::dvec3 pull(0.0);
-    for (const auto& a : config_.attractors) {
+    for (const auto& a : attractors_) {
         glm::dvec3 d = a.point - p;
         double len = glm::length(d);
         if (len >= a.radius || len < 1e-12) continue;
@@ -347,7 +358,7 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
                                     "anchor", "anchor_range", "anchor_release", "friction", "elasticity",
                                     "sphere_radius", "attractor_radius", "attractor_strength", "threads",
                                     "light_cell", "opacity", "air_spacing", "air_density", "air_viscosity",
-                                    "air_stiffness", "air_coupling", "mesh_cell"};
+                                    "air_stiffness", "air_coupling", "mesh_cell", "attractor_reach"};
     static const char* vectors[] = {"gravity", "light", "wind", "sphere", "box_min", "box_max", "plane_point",
                                     "plane_normal", "attractor", "air_min", "air_max"};
     bool air_min = false, air_max = false;
@@ -412,6 +423,7 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
         else if (a.key == "air_stiffness") c.fluid.stiffness = std::max(x, 1e-6);
         else if (a.key == "air_coupling") c.fluid.coupling = std::max(x, 0.0);
         else if (a.key == "mesh_cell") mesh_cell = std::max(x, 1e-3);
+        else if (a.key == "attractor_reach") c.attractor_reach = std::max(x, 0.0);
     }
     if (sphere.size() != sphere_r.size() || box_min.size() != box_max.size() || plane_p.size() != plane_n.size()) {
         error = "climber: give each sphere a sphere_radius, each box_min a box_max and each plane_point a plane_normal";

@@ -60,6 +60,7 @@ public:
         double light_cell = 0.1;    // occupancy grid for occlusion
         double opacity = 0.15;      // occlusion 1 - exp(-opacity * particles between p and the light)
         std::vector<Attractor> attractors;
+        double attractor_reach = 0.1; // a painted sample a particle comes this near is used up
         bool air = false;           // SPH air fills [air_min, air_max] (section 5.3)
         physics::FluidSettings fluid;
     };
@@ -68,6 +69,7 @@ public:
     // Keeps the world as it is now (settings and obstacles) for reset().
     void remember_initial() {
         initial_ = world_;
+        attractors_ = config_.attractors;
         if (config_.air) {
             fluid_ = physics::Fluid(config_.fluid);
             fluid_.fill(config_.fluid.domain_lo, config_.fluid.domain_hi);
@@ -106,6 +108,7 @@ private:
     glm::dvec3 grow_dir(const glm::dvec3& p, const glm::dvec3& h) const;
     void rebuild_occupancy();
 
+    std::vector<Attractor> attractors_; // the painted samples not yet reached
     physics::World world_, initial_;
     physics::Fluid fluid_, initial_fluid_;
     Config config_;

@@ -261,3 +261,27 @@ TEST_CASE("climber: a hook seeds a new branch at a segment, and it grows from th
     const auto& base = seeded.skeleton.axes[1].points.front().position;
     CHECK(glm::distance(base, seeded.skeleton.axes[0].points[2].position) < 1e-9);
 }
+
+TEST_CASE("climber: a painted sample a shoot reaches is used up, so the shoot moves on", "[climber]") {
+    auto shoot = [](double reach) {
+        return grow(fmt::format(R"(
+env ivy = climber(box_min: vec3(-1, 0, -0.2), box_max: vec3(1, 3, 0), adaption: 0.8, anchor: 0.5,
+                  attractor: vec3(0.1, 0.6, 0), attractor_radius: 0.5, attractor_strength: 1.5, attractor_reach: {});
+module Seg(len, r) bound ivy;
+module Apex(k);
+derive 40;
+axiom: @M(0, 0, 0.01) Seg(0.05, 0.006) Apex(0) ?P(0, 0, 0) ?H(0, 1, 0);
+rules {{
+  Apex(k) > ?P(p) ?H(h) {{ let g = ivy.grow_dir(p, h); produce SetHead(g.x, g.y, g.z) Seg(0.05, 0.006) Apex(k + 1); }}
+}}
+)",
+                                reach));
+    };
+    auto highest = [](const Grown& g) {
+        double y = 0;
+        for (const auto& p : g.skeleton.axes.at(0).points) y = std::max(y, p.position.y);
+        return y;
+    };
+    CHECK(highest(shoot(0)) < 0.8);   // never used up: the shoot circles the sample
+    CHECK(highest(shoot(0.1)) > 1.2); // used up once reached: the shoot grows on
+}
