@@ -133,6 +133,12 @@ void interpret(const Program& program, const ModuleString& s, const TurtleOption
         orthonormalize(t);
     };
 
+    // the first segment after '[' or a move starts a new axis
+    auto start_axis = [&]() {
+        if (t.axis >= 0) return;
+        t.axis = next_axis++;
+        sink.axis_begin(t.axis, parent_axis, t);
+    };
     // modules bound to a climber: drawn like F, ending where their particle is
     std::vector<char> bound(program.symbols.size(), 0);
     for (std::size_t k = 0; k < bound.size(); ++k) bound[k] = !program.symbols.all()[k].bound_to.empty();
@@ -143,10 +149,7 @@ void interpret(const Program& program, const ModuleString& s, const TurtleOption
             // Seg(len, r): length and radius; with a particle, the segment ends at its position
             double len = arg(i, 0, t.step);
             if (s.arity(i) > 1) t.width = 2 * s.args(i)[1];
-            if (t.axis < 0) {
-                t.axis = next_axis++;
-                sink.axis_begin(t.axis, parent_axis, t);
-            }
+            start_axis();
             glm::dvec3 from = t.position;
             glm::dvec3 p;
             glm::dmat3 frame;
@@ -170,10 +173,7 @@ void interpret(const Program& program, const ModuleString& s, const TurtleOption
         } else if (sym == y.F || sym == y.G) {
             double len = arg(i, 0, t.step);
             if (s.arity(i) > 1) t.width = s.args(i)[1];
-            if (t.axis < 0) {
-                t.axis = next_axis++;
-                sink.axis_begin(t.axis, parent_axis, t);
-            }
+            start_axis();
             glm::dvec3 from = t.position;
             t.position += t.heading * len;
             tropism();

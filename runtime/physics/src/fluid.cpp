@@ -17,25 +17,30 @@ constexpr double kPi = std::numbers::pi;
 
 } // namespace
 
+// Müller et al. 2003: the constants in front of the kernels. Eq. 21's spiky gradient and Eq.
+// 22's viscosity Laplacian share 45 / (pi h^6).
+double Fluid::poly6_coefficient(double h) { return 315.0 / (64.0 * kPi * std::pow(h, 9)); }
+double Fluid::gradient_coefficient(double h) { return 45.0 / (kPi * std::pow(h, 6)); }
+
 // Müller et al. 2003, Eq. 20: W_poly6 for densities
 double Fluid::poly6(double r2, double h) {
     const double h2 = h * h;
     if (r2 >= h2) return 0;
     const double d = h2 - r2;
-    return 315.0 / (64.0 * kPi * std::pow(h, 9)) * d * d * d;
+    return poly6_coefficient(h) * d * d * d;
 }
 
 // Müller et al. 2003, Eq. 21: the spiky kernel's gradient, for pressure
 double Fluid::spiky_gradient(double r, double h) {
     if (r >= h) return 0;
     const double d = h - r;
-    return 45.0 / (kPi * std::pow(h, 6)) * d * d;
+    return gradient_coefficient(h) * d * d;
 }
 
 // Müller et al. 2003, Eq. 22: the viscosity kernel's Laplacian
 double Fluid::viscosity_laplacian(double r, double h) {
     if (r >= h) return 0;
-    return 45.0 / (kPi * std::pow(h, 6)) * (h - r);
+    return gradient_coefficient(h) * (h - r);
 }
 
 void Fluid::fill(const glm::dvec3& lo, const glm::dvec3& hi) {
@@ -150,8 +155,8 @@ void Fluid::gather_boundary(const World& plant) {
 
 void Fluid::compute_densities(const World* plant) {
     const double hh = s_.support;
-    poly6_c_ = 315.0 / (64.0 * kPi * std::pow(hh, 9));
-    grad_c_ = 45.0 / (kPi * std::pow(hh, 6));
+    poly6_c_ = poly6_coefficient(hh);
+    grad_c_ = gradient_coefficient(hh);
     build_grid();
     if (plant) gather_boundary(*plant);
     else boundary_.clear();

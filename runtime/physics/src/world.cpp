@@ -168,14 +168,17 @@ Handle World::add_grown(Handle parent, const glm::dvec3& position_in, const glm:
     return h;
 }
 
+void World::detach(std::uint32_t i) {
+    if (parent_[i] == kNone) return;
+    auto& siblings = children_[parent_[i]];
+    siblings.erase(std::remove(siblings.begin(), siblings.end(), i), siblings.end());
+    parent_[i] = kNone;
+}
+
 void World::remove(Handle h) {
     if (!alive(h)) return;
     std::vector<std::uint32_t> todo{h.index};
-    if (parent_[h.index] != kNone) {
-        auto& siblings = children_[parent_[h.index]];
-        siblings.erase(std::remove(siblings.begin(), siblings.end(), h.index), siblings.end());
-        parent_[h.index] = kNone;
-    }
+    detach(h.index);
     while (!todo.empty()) {
         std::uint32_t i = todo.back();
         todo.pop_back();
@@ -208,14 +211,16 @@ double World::matching_mass(std::uint32_t j) const {
     return fixed_[j] ? kFixedMass : m_[j];
 }
 
-glm::dmat3 World::ellipsoid_moment(std::uint32_t j) const {
-    // Eq. 15's term for one member, written R D R̄ᵀ (PLANTS.md pitfall)
-    const double m = matching_mass(j);
+glm::dmat3 World::rest_moment(std::uint32_t j) const {
+    // Eq. 15's term for one member is 0.2 m R D R̄ᵀ (PLANTS.md pitfall); this is its rest part,
+    // 0.2 m D R̄ᵀ, which only growth changes
     const glm::dvec3& r = radii_[j];
     glm::dmat3 D(0.0);
     D[0][0] = r.x * r.x, D[1][1] = r.y * r.y, D[2][2] = r.z * r.z;
-    return 0.2 * m * glm::mat3_cast(q_[j]) * D * glm::transpose(glm::mat3_cast(rest_q_[j]));
+    return 0.2 * matching_mass(j) * D * glm::transpose(glm::mat3_cast(rest_q_[j]));
 }
+
+glm::dmat3 World::ellipsoid_moment(std::uint32_t j) const { return glm::mat3_cast(q_[j]) * rest_moment(j); }
 
 World::Frame World::group_frame(std::uint32_t i, const glm::dquat& warm, const glm::dmat3* moments,
                                 int iterations) const {
@@ -333,15 +338,10 @@ void World::step() {
     auto& frames = scratch_.frames;
     auto& goal = scratch_.goal;
     auto& moments = scratch_.moments;
-    auto& rest_moment = scratch_.rest_moment;
-    rest_moment.resize(n);
-    for (std::size_t j = 0; j < n; ++j) {
-        if (!alive_[j]) continue;
-        const glm::dvec3& r = radii_[j];
-        glm::dmat3 D(0.0);
-        D[0][0] = r.x * r.x, D[1][1] = r.y * r.y, D[2][2] = r.z * r.z;
-        rest_moment[j] = 0.2 * matching_mass(static_cast<std::uint32_t>(j)) * D * glm::transpose(glm::mat3_cast(rest_q_[j]));
-    }
+    auto& rest_moments = scratch_.rest_moment;
+    rest_moments.resize(n);
+    for (std::size_t j = 0; j < n; ++j)
+        if (alive_[j]) rest_moments[j] = rest_moment(static_cast<std::uint32_t>(j));
     for (int it = 0; it < settings_.iterations; ++it) {
         match_shapes(frames, goal, moments, settings_.rotation_iterations);
         parallel_ranges(n, settings_.threads, 2048, [&](std::size_t b, std::size_t e) {
@@ -396,14 +396,12 @@ void World::step() {
             double rest = glm::length(rest_x_[i] - rest_x_[p]);
             double now = glm::length(x_[i] - x_[p]);
             if (rest > 0 && std::fabs(now - rest) / rest > break_threshold_) {
-                auto& siblings = children_[p];
-                siblings.erase(std::remove(siblings.begin(), siblings.end(), i), siblings.end());
-                parent_[i] = kNone; // the loose part keeps its own shape and falls
+                detach(i); // the loose part keeps its own shape and falls
             }
         }
     }
     pulls_.clear();
-    rest_moment.clear(); // only valid within this step
+    rest_moments.clear(); // only valid within this step
     times_.collision = collision_ms;
     times_.dynamics = std::chrono::duration<double, std::milli>(clock::now() - t_start).count() - collision_ms;
 }

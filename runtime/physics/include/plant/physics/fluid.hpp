@@ -63,6 +63,9 @@ public:
     static double poly6(double r2, double h);
     static double spiky_gradient(double r, double h); // magnitude of grad W along -r_hat
     static double viscosity_laplacian(double r, double h);
+    // Their constant factors: the passes multiply these by the kernels' polynomials.
+    static double poly6_coefficient(double h);
+    static double gradient_coefficient(double h);
 
 private:
     void build_grid();

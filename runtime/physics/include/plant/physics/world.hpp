@@ -213,7 +213,10 @@ private:
     };
     // A particle's mass inside group sums: a fixed root's is effectively infinite.
     double matching_mass(std::uint32_t j) const;
+    glm::dmat3 rest_moment(std::uint32_t j) const; // Eq. 15's fixed part, 0.2 m D R̄ᵀ
     glm::dmat3 ellipsoid_moment(std::uint32_t j) const;
+    // Unlinks i from its parent: it becomes the root of a loose part.
+    void detach(std::uint32_t i);
     // `moments`: every particle's ellipsoid_moment, or null to compute them here.
     Frame group_frame(std::uint32_t i, const glm::dquat& warm, const glm::dmat3* moments, int iterations) const;
     // One shape-matching pass: every group's frame (warm-started from `frames`) and every
