@@ -2,8 +2,7 @@
 // at least 5 million a second). The skeleton is ABOP Fig. 1.24a grown to n = 7 (78,125 segments);
 // the query radius (2 by default) is a few segment lengths, as density control uses it.
 //   plant_env_bench GRAMMAR [STEPS] [QUERIES] [RADIUS]
-#include "plant/compiler.hpp"
-#include "plant/derive.hpp"
+#include "grown.hpp"
 #include "plant/environments.hpp"
 
 #include <chrono>
@@ -19,18 +18,9 @@ int main(int argc, char** argv) {
     }
     int steps = argc > 2 ? std::atoi(argv[2]) : 6;
     long queries = argc > 3 ? std::atol(argv[3]) : 5000000;
-    SourceManager sm;
-    Diagnostics diags;
-    auto program = compile_file(sm, argv[1], {}, diags);
-    if (!program) {
-        std::fputs(render_all(diags, sm).c_str(), stderr);
-        return 65;
-    }
-    DeriveOptions o;
-    o.steps = steps;
-    Derivation d(*program, o);
-    d.run();
-    Skeleton sk = build_skeleton(*program, d.interpreted(d.string()), turtle_options(d));
+    bench::Grown g;
+    if (!bench::grow(argv[1], steps, 1, g)) return 65;
+    const Skeleton& sk = g.skeleton;
     std::size_t segments = 0;
     glm::dvec3 lo(1e300), hi(-1e300);
     for (const auto& a : sk.axes) {

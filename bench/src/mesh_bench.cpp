@@ -1,8 +1,7 @@
 // Meshing throughput (issue: at least 20 million triangles per second on one thread, flat
 // buffers at most 40 bytes per triangle) on a large tree: ABOP Fig. 2.7 at n = 14, 8 sides.
 //   plant_mesh_bench GRAMMAR [STEPS] [SIDES] [REPEATS]
-#include "plant/compiler.hpp"
-#include "plant/derive.hpp"
+#include "grown.hpp"
 #include "plant/mesh.hpp"
 
 #include <chrono>
@@ -20,27 +19,16 @@ int main(int argc, char** argv) {
     int steps = argc > 2 ? std::atoi(argv[2]) : 14;
     int sides = argc > 3 ? std::atoi(argv[3]) : 8;
     int repeats = argc > 4 ? std::atoi(argv[4]) : 5;
-    SourceManager sm;
-    Diagnostics diags;
-    auto program = compile_file(sm, argv[1], {}, diags);
-    if (!program) {
-        std::fputs(render_all(diags, sm).c_str(), stderr);
-        return 65;
-    }
-    DeriveOptions o;
-    o.steps = steps;
-    o.threads = 1;
-    Derivation d(*program, o);
-    d.run();
-    Skeleton sk = build_skeleton(*program, d.interpreted(d.string()),
-                                 turtle_options(d));
+    bench::Grown g;
+    if (!bench::grow(argv[1], steps, 1, g)) return 65;
+    const Skeleton& sk = g.skeleton;
     MeshOptions mo;
     mo.sides = sides;
     double best = 1e300;
     Scene scene;
     for (int r = 0; r < repeats; ++r) {
         auto t0 = std::chrono::steady_clock::now();
-        scene = build_scene(*program, sk, mo);
+        scene = build_scene(*g.program, sk, mo);
         double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         best = std::min(best, s);
     }
@@ -49,6 +37,6 @@ int main(int argc, char** argv) {
     double bytes = static_cast<double>(t.positions.size() * sizeof(glm::vec3) + t.normals.size() * sizeof(glm::vec3) +
                                        t.uvs.size() * sizeof(glm::vec2) + t.indices.size() * sizeof(std::uint32_t));
     std::printf("meshing modules=%zu axes=%zu triangles=%.0f best_ms=%.3f mtri_per_s=%.2f bytes_per_triangle=%.1f\n",
-                d.string().size(), sk.axes.size(), tris, best * 1e3, tris / best / 1e6, bytes / tris);
+                g.modules, sk.axes.size(), tris, best * 1e3, tris / best / 1e6, bytes / tris);
     return 0;
 }
