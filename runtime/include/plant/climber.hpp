@@ -76,7 +76,6 @@ public:
         }
         initial_fluid_ = fluid_;
     }
-    const physics::Fluid& fluid() const { return fluid_; }
     void reset() override;
     void geometry(std::vector<glm::dvec3>& triangles, const glm::dvec3& lo, const glm::dvec3& hi) const override;
     // A loaded mesh's triangles for obstacle k (a sampled grid), to show it.
