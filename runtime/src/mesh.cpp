@@ -1,11 +1,13 @@
-// Generalized cylinders. Each axis becomes one tube: a ring of `sides` vertices (plus a seam
-// copy for texture coordinates) at every point, shared by the segments on both sides of it.
-// A gentle joint gets one ring in the bisecting plane, widened along the bend (a miter) so the
-// tube keeps its thickness through the joint; a sharp one (past ~45 degrees) is rounded with
-// several rings along a short curve. Ring frames are transported along the axis with the
-// smallest rotation from one tangent to the next, so the tube does not twist.
+// Generalized cylinders. Each tube (an axis, possibly continued into a child axis, see
+// tube_paths) becomes a ring of `sides` vertices (plus a seam copy for texture coordinates) at
+// every point, shared by the segments on both sides of it. A gentle joint gets one ring in the
+// bisecting plane, widened along the bend (a miter) so the tube keeps its thickness through the
+// joint; a sharp one (past ~45 degrees) is rounded with several rings along a short curve. Ring
+// frames are transported along the axis with the smallest rotation from one tangent to the next,
+// so the tube does not twist.
 #include "plant/mesh.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -24,14 +26,14 @@ struct Ring {
     double slope = 0.0; // d radius / d arc length, for normals of tapering tubes
 };
 
-// Smallest rotation taking unit vector a to unit vector b, applied to v.
+// Smallest rotation taking unit vector a to unit vector b, applied to v (Rodrigues' formula with
+// the sine and cosine of the angle read off the cross and dot products, no trigonometry).
 glm::dvec3 transport(const glm::dvec3& v, const glm::dvec3& a, const glm::dvec3& b) {
     glm::dvec3 axis = glm::cross(a, b);
     double s = glm::length(axis), c = glm::dot(a, b);
     if (s < 1e-12) return c > 0 ? v : -v;
     axis /= s;
-    double angle = std::atan2(s, c);
-    return v * std::cos(angle) + glm::cross(axis, v) * std::sin(angle) + axis * glm::dot(axis, v) * (1 - std::cos(angle));
+    return v * c + glm::cross(axis, v) * s + axis * (glm::dot(axis, v) * (1 - c));
 }
 
 // Rotates v about the unit axis k by phi, right-handed.
@@ -44,14 +46,29 @@ glm::dvec3 any_perpendicular(const glm::dvec3& t) {
     return glm::normalize(p);
 }
 
-// The rings of an axis, with sharp joints rounded.
-std::vector<Ring> rings_of(const SkeletonAxis& axis, const MeshOptions& o) {
-    // drop points that coincide with the previous one: they have no direction
+bool same_point(const glm::dvec3& a, const glm::dvec3& b) {
+    return glm::length(a - b) <= 1e-9 * (1.0 + glm::length(a));
+}
+
+// Work space reused from tube to tube, so meshing a tree does not allocate per axis.
+struct Scratch {
     std::vector<const SkeletonPoint*> pts;
-    for (const auto& p : axis.points)
-        if (pts.empty() || glm::length(p.position - pts.back()->position) > 1e-9) pts.push_back(&p);
     std::vector<Ring> rings;
-    if (pts.size() < 2) return rings;
+    std::vector<double> cosines, sines; // of 2 pi j / sides
+    int sides = 0;
+};
+
+// The rings of a tube, with sharp joints rounded; empty when it has fewer than two distinct
+// points.
+void rings_of(const TubePath& path, const MeshOptions& o, Scratch& s) {
+    // drop points that coincide with the previous one: they have no direction
+    auto& pts = s.pts;
+    auto& rings = s.rings;
+    pts.clear();
+    rings.clear();
+    for (const SkeletonPoint* p : path)
+        if (pts.empty() || glm::length(p->position - pts.back()->position) > 1e-9) pts.push_back(p);
+    if (pts.size() < 2) return;
     const double sharp = o.sharp_bend_deg * kPi / 180.0;
     const std::size_t m = pts.size() - 1;
     auto dir = [&](std::size_t k) { return glm::normalize(pts[k + 1]->position - pts[k]->position); };
@@ -64,14 +81,16 @@ std::vector<Ring> rings_of(const SkeletonAxis& axis, const MeshOptions& o) {
             continue;
         }
         glm::dvec3 d0 = dir(k - 1), d1 = dir(k);
-        double theta = std::acos(std::clamp(glm::dot(d0, d1), -1.0, 1.0));
+        double cos_theta = std::clamp(glm::dot(d0, d1), -1.0, 1.0);
+        double theta = std::acos(cos_theta);
         if (theta <= sharp) {
             glm::dvec3 t = glm::normalize(d0 + d1);
             glm::dvec3 bend = d1 - d0;
             bend -= t * glm::dot(bend, t);
             double bl = glm::length(bend);
-            rings.push_back(Ring{p.position, t, r, bl > 1e-12 ? bend / bl : glm::dvec3(0), 1.0 / std::cos(theta / 2),
-                                 p.color});
+            // 1 / cos(theta / 2), from the half-angle identity
+            double miter = 1.0 / std::sqrt(0.5 * (1.0 + cos_theta));
+            rings.push_back(Ring{p.position, t, r, bl > 1e-12 ? bend / bl : glm::dvec3(0), miter, p.color});
             continue;
         }
         // round the corner with a circular arc tangent to both segments, of radius 1.5 tube radii
@@ -104,21 +123,109 @@ std::vector<Ring> rings_of(const SkeletonAxis& axis, const MeshOptions& o) {
         double len = glm::length(rings[b].center - rings[a].center);
         rings[k].slope = len > 1e-12 ? (rings[b].radius - rings[a].radius) / len : 0.0;
     }
-    return rings;
 }
 
 } // namespace
 
-void mesh_axis(const SkeletonAxis& axis, const MeshOptions& o, MeshPart& part,
+std::vector<TubePath> tube_paths(const Skeleton& skeleton, const MeshOptions& o) {
+    const std::size_t n = skeleton.axes.size();
+    std::vector<TubePath> tubes;
+    if (!o.continue_axes) {
+        tubes.reserve(n);
+        for (const auto& axis : skeleton.axes) {
+            TubePath& t = tubes.emplace_back();
+            for (const auto& p : axis.points) t.push_back(&p);
+        }
+        return tubes;
+    }
+    // the child each axis continues into: of the children that begin at its last point, the one
+    // whose first segment turns least from its last one, if that turn is gentle (no extra rings)
+    const double min_cos = std::cos(o.sharp_bend_deg * kPi / 180.0);
+    std::vector<int> next(n, -1);
+    std::vector<double> best(n, -2.0);
+    std::vector<char> continued(n, 0); // this axis is the continuation of its parent
+    auto last_dir = [](const SkeletonAxis& a, glm::dvec3& d) {
+        for (std::size_t k = a.points.size(); k-- > 1;) {
+            glm::dvec3 v = a.points.back().position - a.points[k - 1].position;
+            if (glm::length(v) > 1e-12) {
+                d = glm::normalize(v);
+                return true;
+            }
+        }
+        return false;
+    };
+    auto first_dir = [](const SkeletonAxis& a, glm::dvec3& d) {
+        for (std::size_t k = 1; k < a.points.size(); ++k) {
+            glm::dvec3 v = a.points[k].position - a.points[0].position;
+            if (glm::length(v) > 1e-12) {
+                d = glm::normalize(v);
+                return true;
+            }
+        }
+        return false;
+    };
+    for (std::size_t c = 0; c < n; ++c) {
+        const SkeletonAxis& child = skeleton.axes[c];
+        if (child.parent < 0 || static_cast<std::size_t>(child.parent) >= n || child.points.empty()) continue;
+        const auto pa = static_cast<std::size_t>(child.parent);
+        const SkeletonAxis& parent = skeleton.axes[pa];
+        if (parent.points.empty() || !same_point(parent.points.back().position, child.points[0].position)) continue;
+        glm::dvec3 dp, dc;
+        if (!last_dir(parent, dp) || !first_dir(child, dc)) continue;
+        double cs = glm::dot(dp, dc);
+        if (cs >= min_cos && cs > best[pa]) {
+            best[pa] = cs;
+            next[pa] = static_cast<int>(c);
+        }
+    }
+    for (std::size_t a = 0; a < n; ++a)
+        if (next[a] >= 0) continued[static_cast<std::size_t>(next[a])] = 1;
+    for (std::size_t a = 0; a < n; ++a) {
+        if (continued[a]) continue; // meshed as part of its parent's tube
+        TubePath& t = tubes.emplace_back();
+        for (std::size_t k = a;;) {
+            const auto& pts = skeleton.axes[k].points;
+            // the joint point is the child's first one: its radius and colour start the child's part
+            if (!t.empty()) t.pop_back();
+            for (const auto& p : pts) t.push_back(&p);
+            if (next[k] < 0) break;
+            k = static_cast<std::size_t>(next[k]);
+        }
+    }
+    return tubes;
+}
+
+void mesh_tube(const TubePath& path, const MeshOptions& o, MeshPart& part,
                std::vector<std::vector<std::uint32_t>>& indices_by_material,
                const std::function<std::uint32_t(const glm::vec3&)>& material_of) {
-    std::vector<Ring> rings = rings_of(axis, o);
+    thread_local Scratch s;
+    rings_of(path, o, s);
+    const std::vector<Ring>& rings = s.rings;
     if (rings.size() < 2) return;
     const int sides = std::max(3, o.sides);
+    if (s.sides != sides) {
+        s.sides = sides;
+        s.cosines.resize(static_cast<std::size_t>(sides) + 1);
+        s.sines.resize(static_cast<std::size_t>(sides) + 1);
+        for (int j = 0; j <= sides; ++j) {
+            double phi = 2 * kPi * (j % sides) / sides;
+            s.cosines[static_cast<std::size_t>(j)] = std::cos(phi);
+            s.sines[static_cast<std::size_t>(j)] = std::sin(phi);
+        }
+    }
     // the first frame comes from the turtle's left vector, projected onto the first ring's plane
-    glm::dvec3 normal = axis.points[0].left - rings[0].tangent * glm::dot(axis.points[0].left, rings[0].tangent);
+    const glm::dvec3 left = s.pts[0]->left;
+    glm::dvec3 normal = left - rings[0].tangent * glm::dot(left, rings[0].tangent);
     normal = glm::length(normal) > 1e-9 ? glm::normalize(normal) : any_perpendicular(rings[0].tangent);
+    const auto stride = static_cast<std::uint32_t>(sides + 1);
     const auto base = static_cast<std::uint32_t>(part.positions.size());
+    const std::size_t count = rings.size() * stride;
+    part.positions.resize(base + count);
+    part.normals.resize(base + count);
+    part.uvs.resize(base + count);
+    glm::vec3* pos = part.positions.data() + base;
+    glm::vec3* nrm = part.normals.data() + base;
+    glm::vec2* uv = part.uvs.data() + base;
     double arc = 0;
     for (std::size_t k = 0; k < rings.size(); ++k) {
         const Ring& R = rings[k];
@@ -127,27 +234,49 @@ void mesh_axis(const SkeletonAxis& axis, const MeshOptions& o, MeshPart& part,
             normal = glm::normalize(normal - R.tangent * glm::dot(normal, R.tangent));
             arc += glm::length(R.center - rings[k - 1].center);
         }
-        glm::dvec3 binormal = glm::cross(R.tangent, normal);
-        for (int j = 0; j <= sides; ++j) {
-            double phi = 2 * kPi * (j % sides) / sides;
-            glm::dvec3 radial = std::cos(phi) * normal + std::sin(phi) * binormal;
+        const glm::dvec3 binormal = glm::cross(R.tangent, normal);
+        // the normal of a tapering tube tilts toward the thin end; its length is the same for
+        // every vertex of the ring
+        const double tilt = 1.0 / std::sqrt(1.0 + R.slope * R.slope);
+        const glm::dvec3 along = -R.tangent * R.slope;
+        const bool mitered = R.miter != 1.0;
+        for (std::size_t j = 0; j <= static_cast<std::size_t>(sides); ++j) {
+            const glm::dvec3 radial = s.cosines[j] * normal + s.sines[j] * binormal;
             glm::dvec3 offset = radial * R.radius;
-            if (R.miter != 1.0) offset += R.bend * (glm::dot(offset, R.bend) * (R.miter - 1.0));
-            part.positions.emplace_back(R.center + offset);
-            part.normals.emplace_back(glm::normalize(radial - R.tangent * R.slope));
-            part.uvs.emplace_back(static_cast<float>(double(j) / sides), static_cast<float>(arc));
+            if (mitered) offset += R.bend * (glm::dot(offset, R.bend) * (R.miter - 1.0));
+            *pos++ = glm::vec3(R.center + offset);
+            *nrm++ = glm::vec3((radial + along) * tilt);
+            *uv++ = glm::vec2(static_cast<float>(double(j) / sides), static_cast<float>(arc));
         }
     }
-    const auto stride = static_cast<std::uint32_t>(sides + 1);
+    // triangles, grouped by material (looked up only when the colour changes along the tube)
+    std::vector<std::uint32_t>* idx = nullptr;
+    glm::vec3 last_color(-1.0f);
     for (std::size_t k = 0; k + 1 < rings.size(); ++k) {
-        const std::uint32_t material = material_of(rings[k + 1].color);
-        if (material >= indices_by_material.size()) indices_by_material.resize(material + 1);
-        auto& idx = indices_by_material[material];
+        if (!idx || rings[k + 1].color != last_color) {
+            last_color = rings[k + 1].color;
+            const std::uint32_t material = material_of(last_color);
+            if (material >= indices_by_material.size()) indices_by_material.resize(material + 1);
+            idx = &indices_by_material[material];
+        }
+        const std::size_t at = idx->size();
+        idx->resize(at + 6 * static_cast<std::size_t>(sides));
+        std::uint32_t* out = idx->data() + at;
         for (std::uint32_t j = 0; j < static_cast<std::uint32_t>(sides); ++j) {
             std::uint32_t a = base + static_cast<std::uint32_t>(k) * stride + j, b = a + 1, d = a + stride, c = d + 1;
-            idx.insert(idx.end(), {a, b, c, a, c, d});
+            out[0] = a, out[1] = b, out[2] = c, out[3] = a, out[4] = c, out[5] = d;
+            out += 6;
         }
     }
+}
+
+void mesh_axis(const SkeletonAxis& axis, const MeshOptions& o, MeshPart& part,
+               std::vector<std::vector<std::uint32_t>>& indices_by_material,
+               const std::function<std::uint32_t(const glm::vec3&)>& material_of) {
+    TubePath path;
+    path.reserve(axis.points.size());
+    for (const auto& p : axis.points) path.push_back(&p);
+    mesh_tube(path, o, part, indices_by_material, material_of);
 }
 
 } // namespace plant

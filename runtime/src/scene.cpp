@@ -141,7 +141,16 @@ Scene build_scene(const Program& program, const Skeleton& skeleton, const MeshOp
         return id;
     };
     std::vector<std::vector<std::uint32_t>> by_material;
-    for (const auto& axis : skeleton.axes) mesh_axis(axis, options, scene.tubes, by_material, material_of);
+    const std::vector<TubePath> tubes = tube_paths(skeleton, options);
+    {
+        std::size_t points = 0;
+        for (const auto& t : tubes) points += t.size();
+        const std::size_t vertices = points * static_cast<std::size_t>(std::max(3, options.sides) + 1);
+        scene.tubes.positions.reserve(vertices);
+        scene.tubes.normals.reserve(vertices);
+        scene.tubes.uvs.reserve(vertices);
+    }
+    for (const auto& t : tubes) mesh_tube(t, options, scene.tubes, by_material, material_of);
     for (std::uint32_t m = 0; m < by_material.size(); ++m) {
         if (by_material[m].empty()) continue;
         auto first = static_cast<std::uint32_t>(scene.tubes.indices.size());

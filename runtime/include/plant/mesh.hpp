@@ -12,9 +12,26 @@ struct MeshOptions {
     int sides = 8;                // vertices per ring
     double sharp_bend_deg = 45.0; // past this a joint is rounded with extra rings
     double tip_taper = 0.35;      // radius of the last ring, as a fraction of the axis radius there
+    bool continue_axes = true;    // an axis's tube goes on into a child axis (see tube_paths)
 };
 
-// Appends the tube of one axis to `part`, with primitives grouped by `material_of` (a color ->
+// The points one tube runs through, in order.
+using TubePath = std::vector<const SkeletonPoint*>;
+
+// The tubes of a skeleton. Each axis is one tube, except that an axis that ends where a child
+// axis begins, with the child's first segment turning from its last one by no more than
+// sharp_bend_deg, goes on into that child (the straightest one when several qualify): the
+// sympodial case, where an apex stops and a lateral takes over. The joint is the child's first
+// point, so the radius narrows to the child's there. Without this, a sympodial tree (ABOP
+// Fig. 2.7) is one tube per segment, each with a hidden tapered tip inside the next.
+std::vector<TubePath> tube_paths(const Skeleton& skeleton, const MeshOptions& options);
+
+// Appends one tube to `part` (see mesh_axis).
+void mesh_tube(const TubePath& path, const MeshOptions& options, MeshPart& part,
+               std::vector<std::vector<std::uint32_t>>& indices_by_material,
+               const std::function<std::uint32_t(const glm::vec3&)>& material_of);
+
+// Appends the tube of one axis alone to `part`, with primitives grouped by `material_of` (a color ->
 // material index map the caller keeps across axes). Rings are shared between consecutive
 // segments; frames are parallel-transported from the first point's left vector.
 void mesh_axis(const SkeletonAxis& axis, const MeshOptions& options, MeshPart& part,

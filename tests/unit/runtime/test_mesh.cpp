@@ -35,6 +35,14 @@ MeshPart tube_of(const SkeletonAxis& axis, const MeshOptions& o) {
     return part;
 }
 
+MeshPart tube_of(const TubePath& path, const MeshOptions& o) {
+    MeshPart part;
+    std::vector<std::vector<std::uint32_t>> by_material;
+    mesh_tube(path, o, part, by_material, [](const glm::vec3&) { return 0u; });
+    for (auto& idx : by_material) part.indices.insert(part.indices.end(), idx.begin(), idx.end());
+    return part;
+}
+
 // Boundary loops of a tube, through OpenMesh, with the texture seam welded (its two copies of a
 // vertex have the same position).
 int boundary_loops(const MeshPart& part, bool& manifold) {
@@ -81,6 +89,11 @@ const char* kGrammars[] = {
     "angle 25.7; axiom: !(0.2) F; rules { F -> F[+F]F[-F]F; }",
     // sharp corners (90 and 120 degrees) get rounded with extra rings
     "axiom: !(0.3) F F +(90) F F -(120) F &(100) F F;",
+    // Honda's sympodial tree (ABOP Fig. 2.7a): every axis is one segment, continued into a child
+    R"(param r1 = 0.9; param r2 = 0.7; param a1 = 5; param a2 = 65; const wr = 0.707;
+       module A(l, w); module B(l, w); axiom: A(1, 10);
+       rules { A(l, w) -> !(w) F(l) [ &(a1) B(l * r1, w * wr) ] /(180) [ &(a2) B(l * r2, w * wr) ];
+               B(l, w) -> !(w) F(l) [ +(a1) $ B(l * r1, w * wr) ] [ -(a2) $ B(l * r2, w * wr) ]; })",
 };
 
 } // namespace
@@ -121,12 +134,12 @@ TEST_CASE("every tube is a manifold with two boundary loops, unit normals and no
         MeshOptions o;
         o.sides = 6;
         int tubes = 0;
-        for (const auto& axis : sk.axes) {
-            MeshPart m = tube_of(axis, o);
+        for (const TubePath& path : tube_paths(sk, o)) {
+            MeshPart m = tube_of(path, o);
             if (m.empty()) continue;
             ++tubes;
             bool manifold = false;
-            INFO("axis with " << axis.points.size() << " points");
+            INFO("tube through " << path.size() << " points");
             CHECK(boundary_loops(m, manifold) == 2);
             CHECK(manifold);
             for (const auto& n : m.normals) {
@@ -143,6 +156,45 @@ TEST_CASE("every tube is a manifold with two boundary loops, unit normals and no
         }
         CHECK(tubes > 0);
     }
+}
+
+TEST_CASE("a sympodial axis goes on into its straightest child when the turn is gentle", "[mesh]") {
+    // Fig. 2.7a: each A/B draws one segment, then two laterals turned by a1 = 5 and a2 = 65
+    // degrees. The 5-degree one continues the tube; the 65-degree one (past the 45-degree sharp
+    // bend) starts a new tube inside the joint.
+    Skeleton sk = skeleton_of(kGrammars[3], 5);
+    const std::size_t axes = sk.axes.size();
+    REQUIRE(axes == 31); // 1 + 2 + 4 + 8 + 16 segments, one axis each
+    MeshOptions o;
+    std::vector<TubePath> tubes = tube_paths(sk, o);
+    // every fork with drawn branches hands on one of them: the tubes are the root's and the 15
+    // weak branches' (the 16 apices of the last generation have not drawn anything yet)
+    CHECK(tubes.size() == 16);
+    std::size_t points = 0;
+    for (const TubePath& t : tubes) {
+        points += t.size();
+        for (std::size_t k = 1; k < t.size(); ++k) CHECK(glm::length(t[k]->position - t[k - 1]->position) > 1e-9);
+        for (std::size_t k = 1; k + 1 < t.size(); ++k) {
+            // every joint in a tube is gentle: a 5 degree turn
+            glm::dvec3 d0 = glm::normalize(t[k]->position - t[k - 1]->position);
+            glm::dvec3 d1 = glm::normalize(t[k + 1]->position - t[k]->position);
+            CHECK(glm::degrees(std::acos(std::clamp(glm::dot(d0, d1), -1.0, 1.0))) == Approx(5.0).margin(1e-6));
+        }
+    }
+    // each axis contributes its two points, minus the shared joint where it continues a parent
+    CHECK(points == 2 * axes - (axes - tubes.size()));
+    // the longest tube follows the strong branch from the root to the last generation
+    std::size_t longest = 0;
+    for (const TubePath& t : tubes) longest = std::max(longest, t.size());
+    CHECK(longest == 6); // five segments
+    // the same skeleton, one tube per axis, when continuation is off
+    o.continue_axes = false;
+    CHECK(tube_paths(sk, o).size() == axes);
+    // a continued tube shares a ring per joint: fewer vertices, the same triangles
+    Scene joined = build_scene(*test::compile(kGrammars[3])->program, sk, MeshOptions{});
+    Scene apart = build_scene(*test::compile(kGrammars[3])->program, sk, o);
+    CHECK(joined.tubes.triangle_count() == apart.tubes.triangle_count());
+    CHECK(joined.tubes.positions.size() == apart.tubes.positions.size() - 9 * (axes - tubes.size()));
 }
 
 TEST_CASE("the scene shares organ prototypes between placements and bounds include them", "[mesh]") {
