@@ -45,6 +45,7 @@ SymbolTable::SymbolTable() {
 SymbolId SymbolTable::intern(std::string_view name) {
     auto it = index_.find(std::string(name));
     if (it != index_.end()) return it->second;
+    if (infos_.size() >= kNoSymbol) throw Full{};
     auto id = static_cast<SymbolId>(infos_.size());
     SymbolInfo info;
     info.name = std::string(name);
@@ -782,7 +783,14 @@ std::unique_ptr<Program> Compiler::compile(std::uint32_t main_file) {
 std::unique_ptr<Program> compile_source(SourceManager& sources, std::uint32_t file_id, const CompileOptions& options,
                                         Diagnostics& diags) {
     Compiler c(sources, options, diags);
-    return c.compile(file_id);
+    try {
+        return c.compile(file_id);
+    } catch (const SymbolTable::Full&) {
+        diags.error(Span{file_id, 0, 0}, fmt::format("the program names more than {} different modules, the most "
+                                                     "plant can tell apart",
+                                                     kNoSymbol - 1));
+        return nullptr;
+    }
 }
 
 std::unique_ptr<Program> compile_file(SourceManager& sources, const std::string& path, const CompileOptions& options,

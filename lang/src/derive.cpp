@@ -424,6 +424,7 @@ void Derivation::run() {
     while (step()) {
     }
     finish();
+    big_pages::trim(); // the pages freed strings kept for later steps go back to the system
 }
 
 std::vector<std::size_t> find_matches(const Derivation& d, const Program& program, const RuleSet& rules) {

@@ -65,10 +65,10 @@ glm::dmat4 frame_matrix(const TurtleState& t, double scale) {
 }
 
 struct Symbols {
-    SymbolId F = ~0u, f = ~0u, G = ~0u, plus = ~0u, minus = ~0u, amp = ~0u, caret = ~0u, back = ~0u, slash = ~0u,
-             pipe = ~0u, dollar = ~0u, open = ~0u, close = ~0u, bang = ~0u, semi = ~0u, sphere = ~0u, set_head = ~0u,
-             set_head2 = ~0u, move_to = ~0u, tropism = ~0u, elasticity = ~0u, set_color = ~0u, qP = ~0u, qH = ~0u,
-             qU = ~0u, qL = ~0u, qE = ~0u;
+    SymbolId F = kNoSymbol, f = kNoSymbol, G = kNoSymbol, plus = kNoSymbol, minus = kNoSymbol, amp = kNoSymbol, caret = kNoSymbol, back = kNoSymbol, slash = kNoSymbol,
+             pipe = kNoSymbol, dollar = kNoSymbol, open = kNoSymbol, close = kNoSymbol, bang = kNoSymbol, semi = kNoSymbol, sphere = kNoSymbol, set_head = kNoSymbol,
+             set_head2 = kNoSymbol, move_to = kNoSymbol, tropism = kNoSymbol, elasticity = kNoSymbol, set_color = kNoSymbol, qP = kNoSymbol, qH = kNoSymbol,
+             qU = kNoSymbol, qL = kNoSymbol, qE = kNoSymbol;
     explicit Symbols(const SymbolTable& st) {
         auto get = [&](const char* n, SymbolId& out) {
             if (auto id = st.find(n)) out = *id;

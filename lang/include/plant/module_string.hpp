@@ -12,7 +12,11 @@
 
 namespace plant {
 
-using SymbolId = std::uint32_t;
+// 16 bits: the string's largest array after the parameters and identities, so two bytes saved
+// per module are about a tenth of a derivation's memory traffic. A program has at most
+// kNoSymbol - 1 symbols (the compiler says so past that); kNoSymbol itself means "none".
+using SymbolId = std::uint16_t;
+constexpr SymbolId kNoSymbol = 0xFFFF;
 using ModuleId = std::uint64_t;
 
 struct ModuleString {

@@ -36,6 +36,8 @@ struct SymbolInfo {
 
 class SymbolTable {
 public:
+    // Thrown by intern when every symbol id is taken (kNoSymbol - 1 names).
+    struct Full {};
     SymbolTable();
     SymbolId intern(std::string_view name);
     std::optional<SymbolId> find(std::string_view name) const;

@@ -128,3 +128,18 @@ TEST_CASE("a surface in an importing file replaces the library's, but twice in o
     CHECK(!twice->program);
     CHECK(twice->rendered().find("surface 'leaf'") != std::string::npos);
 }
+
+TEST_CASE("a program with more module names than symbol ids is refused, not wrapped around", "[compiler]") {
+    // symbol ids are 16 bits: 65,534 names at most, the builtins among them
+    auto source = [](int n) {
+        std::string s = "axiom: M0;\n";
+        for (int i = 0; i < n; ++i) s += "module M" + std::to_string(i) + ";";
+        return s;
+    };
+    auto fits = compile(source(60000));
+    CHECK(fits->program);
+    auto c = compile(source(70000));
+    CHECK(!c->program);
+    CHECK(messages(*c, Severity::Error) ==
+          std::vector<std::string>{"the program names more than 65534 different modules, the most plant can tell apart"});
+}
