@@ -66,6 +66,82 @@ public:
                 break;
             }
         }
+        if (brackets && !multi && !left_new && !right_new) build_context_table();
+    }
+
+    // The context table. When every production of a symbol is `l < s > r -> successor` with
+    // modules that carry no parameters, at most one context module a side and no condition,
+    // weight or new context (ABOP's Fig. 1.31 and other signal-propagation systems), which
+    // production applies depends only on the symbols of the two neighbours. A K x K table per
+    // such symbol, K being the number of symbols the patterns name plus one for all others,
+    // answers that with one lookup instead of trying the productions in turn.
+    void build_context_table() {
+        const std::size_t S = P.symbols.size();
+        ctx_block.assign(S, -1);
+        ctx_sides.assign(S, 0);
+        ctx_key.assign(S, 0);
+        std::vector<std::vector<const Production*>> cands(S);
+        auto plain = [&](const PatternModule& m) {
+            return m.width == 0 && m.args.empty() && m.sym != P.symbols.open_bracket && m.sym != P.symbols.close_bracket;
+        };
+        std::vector<SymbolId> eligible;
+        for (SymbolId sym = 0; sym < S; ++sym) {
+            if (!has_prod[sym] || direct[sym]) continue;
+            bool ok = true;
+            for (const RuleSet* rs : sets)
+                for (std::uint32_t pi : rs->by_symbol[sym]) {
+                    const Production& pr = rs->productions[pi];
+                    ok = ok && pr.strict.size() == 1 && plain(pr.strict[0]) && pr.left.size() <= 1 &&
+                         pr.right.size() <= 1 && (pr.left.empty() || plain(pr.left[0])) &&
+                         (pr.right.empty() || plain(pr.right[0])) && pr.condition.empty() && pr.weight.empty() &&
+                         !pr.has_new_context() && pr.tmpl.valid;
+                    cands[sym].push_back(&pr);
+                }
+            if (!ok) continue;
+            eligible.push_back(sym);
+            for (const Production* pr : cands[sym]) {
+                for (const auto* side : {&pr->left, &pr->right})
+                    if (!side->empty() && ctx_key[(*side)[0].sym] == 0) {
+                        if (ctx_keys == 255) return; // too many to tabulate: the general path it is
+                        ctx_key[(*side)[0].sym] = static_cast<std::uint8_t>(ctx_keys++);
+                    }
+                if (!pr->left.empty()) ctx_sides[sym] |= 1;
+                if (!pr->right.empty()) ctx_sides[sym] |= 2;
+            }
+        }
+        const std::size_t K = ctx_keys;
+        for (SymbolId sym : eligible) {
+            ctx_block[sym] = static_cast<std::int32_t>(ctx_entries.size());
+            for (std::size_t lk = 0; lk < K; ++lk)
+                for (std::size_t rk = 0; rk < K; ++rk) {
+                    const Production* hit = nullptr;
+                    for (const Production* pr : cands[sym]) {
+                        bool l = pr->left.empty() || (lk != 0 && ctx_key[pr->left[0].sym] == lk);
+                        bool r = pr->right.empty() || (rk != 0 && ctx_key[pr->right[0].sym] == rk);
+                        if (l && r) {
+                            hit = pr;
+                            break;
+                        }
+                    }
+                    ctx_entries.push_back(hit);
+                }
+        }
+    }
+
+    // The production the context table gives for module i, which has a table and no parameters.
+    // nullptr: none applies.
+    const Production* table_lookup(std::size_t i) const {
+        const SymbolId sym = in.sym[i];
+        std::size_t lk = 0, rk = 0;
+        if (ctx_sides[sym] & 1) {
+            const std::int64_t j = left_step(static_cast<std::int64_t>(i) - 1);
+            if (j >= 0 && in.arity(static_cast<std::size_t>(j)) == 0) lk = ctx_key[in.sym[static_cast<std::size_t>(j)]];
+        }
+        if (ctx_sides[sym] & 2) {
+            const std::size_t j = right_step(i + 1);
+            if (j < n && in.arity(j) == 0) rk = ctx_key[in.sym[j]];
+        }
+        return ctx_entries[static_cast<std::size_t>(ctx_block[sym]) + lk * ctx_keys + rk];
     }
 
     bool sequential() const { return multi || left_new || right_new; }
@@ -133,11 +209,22 @@ public:
                 while (j < e && !has_prod[in.sym[j]]) ++j;
                 const std::size_t n = j - i;
                 const std::uint32_t pb = in.poff[i], pe = in.poff[j];
-                std::memcpy(S, in.sym.data() + i, n * sizeof(SymbolId));
-                std::memcpy(ID, in.ids.data() + i, n * sizeof(ModuleId));
-                if (pe > pb) std::memcpy(PA, in.params.data() + pb, (pe - pb) * sizeof(double));
                 const auto shift = static_cast<std::uint32_t>(p - pb); // wraps around on purpose
-                for (std::size_t k = 0; k < n; ++k) PO[k] = in.poff[i + 1 + k] + shift;
+                if (n <= 8 && pe - pb <= 8) {
+                    // the usual run between two rewritten modules is a few turtle symbols: plain
+                    // loops beat three library calls
+                    for (std::size_t k = 0; k < n; ++k) {
+                        S[k] = in.sym[i + k];
+                        ID[k] = in.ids[i + k];
+                        PO[k] = in.poff[i + 1 + k] + shift;
+                    }
+                    for (std::uint32_t k = 0; k < pe - pb; ++k) PA[k] = in.params[pb + k];
+                } else {
+                    std::memcpy(S, in.sym.data() + i, n * sizeof(SymbolId));
+                    std::memcpy(ID, in.ids.data() + i, n * sizeof(ModuleId));
+                    if (pe > pb) std::memcpy(PA, in.params.data() + pb, (pe - pb) * sizeof(double));
+                    for (std::size_t k = 0; k < n; ++k) PO[k] = in.poff[i + 1 + k] + shift;
+                }
                 S += n;
                 ID += n;
                 PO += n;
@@ -167,9 +254,18 @@ public:
             // memcpy with a null source is undefined even for zero bytes.
             if (!t.params.empty()) std::memcpy(PA, t.params.data(), t.params.size() * sizeof(double));
             for (std::size_t h = 0; h < t.holes.size(); ++h) PA[t.holes[h]] = values[h];
+            const auto p32 = static_cast<std::uint32_t>(p);
             for (std::size_t j = 0; j < m; ++j) {
-                PO[j] = static_cast<std::uint32_t>(p + t.param_end[j]);
-                ID[j] = static_cast<int>(j) == t.keep ? in.ids[i] : id_at++;
+                PO[j] = p32 + t.param_end[j];
+                ID[j] = id_at + j;
+            }
+            if (t.keep >= 0) { // the kept module has the predecessor's identity; the rest are new
+                const auto keep = static_cast<std::size_t>(t.keep);
+                for (std::size_t j = keep + 1; j < m; ++j) --ID[j];
+                ID[keep] = in.ids[i];
+                id_at += m - 1;
+            } else {
+                id_at += m;
             }
             S += m;
             ID += m;
@@ -229,6 +325,18 @@ public:
                     w.env.id = in.ids[i];
                 }
                 apply_template(w, i, *pr);
+                ++i;
+                continue;
+            }
+            if (!ctx_block.empty() && ctx_block[in.sym[i]] >= 0 && in.arity(i) == 0) {
+                if (const Production* pr = table_lookup(i)) {
+                    w.env.position = i;
+                    w.env.draw = 0;
+                    w.env.id = in.ids[i];
+                    apply_template(w, i, *pr);
+                } else {
+                    w.out.append_range(in, i, i + 1);
+                }
                 ++i;
                 continue;
             }
@@ -656,6 +764,13 @@ private:
     std::vector<std::uint8_t> has_prod;
     std::vector<std::uint32_t> match;
     std::vector<const Production*> direct;
+    // The context table (see build_context_table): per symbol, the offset of its K x K block in
+    // ctx_entries (-1: no table), and whether its productions read the left or right neighbour.
+    std::vector<std::int32_t> ctx_block;
+    std::vector<std::uint8_t> ctx_sides; // bit 0: left, bit 1: right
+    std::vector<std::uint8_t> ctx_key;   // per symbol: its row/column, 0 for symbols no pattern names
+    std::size_t ctx_keys = 1;
+    std::vector<const Production*> ctx_entries; // nullptr: no production applies
     std::vector<std::size_t> piece_starts;
     std::size_t frame_size = 1;
     bool multi = false, left_new = false, right_new = false;
