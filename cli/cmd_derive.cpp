@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <vector>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -35,11 +36,12 @@ int derive_main(const DeriveCmd& c) {
     if (!program) return exit_code;
     DeriveOptions opt = derive_options(c.g);
     const bool progress = !c.stats && isatty(2);
-    double total_ms = 0;
-    std::string stats_out;
+    // the figures are kept and formatted at the end, so that the timing of one step is not
+    // disturbed by formatting the last one
+    std::vector<StepStats> steps;
+    steps.reserve(256);
     opt.on_step = [&](const StepStats& s) {
-        total_ms += s.ms;
-        if (c.stats) stats_out += fmt::format("step {} modules={} bytes={} ms={:.3f}\n", s.step, s.modules, s.bytes, s.ms);
+        if (c.stats) steps.push_back(s);
         if (progress) std::cerr << fmt::format("\rstep {}: {} modules   ", s.step, s.modules) << std::flush;
     };
     opt.on_print = [](const std::string& text) { std::cerr << text; };
@@ -50,6 +52,12 @@ int derive_main(const DeriveCmd& c) {
     if (progress) std::cerr << "\r\x1b[K" << std::flush;
     if (!ok) return kRuntime;
     if (c.stats) {
+        std::string stats_out;
+        double total_ms = 0;
+        for (const StepStats& s : steps) {
+            total_ms += s.ms;
+            stats_out += fmt::format("step {} modules={} bytes={} ms={:.3f}\n", s.step, s.modules, s.bytes, s.ms);
+        }
         stats_out += fmt::format("total steps={} modules={} bytes={} ms={:.3f} peak_rss_kb={}\n", d.steps_done(),
                                  d.string().size(), d.string().bytes(), total_ms, peak_rss_kb());
         std::fwrite(stats_out.data(), 1, stats_out.size(), stdout);

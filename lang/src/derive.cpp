@@ -52,9 +52,16 @@ void Derivation::check_limits(std::size_t modules, std::size_t params) const {
                                                step_, estimate / double(1 << 30), opt_.max_bytes / double(1 << 30))};
 }
 
+const RulePlan& Derivation::plan_for(const std::vector<const RuleSet*>& sets) const {
+    for (const auto& p : plans_)
+        if (p->sets == sets) return *p;
+    plans_.push_back(std::make_shared<const RulePlan>(prog_, sets));
+    return *plans_.back();
+}
+
 void Derivation::rewrite(const ModuleString& in, ModuleString& out, const std::vector<const RuleSet*>& sets,
                          std::uint64_t phase, int step_for_env) const {
-    Rewriter rw(prog_, in, sets);
+    Rewriter rw(plan_for(sets), in);
     auto setup = [&](Worker& w) {
         w.env.prog = &prog_;
         w.env.globals = const_cast<double*>(globals_.data()); // read-only during rewriting
@@ -431,8 +438,8 @@ std::vector<std::size_t> find_matches(const Derivation& d, const Program& progra
     std::vector<std::size_t> out;
     if (rules.productions.empty()) return out;
     const ModuleString& s = d.string();
-    std::vector<const RuleSet*> sets{&rules};
-    Rewriter rw(program, s, sets);
+    RulePlan plan(program, {&rules});
+    Rewriter rw(plan, s);
     Worker w;
     w.env.prog = &program;
     std::vector<double> globals = const_cast<Derivation&>(d).globals();

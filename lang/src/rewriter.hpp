@@ -31,11 +31,11 @@ struct Worker {
     std::int64_t ctx_left = kUnknown, ctx_right = kUnknown;
 };
 
-class Rewriter {
-public:
-    Rewriter(const Program& p, const ModuleString& in, const std::vector<const RuleSet*>& sets)
-        : P(p), in(in), sets(sets), n(in.size()) {
-        bool brackets = false;
+// What rewriting with a list of rule sets needs that does not depend on the string: which
+// symbols have productions, which apply at once (direct), the context table. The derivation
+// builds it once per list of rule sets and keeps it, not once per step.
+struct RulePlan {
+    RulePlan(const Program& p, std::vector<const RuleSet*> rule_sets) : P(p), sets(std::move(rule_sets)) {
         std::size_t frame = 1;
         has_prod.assign(P.symbols.size(), 0);
         for (const RuleSet* rs : sets) {
@@ -49,7 +49,6 @@ public:
             right_new = right_new || rs->uses_right_new;
         }
         frame_size = frame;
-        if (brackets) match = bracket_table(in, P.symbols.open_bracket, P.symbols.close_bracket);
         // A symbol whose first production always applies (no condition, context or weight, one
         // predecessor module whose arguments are all bound) needs no matching: with the right
         // number of parameters, its template is applied at once.
@@ -69,6 +68,21 @@ public:
         if (brackets && !multi && !left_new && !right_new) build_context_table();
     }
 
+    const Program& P;
+    std::vector<const RuleSet*> sets;
+    std::vector<std::uint8_t> has_prod;
+    std::vector<const Production*> direct;
+    // The context table (see build_context_table): per symbol, the offset of its K x K block in
+    // ctx_entries (-1: no table), and whether its productions read the left or right neighbour.
+    std::vector<std::int32_t> ctx_block;
+    std::vector<std::uint8_t> ctx_sides; // bit 0: left, bit 1: right
+    std::vector<std::uint8_t> ctx_key;   // per symbol: its row/column, 0 for symbols no pattern names
+    std::size_t ctx_keys = 1;
+    std::vector<const Production*> ctx_entries; // nullptr: no production applies
+    std::size_t frame_size = 1;
+    bool brackets = false, multi = false, left_new = false, right_new = false;
+
+private:
     // The context table. When every production of a symbol is `l < s > r -> successor` with
     // modules that carry no parameters, at most one context module a side and no condition,
     // weight or new context (ABOP's Fig. 1.31 and other signal-propagation systems), which
@@ -126,6 +140,18 @@ public:
                     ctx_entries.push_back(hit);
                 }
         }
+    }
+
+};
+
+class Rewriter {
+public:
+    Rewriter(const RulePlan& plan, const ModuleString& in)
+        : P(plan.P), in(in), sets(plan.sets), n(in.size()), has_prod(plan.has_prod), direct(plan.direct),
+          ctx_block(plan.ctx_block), ctx_sides(plan.ctx_sides), ctx_key(plan.ctx_key), ctx_keys(plan.ctx_keys),
+          ctx_entries(plan.ctx_entries), frame_size(plan.frame_size), multi(plan.multi), left_new(plan.left_new),
+          right_new(plan.right_new) {
+        if (plan.brackets) match = bracket_table(in, P.symbols.open_bracket, P.symbols.close_bracket);
     }
 
     // The production the context table gives for module i, which has a table and no parameters.
@@ -761,19 +787,17 @@ private:
     const ModuleString& in;
     const std::vector<const RuleSet*>& sets;
     const std::size_t n;
-    std::vector<std::uint8_t> has_prod;
+    const std::vector<std::uint8_t>& has_prod;
+    const std::vector<const Production*>& direct;
+    const std::vector<std::int32_t>& ctx_block;
+    const std::vector<std::uint8_t>& ctx_sides;
+    const std::vector<std::uint8_t>& ctx_key;
+    const std::size_t ctx_keys;
+    const std::vector<const Production*>& ctx_entries;
+    const std::size_t frame_size;
+    const bool multi, left_new, right_new;
     std::vector<std::uint32_t> match;
-    std::vector<const Production*> direct;
-    // The context table (see build_context_table): per symbol, the offset of its K x K block in
-    // ctx_entries (-1: no table), and whether its productions read the left or right neighbour.
-    std::vector<std::int32_t> ctx_block;
-    std::vector<std::uint8_t> ctx_sides; // bit 0: left, bit 1: right
-    std::vector<std::uint8_t> ctx_key;   // per symbol: its row/column, 0 for symbols no pattern names
-    std::size_t ctx_keys = 1;
-    std::vector<const Production*> ctx_entries; // nullptr: no production applies
     std::vector<std::size_t> piece_starts;
-    std::size_t frame_size = 1;
-    bool multi = false, left_new = false, right_new = false;
 };
 
 

@@ -9,13 +9,16 @@
 
 #include <atomic>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace plant {
 
 class Rewriter;   // derive.cpp
 class Derivation; // below
+struct RulePlan;  // rewriter.hpp
 
 // Implemented by the runtime: interprets the string with the turtle and writes the position,
 // heading, up or left vector into every query module (?P ?H ?U ?L). Called before a step whose
@@ -90,6 +93,8 @@ private:
     void apply_cut(ModuleString& s) const;
     void check_limits(const ModuleString& s) const;
     void check_limits(std::size_t modules, std::size_t params) const;
+    // The plan for rewriting with `sets`, built the first time and kept (copies share them).
+    const RulePlan& plan_for(const std::vector<const RuleSet*>& sets) const;
 
     const Program& prog_;
     DeriveOptions opt_;
@@ -104,6 +109,7 @@ private:
     double angle_ = 90, step_length_ = 1, width_ = 1;
     mutable ModuleId next_id_ = 1;
     mutable double growth_ = 2.0, param_growth_ = 2.0; // last step's growth, for reserving memory
+    mutable std::vector<std::shared_ptr<const RulePlan>> plans_;
 };
 
 // The positions where the first production of `rules` matches in the derivation's current string
