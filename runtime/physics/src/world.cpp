@@ -250,12 +250,58 @@ glm::dquat World::group_rotation(std::uint32_t i) const {
 }
 
 
-void World::match_shapes(std::vector<Frame>& frames, std::vector<glm::dvec3>& goal, std::vector<glm::dmat3>& moments,
-                         int iterations) const {
+void World::build_groups(Groups& g) const {
+    const std::size_t n = x_.size();
+    g.start.assign(n + 1, 0);
+    g.member.clear();
+    g.mass.clear();
+    g.rest_off.clear();
+    g.total.assign(n, 0.0);
+    g.rest_center.assign(n, glm::dvec3(0.0));
+    for (std::uint32_t i = 0; i < n; ++i) {
+        g.start[i] = static_cast<std::uint32_t>(g.member.size());
+        if (!alive_[i]) continue;
+        // the same sums, in the same order, as group_frame
+        double M = 0;
+        glm::dvec3 rc(0.0);
+        for_group(i, [&](std::uint32_t j) {
+            const double m = matching_mass(j);
+            M += m;
+            rc += m * rest_x_[j];
+            g.member.push_back(j);
+            g.mass.push_back(m);
+        });
+        rc /= M;
+        g.total[i] = M;
+        g.rest_center[i] = rc;
+        for (std::size_t k = g.start[i]; k < g.member.size(); ++k) g.rest_off.push_back(rest_x_[g.member[k]] - rc);
+    }
+    g.start[n] = static_cast<std::uint32_t>(g.member.size());
+    // goal sources: its own group, its parent's (twice the weight), its children's (half)
+    g.source_start.assign(n + 1, 0);
+    g.source.clear();
+    g.weight.clear();
+    g.offset.clear();
+    for (std::uint32_t j = 0; j < n; ++j) {
+        g.source_start[j] = static_cast<std::uint32_t>(g.source.size());
+        auto add = [&](std::uint32_t i, double w) {
+            if (!alive_[i]) return;
+            g.source.push_back(i);
+            g.weight.push_back(w);
+            g.offset.push_back(rest_x_[j] - g.rest_center[i]);
+        };
+        add(j, m_[j]);
+        if (parent_[j] != kNone) add(parent_[j], 2.0 * m_[j]);
+        for (std::uint32_t c : children_[j]) add(c, 0.5 * m_[j]);
+    }
+    g.source_start[n] = static_cast<std::uint32_t>(g.source.size());
+}
+
+void World::match_shapes(std::vector<Frame>& frames, std::vector<glm::dmat3>& moments, int iterations,
+                         const Groups& g) const {
     const std::size_t n = x_.size();
     frames.resize(n);
     moments.resize(n);
-    goal.resize(n);
     const int threads = settings_.threads;
     // Eq. 15's moment R D R̄ᵀ: the rest part D R̄ᵀ (with the mass) is fixed within a step and
     // computed once in step(); here only the current rotation changes
@@ -267,43 +313,52 @@ void World::match_shapes(std::vector<Frame>& frames, std::vector<glm::dvec3>& go
                                 : ellipsoid_moment(static_cast<std::uint32_t>(j));
         }
     });
+    // Eq. 14 with Eq. 15's ellipsoid moments, positions relative to the centers to keep the sums
+    // well conditioned (group_frame's sums, over the flattened groups)
     parallel_ranges(n, threads, 2048, [&](std::size_t b, std::size_t e) {
-        for (std::size_t k = b; k < e; ++k) {
-            const auto i = static_cast<std::uint32_t>(k);
+        for (std::size_t i = b; i < e; ++i) {
             if (!alive_[i]) continue;
+            const std::uint32_t from = g.start[i], to = g.start[i + 1];
+            glm::dvec3 c(0.0);
+            for (std::uint32_t k = from; k < to; ++k) c += g.mass[k] * x_[g.member[k]];
+            c /= g.total[i];
+            glm::dmat3 A(0.0);
+            for (std::uint32_t k = from; k < to; ++k) {
+                const std::uint32_t j = g.member[k];
+                A += moments[j];
+                A += g.mass[k] * outer(x_[j] - c, g.rest_off[k]);
+            }
             // warm start from the last pass's rotation when there is one, else from the
             // particle's own rotation from rest
-            frames[i] = group_frame(i, frames[i].valid ? frames[i].R : rotation_from_rest(i), moments.data(), iterations);
-        }
-    });
-    // Eq. 3: the target of particle j in group i is R_i (x̄_j - c̄_i) + c_i; Eq. 4: j's goal is
-    // their mass-weighted mean over the groups j belongs to (its own, its parent's, its
-    // children's), its parent's group counting twice as much as its own and its children's half.
-    // Gathered per particle, so each slot is written by one thread.
-    parallel_ranges(n, threads, 2048, [&](std::size_t b, std::size_t e) {
-        for (std::size_t k = b; k < e; ++k) {
-            const auto j = static_cast<std::uint32_t>(k);
-            glm::dvec3 sum(0.0);
-            double wsum = 0;
-            auto add = [&](std::uint32_t i, double w) {
-                if (!alive_[i]) return;
-                const Frame& f = frames[i];
-                sum += w * (f.R * (rest_x_[j] - f.rc) + f.c);
-                wsum += w;
-            };
-            add(j, m_[j]);
-            if (parent_[j] != kNone) add(parent_[j], 2.0 * m_[j]);
-            for (std::uint32_t c : children_[j]) add(c, 0.5 * m_[j]);
-            goal[j] = wsum > 0 ? sum / wsum : x_[j];
+            const auto ii = static_cast<std::uint32_t>(i);
+            const glm::dquat warm = frames[i].valid ? frames[i].R : rotation_from_rest(ii);
+            frames[i] = Frame{c, g.rest_center[i], extract_rotation(A, warm, iterations), true};
         }
     });
 }
 
+glm::dvec3 World::goal_of(std::uint32_t j, const std::vector<Frame>& frames, const Groups& g) const {
+    // Eq. 3: the target of particle j in group i is R_i (x̄_j - c̄_i) + c_i; Eq. 4: j's goal is
+    // their mass-weighted mean over the groups j belongs to (its own, its parent's, its
+    // children's), its parent's group counting twice as much as its own and its children's half.
+    glm::dvec3 sum(0.0);
+    double wsum = 0;
+    for (std::uint32_t k = g.source_start[j]; k < g.source_start[j + 1]; ++k) {
+        const Frame& f = frames[g.source[k]];
+        sum += g.weight[k] * (f.R * g.offset[k] + f.c);
+        wsum += g.weight[k];
+    }
+    return wsum > 0 ? sum / wsum : x_[j];
+}
+
 std::vector<glm::dvec3> World::goals() const {
     std::vector<Frame> frames;
-    std::vector<glm::dvec3> goal;
     std::vector<glm::dmat3> moments;
-    match_shapes(frames, goal, moments, 20);
+    Groups groups;
+    build_groups(groups);
+    match_shapes(frames, moments, 20, groups);
+    std::vector<glm::dvec3> goal(x_.size());
+    for (std::uint32_t j = 0; j < x_.size(); ++j) goal[j] = goal_of(j, frames, groups);
     return goal;
 }
 
@@ -336,14 +391,16 @@ void World::step() {
     // across steps: no allocation in a step, and each group's rotation is warm-started from the
     // last pass, also the previous step's.
     auto& frames = scratch_.frames;
-    auto& goal = scratch_.goal;
     auto& moments = scratch_.moments;
     auto& rest_moments = scratch_.rest_moment;
     rest_moments.resize(n);
     for (std::size_t j = 0; j < n; ++j)
         if (alive_[j]) rest_moments[j] = rest_moment(static_cast<std::uint32_t>(j));
+    build_groups(scratch_.groups);
     for (int it = 0; it < settings_.iterations; ++it) {
-        match_shapes(frames, goal, moments, settings_.rotation_iterations);
+        match_shapes(frames, moments, settings_.rotation_iterations, scratch_.groups);
+        // each particle's goal, and the move toward it: the goals read only the frames, so a
+        // particle can move as soon as its own goal is known
         parallel_ranges(n, settings_.threads, 2048, [&](std::size_t b, std::size_t e) {
             for (std::size_t i = b; i < e; ++i) {
                 if (!alive_[i]) continue;
@@ -353,7 +410,8 @@ void World::step() {
                 }
                 // x'_g = x_p + s (x_g - x_p) (section 4.3)
                 const double st = stiffness(static_cast<std::uint32_t>(i));
-                x_[i] = x_[i] + st * (goal[i] - x_[i]);
+                const glm::dvec3 goal = goal_of(static_cast<std::uint32_t>(i), frames, scratch_.groups);
+                x_[i] = x_[i] + st * (goal - x_[i]);
                 // normalized linear blend toward the goal orientation, on the short arc: the
                 // steps are small, where it and slerp agree to second order, and it needs no
                 // trigonometry
@@ -491,33 +549,33 @@ void World::separate_particles() {
                static_cast<std::uint64_t>(c.z * 83492791);
     };
     // an open-addressing table from a cell's key to its run of particles in `members` (in index
-    // order), built by counting: no sort
+    // order), built by counting: no sort. A slot holds the key and the run's bounds together, so
+    // a lookup touches one cache line.
     std::size_t size = 16;
     while (size < 4 * n) size *= 2; // a quarter full at most: short probes
-    auto& table = scratch_.table; // (key, count) per slot; count 0: empty
-    table.assign(size, {0, 0});
+    auto& table = scratch_.table; // begin == end: an empty slot
+    table.assign(size, Cell{});
     auto& slot_of = scratch_.slot_of;
     slot_of.assign(n, ~0u);
     for (std::uint32_t i = 0; i < n; ++i) {
         if (!alive_[i]) continue;
         const std::uint64_t k = hash(glm::i64vec3(glm::floor(x_[i] / cell)));
         std::size_t slot = k & (size - 1);
-        while (table[slot].second != 0 && table[slot].first != k) slot = (slot + 1) & (size - 1);
-        table[slot].first = k;
-        ++table[slot].second;
+        while (table[slot].end != 0 && table[slot].key != k) slot = (slot + 1) & (size - 1);
+        table[slot].key = k;
+        ++table[slot].end; // counts, for now
         slot_of[i] = static_cast<std::uint32_t>(slot);
     }
-    auto& start = scratch_.start;
-    start.assign(size + 1, 0);
-    for (std::size_t t = 0; t < size; ++t) start[t + 1] = start[t] + table[t].second;
-    auto& members = scratch_.members;
-    members.resize(start[size]);
-    {
-        std::vector<std::uint32_t>& fill = scratch_.fill;
-        fill.assign(start.begin(), start.end() - 1);
-        for (std::uint32_t i = 0; i < n; ++i)
-            if (slot_of[i] != ~0u) members[fill[slot_of[i]]++] = i;
+    std::uint32_t running = 0;
+    for (Cell& c : table) { // counts to runs; `end` is the fill cursor below
+        const std::uint32_t count = c.end;
+        c.begin = c.end = running;
+        running += count;
     }
+    auto& members = scratch_.members;
+    members.resize(running);
+    for (std::uint32_t i = 0; i < n; ++i)
+        if (slot_of[i] != ~0u) members[table[slot_of[i]].end++] = i;
     auto& push = scratch_.push;
     push.assign(n, glm::dvec3(0.0));
     parallel_ranges(n, settings_.threads, 2048, [&](std::size_t b, std::size_t e) {
@@ -536,8 +594,9 @@ void World::separate_particles() {
                     for (int dx = 0; dx <= 1; ++dx) {
                         const std::uint64_t k = hash(c + glm::i64vec3(dx, dy, dz) * side);
                         std::size_t slot = k & (size - 1);
-                        while (table[slot].second != 0 && table[slot].first != k) slot = (slot + 1) & (size - 1);
-                        for (std::uint32_t at = start[slot]; at < start[slot + 1]; ++at) {
+                        while (table[slot].end != table[slot].begin && table[slot].key != k) slot = (slot + 1) & (size - 1);
+                        const Cell& run = table[slot];
+                        for (std::uint32_t at = run.begin; at < run.end; ++at) {
                             const std::uint32_t j = members[at];
                             const glm::dvec3 d = xi - x_[j];
                             const double dist2 = glm::dot(d, d), want = ri + thin[j];

@@ -51,7 +51,7 @@ struct Settings {
     // Rotation-extraction iterations per group and pass. Each pass warm-starts from the last
     // one's rotation, so the iterations add up over a step's passes, as Müller et al. 2016
     // suggest for simulations; a cold solve (goals(), group_rotation()) runs up to 20.
-    int rotation_iterations = 2;
+    int rotation_iterations = 1;
     // Plant-plant and self collision between particles not joined to each other (section 5.2).
     bool collisions = true;
 };
@@ -219,11 +219,29 @@ private:
     void detach(std::uint32_t i);
     // `moments`: every particle's ellipsoid_moment, or null to compute them here.
     Frame group_frame(std::uint32_t i, const glm::dquat& warm, const glm::dmat3* moments, int iterations) const;
-    // One shape-matching pass: every group's frame (warm-started from `frames`) and every
-    // particle's goal (Eq. 3-4), with at most `iterations` rotation-extraction iterations per
-    // group; `moments` is scratch.
-    void match_shapes(std::vector<Frame>& frames, std::vector<glm::dvec3>& goal, std::vector<glm::dmat3>& moments,
-                      int iterations) const;
+    // What shape matching reads of the groups that does not change within a step, flattened:
+    // each group's members (parent, itself, children) with their masses and rest offsets from
+    // the group's rest center, and each particle's goal sources (the groups it belongs to, with
+    // Eq. 4's weights and its rest offset in each). Built once a step instead of walked through
+    // the child lists and recomputed in every pass; the sums keep their order, so the numbers
+    // are the same.
+    struct Groups {
+        std::vector<std::uint32_t> start, member; // group i: member[start[i] .. start[i + 1])
+        std::vector<double> mass;                 // per member entry: matching_mass
+        std::vector<glm::dvec3> rest_off;         // per member entry: rest position - rest center
+        std::vector<double> total;                // per group: M
+        std::vector<glm::dvec3> rest_center;      // per group: c̄
+        std::vector<std::uint32_t> source_start, source; // particle j: groups source[source_start[j] ..]
+        std::vector<double> weight;               // per source entry
+        std::vector<glm::dvec3> offset;           // per source entry: x̄_j - c̄_i
+    };
+    void build_groups(Groups& g) const;
+    // One shape-matching pass: every group's frame (Eq. 14-15, warm-started from `frames`),
+    // with at most `iterations` rotation-extraction iterations per group; `moments` is scratch.
+    void match_shapes(std::vector<Frame>& frames, std::vector<glm::dmat3>& moments, int iterations,
+                      const Groups& groups) const;
+    // Particle j's goal from the groups' frames (Eq. 3-4).
+    glm::dvec3 goal_of(std::uint32_t j, const std::vector<Frame>& frames, const Groups& groups) const;
     double stiffness(std::uint32_t i) const;
     void separate_particles();
 
@@ -247,16 +265,21 @@ private:
     glm::dvec3 wind_{0.0};
     StepTimes times_;
     std::vector<glm::dvec3> external_; // per particle, cleared after each step
+    // A cell of the collision pass's hash table: its key and its particles' run in `members`.
+    struct Cell {
+        std::uint64_t key = 0;
+        std::uint32_t begin = 0, end = 0;
+    };
     struct Scratch {
         std::vector<Frame> frames;
-        std::vector<glm::dvec3> goal;
         std::vector<glm::dmat3> moments;
         std::vector<glm::dvec3> old;
-        std::vector<std::pair<std::uint64_t, std::uint32_t>> table; // cell key and its particle count
-        std::vector<std::uint32_t> slot_of, start, members, fill;   // particles grouped by table slot
+        std::vector<Cell> table;                  // the collision pass's cells
+        std::vector<std::uint32_t> slot_of, members; // particles grouped by table slot
         std::vector<double> thin;                                   // each particle's thinnest radius
         std::vector<glm::dmat3> rest_moment;                        // 0.2 m D R̄ᵀ, during a step
         std::vector<glm::dvec3> push;
+        Groups groups;
     } scratch_;
 };
 
