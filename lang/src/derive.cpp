@@ -37,6 +37,8 @@ Derivation::Derivation(const Program& program, DeriveOptions options) : prog_(pr
     globals_ = prog_.global_values;
 }
 
+Derivation::~Derivation() { big_pages::trim(); }
+
 void Derivation::check_limits(const ModuleString& s) const { check_limits(s.size(), s.params.size()); }
 
 void Derivation::check_limits(std::size_t modules, std::size_t params) const {

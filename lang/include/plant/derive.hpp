@@ -52,6 +52,10 @@ struct DeriveOptions {
 class Derivation {
 public:
     Derivation(const Program& program, DeriveOptions options);
+    Derivation(const Derivation&) = default;
+    Derivation& operator=(const Derivation&) = delete; // holds a reference to its program
+    // Gives the memory freed strings kept for later steps back to the system (big_pages).
+    ~Derivation();
 
     // Evaluates settings, builds the axiom (with decomposition) and runs `on start`.
     void start();
