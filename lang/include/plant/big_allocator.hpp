@@ -1,7 +1,7 @@
 // Allocator for the module string's arrays. Three things a derivation step pays for otherwise:
 // - value-initialisation: resize() would zero memory that is overwritten right after, so
 //   construct() without arguments default-initialises (leaves numbers as they are);
-// - page faults: a step writes its whole output into fresh memory, so blocks of 256 KiB and more
+// - page faults: a step writes its whole output into fresh memory, so blocks of 64 KiB and more
 //   are whole 2 MiB pages, aligned and marked for transparent huge pages: one fault per 2 MiB
 //   instead of one per 4 KiB. Measured on the parametric tree (n = 16): 15 ms -> 6 ms;
 // - zeroing: the kernel clears every page it hands out, and a growing derivation frees a string
@@ -32,7 +32,7 @@ std::size_t kept_bytes();
 
 template <typename T> struct BigAllocator {
     using value_type = T;
-    static constexpr std::size_t kMapped = std::size_t{256} << 10;
+    static constexpr std::size_t kMapped = std::size_t{64} << 10;
 
     BigAllocator() noexcept = default;
     template <typename U> BigAllocator(const BigAllocator<U>&) noexcept {}
