@@ -270,13 +270,4 @@ void mesh_tube(const TubePath& path, const MeshOptions& o, MeshPart& part,
     }
 }
 
-void mesh_axis(const SkeletonAxis& axis, const MeshOptions& o, MeshPart& part,
-               std::vector<std::vector<std::uint32_t>>& indices_by_material,
-               const std::function<std::uint32_t(const glm::vec3&)>& material_of) {
-    TubePath path;
-    path.reserve(axis.points.size());
-    for (const auto& p : axis.points) path.push_back(&p);
-    mesh_tube(path, o, part, indices_by_material, material_of);
-}
-
 } // namespace plant

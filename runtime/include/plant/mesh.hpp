@@ -26,15 +26,10 @@ using TubePath = std::vector<const SkeletonPoint*>;
 // Fig. 2.7) is one tube per segment, each with a hidden tapered tip inside the next.
 std::vector<TubePath> tube_paths(const Skeleton& skeleton, const MeshOptions& options);
 
-// Appends one tube to `part` (see mesh_axis).
+// Appends one tube to `part`, with primitives grouped by `material_of` (a color -> material
+// index map the caller keeps across tubes). Rings are shared between consecutive segments;
+// frames are parallel-transported from the first point's left vector.
 void mesh_tube(const TubePath& path, const MeshOptions& options, MeshPart& part,
-               std::vector<std::vector<std::uint32_t>>& indices_by_material,
-               const std::function<std::uint32_t(const glm::vec3&)>& material_of);
-
-// Appends the tube of one axis alone to `part`, with primitives grouped by `material_of` (a color ->
-// material index map the caller keeps across axes). Rings are shared between consecutive
-// segments; frames are parallel-transported from the first point's left vector.
-void mesh_axis(const SkeletonAxis& axis, const MeshOptions& options, MeshPart& part,
                std::vector<std::vector<std::uint32_t>>& indices_by_material,
                const std::function<std::uint32_t(const glm::vec3&)>& material_of);
 

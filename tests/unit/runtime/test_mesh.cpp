@@ -27,20 +27,19 @@ Skeleton skeleton_of(const std::string& grammar, int steps) {
                           turtle_options(d));
 }
 
-MeshPart tube_of(const SkeletonAxis& axis, const MeshOptions& o) {
-    MeshPart part;
-    std::vector<std::vector<std::uint32_t>> by_material;
-    mesh_axis(axis, o, part, by_material, [](const glm::vec3&) { return 0u; });
-    for (auto& idx : by_material) part.indices.insert(part.indices.end(), idx.begin(), idx.end());
-    return part;
-}
-
 MeshPart tube_of(const TubePath& path, const MeshOptions& o) {
     MeshPart part;
     std::vector<std::vector<std::uint32_t>> by_material;
     mesh_tube(path, o, part, by_material, [](const glm::vec3&) { return 0u; });
     for (auto& idx : by_material) part.indices.insert(part.indices.end(), idx.begin(), idx.end());
     return part;
+}
+
+// One axis alone, as one tube.
+MeshPart tube_of(const SkeletonAxis& axis, const MeshOptions& o) {
+    TubePath path;
+    for (const auto& p : axis.points) path.push_back(&p);
+    return tube_of(path, o);
 }
 
 // Boundary loops of a tube, through OpenMesh, with the texture seam welded (its two copies of a
