@@ -141,16 +141,12 @@ private:
                 }
         }
     }
-
 };
 
 class Rewriter {
 public:
-    Rewriter(const RulePlan& plan, const ModuleString& in)
-        : P(plan.P), in(in), sets(plan.sets), n(in.size()), has_prod(plan.has_prod), direct(plan.direct),
-          ctx_block(plan.ctx_block), ctx_sides(plan.ctx_sides), ctx_key(plan.ctx_key), ctx_keys(plan.ctx_keys),
-          ctx_entries(plan.ctx_entries), frame_size(plan.frame_size), multi(plan.multi), left_new(plan.left_new),
-          right_new(plan.right_new) {
+    Rewriter(const RulePlan& rule_plan, const ModuleString& in)
+        : plan(rule_plan), P(rule_plan.P), in(in), n(in.size()) {
         if (plan.brackets) match = bracket_table(in, P.symbols.open_bracket, P.symbols.close_bracket);
     }
 
@@ -159,23 +155,23 @@ public:
     const Production* table_lookup(std::size_t i) const {
         const SymbolId sym = in.sym[i];
         std::size_t lk = 0, rk = 0;
-        if (ctx_sides[sym] & 1) {
+        if (plan.ctx_sides[sym] & 1) {
             const std::int64_t j = left_step(static_cast<std::int64_t>(i) - 1);
-            if (j >= 0 && in.arity(static_cast<std::size_t>(j)) == 0) lk = ctx_key[in.sym[static_cast<std::size_t>(j)]];
+            if (j >= 0 && in.arity(static_cast<std::size_t>(j)) == 0) lk = plan.ctx_key[in.sym[static_cast<std::size_t>(j)]];
         }
-        if (ctx_sides[sym] & 2) {
+        if (plan.ctx_sides[sym] & 2) {
             const std::size_t j = right_step(i + 1);
-            if (j < n && in.arity(j) == 0) rk = ctx_key[in.sym[j]];
+            if (j < n && in.arity(j) == 0) rk = plan.ctx_key[in.sym[j]];
         }
-        return ctx_entries[static_cast<std::size_t>(ctx_block[sym]) + lk * ctx_keys + rk];
+        return plan.ctx_entries[static_cast<std::size_t>(plan.ctx_block[sym]) + lk * plan.ctx_keys + rk];
     }
 
-    bool sequential() const { return multi || left_new || right_new; }
+    bool sequential() const { return plan.multi || plan.left_new || plan.right_new; }
 
     // Whether production `pr` (pattern, context and condition) matches at module i: the REPL's
     // :find. Binds the worker's frame.
     bool matches_at(Worker& w, std::size_t i, const Production& pr) {
-        if (w.frame.size() < frame_size) w.frame.assign(frame_size, 0.0);
+        if (w.frame.size() < plan.frame_size) w.frame.assign(plan.frame_size, 0.0);
         w.env.position = i;
         w.env.draw = 0;
         w.env.id = in.ids[i];
@@ -195,12 +191,12 @@ public:
         Counts c;
         for (std::size_t i = b; i < e; ++i) {
             const SymbolId s = in.sym[i];
-            if (!has_prod[s]) {
+            if (!plan.has_prod[s]) {
                 ++c.modules;
                 c.params += in.arity(i);
                 continue;
             }
-            const Production* pr = direct[s];
+            const Production* pr = plan.direct[s];
             if (!pr || in.arity(i) != pr->strict[0].width) {
                 c.ok = false;
                 return c;
@@ -216,7 +212,7 @@ public:
     // arrays are already sized; new identities are numbered from id_at.
     void write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at, std::size_t p_at,
                       ModuleId id_at) {
-        w.frame.assign(frame_size, 0.0);
+        w.frame.assign(plan.frame_size, 0.0);
         SymbolId* S = out.sym.data() + m_at;
         ModuleId* ID = out.ids.data() + m_at;
         std::uint32_t* PO = out.poff.data() + m_at + 1; // poff[m_at] is the previous stretch's end
@@ -230,9 +226,9 @@ public:
                 next_check = i + 65536;
                 if (w.env.interrupt && w.env.interrupt->load()) throw RuntimeError{Span{}, "interrupted"};
             }
-            if (!has_prod[in.sym[i]]) { // a run of modules without productions: copy it
+            if (!plan.has_prod[in.sym[i]]) { // a run of modules without productions: copy it
                 std::size_t j = i + 1;
-                while (j < e && !has_prod[in.sym[j]]) ++j;
+                while (j < e && !plan.has_prod[in.sym[j]]) ++j;
                 const std::size_t n = j - i;
                 const std::uint32_t pb = in.poff[i], pe = in.poff[j];
                 const auto shift = static_cast<std::uint32_t>(p - pb); // wraps around on purpose
@@ -259,7 +255,7 @@ public:
                 i = j;
                 continue;
             }
-            const Production& pr = *direct[in.sym[i]];
+            const Production& pr = *plan.direct[in.sym[i]];
             const SuccessorTemplate& t = pr.tmpl;
             if (!t.holes.empty()) {
                 const double* a = in.args(i);
@@ -328,18 +324,18 @@ public:
 
     // Rewrites modules [b, e) into w.out.
     void run_range(Worker& w, std::size_t b, std::size_t e) {
-        w.frame.assign(frame_size, 0.0);
+        w.frame.assign(plan.frame_size, 0.0);
         std::size_t i = b;
         while (i < e) {
-            if (!has_prod[in.sym[i]]) {
+            if (!plan.has_prod[in.sym[i]]) {
                 std::size_t j = i + 1;
-                while (j < e && !has_prod[in.sym[j]]) ++j;
+                while (j < e && !plan.has_prod[in.sym[j]]) ++j;
                 w.out.append_range(in, i, j);
                 i = j;
                 if (w.out.size() > w.env.max_output || w.out.params.size() > w.env.max_params) limit_error(w);
                 continue;
             }
-            if (const Production* pr = direct[in.sym[i]]; pr && in.arity(i) == pr->strict[0].width) {
+            if (const Production* pr = plan.direct[in.sym[i]]; pr && in.arity(i) == pr->strict[0].width) {
                 if (!pr->tmpl.holes.empty()) {
                     const double* a = in.args(i);
                     for (const auto& pa : pr->strict[0].args) {
@@ -354,7 +350,7 @@ public:
                 ++i;
                 continue;
             }
-            if (!ctx_block.empty() && ctx_block[in.sym[i]] >= 0 && in.arity(i) == 0) {
+            if (!plan.ctx_block.empty() && plan.ctx_block[in.sym[i]] >= 0 && in.arity(i) == 0) {
                 if (const Production* pr = table_lookup(i)) {
                     w.env.position = i;
                     w.env.draw = 0;
@@ -378,19 +374,19 @@ public:
     // Backward processing for `>>`: modules right to left; each successor becomes a piece and
     // the new string to the right is the pieces made so far, newest first.
     void run_backward(Worker& w) {
-        w.frame.assign(frame_size, 0.0);
+        w.frame.assign(plan.frame_size, 0.0);
         piece_starts.clear();
         // Going right to left, a predecessor is found by its last module.
         std::vector<std::vector<std::pair<std::size_t, std::size_t>>> by_last(P.symbols.size());
-        for (std::size_t si = 0; si < sets.size(); ++si)
-            for (std::size_t pi = 0; pi < sets[si]->productions.size(); ++pi)
-                by_last[sets[si]->productions[pi].strict.back().sym].emplace_back(si, pi);
+        for (std::size_t si = 0; si < plan.sets.size(); ++si)
+            for (std::size_t pi = 0; pi < plan.sets[si]->productions.size(); ++pi)
+                by_last[plan.sets[si]->productions[pi].strict.back().sym].emplace_back(si, pi);
         std::size_t k = n;
         while (k-- > 0) {
             piece_starts.push_back(w.out.size());
             std::size_t used = 0;
             for (const auto& [si, pi] : by_last[in.sym[k]]) {
-                const Production& pr = sets[si]->productions[pi];
+                const Production& pr = plan.sets[si]->productions[pi];
                 const std::size_t len = pr.strict.size();
                 if (len > k + 1) continue;
                 const std::size_t start = k + 1 - len;
@@ -399,7 +395,7 @@ public:
                 w.env.id = in.ids[start];
                 if (!matches(w, start, pr)) continue;
                 if (!pr.weight.empty()) {
-                    const auto& cands = sets[si]->by_symbol[pr.strict[0].sym];
+                    const auto& cands = plan.sets[si]->by_symbol[pr.strict[0].sym];
                     std::size_t ci = 0;
                     while (ci < cands.size() && cands[ci] != pi) ++ci;
                     used = choose(w, start, si, ci, len); // only predecessors that end at k
@@ -659,8 +655,8 @@ private:
         env.draw = 0;
         env.id = in.ids[i];
         const SymbolId sym = in.sym[i];
-        for (std::size_t si = 0; si < sets.size(); ++si) {
-            const RuleSet& rs = *sets[si];
+        for (std::size_t si = 0; si < plan.sets.size(); ++si) {
+            const RuleSet& rs = *plan.sets[si];
             const auto& cands = rs.by_symbol[sym];
             for (std::size_t ci = 0; ci < cands.size(); ++ci) {
                 const Production& pr = rs.productions[cands[ci]];
@@ -753,10 +749,10 @@ private:
         std::size_t count = 0;
         double total = 0;
         const SymbolId sym = in.sym[i];
-        for (std::size_t si = set0; si < sets.size(); ++si) {
-            const auto& cands = sets[si]->by_symbol[sym];
+        for (std::size_t si = set0; si < plan.sets.size(); ++si) {
+            const auto& cands = plan.sets[si]->by_symbol[sym];
             for (std::size_t ci = si == set0 ? cand0 : 0; ci < cands.size(); ++ci) {
-                const Production& pr = sets[si]->productions[cands[ci]];
+                const Production& pr = plan.sets[si]->productions[cands[ci]];
                 if (pr.weight.empty() || (length && pr.strict.size() != length) || !matches(w, i, pr)) continue;
                 double wt = eval_number(pr.weight, w.frame.data(), w.env);
                 if (!(wt >= 0) || !std::isfinite(wt))
@@ -783,19 +779,10 @@ private:
         return run_body(w, i, pr);
     }
 
+    const RulePlan& plan;
     const Program& P;
     const ModuleString& in;
-    const std::vector<const RuleSet*>& sets;
     const std::size_t n;
-    const std::vector<std::uint8_t>& has_prod;
-    const std::vector<const Production*>& direct;
-    const std::vector<std::int32_t>& ctx_block;
-    const std::vector<std::uint8_t>& ctx_sides;
-    const std::vector<std::uint8_t>& ctx_key;
-    const std::size_t ctx_keys;
-    const std::vector<const Production*>& ctx_entries;
-    const std::size_t frame_size;
-    const bool multi, left_new, right_new;
     std::vector<std::uint32_t> match;
     std::vector<std::size_t> piece_starts;
 };
