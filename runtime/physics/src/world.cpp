@@ -222,33 +222,30 @@ glm::dmat3 World::rest_moment(std::uint32_t j) const {
 
 glm::dmat3 World::ellipsoid_moment(std::uint32_t j) const { return glm::mat3_cast(q_[j]) * rest_moment(j); }
 
-World::Frame World::group_frame(std::uint32_t i, const glm::dquat& warm, const glm::dmat3* moments,
-                                int iterations) const {
-    double M = 0;
-    glm::dvec3 c(0.0), rc(0.0);
-    for_group(i, [&](std::uint32_t j) {
-        const double m = matching_mass(j);
-        M += m;
-        c += m * x_[j];
-        rc += m * rest_x_[j];
-    });
-    c /= M;
-    rc /= M;
-    // Eq. 14 with Eq. 15's ellipsoid moments (precomputed per pass when `moments` is given),
-    // positions relative to the centers to keep the sums well conditioned
+World::Frame World::group_frame(std::uint32_t i, const glm::dquat& warm, const std::vector<glm::dmat3>& moments,
+                                int iterations, const Groups& g) const {
+    // Eq. 14 with Eq. 15's ellipsoid moments, positions relative to the centers to keep the sums
+    // well conditioned
+    const std::uint32_t from = g.start[i], to = g.start[i + 1];
+    glm::dvec3 c(0.0);
+    for (std::uint32_t k = from; k < to; ++k) c += g.mass[k] * x_[g.member[k]];
+    c /= g.total[i];
     glm::dmat3 A(0.0);
-    for_group(i, [&](std::uint32_t j) {
-        const double m = matching_mass(j);
-        A += moments ? moments[j] : ellipsoid_moment(j);
-        A += m * outer(x_[j] - c, rest_x_[j] - rc);
-    });
-    return {c, rc, extract_rotation(A, warm, iterations), true};
+    for (std::uint32_t k = from; k < to; ++k) {
+        const std::uint32_t j = g.member[k];
+        A += moments[j];
+        A += g.mass[k] * outer(x_[j] - c, g.rest_off[k]);
+    }
+    return {c, g.rest_center[i], extract_rotation(A, warm, iterations), true};
 }
 
 glm::dquat World::group_rotation(std::uint32_t i) const {
-    return group_frame(i, rotation_from_rest(i), nullptr, 20).R;
+    Groups g;
+    build_groups(g);
+    std::vector<glm::dmat3> moments(x_.size());
+    for_group(i, [&](std::uint32_t j) { moments[j] = ellipsoid_moment(j); });
+    return group_frame(i, rotation_from_rest(i), moments, 20, g).R;
 }
-
 
 void World::build_groups(Groups& g) const {
     const std::size_t n = x_.size();
@@ -261,7 +258,6 @@ void World::build_groups(Groups& g) const {
     for (std::uint32_t i = 0; i < n; ++i) {
         g.start[i] = static_cast<std::uint32_t>(g.member.size());
         if (!alive_[i]) continue;
-        // the same sums, in the same order, as group_frame
         double M = 0;
         glm::dvec3 rc(0.0);
         for_group(i, [&](std::uint32_t j) {
@@ -313,26 +309,14 @@ void World::match_shapes(std::vector<Frame>& frames, std::vector<glm::dmat3>& mo
                                 : ellipsoid_moment(static_cast<std::uint32_t>(j));
         }
     });
-    // Eq. 14 with Eq. 15's ellipsoid moments, positions relative to the centers to keep the sums
-    // well conditioned (group_frame's sums, over the flattened groups)
     parallel_ranges(n, threads, 2048, [&](std::size_t b, std::size_t e) {
-        for (std::size_t i = b; i < e; ++i) {
+        for (std::size_t k = b; k < e; ++k) {
+            const auto i = static_cast<std::uint32_t>(k);
             if (!alive_[i]) continue;
-            const std::uint32_t from = g.start[i], to = g.start[i + 1];
-            glm::dvec3 c(0.0);
-            for (std::uint32_t k = from; k < to; ++k) c += g.mass[k] * x_[g.member[k]];
-            c /= g.total[i];
-            glm::dmat3 A(0.0);
-            for (std::uint32_t k = from; k < to; ++k) {
-                const std::uint32_t j = g.member[k];
-                A += moments[j];
-                A += g.mass[k] * outer(x_[j] - c, g.rest_off[k]);
-            }
             // warm start from the last pass's rotation when there is one, else from the
             // particle's own rotation from rest
-            const auto ii = static_cast<std::uint32_t>(i);
-            const glm::dquat warm = frames[i].valid ? frames[i].R : rotation_from_rest(ii);
-            frames[i] = Frame{c, g.rest_center[i], extract_rotation(A, warm, iterations), true};
+            const glm::dquat warm = frames[i].valid ? frames[i].R : rotation_from_rest(i);
+            frames[i] = group_frame(i, warm, moments, iterations, g);
         }
     });
 }

@@ -217,8 +217,6 @@ private:
     glm::dmat3 ellipsoid_moment(std::uint32_t j) const;
     // Unlinks i from its parent: it becomes the root of a loose part.
     void detach(std::uint32_t i);
-    // `moments`: every particle's ellipsoid_moment, or null to compute them here.
-    Frame group_frame(std::uint32_t i, const glm::dquat& warm, const glm::dmat3* moments, int iterations) const;
     // What shape matching reads of the groups that does not change within a step, flattened:
     // each group's members (parent, itself, children) with their masses and rest offsets from
     // the group's rest center, and each particle's goal sources (the groups it belongs to, with
@@ -236,6 +234,10 @@ private:
         std::vector<glm::dvec3> offset;           // per source entry: x̄_j - c̄_i
     };
     void build_groups(Groups& g) const;
+    // Group i's frame from every particle's ellipsoid moment (`moments`, indexed by particle),
+    // with at most `iterations` rotation-extraction iterations warm-started from `warm`.
+    Frame group_frame(std::uint32_t i, const glm::dquat& warm, const std::vector<glm::dmat3>& moments,
+                      int iterations, const Groups& groups) const;
     // One shape-matching pass: every group's frame (Eq. 14-15, warm-started from `frames`),
     // with at most `iterations` rotation-extraction iterations per group; `moments` is scratch.
     void match_shapes(std::vector<Frame>& frames, std::vector<glm::dmat3>& moments, int iterations,
