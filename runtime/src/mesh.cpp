@@ -144,21 +144,15 @@ std::vector<TubePath> tube_paths(const Skeleton& skeleton, const MeshOptions& o)
     std::vector<int> next(n, -1);
     std::vector<double> best(n, -2.0);
     std::vector<char> continued(n, 0); // this axis is the continuation of its parent
-    auto last_dir = [](const SkeletonAxis& a, glm::dvec3& d) {
-        for (std::size_t k = a.points.size(); k-- > 1;) {
-            glm::dvec3 v = a.points.back().position - a.points[k - 1].position;
+    // the unit direction of an axis's first segment (last = false) or its last one, over points
+    // that coincide with that end; false when every point does
+    auto end_direction = [](const SkeletonAxis& a, bool last, glm::dvec3& d) {
+        const auto& pts = a.points;
+        const glm::dvec3 end = last ? pts.back().position : pts.front().position;
+        for (std::size_t k = 1; k < pts.size(); ++k) {
+            const glm::dvec3 v = pts[last ? pts.size() - 1 - k : k].position - end;
             if (glm::length(v) > 1e-12) {
-                d = glm::normalize(v);
-                return true;
-            }
-        }
-        return false;
-    };
-    auto first_dir = [](const SkeletonAxis& a, glm::dvec3& d) {
-        for (std::size_t k = 1; k < a.points.size(); ++k) {
-            glm::dvec3 v = a.points[k].position - a.points[0].position;
-            if (glm::length(v) > 1e-12) {
-                d = glm::normalize(v);
+                d = glm::normalize(last ? -v : v);
                 return true;
             }
         }
@@ -171,7 +165,7 @@ std::vector<TubePath> tube_paths(const Skeleton& skeleton, const MeshOptions& o)
         const SkeletonAxis& parent = skeleton.axes[pa];
         if (parent.points.empty() || !same_point(parent.points.back().position, child.points[0].position)) continue;
         glm::dvec3 dp, dc;
-        if (!last_dir(parent, dp) || !first_dir(child, dc)) continue;
+        if (!end_direction(parent, true, dp) || !end_direction(child, false, dc)) continue;
         double cs = glm::dot(dp, dc);
         if (cs >= min_cos && cs > best[pa]) {
             best[pa] = cs;
