@@ -35,6 +35,7 @@ int derive_main(const DeriveCmd& c) {
     auto program = load_program(c.g, sources, exit_code);
     if (!program) return exit_code;
     DeriveOptions opt = derive_options(c.g);
+    opt.identities = c.ids; // the string printed without --ids needs none (kept if the program reads them)
     const bool progress = !c.stats && isatty(2);
     // the figures are kept and formatted at the end, so that the timing of one step is not
     // disturbed by formatting the last one

@@ -268,7 +268,7 @@ void Session::find(const std::string& pattern) {
         for (std::size_t k = 0; k < found.size() && k < 50; ++k) {
             ModuleString one;
             one.append_range(s, found[k], found[k] + 1);
-            out_ << fmt::format("  {:>8}  #{:<8} {}\n", found[k], s.ids[found[k]], format_string(*program_, one));
+            out_ << fmt::format("  {:>8}  #{:<8} {}\n", found[k], s.id(found[k]), format_string(*program_, one));
         }
         if (found.size() > 50) out_ << fmt::format("  ... and {} more\n", found.size() - 50);
         out_ << fmt::format("{} {}{}\n", found.size(), what, found.size() == 1 ? "" : "es");

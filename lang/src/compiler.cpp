@@ -528,6 +528,7 @@ ValueType Compiler::compile_call(Ctx& c, const ast::Expr& e) {
              b.id == BuiltinId::Id) &&
             c.function >= 0)
             fn_random_[static_cast<std::size_t>(c.function)] = true;
+        if (b.id == BuiltinId::Id) P_.uses_id = true;
         emit(c, Op::Builtin, static_cast<std::int32_t>(b.id), width, e.span,
              static_cast<std::uint16_t>(value_width(b.result)));
         return b.result;

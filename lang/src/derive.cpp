@@ -23,6 +23,29 @@ namespace plant {
 
 namespace {
 
+// Whether some production of `rs` names a query module (?P, ?H, ...) in its predecessor or
+// context: then the turtle pass runs before each step to fill them.
+bool reads_queries(const Program& p, const RuleSet& rs) {
+    auto named = [&](const std::vector<PatternModule>& v) {
+        for (const auto& m : v)
+            if (p.symbols[m.sym].query) return true;
+        return false;
+    };
+    for (const auto& pr : rs.productions)
+        if (named(pr.strict) || named(pr.left) || named(pr.right)) return true;
+    return false;
+}
+
+// Whether anything the program does depends on module identities: id(), the query pass (which
+// finds modules by identity between the turtle and the rewrite) and environments (which
+// remember the modules they were told about).
+bool observes_identities(const Program& p) {
+    if (p.uses_id || !p.environments.empty() || reads_queries(p, p.rules)) return true;
+    for (const RuleSet& g : p.groups)
+        if (reads_queries(p, g)) return true;
+    return false;
+}
+
 double now_ms() {
     using namespace std::chrono;
     return duration<double, std::milli>(steady_clock::now().time_since_epoch()).count();
@@ -46,7 +69,8 @@ void Derivation::check_limits(std::size_t modules, std::size_t params) const {
         throw RuntimeError{Span{}, fmt::format("step {}: the string grew past the limit of {} modules (raise it "
                                                "with --max-modules)",
                                                step_, opt_.max_modules)};
-    std::size_t estimate = modules * (sizeof(SymbolId) + sizeof(std::uint32_t) + sizeof(ModuleId)) +
+    std::size_t estimate = modules * (sizeof(SymbolId) + sizeof(std::uint32_t) +
+                                      (current_.keep_ids ? sizeof(ModuleId) : 0)) +
                            params * sizeof(double);
     if (estimate > opt_.max_bytes)
         throw RuntimeError{Span{}, fmt::format("step {}: the string needs about {:.1f} GiB, more than the limit of "
@@ -73,11 +97,13 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const std::v
         w.env.max_output = opt_.max_modules;
         w.env.max_params = opt_.max_bytes / sizeof(double);
         w.env.interrupt = opt_.interrupt;
+        w.out.keep_ids = in.keep_ids;
     };
     const std::size_t n = in.size();
     int threads = std::max(1, opt_.threads);
     if (rw.sequential() || n < 20000) threads = 1;
     out.clear();
+    out.keep_ids = in.keep_ids;
     if (!rw.sequential() && rewrite_direct(rw, in, out, threads, setup)) {
         // done
     } else if (threads == 1) {
@@ -85,7 +111,7 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const std::v
         setup(w);
         w.env.id_base = next_id_; // one thread numbers new modules in string order directly
         w.out.sym.reserve(static_cast<std::size_t>(n * growth_ * 1.02) + 16);
-        w.out.ids.reserve(w.out.sym.capacity());
+        if (w.out.keep_ids) w.out.ids.reserve(w.out.sym.capacity());
         w.out.poff.reserve(w.out.sym.capacity() + 1);
         w.out.params.reserve(static_cast<std::size_t>(in.params.size() * param_growth_ * 1.02) + 16);
         try {
@@ -128,7 +154,7 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const std::v
                         w.env.id_base = next_id_;
                     }
                     w.out.sym.reserve(static_cast<std::size_t>(modules * growth_ * 1.02) + 16);
-                    w.out.ids.reserve(w.out.sym.capacity());
+                    if (w.out.keep_ids) w.out.ids.reserve(w.out.sym.capacity());
                     w.out.poff.reserve(w.out.sym.capacity() + 1);
                     w.out.params.reserve(static_cast<std::size_t>(params * param_growth_ * 1.02) + 16);
                     try {
@@ -166,7 +192,7 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const std::v
         }
         out.swap(workers[0].out);
         out.sym.resize(total);
-        out.ids.resize(total);
+        if (out.keep_ids) out.ids.resize(total);
         out.poff.resize(total + 1);
         out.params.resize(total_params);
         {
@@ -179,6 +205,7 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const std::v
                               out.params.begin() + static_cast<std::ptrdiff_t>(par_at[t]));
                     for (std::size_t i = 0; i < src.size(); ++i) {
                         out.poff[mod_at[t] + i] = static_cast<std::uint32_t>(par_at[t] + src.poff[i]);
+                        if (!out.keep_ids) continue;
                         ModuleId id = src.ids[i];
                         out.ids[mod_at[t] + i] = (id & kNewIdBit) ? id_at[t] + (id & ~kNewIdBit) : id;
                     }
@@ -234,7 +261,7 @@ bool Derivation::rewrite_direct(Rewriter& rw, const ModuleString& in, ModuleStri
     }
     check_limits(modules, params); // before allocating anything
     out.sym.resize(modules);
-    out.ids.resize(modules);
+    if (out.keep_ids) out.ids.resize(modules);
     out.poff.resize(modules + 1);
     out.params.resize(params);
     out.poff[0] = 0;
@@ -365,6 +392,7 @@ void Derivation::start() {
     env.seed = seed_;
     env.phase = 0xFFFF0000ULL;
     ModuleString axiom;
+    axiom.keep_ids = opt_.identities || observes_identities(prog_);
     env.out = &axiom;
     env.max_output = opt_.max_modules;
     env.id_base = next_id_;
@@ -398,15 +426,7 @@ bool Derivation::step() {
     if (group_ >= 0 && group_ < static_cast<int>(prog_.groups.size())) sets.push_back(&prog_.groups[group_]);
     sets.push_back(&prog_.rules);
     bool queries = false;
-    for (const RuleSet* rs : sets)
-        for (const auto& pr : rs->productions) {
-            auto is_query = [&](const std::vector<PatternModule>& v) {
-                for (const auto& m : v)
-                    if (prog_.symbols[m.sym].query) return true;
-                return false;
-            };
-            queries = queries || is_query(pr.strict) || is_query(pr.left) || is_query(pr.right);
-        }
+    for (const RuleSet* rs : sets) queries = queries || reads_queries(prog_, *rs);
     // the turtle pass fills query modules and shows the environments the plant as it is now
     if ((queries || !prog_.environments.empty()) && opt_.queries) opt_.queries->fill_queries(*this, current_);
     ModuleString next;

@@ -13,7 +13,7 @@ void ModuleString::append_range(const ModuleString& o, std::size_t b, std::size_
     if (b >= e) return;
     if (e - b == 1) { // the common case in context-sensitive grammars: one module between rewrites
         sym.push_back(o.sym[b]);
-        ids.push_back(o.ids[b]);
+        if (keep_ids) ids.push_back(o.ids[b]);
         for (std::uint32_t k = o.poff[b]; k < o.poff[e]; ++k) params.push_back(o.params[k]);
         poff.push_back(static_cast<std::uint32_t>(params.size()));
         return;
@@ -21,11 +21,11 @@ void ModuleString::append_range(const ModuleString& o, std::size_t b, std::size_
     const std::size_t n = e - b, m0 = sym.size(), p0 = params.size();
     const std::uint32_t pb = o.poff[b], pe = o.poff[e];
     sym.resize(m0 + n);
-    ids.resize(m0 + n);
+    if (keep_ids) ids.resize(m0 + n);
     poff.resize(m0 + n + 1);
     params.resize(p0 + (pe - pb));
     std::memcpy(sym.data() + m0, o.sym.data() + b, n * sizeof(SymbolId));
-    std::memcpy(ids.data() + m0, o.ids.data() + b, n * sizeof(ModuleId));
+    if (keep_ids) std::memcpy(ids.data() + m0, o.ids.data() + b, n * sizeof(ModuleId));
     if (pe > pb) std::memcpy(params.data() + p0, o.params.data() + pb, (pe - pb) * sizeof(double));
     const auto shift = static_cast<std::uint32_t>(p0 - pb); // unsigned wrap-around is intended
     std::uint32_t* dst = poff.data() + m0 + 1;
@@ -94,7 +94,7 @@ std::string format_string(const Program& program, const ModuleString& s, bool wi
             }
             out += ')';
         }
-        if (with_ids) out += fmt::format("#{}", s.ids[i]);
+        if (with_ids) out += fmt::format("#{}", s.id(i));
         bool ends_letters = !name.empty() && (std::isalnum(static_cast<unsigned char>(name.back())) || name.back() == '_');
         // a bare '~' followed by a letter would read back as one surface name
         prev = (k == 0 && !with_ids && (ends_letters || name == "~")) ? &name : nullptr;
@@ -104,6 +104,7 @@ std::string format_string(const Program& program, const ModuleString& s, bool wi
 
 void cut_branches(ModuleString& s, SymbolId open, SymbolId close, const std::function<bool(std::size_t)>& cuts) {
     ModuleString out;
+    out.keep_ids = s.keep_ids;
     const std::size_t n = s.size();
     std::size_t i = 0;
     while (i < n) {

@@ -174,7 +174,7 @@ public:
         if (w.frame.size() < plan.frame_size) w.frame.assign(plan.frame_size, 0.0);
         w.env.position = i;
         w.env.draw = 0;
-        w.env.id = in.ids[i];
+        w.env.id = in.id(i);
         return matches(w, i, pr);
     }
 
@@ -210,11 +210,22 @@ public:
 
     // Writes the output of modules [b, e) at module m_at and parameter p_at of `out`, whose
     // arrays are already sized; new identities are numbered from id_at.
+    // Identities are written only when `out` keeps them (Ids, a template argument so that the
+    // loop has no test for it).
     void write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at, std::size_t p_at,
                       ModuleId id_at) {
+        if (out.keep_ids)
+            write_direct<true>(w, b, e, out, m_at, p_at, id_at);
+        else
+            write_direct<false>(w, b, e, out, m_at, p_at, id_at);
+    }
+    template <bool Ids>
+    void write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at, std::size_t p_at,
+                      ModuleId id_at) {
+        if constexpr (!Ids) (void)id_at;
         w.frame.assign(plan.frame_size, 0.0);
         SymbolId* S = out.sym.data() + m_at;
-        ModuleId* ID = out.ids.data() + m_at;
+        ModuleId* ID = Ids ? out.ids.data() + m_at : nullptr;
         std::uint32_t* PO = out.poff.data() + m_at + 1; // poff[m_at] is the previous stretch's end
         double* PA = out.params.data() + p_at;
         std::size_t p = p_at;
@@ -237,18 +248,18 @@ public:
                     // loops beat three library calls
                     for (std::size_t k = 0; k < n; ++k) {
                         S[k] = in.sym[i + k];
-                        ID[k] = in.ids[i + k];
+                        if constexpr (Ids) ID[k] = in.ids[i + k];
                         PO[k] = in.poff[i + 1 + k] + shift;
                     }
                     for (std::uint32_t k = 0; k < pe - pb; ++k) PA[k] = in.params[pb + k];
                 } else {
                     std::memcpy(S, in.sym.data() + i, n * sizeof(SymbolId));
-                    std::memcpy(ID, in.ids.data() + i, n * sizeof(ModuleId));
+                    if constexpr (Ids) std::memcpy(ID, in.ids.data() + i, n * sizeof(ModuleId));
                     if (pe > pb) std::memcpy(PA, in.params.data() + pb, (pe - pb) * sizeof(double));
                     for (std::size_t k = 0; k < n; ++k) PO[k] = in.poff[i + 1 + k] + shift;
                 }
                 S += n;
-                ID += n;
+                if constexpr (Ids) ID += n;
                 PO += n;
                 PA += pe - pb;
                 p += pe - pb;
@@ -265,7 +276,7 @@ public:
                 }
                 w.env.position = i;
                 w.env.draw = 0;
-                w.env.id = in.ids[i];
+                w.env.id = in.id(i);
                 w.env.out = nullptr;
                 compute_holes(w, t, values);
                 check_holes(t, values);
@@ -277,20 +288,20 @@ public:
             if (!t.params.empty()) std::memcpy(PA, t.params.data(), t.params.size() * sizeof(double));
             for (std::size_t h = 0; h < t.holes.size(); ++h) PA[t.holes[h]] = values[h];
             const auto p32 = static_cast<std::uint32_t>(p);
-            for (std::size_t j = 0; j < m; ++j) {
-                PO[j] = p32 + t.param_end[j];
-                ID[j] = id_at + j;
-            }
-            if (t.keep >= 0) { // the kept module has the predecessor's identity; the rest are new
-                const auto keep = static_cast<std::size_t>(t.keep);
-                for (std::size_t j = keep + 1; j < m; ++j) --ID[j];
-                ID[keep] = in.ids[i];
-                id_at += m - 1;
-            } else {
-                id_at += m;
+            for (std::size_t j = 0; j < m; ++j) PO[j] = p32 + t.param_end[j];
+            if constexpr (Ids) {
+                for (std::size_t j = 0; j < m; ++j) ID[j] = id_at + j;
+                if (t.keep >= 0) { // the kept module has the predecessor's identity; the rest are new
+                    const auto keep = static_cast<std::size_t>(t.keep);
+                    for (std::size_t j = keep + 1; j < m; ++j) --ID[j];
+                    ID[keep] = in.ids[i];
+                    id_at += m - 1;
+                } else {
+                    id_at += m;
+                }
+                ID += m;
             }
             S += m;
-            ID += m;
             PO += m;
             PA += t.params.size();
             p += t.params.size();
@@ -344,7 +355,7 @@ public:
                     }
                     w.env.position = i;
                     w.env.draw = 0;
-                    w.env.id = in.ids[i];
+                    w.env.id = in.id(i);
                 }
                 apply_template(w, i, *pr);
                 ++i;
@@ -354,7 +365,7 @@ public:
                 if (const Production* pr = table_lookup(i)) {
                     w.env.position = i;
                     w.env.draw = 0;
-                    w.env.id = in.ids[i];
+                    w.env.id = in.id(i);
                     apply_template(w, i, *pr);
                 } else {
                     w.out.append_range(in, i, i + 1);
@@ -392,7 +403,7 @@ public:
                 const std::size_t start = k + 1 - len;
                 w.env.position = start;
                 w.env.draw = 0;
-                w.env.id = in.ids[start];
+                w.env.id = in.id(start);
                 if (!matches(w, start, pr)) continue;
                 if (!pr.weight.empty()) {
                     const auto& cands = plan.sets[si]->by_symbol[pr.strict[0].sym];
@@ -415,6 +426,7 @@ public:
 
     ModuleString assemble_backward(const ModuleString& pieces) const {
         ModuleString out;
+        out.keep_ids = pieces.keep_ids;
         for (std::size_t p = piece_starts.size() - 1; p-- > 0;) out.append_range(pieces, piece_starts[p], piece_starts[p + 1]);
         return out;
     }
@@ -653,7 +665,7 @@ private:
         EvalEnv& env = w.env;
         env.position = i;
         env.draw = 0;
-        env.id = in.ids[i];
+        env.id = in.id(i);
         const SymbolId sym = in.sym[i];
         for (std::size_t si = 0; si < plan.sets.size(); ++si) {
             const RuleSet& rs = *plan.sets[si];
@@ -685,7 +697,8 @@ private:
                 out.sym.push_back(t.syms[j]);
                 for (std::uint32_t k = j ? t.param_end[j - 1] : 0; k < t.param_end[j]; ++k) out.params.push_back(t.params[k]);
                 out.poff.push_back(static_cast<std::uint32_t>(out.params.size()));
-                out.ids.push_back(static_cast<int>(j) == t.keep ? in.ids[i] : env.id_base + env.new_count++);
+                const ModuleId id = static_cast<int>(j) == t.keep ? in.id(i) : env.id_base + env.new_count++;
+                if (out.keep_ids) out.ids.push_back(id);
             }
             if (out.size() > env.max_output) throw RuntimeError{Span{}, "module limit"};
             return 1;
@@ -693,7 +706,7 @@ private:
         const std::size_t m0 = out.sym.size();
         const std::size_t p0 = out.params.size();
         out.sym.resize(m0 + m);
-        out.ids.resize(m0 + m);
+        if (out.keep_ids) out.ids.resize(m0 + m);
         out.poff.resize(m0 + m + 1);
         out.params.resize(p0 + t.params.size());
         std::copy(t.syms.begin(), t.syms.end(), out.sym.begin() + static_cast<std::ptrdiff_t>(m0));
@@ -701,11 +714,14 @@ private:
         std::copy(t.params.begin(), t.params.end(), pp);
         for (std::size_t h = 0; h < t.holes.size(); ++h) pp[t.holes[h]] = values[h];
         std::uint32_t* po = out.poff.data() + m0 + 1;
-        ModuleId* ids = out.ids.data() + m0;
         const auto base = static_cast<std::uint32_t>(p0);
-        for (std::size_t j = 0; j < m; ++j) {
-            po[j] = base + t.param_end[j];
-            ids[j] = static_cast<int>(j) == t.keep ? in.ids[i] : env.id_base + env.new_count++;
+        for (std::size_t j = 0; j < m; ++j) po[j] = base + t.param_end[j];
+        if (out.keep_ids) {
+            ModuleId* ids = out.ids.data() + m0;
+            for (std::size_t j = 0; j < m; ++j)
+                ids[j] = static_cast<int>(j) == t.keep ? in.ids[i] : env.id_base + env.new_count++;
+        } else {
+            env.new_count += m - (t.keep >= 0 ? 1 : 0);
         }
         if (out.size() > env.max_output) throw RuntimeError{Span{}, "module limit"};
         return 1;
@@ -719,7 +735,7 @@ private:
         const std::size_t k = std::min<std::size_t>(pr.strict.size(), 32);
         for (std::size_t m = 0; m < k; ++m) {
             keep_syms[m] = in.sym[i + m];
-            keep_ids[m] = in.ids[i + m];
+            keep_ids[m] = in.id(i + m);
         }
         env.keep_syms = keep_syms;
         env.keep_ids = keep_ids;
@@ -733,7 +749,7 @@ private:
         if (st == RunStatus::Produced || env.produced) return pr.strict.size();
         // not applied: drop anything a partial body emitted
         w.out.sym.resize(mark);
-        w.out.ids.resize(mark);
+        if (w.out.keep_ids) w.out.ids.resize(mark);
         w.out.params.resize(w.out.poff[mark]);
         w.out.poff.resize(mark + 1);
         return 0;

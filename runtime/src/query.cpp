@@ -21,11 +21,11 @@ public:
     void query(std::size_t module, const TurtleState& t) override {
         const std::string& name = program_.symbols[string_.sym[module]].name;
         if (name == "?E") { // communication modules: answered after the environments see the plant
-            positions[string_.ids[module]] = Place{t.position, t.axis};
+            positions[string_.id(module)] = Place{t.position, t.axis};
             return;
         }
         glm::dvec3 v = name == "?P" ? t.position : name == "?H" ? t.heading : name == "?U" ? t.up : t.left;
-        found[string_.ids[module]] = v;
+        found[string_.id(module)] = v;
     }
     struct Place {
         glm::dvec3 position;
@@ -82,7 +82,7 @@ void advance_climbers(const Derivation& d, ModuleString& string) {
     // identity that the next step may give to another module
     std::unordered_set<ModuleId> own;
     for (std::size_t i = 0; i < string.size(); ++i)
-        if (string.sym[i] < by_symbol.size() && by_symbol[string.sym[i]]) own.insert(string.ids[i]);
+        if (string.sym[i] < by_symbol.size() && by_symbol[string.sym[i]]) own.insert(string.id(i));
     ClimberSink sink(interpreted, by_symbol, own);
     interpret(p, interpreted, turtle_options(d), sink);
     std::set<ModuleId> gone;
@@ -92,7 +92,7 @@ void advance_climbers(const Derivation& d, ModuleString& string) {
     }
     if (!gone.empty())
         cut_branches(string, p.symbols.open_bracket, p.symbols.close_bracket,
-                     [&](std::size_t i) { return gone.count(string.ids[i]) > 0; });
+                     [&](std::size_t i) { return gone.count(string.id(i)) > 0; });
 }
 
 } // namespace
@@ -142,15 +142,15 @@ void TurtleQueryPass::fill_queries(const Derivation& d, ModuleString& string) {
     const auto e_symbol = p.symbols.find("?E");
     for (std::size_t i = 0; e_symbol && i < string.size(); ++i) {
         if (string.sym[i] != *e_symbol || string.arity(i) < 2) continue;
-        auto it = sink.positions.find(string.ids[i]);
+        auto it = sink.positions.find(string.id(i));
         double* a = string.params.data() + string.poff[i];
         const auto env = static_cast<std::size_t>(a[0]);
         if (it == sink.positions.end() || a[0] < 0 || env >= p.environments.size() || !p.environments[env]) continue;
-        p.environments[env]->communicate(it->second.position, string.ids[i], it->second.axis, a + 1, string.arity(i) - 1);
+        p.environments[env]->communicate(it->second.position, string.id(i), it->second.axis, a + 1, string.arity(i) - 1);
     }
     for (std::size_t i = 0; i < string.size(); ++i) {
         if (!p.symbols[string.sym[i]].query || string.arity(i) != 3) continue;
-        auto it = sink.found.find(string.ids[i]);
+        auto it = sink.found.find(string.id(i));
         if (it == sink.found.end()) continue;
         double* a = string.params.data() + string.poff[i];
         a[0] = it->second.x;

@@ -155,7 +155,7 @@ void interpret(const Program& program, const ModuleString& s, const TurtleOption
             glm::dmat3 frame;
             bool placed = false;
             for (const BoundPoses* bp : options.poses)
-                if (bp && bp->pose(s.ids[i], p, frame)) {
+                if (bp && bp->pose(s.id(i), p, frame)) {
                     placed = true;
                     break;
                 }
@@ -168,8 +168,8 @@ void interpret(const Program& program, const ModuleString& s, const TurtleOption
                 t.position += t.heading * len;
             }
             check(i);
-            sink.segment(TurtleSegment{from, t.position, &t, i, s.ids[i]});
-            t.bound_parent = s.ids[i];
+            sink.segment(TurtleSegment{from, t.position, &t, i, s.id(i)});
+            t.bound_parent = s.id(i);
         } else if (sym == y.F || sym == y.G) {
             double len = arg(i, 0, t.step);
             if (s.arity(i) > 1) t.width = s.args(i)[1];
@@ -178,7 +178,7 @@ void interpret(const Program& program, const ModuleString& s, const TurtleOption
             t.position += t.heading * len;
             tropism();
             check(i);
-            sink.segment(TurtleSegment{from, t.position, &t, i, s.ids[i]});
+            sink.segment(TurtleSegment{from, t.position, &t, i, s.id(i)});
         } else if (sym == y.f) {
             t.position += t.heading * arg(i, 0, t.step);
             t.axis = -1;
@@ -226,7 +226,7 @@ void interpret(const Program& program, const ModuleString& s, const TurtleOption
             t.color = glm::clamp(glm::vec3(c), glm::vec3(0.0f), glm::vec3(1.0f));
         } else if (sym == y.sphere) {
             double r = arg(i, 0, t.width / 2);
-            sink.organ(TurtleOrgan{"@O", frame_matrix(t, r), t.color, i, s.ids[i]});
+            sink.organ(TurtleOrgan{"@O", frame_matrix(t, r), t.color, i, s.id(i)});
         } else if (sym == y.set_head || sym == y.set_head2) {
             if (s.arity(i) >= 6)
                 set_heading(t, vec_arg(i, 0), vec_arg(i, 3));
@@ -247,7 +247,7 @@ void interpret(const Program& program, const ModuleString& s, const TurtleOption
             const std::string& name = program.symbols[sym].name;
             if (name.size() > 1 && name[0] == '~') {
                 double scale = arg(i, 0, 1.0);
-                sink.organ(TurtleOrgan{name.substr(1), frame_matrix(t, scale), t.color, i, s.ids[i]});
+                sink.organ(TurtleOrgan{name.substr(1), frame_matrix(t, scale), t.color, i, s.id(i)});
             }
         }
     }

@@ -47,6 +47,10 @@ struct DeriveOptions {
     std::function<void(const StepStats&)> on_step;
     std::function<void(const std::string&)> on_print; // output of print(...) in hooks
     const std::atomic<bool>* interrupt = nullptr;     // set asynchronously to abandon a step
+    // Whether the string keeps module identities (LANGUAGE.md section 6). Without them a
+    // derivation writes 8 bytes less per module; they are kept anyway when the program can
+    // observe them (it calls id(), or has query modules or environments).
+    bool identities = true;
 };
 
 class Derivation {
@@ -82,6 +86,8 @@ public:
     void set_seed(std::uint64_t seed) { seed_ = seed; }
     ModuleId next_id() const { return next_id_; }
     const Program& program() const { return prog_; }
+    // Whether the string keeps module identities (see DeriveOptions::identities).
+    bool keeps_identities() const { return current_.keep_ids; }
 
     // The string as the turtle sees it: interpretation rules applied (max_depth passes).
     ModuleString interpreted(const ModuleString& s) const;

@@ -1,13 +1,19 @@
 // The module string: flat arrays, no per-module heap objects (ARCHITECTURE.md, "Data that
 // matters for speed"). Module i has symbol sym[i], parameters params[poff[i] .. poff[i+1]) and
 // the identity ids[i] (LANGUAGE.md section 6). Vec3 parameters occupy three consecutive doubles.
+//
+// A string may go without identities (keep_ids false, ids empty): a derivation whose identities
+// nobody can observe (`plant derive` without --ids, a program that never calls id() and has no
+// query modules or environments) saves the 8 bytes per module they cost, about a third of the
+// memory a parametric derivation writes. id(i) is 0 in such a string.
 #pragma once
 
 #include "plant/big_allocator.hpp"
 
 #include <cstdint>
-#include <span>
 #include <functional>
+#include <span>
+#include <utility>
 #include <vector>
 
 namespace plant {
@@ -23,9 +29,11 @@ struct ModuleString {
     BigVector<SymbolId> sym;
     BigVector<std::uint32_t> poff{0}; // size() + 1 entries
     BigVector<double> params;
-    BigVector<ModuleId> ids;
+    BigVector<ModuleId> ids; // empty when !keep_ids
+    bool keep_ids = true;
 
     std::size_t size() const { return sym.size(); }
+    ModuleId id(std::size_t i) const { return keep_ids ? ids[i] : 0; }
     bool empty() const { return sym.empty(); }
     std::uint32_t arity(std::size_t i) const { return poff[i + 1] - poff[i]; }
     const double* args(std::size_t i) const { return params.data() + poff[i]; }
@@ -41,9 +49,9 @@ struct ModuleString {
         sym.push_back(s);
         for (std::uint32_t i = 0; i < k; ++i) params.push_back(p[i]);
         poff.push_back(static_cast<std::uint32_t>(params.size()));
-        ids.push_back(id);
+        if (keep_ids) ids.push_back(id);
     }
-    // Appends modules [b, e) of another string.
+    // Appends modules [b, e) of another string (which keeps identities if this one does).
     void append_range(const ModuleString& o, std::size_t b, std::size_t e);
     void append(const ModuleString& o) { append_range(o, 0, o.size()); }
     // Bytes held by the arrays (capacity, not size: what the process really pays).
@@ -56,6 +64,7 @@ struct ModuleString {
         poff.swap(o.poff);
         params.swap(o.params);
         ids.swap(o.ids);
+        std::swap(keep_ids, o.keep_ids);
     }
 };
 

@@ -230,6 +230,7 @@ struct Program {
     double default_angle = 90, default_step = 1, default_width = 1;
     std::vector<std::uint8_t> ignored; // per symbol: skipped when matching context
     bool uses_cut = false;             // some successor or the axiom produces '%'
+    bool uses_id = false;              // some code calls id()
 
     RuleSet rules;                // the unnamed, always-active group
     std::vector<RuleSet> groups;  // named groups, selected by `use`

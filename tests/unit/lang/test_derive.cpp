@@ -2,6 +2,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <filesystem>
+
 using namespace plant;
 using plant::test::derive;
 
@@ -154,4 +157,91 @@ TEST_CASE("string output reads back as the same modules", "[derive]") {
 
 TEST_CASE("string output: modules back to back, parameters in parentheses", "[derive]") {
     CHECK(derive("module B(l, w); axiom: !(10)F(1)[&(45)B(0.6, 7.07)];") == "!(10)F(1)[&(45)B(0.6,7.07)]");
+}
+
+namespace {
+
+// Derives `program` with and without identities and checks that only the identities differ.
+void same_without_identities(const Program& program, DeriveOptions o) {
+    o.identities = true;
+    Derivation with(program, o);
+    with.run();
+    o.identities = false;
+    Derivation without(program, o);
+    without.run();
+    const ModuleString &a = with.string(), &b = without.string();
+    REQUIRE(a.size() == b.size());
+    CHECK(std::equal(a.sym.begin(), a.sym.end(), b.sym.begin()));
+    CHECK(std::equal(a.poff.begin(), a.poff.end(), b.poff.begin()));
+    CHECK(std::equal(a.params.begin(), a.params.end(), b.params.begin()));
+    CHECK(with.next_id() == without.next_id()); // new modules are still counted
+    CHECK(a.keep_ids);
+    CHECK(a.ids.size() == a.size());
+    CHECK_FALSE(b.keep_ids);
+    CHECK(b.ids.empty());
+}
+
+} // namespace
+
+TEST_CASE("without identities a derivation writes the same string, every grammar of grammars/abop and lpy",
+          "[derive][ids]") {
+    namespace fs = std::filesystem;
+    int grammars = 0;
+    for (const char* dir : {"abop", "lpy", "demo"})
+        for (const auto& entry : fs::directory_iterator(fs::path(PLANT_SOURCE_DIR) / "grammars" / dir)) {
+            if (entry.path().extension() != ".plant") continue;
+            INFO(entry.path().string());
+            SourceManager sources;
+            Diagnostics diags;
+            auto program = compile_file(sources, entry.path().string(), {}, diags);
+            REQUIRE(program);
+            same_without_identities(*program, {});
+            ++grammars;
+        }
+    CHECK(grammars >= 30);
+}
+
+TEST_CASE("without identities: every rewriting route, on one and two threads", "[derive][ids]") {
+    const char* grammars[] = {
+        // the direct route (every production applies at once), parameters computed
+        "module A(l, w); axiom: A(1, 1); derive 13; "
+        "rules { A(l, w) -> F(l) [ &(30) A(l * 0.9, w) ] /(137.5) [ &(-30) A(l * 0.7, w) ]; }",
+        // the general route: conditions, a body with nproduce, context, cut and decomposition
+        "module A(x); module B(x); module C; axiom: A(0); derive 18; "
+        "rules { A(x) : x < 2 -> A(x + 1) [ B(x) C ] A(x + 1); A(x) -> [ % A(9) ] B(x) A(0); "
+        "        B(x) < B(y) -> B(x + y); B(x) { nproduce F; if (x > 2) { produce B(x - 1) C; } } } "
+        "decompose { C -> F F; }",
+        // backward new context
+        "axiom: A B B B B; derive 4; rules { A >> B -> A; B -> B B; }",
+        // a table-driven context-sensitive system
+    // (the first, second and last grow past 20,000 modules, where two threads split the work)
+        "ignore: + - F; axiom: F b F b F b; derive 36; "
+        "rules { a < a > a -> a; a < a > b -> b [ + F b F b ]; a < b > a -> b; a < b > b -> b; "
+        "        b < a > a -> a; b < a > b -> b F b; b < b > a -> a; b < b > b -> a; + -> -; - -> +; }",
+    };
+    for (const char* g : grammars)
+        for (int threads : {1, 2}) {
+            INFO(g << " threads " << threads);
+            auto c = test::compile(g);
+            REQUIRE(c->program);
+            DeriveOptions o;
+            o.threads = threads;
+            same_without_identities(*c->program, o);
+        }
+}
+
+TEST_CASE("identities are kept when the program reads them, whatever the options say", "[derive][ids]") {
+    auto c = test::compile("module A(x); axiom: A(0) B; derive 3; rules { A(x) -> A(id()) B; B -> B B; }");
+    REQUIRE(c->program);
+    CHECK(c->program->uses_id);
+    DeriveOptions o;
+    o.identities = false;
+    Derivation d(*c->program, o);
+    d.run();
+    CHECK(d.keeps_identities());
+    CHECK(d.string().ids.size() == d.string().size());
+    o.identities = true;
+    Derivation e(*c->program, o);
+    e.run();
+    CHECK(format_string(*c->program, d.string(), true) == format_string(*c->program, e.string(), true));
 }
