@@ -85,9 +85,22 @@ const RulePlan& Derivation::plan_for(const std::vector<const RuleSet*>& sets) co
     return *plans_.back();
 }
 
-void Derivation::rewrite(const ModuleString& in, ModuleString& out, const std::vector<const RuleSet*>& sets,
-                         std::uint64_t phase, int step_for_env) const {
-    Rewriter rw(plan_for(sets), in);
+const RulePlan& Derivation::step_plan() const {
+    const int g = group_ >= 0 && group_ < static_cast<int>(prog_.groups.size()) ? group_ : -1;
+    if (step_plans_.size() != prog_.groups.size() + 1) step_plans_.assign(prog_.groups.size() + 1, nullptr);
+    const RulePlan*& slot = step_plans_[static_cast<std::size_t>(g + 1)];
+    if (!slot) {
+        std::vector<const RuleSet*> sets;
+        if (g >= 0) sets.push_back(&prog_.groups[static_cast<std::size_t>(g)]);
+        sets.push_back(&prog_.rules);
+        slot = &plan_for(sets);
+    }
+    return *slot;
+}
+
+void Derivation::rewrite(const ModuleString& in, ModuleString& out, const RulePlan& plan, std::uint64_t phase,
+                         int step_for_env) const {
+    Rewriter rw(plan, in, &brackets_);
     auto setup = [&](Worker& w) {
         w.env.prog = &prog_;
         w.env.globals = const_cast<double*>(globals_.data()); // read-only during rewriting
@@ -115,9 +128,7 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const std::v
         w.out.poff.reserve(w.out.sym.capacity() + 1);
         w.out.params.reserve(static_cast<std::size_t>(in.params.size() * param_growth_ * 1.02) + 16);
         try {
-            bool backward = false;
-            for (const RuleSet* rs : sets) backward = backward || rs->uses_right_new;
-            if (backward) {
+            if (plan.right_new) {
                 // right to left: new modules are marked, then numbered in string order
                 w.env.id_base = kNewIdBit;
                 rw.run_backward(w);
@@ -300,7 +311,7 @@ void Derivation::decompose(ModuleString& s, int step_for_env) {
         if (!any_candidate(s, prog_.decompose)) break;
         ModuleString next;
         ModuleId before = next_id_;
-        rewrite(s, next, sets, (static_cast<std::uint64_t>(step_for_env) << 16) | static_cast<std::uint64_t>(pass + 1),
+        rewrite(s, next, plan_for(sets), (static_cast<std::uint64_t>(step_for_env) << 16) | static_cast<std::uint64_t>(pass + 1),
                 step_for_env);
         bool changed = next_id_ != before || next.size() != s.size() || next.sym != s.sym || next.params != s.params;
         s.swap(next);
@@ -329,7 +340,7 @@ ModuleString Derivation::interpreted(const ModuleString& s) const {
     for (int pass = 0; pass < prog_.interpret.max_depth; ++pass) {
         if (!any_candidate(cur, prog_.interpret)) break;
         ModuleString next;
-        rewrite(cur, next, sets, (static_cast<std::uint64_t>(step_) << 16) | 0x8000u | static_cast<std::uint64_t>(pass),
+        rewrite(cur, next, plan_for(sets), (static_cast<std::uint64_t>(step_) << 16) | 0x8000u | static_cast<std::uint64_t>(pass),
                 step_);
         bool changed = next.sym != cur.sym || next.params != cur.params;
         cur.swap(next);
@@ -413,6 +424,10 @@ void Derivation::start() {
     }
     started_ = true;
     run_hook(HookKind::Start);
+    // The plan for the rule sets the first step uses is prepared here, with the axiom, as
+    // lindenmayer.js prepares its productions when the system is made: the steps' timings
+    // (plant derive --stats) are then the rewriting alone.
+    (void)step_plan();
 }
 
 bool Derivation::step() {
@@ -422,17 +437,13 @@ bool Derivation::step() {
     double t0 = now_ms();
     run_hook(HookKind::BeforeStep);
     if (stopped_) return false;
-    std::vector<const RuleSet*> sets;
-    if (group_ >= 0 && group_ < static_cast<int>(prog_.groups.size())) sets.push_back(&prog_.groups[group_]);
-    sets.push_back(&prog_.rules);
-    bool queries = false;
-    for (const RuleSet* rs : sets) queries = queries || reads_queries(prog_, *rs);
+    const RulePlan& plan = step_plan();
     // the turtle pass fills query modules and shows the environments the plant as it is now
-    if ((queries || !prog_.environments.empty()) && opt_.queries) opt_.queries->fill_queries(*this, current_);
+    if ((plan.queries || !prog_.environments.empty()) && opt_.queries) opt_.queries->fill_queries(*this, current_);
     ModuleString next;
     ++step_;
     try {
-        rewrite(current_, next, sets, static_cast<std::uint64_t>(step_) << 16, step_);
+        rewrite(current_, next, plan, static_cast<std::uint64_t>(step_) << 16, step_);
         current_.swap(next);
         { ModuleString().swap(next); }
         decompose(current_, step_);

@@ -33,20 +33,33 @@ void ModuleString::append_range(const ModuleString& o, std::size_t b, std::size_
     for (std::size_t i = 0; i < n; ++i) dst[i] = src[i] + shift;
 }
 
-std::vector<std::uint32_t> bracket_table(const ModuleString& s, SymbolId open, SymbolId close) {
+void bracket_table(const ModuleString& s, SymbolId open, SymbolId close, std::vector<std::uint32_t>& match) {
     const auto n = static_cast<std::uint32_t>(s.size());
-    std::vector<std::uint32_t> match(s.size(), n);
-    std::vector<std::uint32_t> stack;
+    match.resize(s.size());
+    // The stack of open brackets is kept in the table itself: an open '[' holds the index of the
+    // '[' below it until its ']' is found. No allocation besides the table.
+    std::uint32_t top = n;
     for (std::uint32_t i = 0; i < n; ++i) {
-        if (s.sym[i] == open) {
-            stack.push_back(i);
-        } else if (s.sym[i] == close && !stack.empty()) {
-            match[i] = stack.back();
-            match[stack.back()] = i;
-            stack.pop_back();
+        const SymbolId x = s.sym[i];
+        if (x == open) {
+            match[i] = top;
+            top = i;
+        } else if (x == close) {
+            if (top == n) {
+                match[i] = n;
+                continue;
+            }
+            const std::uint32_t below = match[top];
+            match[top] = i;
+            match[i] = top;
+            top = below;
         }
     }
-    return match;
+    while (top != n) { // unclosed: no partner
+        const std::uint32_t below = match[top];
+        match[top] = n;
+        top = below;
+    }
 }
 
 // ---- printing --------------------------------------------------------------------------------

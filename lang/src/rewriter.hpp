@@ -47,6 +47,13 @@ struct RulePlan {
             }
             left_new = left_new || rs->uses_left_new;
             right_new = right_new || rs->uses_right_new;
+            auto named = [&](const std::vector<PatternModule>& v) {
+                for (const auto& m : v)
+                    if (P.symbols[m.sym].query) return true;
+                return false;
+            };
+            for (const auto& pr : rs->productions)
+                queries = queries || named(pr.strict) || named(pr.left) || named(pr.right);
         }
         frame_size = frame;
         // A symbol whose first production always applies (no condition, context or weight, one
@@ -81,6 +88,7 @@ struct RulePlan {
     std::vector<const Production*> ctx_entries; // nullptr: no production applies
     std::size_t frame_size = 1;
     bool brackets = false, multi = false, left_new = false, right_new = false;
+    bool queries = false; // some pattern names a query module: the turtle pass fills them first
 
 private:
     // The context table. When every production of a symbol is `l < s > r -> successor` with
@@ -145,9 +153,15 @@ private:
 
 class Rewriter {
 public:
-    Rewriter(const RulePlan& rule_plan, const ModuleString& in)
+    // `brackets`: where to build the bracket table (a buffer kept from step to step saves an
+    // allocation each step); null: a buffer of the rewriter's own.
+    Rewriter(const RulePlan& rule_plan, const ModuleString& in, std::vector<std::uint32_t>* brackets = nullptr)
         : plan(rule_plan), P(rule_plan.P), in(in), n(in.size()) {
-        if (plan.brackets) match = bracket_table(in, P.symbols.open_bracket, P.symbols.close_bracket);
+        if (plan.brackets) {
+            std::vector<std::uint32_t>& table = brackets ? *brackets : own_match;
+            bracket_table(in, P.symbols.open_bracket, P.symbols.close_bracket, table);
+            match = table.data();
+        }
     }
 
     // The production the context table gives for module i, which has a table and no parameters.
@@ -799,7 +813,8 @@ private:
     const Program& P;
     const ModuleString& in;
     const std::size_t n;
-    std::vector<std::uint32_t> match;
+    std::vector<std::uint32_t> own_match;
+    const std::uint32_t* match = nullptr; // the bracket table (see bracket_table)
     std::vector<std::size_t> piece_starts;
 };
 

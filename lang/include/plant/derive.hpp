@@ -94,7 +94,7 @@ public:
 
 private:
     void run_hook(HookKind kind);
-    void rewrite(const ModuleString& in, ModuleString& out, const std::vector<const RuleSet*>& sets,
+    void rewrite(const ModuleString& in, ModuleString& out, const RulePlan& plan,
                  std::uint64_t phase, int step_for_env) const;
     template <typename Setup>
     bool rewrite_direct(Rewriter& rw, const ModuleString& in, ModuleString& out, int threads,
@@ -105,6 +105,8 @@ private:
     void check_limits(std::size_t modules, std::size_t params) const;
     // The plan for rewriting with `sets`, built the first time and kept (copies share them).
     const RulePlan& plan_for(const std::vector<const RuleSet*>& sets) const;
+    // The plan for a step with the active group: plan_for(group's rules, then the unnamed ones).
+    const RulePlan& step_plan() const;
 
     const Program& prog_;
     DeriveOptions opt_;
@@ -120,6 +122,8 @@ private:
     mutable ModuleId next_id_ = 1;
     mutable double growth_ = 2.0, param_growth_ = 2.0; // last step's growth, for reserving memory
     mutable std::vector<std::shared_ptr<const RulePlan>> plans_;
+    mutable std::vector<const RulePlan*> step_plans_; // per group + 1 (index 0: no group), from plans_
+    mutable std::vector<std::uint32_t> brackets_;     // the bracket table, kept from step to step
 };
 
 // The positions where the first production of `rules` matches in the derivation's current string

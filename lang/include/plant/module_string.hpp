@@ -68,10 +68,10 @@ struct ModuleString {
     }
 };
 
-// For each '[' the index of its ']' and for each ']' the index of its '['; other entries are
-// unused. Unbalanced brackets map to size() (no partner). Built once per step, only when some
-// production has context.
-std::vector<std::uint32_t> bracket_table(const ModuleString& s, SymbolId open, SymbolId close);
+// Fills `match` (resized to s.size()): for each '[' the index of its ']' and for each ']' the
+// index of its '['; other entries are left as they were. Unbalanced brackets map to size() (no
+// partner). Built once per step, only when some production has context.
+void bracket_table(const ModuleString& s, SymbolId open, SymbolId close, std::vector<std::uint32_t>& match);
 
 // Removes every module for which `cuts(i)` holds together with the rest of its branch, up to the
 // ']' that closes it (kept) or the string's end: what '%' does, and what a climber does to a
