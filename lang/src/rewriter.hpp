@@ -73,6 +73,25 @@ struct RulePlan {
             }
         }
         if (brackets && !multi && !left_new && !right_new) build_context_table();
+        // Whether every symbol with productions is rewritten by a direct template or by the
+        // context table: then a step needs no matching beyond a table lookup, and the output of
+        // any module is bounded by the longest template (see Rewriter::run_templates).
+        templated = !multi && !left_new && !right_new;
+        for (SymbolId sym = 0; sym < P.symbols.size() && templated; ++sym) {
+            if (!has_prod[sym]) continue;
+            if (direct[sym]) {
+                max_modules_out = std::max(max_modules_out, direct[sym]->tmpl.syms.size());
+                max_params_out = std::max(max_params_out, direct[sym]->tmpl.params.size());
+            } else if (!ctx_block.empty() && ctx_block[sym] >= 0) {
+                for (const RuleSet* rs : sets)
+                    for (std::uint32_t pi : rs->by_symbol[sym]) {
+                        max_modules_out = std::max(max_modules_out, rs->productions[pi].tmpl.syms.size());
+                        max_params_out = std::max(max_params_out, rs->productions[pi].tmpl.params.size());
+                    }
+            } else {
+                templated = false;
+            }
+        }
     }
 
     const Program& P;
@@ -89,6 +108,9 @@ struct RulePlan {
     std::size_t frame_size = 1;
     bool brackets = false, multi = false, left_new = false, right_new = false;
     bool queries = false; // some pattern names a query module: the turtle pass fills them first
+    bool templated = false;              // see the end of the constructor
+    std::size_t max_modules_out = 1;     // the longest template's modules (at least 1: a copy)
+    std::size_t max_params_out = 0;      // and the most parameters a template holds
 
 private:
     // The context table. When every production of a symbol is `l < s > r -> successor` with
@@ -349,6 +371,13 @@ public:
 
     // Rewrites modules [b, e) into w.out.
     void run_range(Worker& w, std::size_t b, std::size_t e) {
+        if (plan.templated) {
+            if (w.out.keep_ids)
+                run_templates<true>(w, b, e);
+            else
+                run_templates<false>(w, b, e);
+            return;
+        }
         w.frame.assign(plan.frame_size, 0.0);
         std::size_t i = b;
         while (i < e) {
@@ -394,6 +423,123 @@ public:
             }
             i += used;
         }
+    }
+
+    // run_range for a templated plan (every rewritten symbol has a direct template or a context
+    // table). The output is written through plain pointers into arrays opened up to their
+    // capacity (which the derivation reserved from the last step's growth), checked once per
+    // module against the longest template, and cut to what was written at the end. A module that
+    // needs matching after all (its parameter count differs from the pattern's) goes through
+    // apply() with the arrays at their true size.
+    template <bool Ids> void run_templates(Worker& w, std::size_t b, std::size_t e) {
+        w.frame.assign(plan.frame_size, 0.0);
+        ModuleString& out = w.out;
+        EvalEnv& env = w.env;
+        const std::size_t Mmax = plan.max_modules_out, Pmax = plan.max_params_out;
+        double values[256];
+        std::size_t m = out.size(), p = out.params.size();
+        std::size_t mcap = 0, pcap = 0;
+        SymbolId* S = nullptr;
+        std::uint32_t* PO = nullptr; // PO[m]: where module m's parameters end
+        double* PA = nullptr;
+        ModuleId* ID = nullptr;
+        auto open = [&](std::size_t need_m, std::size_t need_p) {
+            mcap = std::max({out.sym.capacity(), need_m, 2 * m});
+            pcap = std::max({out.params.capacity(), need_p, 2 * p});
+            out.sym.resize(mcap);
+            if constexpr (Ids) out.ids.resize(mcap);
+            out.poff.resize(mcap + 1);
+            out.params.resize(pcap);
+            S = out.sym.data();
+            PO = out.poff.data() + 1;
+            PA = out.params.data();
+            if constexpr (Ids) ID = out.ids.data();
+        };
+        auto close = [&] {
+            out.sym.resize(m);
+            if constexpr (Ids) out.ids.resize(m);
+            out.poff.resize(m + 1);
+            out.params.resize(p);
+        };
+        open(m + Mmax, p + Pmax);
+        std::size_t next_check = b + 65536;
+        std::size_t i = b;
+        while (i < e) {
+            if (i >= next_check) {
+                next_check = i + 65536;
+                if (env.interrupt && env.interrupt->load()) throw RuntimeError{Span{}, "interrupted"};
+                if (m > env.max_output || p > env.max_params) {
+                    close();
+                    limit_error(w);
+                }
+            }
+            const SymbolId sym = in.sym[i];
+            const std::uint32_t arity = in.poff[i + 1] - in.poff[i];
+            if (m + Mmax > mcap || p + arity + Pmax > pcap) open(m + Mmax, p + arity + Pmax);
+            const Production* pr = nullptr;
+            if (plan.has_prod[sym]) {
+                pr = plan.direct[sym];
+                if (pr && arity == pr->strict[0].width) {
+                    if (!pr->tmpl.holes.empty()) {
+                        const double* a = in.params.data() + in.poff[i];
+                        for (const auto& pa : pr->strict[0].args) {
+                            for (int k = 0; k < pa.width; ++k) w.frame[pa.slot + k] = a[k];
+                            a += pa.width;
+                        }
+                    }
+                } else if (!pr && arity == 0) {
+                    pr = table_lookup(i); // nullptr: no production applies, the module is copied
+                } else { // matching after all, with the arrays at their true size
+                    close();
+                    std::size_t used = apply(w, i);
+                    if (used == 0) {
+                        out.append_range(in, i, i + 1);
+                        used = 1;
+                    }
+                    i += used;
+                    m = out.size();
+                    p = out.params.size();
+                    open(m + Mmax, p + Pmax);
+                    continue;
+                }
+            }
+            if (!pr) { // copied as it is
+                S[m] = sym;
+                if constexpr (Ids) ID[m] = in.ids[i];
+                for (std::uint32_t k = in.poff[i]; k < in.poff[i + 1]; ++k) PA[p++] = in.params[k];
+                PO[m] = static_cast<std::uint32_t>(p);
+                ++m;
+                ++i;
+                continue;
+            }
+            const SuccessorTemplate& t = pr->tmpl;
+            if (!t.holes.empty()) {
+                env.position = i;
+                env.draw = 0;
+                env.id = Ids ? in.ids[i] : 0;
+                env.out = nullptr;
+                compute_holes(w, t, values);
+                check_holes(t, values);
+            }
+            const std::size_t tm = t.syms.size(), tp = t.params.size();
+            for (std::size_t j = 0; j < tm; ++j) {
+                S[m + j] = t.syms[j];
+                PO[m + j] = static_cast<std::uint32_t>(p) + t.param_end[j];
+            }
+            for (std::size_t k = 0; k < tp; ++k) PA[p + k] = t.params[k];
+            for (std::size_t h = 0; h < t.holes.size(); ++h) PA[p + t.holes[h]] = values[h];
+            if constexpr (Ids) {
+                for (std::size_t j = 0; j < tm; ++j)
+                    ID[m + j] = static_cast<int>(j) == t.keep ? in.ids[i] : env.id_base + env.new_count++;
+            } else {
+                env.new_count += tm - (t.keep >= 0 ? 1 : 0);
+            }
+            m += tm;
+            p += tp;
+            ++i;
+        }
+        close();
+        if (out.size() > env.max_output || out.params.size() > env.max_params) limit_error(w);
     }
 
     // Backward processing for `>>`: modules right to left; each successor becomes a piece and
