@@ -266,19 +266,8 @@ private:
 
 class Obstacles : public Environment {
 public:
-    struct Sphere {
-        glm::dvec3 c;
-        double r;
-    };
-    struct Box {
-        glm::dvec3 lo, hi;
-    };
-    struct Plane {
-        glm::dvec3 p, n;
-    };
-    std::vector<Sphere> spheres;
-    std::vector<Box> boxes;
-    std::vector<Plane> planes;
+    // spheres, boxes and planes as the climbers' physics has them (one distance function for both)
+    std::vector<physics::Obstacle> shapes;
     std::vector<Triangle> triangles; // of loaded meshes, each a closed surface with outward faces
 
     const std::vector<EnvMethod>& methods() const override {
@@ -290,35 +279,12 @@ public:
     }
     double distance(const glm::dvec3& p) const {
         double d = std::numeric_limits<double>::infinity();
-        for (const auto& s : spheres) d = std::min(d, glm::length(p - s.c) - s.r);
-        for (const auto& b : boxes) {
-            // the usual box distance: outside part plus the (negative) inside part
-            glm::dvec3 c = (b.lo + b.hi) * 0.5, h = (b.hi - b.lo) * 0.5;
-            glm::dvec3 q = glm::abs(p - c) - h;
-            double outside = glm::length(glm::max(q, glm::dvec3(0.0)));
-            double inside = std::min(std::max(q.x, std::max(q.y, q.z)), 0.0);
-            d = std::min(d, outside + inside);
-        }
-        for (const auto& pl : planes) d = std::min(d, glm::dot(p - pl.p, pl.n));
+        for (const auto& o : shapes) d = std::min(d, o.distance(p));
         if (!triangles.empty()) d = std::min(d, signed_distance(triangles, p));
         return d;
     }
     void geometry(std::vector<glm::dvec3>& out, const glm::dvec3& lo, const glm::dvec3& hi) const override {
-        for (const auto& sp : spheres) {
-            physics::Obstacle o;
-            o.kind = physics::Obstacle::Sphere, o.a = sp.c, o.b = glm::dvec3(sp.r, 0, 0);
-            obstacle_triangles(o, lo, hi, out);
-        }
-        for (const auto& b : boxes) {
-            physics::Obstacle o;
-            o.kind = physics::Obstacle::Box, o.a = b.lo, o.b = b.hi;
-            obstacle_triangles(o, lo, hi, out);
-        }
-        for (const auto& pl : planes) {
-            physics::Obstacle o;
-            o.kind = physics::Obstacle::Plane, o.a = pl.p, o.b = pl.n;
-            obstacle_triangles(o, lo, hi, out);
-        }
+        for (const auto& o : shapes) obstacle_triangles(o, lo, hi, out);
         for (const auto& t : triangles) out.insert(out.end(), {t.a, t.b, t.c});
     }
     void call(std::size_t method, const double* a, double* r) const override {
@@ -527,15 +493,21 @@ EnvironmentFactory runtime_environments() {
                         "plane_normal";
                 return nullptr;
             }
-            for (std::size_t i = 0; i < centers.size(); ++i) o->spheres.push_back({centers[i], radii[i]});
+            auto add = [&](physics::Obstacle::Kind shape_kind, const glm::dvec3& first, const glm::dvec3& second) {
+                physics::Obstacle shape;
+                shape.kind = shape_kind, shape.a = first, shape.b = second;
+                o->shapes.push_back(shape);
+            };
+            for (std::size_t i = 0; i < centers.size(); ++i)
+                add(physics::Obstacle::Sphere, centers[i], glm::dvec3(radii[i], 0, 0));
             for (std::size_t i = 0; i < box_min.size(); ++i)
-                o->boxes.push_back({glm::min(box_min[i], box_max[i]), glm::max(box_min[i], box_max[i])});
+                add(physics::Obstacle::Box, glm::min(box_min[i], box_max[i]), glm::max(box_min[i], box_max[i]));
             for (std::size_t i = 0; i < plane_p.size(); ++i) {
                 if (glm::length(plane_n[i]) == 0) {
                     error = "obstacles: a plane_normal must not be zero";
                     return nullptr;
                 }
-                o->planes.push_back({plane_p[i], glm::normalize(plane_n[i])});
+                add(physics::Obstacle::Plane, plane_p[i], glm::normalize(plane_n[i]));
             }
             return o;
         }
