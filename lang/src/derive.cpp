@@ -122,7 +122,6 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const RulePl
     } else if (threads == 1) {
         Worker w;
         setup(w);
-        w.out.swap(out); // empty, but it may bring arrays to reuse (see Derivation::spare_)
         w.env.id_base = next_id_; // one thread numbers new modules in string order directly
         w.out.sym.reserve(static_cast<std::size_t>(n * growth_ * 1.02) + 16);
         if (w.out.keep_ids) w.out.ids.reserve(w.out.sym.capacity());
@@ -442,16 +441,11 @@ bool Derivation::step() {
     // the turtle pass fills query modules and shows the environments the plant as it is now
     if ((plan.queries || !prog_.environments.empty()) && opt_.queries) opt_.queries->fill_queries(*this, current_);
     ModuleString next;
-    next.swap(spare_);
     ++step_;
     try {
         rewrite(current_, next, plan, static_cast<std::uint64_t>(step_) << 16, step_);
         current_.swap(next);
-        // the string before is freed now, or, when small, kept for the next step to write into
-        if (next.bytes() <= kSpareBytes)
-            spare_.swap(next);
-        else
-            ModuleString().swap(next);
+        { ModuleString().swap(next); }
         decompose(current_, step_);
         apply_cut(current_);
     } catch (RuntimeError& e) {

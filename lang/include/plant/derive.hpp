@@ -124,12 +124,6 @@ private:
     mutable std::vector<std::shared_ptr<const RulePlan>> plans_;
     mutable std::vector<const RulePlan*> step_plans_; // per group + 1 (index 0: no group), from plans_
     mutable std::vector<std::uint32_t> brackets_;     // the bracket table, kept from step to step
-    // A step writes into the arrays of the string from two steps before when that one was small:
-    // many short steps (a signal running through a small plant) then allocate nothing. Large
-    // strings are freed at once (their pages are recycled by big_pages instead), so that a step's
-    // peak memory stays the old string plus the new one.
-    static constexpr std::size_t kSpareBytes = std::size_t{64} << 10;
-    ModuleString spare_;
 };
 
 // The positions where the first production of `rules` matches in the derivation's current string
