@@ -23,19 +23,6 @@ namespace plant {
 
 namespace {
 
-// Whether some production of `rs` names a query module (?P, ?H, ...) in its predecessor or
-// context: then the turtle pass runs before each step to fill them.
-bool reads_queries(const Program& p, const RuleSet& rs) {
-    auto named = [&](const std::vector<PatternModule>& v) {
-        for (const auto& m : v)
-            if (p.symbols[m.sym].query) return true;
-        return false;
-    };
-    for (const auto& pr : rs.productions)
-        if (named(pr.strict) || named(pr.left) || named(pr.right)) return true;
-    return false;
-}
-
 // Whether anything the program does depends on module identities: id(), the query pass (which
 // finds modules by identity between the turtle and the rewrite) and environments (which
 // remember the modules they were told about).

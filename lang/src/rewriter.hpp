@@ -31,6 +31,19 @@ struct Worker {
     std::int64_t ctx_left = kUnknown, ctx_right = kUnknown;
 };
 
+// Whether some production of `rs` names a query module (?P, ?H, ...) in its predecessor or
+// context: then the turtle pass runs before each step to fill them.
+inline bool reads_queries(const Program& p, const RuleSet& rs) {
+    auto named = [&](const std::vector<PatternModule>& v) {
+        for (const auto& m : v)
+            if (p.symbols[m.sym].query) return true;
+        return false;
+    };
+    for (const auto& pr : rs.productions)
+        if (named(pr.strict) || named(pr.left) || named(pr.right)) return true;
+    return false;
+}
+
 // What rewriting with a list of rule sets needs that does not depend on the string: which
 // symbols have productions, which apply at once (direct), the context table. The derivation
 // builds it once per list of rule sets and keeps it, not once per step.
@@ -47,13 +60,7 @@ struct RulePlan {
             }
             left_new = left_new || rs->uses_left_new;
             right_new = right_new || rs->uses_right_new;
-            auto named = [&](const std::vector<PatternModule>& v) {
-                for (const auto& m : v)
-                    if (P.symbols[m.sym].query) return true;
-                return false;
-            };
-            for (const auto& pr : rs->productions)
-                queries = queries || named(pr.strict) || named(pr.left) || named(pr.right);
+            queries = queries || reads_queries(P, *rs);
         }
         frame_size = frame;
         // A symbol whose first production always applies (no condition, context or weight, one
