@@ -265,7 +265,6 @@ public:
     template <bool Ids>
     void write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at, std::size_t p_at,
                       ModuleId id_at) {
-        if constexpr (!Ids) (void)id_at;
         w.frame.assign(plan.frame_size, 0.0);
         SymbolId* S = out.sym.data() + m_at;
         ModuleId* ID = Ids ? out.ids.data() + m_at : nullptr;
@@ -325,30 +324,35 @@ public:
                 check_holes(t, values);
             }
             const std::size_t m = t.syms.size();
-            if (m != 0) std::memcpy(S, t.syms.data(), m * sizeof(SymbolId));
-            // An erasing or parameterless successor has no parameter storage;
-            // memcpy with a null source is undefined even for zero bytes.
-            if (!t.params.empty()) std::memcpy(PA, t.params.data(), t.params.size() * sizeof(double));
-            for (std::size_t h = 0; h < t.holes.size(); ++h) PA[t.holes[h]] = values[h];
-            const auto p32 = static_cast<std::uint32_t>(p);
-            for (std::size_t j = 0; j < m; ++j) PO[j] = p32 + t.param_end[j];
-            if constexpr (Ids) {
-                for (std::size_t j = 0; j < m; ++j) ID[j] = id_at + j;
-                if (t.keep >= 0) { // the kept module has the predecessor's identity; the rest are new
-                    const auto keep = static_cast<std::size_t>(t.keep);
-                    for (std::size_t j = keep + 1; j < m; ++j) --ID[j];
-                    ID[keep] = in.ids[i];
-                    id_at += m - 1;
-                } else {
-                    id_at += m;
-                }
-                ID += m;
-            }
+            put_template<Ids>(t, values, p, Ids ? in.ids[i] : 0, id_at, S, PO, PA, ID);
+            if constexpr (Ids) ID += m;
             S += m;
             PO += m;
             PA += t.params.size();
             p += t.params.size();
             ++i;
+        }
+    }
+
+    // Writes successor template t, its computed numbers in `values`, at S, PO, PA and ID, its
+    // parameters starting at parameter p of the output. Module t.keep gets the identity `kept`
+    // (the predecessor's), the others new ones counted on from `next_new`. Identities are
+    // written only when Ids.
+    template <bool Ids>
+    static void put_template(const SuccessorTemplate& t, const double* values, std::size_t p, ModuleId kept,
+                             ModuleId& next_new, SymbolId* S, std::uint32_t* PO, double* PA, ModuleId* ID) {
+        const std::size_t m = t.syms.size();
+        if (m != 0) std::memcpy(S, t.syms.data(), m * sizeof(SymbolId));
+        // An erasing or parameterless successor has no parameter storage;
+        // memcpy with a null source is undefined even for zero bytes.
+        if (!t.params.empty()) std::memcpy(PA, t.params.data(), t.params.size() * sizeof(double));
+        for (std::size_t h = 0; h < t.holes.size(); ++h) PA[t.holes[h]] = values[h];
+        const auto p32 = static_cast<std::uint32_t>(p);
+        for (std::size_t j = 0; j < m; ++j) PO[j] = p32 + t.param_end[j];
+        if constexpr (Ids) {
+            for (std::size_t j = 0; j < m; ++j) ID[j] = static_cast<int>(j) == t.keep ? kept : next_new++;
+        } else {
+            next_new += m - (t.keep >= 0 ? 1 : 0);
         }
     }
 
@@ -528,21 +532,11 @@ public:
                 compute_holes(w, t, values);
                 check_holes(t, values);
             }
-            const std::size_t tm = t.syms.size(), tp = t.params.size();
-            for (std::size_t j = 0; j < tm; ++j) {
-                S[m + j] = t.syms[j];
-                PO[m + j] = static_cast<std::uint32_t>(p) + t.param_end[j];
-            }
-            for (std::size_t k = 0; k < tp; ++k) PA[p + k] = t.params[k];
-            for (std::size_t h = 0; h < t.holes.size(); ++h) PA[p + t.holes[h]] = values[h];
-            if constexpr (Ids) {
-                for (std::size_t j = 0; j < tm; ++j)
-                    ID[m + j] = static_cast<int>(j) == t.keep ? in.ids[i] : env.id_base + env.new_count++;
-            } else {
-                env.new_count += tm - (t.keep >= 0 ? 1 : 0);
-            }
-            m += tm;
-            p += tp;
+            ModuleId next_new = env.id_base + env.new_count;
+            put_template<Ids>(t, values, p, Ids ? in.ids[i] : 0, next_new, S + m, PO + m, PA + p, Ids ? ID + m : nullptr);
+            env.new_count = next_new - env.id_base;
+            m += t.syms.size();
+            p += t.params.size();
             ++i;
         }
         close();
