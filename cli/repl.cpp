@@ -49,7 +49,7 @@ const CommandInfo kCommands[] = {
     {"load", ":load FILE", "read a grammar file; the session starts again at step 0"},
     {"reload", ":reload", "read the file again, keep :set values and typed rules, replay the same number of steps"},
     {"step", ":step [N]", "derive N more steps (default 1)"},
-    {"back", ":back [N]", "undo the last N steps (default 1)"},
+    {"back", ":back [N]", "undo the last N steps (default 1), with the edits (:do) made in them and the :use choices made after the step it goes back to"},
     {"reset", ":reset", "go back to the axiom (step 0)"},
     {"show", ":show [A..B] [--ids]", "print the string, or modules A to B; long strings are shortened"},
     {"find", ":find PATTERN", "list the modules a name or predecessor pattern matches (A, A(x) : x > 2, B < A(x)), with positions and identities"},
@@ -58,6 +58,11 @@ const CommandInfo kCommands[] = {
     {"seed", ":seed S", "change the random seed and replay"},
     {"rules", ":rules", "list the productions, typed ones included"},
     {"use", ":use GROUP", "select a rule group for the next steps (:use none to clear)"},
+    {"do", ":do STATEMENTS", "run statements as an on before_step hook would before the next step: a climber's edits "
+                             "(ivy.cut(ID), ivy.pull(ID, vec3(X, Y, Z)), ivy.wind(vec3(X, Y, Z)), ivy.seed(ID), "
+                             "ivy.move(K, vec3(X, Y, Z))), or assigning vars; such a call typed alone needs no :do. "
+                             "Kept with the step for replays; :back undoes it"},
+    {"edits", ":edits", "list the edits (:do) and the steps they run before"},
     {"stats", ":stats", "modules per symbol, branch depth, steps and the time of the last step"},
     {"time", ":time", "the time of the last step"},
     {"export", ":export FILE...", "write files as plant run does (.glb .png .obj .svg .txt .skel.json ...)"},
@@ -90,6 +95,12 @@ std::string Session::session_source(const std::string* extra_fn) const {
     if (!extra_rules_.empty()) {
         s += "rules {\n";
         for (const auto& r : extra_rules_) s += r + "\n";
+        s += "}\n";
+    }
+    if (!edits_.empty()) {
+        // each edit on lines of its own, so that an error points into what the user typed
+        s += "on before_step {\n";
+        for (const auto& [at, statements] : edits_) s += fmt::format("if step() == {} {{\n{}\n}}\n", at, statements);
         s += "}\n";
     }
     if (extra_fn) s += *extra_fn + "\n";
@@ -169,7 +180,7 @@ int Session::load(const std::string& path) {
         return 66;
     }
     // a new grammar starts a new session; a grammar that does not build leaves the old one as it was
-    auto saved = std::tuple{file_, file_text_, axiom_, extra_rules_, params_, seed_, uses_};
+    auto saved = std::tuple{file_, file_text_, axiom_, extra_rules_, params_, seed_, uses_, edits_};
     file_ = fs::path(path).lexically_normal().string(); // as given: messages stay short and portable
     read_file(file_, file_text_);
     axiom_.reset();
@@ -177,8 +188,9 @@ int Session::load(const std::string& path) {
     params_.clear();
     seed_.reset();
     uses_.clear();
+    edits_.clear();
     if (!rebuild(0)) {
-        std::tie(file_, file_text_, axiom_, extra_rules_, params_, seed_, uses_) = saved;
+        std::tie(file_, file_text_, axiom_, extra_rules_, params_, seed_, uses_, edits_) = saved;
         return last_error_runtime_ ? 70 : 65;
     }
     out_ << fmt::format("loaded {}: {} at step 0\n", path, modules(current().string().size()));
@@ -409,6 +421,57 @@ void Session::evaluate(const std::string& expr) {
         out_ << format_double(r[0]) << "\n";
 }
 
+void Session::back_to(int k) {
+    history_.resize(std::min(history_.size(), static_cast<std::size_t>(k) + 1));
+    // what was chosen or done after step k belongs to the steps undone
+    std::erase_if(uses_, [&](const auto& u) { return u.first > k; });
+    std::size_t before = edits_.size();
+    // an edit at step k ran in step k + 1 (undone), or is still waiting for it
+    std::erase_if(edits_, [&](const auto& e) { return e.first >= k; });
+    if (edits_.size() < before)
+        out_ << fmt::format("undid {} edit{} made at step {} or later\n", before - edits_.size(),
+                            before - edits_.size() == 1 ? "" : "s", k);
+    // an environment that evolves (a climber's particles) is where the later steps left it:
+    // derive again up to step k; the earlier string alone would not bring its state back
+    bool evolves = std::any_of(program_->environments.begin(), program_->environments.end(),
+                               [](const auto& e) { return e && e->evolves(); });
+    if (evolves || edits_.size() < before) rebuild(k);
+}
+
+void Session::edit(std::string statements) {
+    if (!need_derivation()) return;
+    statements = trim(statements);
+    if (statements.empty()) {
+        error() << "':do' expects statements, as in :do ivy.cut(12);\n";
+        return;
+    }
+    if (statements.back() != ';' && statements.back() != '}') statements += ';';
+    int at = current().steps_done();
+    edits_.emplace_back(at, statements);
+    if (rebuild(at))
+        out_ << fmt::format("before step {}: {}\n", at + 1, statements);
+    else
+        edits_.pop_back();
+}
+
+void Session::list_edits() {
+    if (edits_.empty()) out_ << "no edits\n";
+    for (const auto& [at, statements] : edits_) out_ << fmt::format("  before step {}: {}\n", at + 1, statements);
+}
+
+bool Session::is_edit(const std::string& line) const {
+    if (!program_) return false;
+    std::size_t dot = line.find('.'), paren = line.find('(');
+    if (dot == std::string::npos || paren == std::string::npos || paren < dot) return false;
+    std::string env = trim(line.substr(0, dot)), method = trim(line.substr(dot + 1, paren - dot - 1));
+    for (std::size_t k = 0; k < program_->environment_names.size() && k < program_->environments.size(); ++k) {
+        if (program_->environment_names[k] != env || !program_->environments[k]) continue;
+        for (const auto& m : program_->environments[k]->methods())
+            if (m.name == method) return m.hook_only;
+    }
+    return false;
+}
+
 void Session::export_files(const std::vector<std::string>& paths) {
     if (!need_derivation()) return;
     try {
@@ -476,11 +539,12 @@ bool Session::command(const std::string& name, const std::string& rest) {
                 out_ << "nothing to undo\n";
             else if (k < *n)
                 out_ << fmt::format("only {} step{} to undo\n", k, k == 1 ? "" : "s");
-            history_.resize(history_.size() - static_cast<std::size_t>(k));
+            back_to(static_cast<int>(history_.size()) - 1 - k);
             out_ << fmt::format("step {}: {}\n", current().steps_done(), modules(current().string().size()));
         }
     } else if (name == "reset") {
-        if (need_derivation() && rebuild(0)) out_ << fmt::format("step 0: {}\n", modules(current().string().size()));
+        if (need_derivation()) back_to(0);
+        if (!history_.empty() && rebuild(0)) out_ << fmt::format("step 0: {}\n", modules(current().string().size()));
     } else if (name == "show") {
         show(rest);
     } else if (name == "find") {
@@ -534,6 +598,10 @@ bool Session::command(const std::string& name, const std::string& rest) {
                 out_ << fmt::format("using {}\n", rest);
             }
         }
+    } else if (name == "do") {
+        edit(rest);
+    } else if (name == "edits") {
+        list_edits();
     } else if (name == "stats") {
         stats();
     } else if (name == "time") {
@@ -584,6 +652,10 @@ bool Session::execute(const std::string& raw) {
             out_ << fmt::format("rule added; step {}: {}\n", current().steps_done(), modules(current().string().size()));
         else
             extra_rules_.pop_back();
+        return true;
+    }
+    if (is_edit(line)) {
+        edit(line);
         return true;
     }
     if (line.back() == ';') line.pop_back(); // `2 * r1;` is an expression too

@@ -53,6 +53,13 @@ private:
     void evaluate(const std::string& expr);
     void export_files(const std::vector<std::string>& paths);
     bool need_derivation();
+    // :do STATEMENTS: adds them as an edit at the current step and replays.
+    void edit(std::string statements);
+    void list_edits();
+    // A line calling a hook-only environment method (ivy.cut(12)): an edit, not an expression.
+    bool is_edit(const std::string& line) const;
+    // Going back to step k: uses and edits made after it are forgotten.
+    void back_to(int k);
     Derivation& current() { return *history_.back(); }
     DeriveOptions options() const;
 
@@ -68,6 +75,9 @@ private:
     std::map<std::string, std::string> params_; // :set NAME VALUE
     std::optional<std::uint64_t> seed_;
     std::vector<std::pair<int, std::string>> uses_; // :use GROUP at step N, replayed by rebuilds
+    // Edits (:do, or a hook-only call such as ivy.cut(12) typed at the prompt): statements run
+    // by an `on before_step` hook at step N, that is before the step that follows N.
+    std::vector<std::pair<int, std::string>> edits_;
     std::set<std::string> shown_; // warnings already shown
     bool failed_ = false;
     bool last_error_runtime_ = false;

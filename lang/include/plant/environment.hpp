@@ -44,6 +44,10 @@ public:
     // Back to the state it was declared with: a derivation starting again (the REPL's :set, a
     // second run of one compiled program) must not see the last one's plant.
     virtual void reset() {}
+    // Whether its state depends on the steps it went through and not only on the string it was
+    // last shown (the climber's particles). Going back to an earlier step (the REPL's :back) then
+    // means deriving again up to that step, rather than only taking an earlier string.
+    virtual bool evolves() const { return false; }
     // Triangles (world space, consecutive corners, wound outward) that show the environment in
     // meshes and previews: the wall a climber clings to, say. `lo` and `hi` bound the plant, for
     // giving an unbounded shape (a plane) a size.

@@ -77,6 +77,7 @@ public:
         initial_fluid_ = fluid_;
     }
     void reset() override;
+    bool evolves() const override { return true; }
     void geometry(std::vector<glm::dvec3>& triangles, const glm::dvec3& lo, const glm::dvec3& hi) const override;
     // A loaded mesh's triangles for obstacle k (a sampled grid), to show it.
     void show_mesh(std::size_t k, std::vector<glm::dvec3> triangles) { meshes_.emplace_back(k, std::move(triangles)); }
