@@ -127,6 +127,7 @@ Handle World::add_root(const glm::dvec3& position_in, const glm::dquat& orientat
     const glm::dvec3 position = position_in, radii = radii_in;
     const glm::dquat orientation = orientation_in;
     Handle h{static_cast<std::uint32_t>(x_.size()), 0};
+    groups_stale_ = true;
     x_.push_back(position);
     v_.emplace_back(0.0);
     rest_x_.push_back(position);
@@ -170,6 +171,7 @@ Handle World::add_grown(Handle parent, const glm::dvec3& position_in, const glm:
 
 void World::detach(std::uint32_t i) {
     if (parent_[i] == kNone) return;
+    groups_stale_ = true;
     auto& siblings = children_[parent_[i]];
     siblings.erase(std::remove(siblings.begin(), siblings.end(), i), siblings.end());
     parent_[i] = kNone;
@@ -177,6 +179,7 @@ void World::detach(std::uint32_t i) {
 
 void World::remove(Handle h) {
     if (!alive(h)) return;
+    groups_stale_ = true;
     std::vector<std::uint32_t> todo{h.index};
     detach(h.index);
     while (!todo.empty()) {
@@ -301,7 +304,7 @@ void World::match_shapes(std::vector<Frame>& frames, std::vector<glm::dmat3>& mo
     const int threads = settings_.threads;
     // Eq. 15's moment R D R̄ᵀ: the rest part D R̄ᵀ (with the mass) is fixed within a step and
     // computed once in step(); here only the current rotation changes
-    const bool cached = scratch_.rest_moment.size() == n;
+    const bool cached = !groups_stale_ && scratch_.rest_moment.size() == n;
     parallel_ranges(n, threads, 2048, [&](std::size_t b, std::size_t e) {
         for (std::size_t j = b; j < e; ++j) {
             if (!alive_[j]) continue;
@@ -376,11 +379,14 @@ void World::step() {
     // last pass, also the previous step's.
     auto& frames = scratch_.frames;
     auto& moments = scratch_.moments;
-    auto& rest_moments = scratch_.rest_moment;
-    rest_moments.resize(n);
-    for (std::size_t j = 0; j < n; ++j)
-        if (alive_[j]) rest_moments[j] = rest_moment(static_cast<std::uint32_t>(j));
-    build_groups(scratch_.groups);
+    if (groups_stale_) { // kept from the last step when nothing grew, broke or was cut
+        auto& rest_moments = scratch_.rest_moment;
+        rest_moments.resize(n);
+        for (std::size_t j = 0; j < n; ++j)
+            if (alive_[j]) rest_moments[j] = rest_moment(static_cast<std::uint32_t>(j));
+        build_groups(scratch_.groups);
+        groups_stale_ = false;
+    }
     for (int it = 0; it < settings_.iterations; ++it) {
         match_shapes(frames, moments, settings_.rotation_iterations, scratch_.groups);
         // each particle's goal, and the move toward it: the goals read only the frames, so a
@@ -443,7 +449,6 @@ void World::step() {
         }
     }
     pulls_.clear();
-    rest_moments.clear(); // only valid within this step
     times_.collision = collision_ms;
     times_.dynamics = std::chrono::duration<double, std::milli>(clock::now() - t_start).count() - collision_ms;
 }

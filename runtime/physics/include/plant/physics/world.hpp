@@ -272,6 +272,9 @@ private:
         std::uint64_t key = 0;
         std::uint32_t begin = 0, end = 0;
     };
+    // Whether the particles, their links, rest states or masses changed since the groups and
+    // the rest moments were built: growth, cuts and breaks do, a step without them does not.
+    bool groups_stale_ = true;
     struct Scratch {
         std::vector<Frame> frames;
         std::vector<glm::dmat3> moments;
@@ -279,7 +282,7 @@ private:
         std::vector<Cell> table;                  // the collision pass's cells
         std::vector<std::uint32_t> slot_of, members; // particles grouped by table slot
         std::vector<double> thin;                                   // each particle's thinnest radius
-        std::vector<glm::dmat3> rest_moment;                        // 0.2 m D R̄ᵀ, during a step
+        std::vector<glm::dmat3> rest_moment;                        // 0.2 m D R̄ᵀ, while the groups are current
         std::vector<glm::dvec3> push;
         Groups groups;
     } scratch_;
