@@ -107,18 +107,32 @@ std::size_t World::components() const {
     return n;
 }
 
-glm::dquat extract_rotation(const glm::dmat3& A, glm::dquat q, int iterations) {
-    // Müller et al. 2016, Eq. 10-12: turn R toward the columns of A about omega
+namespace {
+
+// Müller et al. 2016, Eq. 10-12: turn R toward the columns of A about omega. Also gives R as a
+// matrix: the last one computed when the iterations stop on convergence.
+glm::dquat rotation_of(const glm::dmat3& A, glm::dquat q, int iterations, glm::dmat3& matrix) {
+    bool current = false; // whether `matrix` is q's
     for (int k = 0; k < iterations; ++k) {
-        glm::dmat3 R = glm::mat3_cast(q);
-        glm::dvec3 omega = glm::cross(R[0], A[0]) + glm::cross(R[1], A[1]) + glm::cross(R[2], A[2]);
-        double denom = std::fabs(glm::dot(R[0], A[0]) + glm::dot(R[1], A[1]) + glm::dot(R[2], A[2])) + 1e-9;
+        matrix = glm::mat3_cast(q);
+        current = true;
+        glm::dvec3 omega = glm::cross(matrix[0], A[0]) + glm::cross(matrix[1], A[1]) + glm::cross(matrix[2], A[2]);
+        double denom = std::fabs(glm::dot(matrix[0], A[0]) + glm::dot(matrix[1], A[1]) + glm::dot(matrix[2], A[2])) + 1e-9;
         omega /= denom;
         double w = glm::length(omega);
         if (!(w >= 1e-9)) break; // converged, or nothing to match (zero A), or NaN
         q = glm::normalize(glm::angleAxis(w, omega / w) * q);
+        current = false;
     }
+    if (!current) matrix = glm::mat3_cast(q);
     return q;
+}
+
+} // namespace
+
+glm::dquat extract_rotation(const glm::dmat3& A, glm::dquat q, int iterations) {
+    glm::dmat3 matrix;
+    return rotation_of(A, q, iterations, matrix);
 }
 
 Handle World::add_root(const glm::dvec3& position_in, const glm::dquat& orientation_in, const glm::dvec3& radii_in,
@@ -225,38 +239,56 @@ glm::dmat3 World::rest_moment(std::uint32_t j) const {
 
 glm::dmat3 World::ellipsoid_moment(std::uint32_t j) const { return glm::mat3_cast(q_[j]) * rest_moment(j); }
 
-World::Frame World::group_frame(std::uint32_t i, const glm::dquat& warm, const std::vector<glm::dmat3>& moments,
-                                int iterations, const Groups& g) const {
-    // Eq. 14 with Eq. 15's ellipsoid moments, positions relative to the centers to keep the sums
-    // well conditioned
-    const std::uint32_t from = g.start[i], to = g.start[i + 1];
+void World::group_moments(const Groups& g, std::vector<glm::dmat3>& each, std::vector<glm::dmat3>& sums) const {
+    const std::size_t n = x_.size();
+    each.resize(n);
+    sums.resize(n);
+    // Eq. 15's moment R D R̄ᵀ: the rest part D R̄ᵀ (with the mass) changes only with growth and
+    // is kept with the groups (step()); here only the current rotation enters
+    const bool cached = !groups_stale_ && scratch_.rest_moment.size() == n;
+    parallel_ranges(n, settings_.threads, 2048, [&](std::size_t b, std::size_t e) {
+        for (std::size_t j = b; j < e; ++j)
+            if (alive_[j])
+                each[j] = cached ? glm::mat3_cast(q_[j]) * scratch_.rest_moment[j] : ellipsoid_moment(static_cast<std::uint32_t>(j));
+    });
+    parallel_ranges(n, settings_.threads, 2048, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) {
+            glm::dmat3 M(0.0);
+            for (std::uint32_t k = g.start[i]; k < g.start[i + 1]; ++k) M += each[g.member[k].particle];
+            sums[i] = M;
+        }
+    });
+}
+
+void World::group_frame(std::uint32_t i, glm::dquat warm, const glm::dmat3& moment, int iterations, const Groups& g,
+                        Frame& out) const {
+    // Eq. 14 with Eq. 15's ellipsoid moments (summed over the group already), positions
+    // relative to the centers to keep the sums well conditioned
+    const Groups::Member* from = g.member.data() + g.start[i];
+    const Groups::Member* to = g.member.data() + g.start[i + 1];
     glm::dvec3 c(0.0);
-    for (std::uint32_t k = from; k < to; ++k) c += g.mass[k] * x_[g.member[k]];
-    c /= g.total[i];
-    glm::dmat3 A(0.0);
-    for (std::uint32_t k = from; k < to; ++k) {
-        const std::uint32_t j = g.member[k];
-        A += moments[j];
-        A += g.mass[k] * outer(x_[j] - c, g.rest_off[k]);
-    }
-    return {c, g.rest_center[i], extract_rotation(A, warm, iterations), true};
+    for (const auto* k = from; k < to; ++k) c += k->share * x_[k->particle];
+    glm::dmat3 A = moment;
+    for (const auto* k = from; k < to; ++k) A += outer(x_[k->particle] - c, k->mr);
+    out.c = c;
+    out.R = rotation_of(A, warm, iterations, out.M);
+    out.valid = true;
 }
 
 glm::dquat World::group_rotation(std::uint32_t i) const {
     Groups g;
     build_groups(g);
-    std::vector<glm::dmat3> moments(x_.size());
-    for_group(i, [&](std::uint32_t j) { moments[j] = ellipsoid_moment(j); });
-    return group_frame(i, rotation_from_rest(i), moments, 20, g).R;
+    glm::dmat3 moment(0.0);
+    for_group(i, [&](std::uint32_t j) { moment += ellipsoid_moment(j); });
+    Frame f;
+    group_frame(i, rotation_from_rest(i), moment, 20, g, f);
+    return f.R;
 }
 
 void World::build_groups(Groups& g) const {
     const std::size_t n = x_.size();
     g.start.assign(n + 1, 0);
     g.member.clear();
-    g.mass.clear();
-    g.rest_off.clear();
-    g.total.assign(n, 0.0);
     g.rest_center.assign(n, glm::dvec3(0.0));
     for (std::uint32_t i = 0; i < n; ++i) {
         g.start[i] = static_cast<std::uint32_t>(g.member.size());
@@ -267,59 +299,51 @@ void World::build_groups(Groups& g) const {
             const double m = matching_mass(j);
             M += m;
             rc += m * rest_x_[j];
-            g.member.push_back(j);
-            g.mass.push_back(m);
+            g.member.push_back({j, m, glm::dvec3(0.0)});
         });
         rc /= M;
-        g.total[i] = M;
         g.rest_center[i] = rc;
-        for (std::size_t k = g.start[i]; k < g.member.size(); ++k) g.rest_off.push_back(rest_x_[g.member[k]] - rc);
+        for (std::size_t k = g.start[i]; k < g.member.size(); ++k) {
+            auto& e = g.member[k];
+            e.mr = e.share * (rest_x_[e.particle] - rc);
+            e.share /= M;
+        }
     }
     g.start[n] = static_cast<std::uint32_t>(g.member.size());
     // goal sources: its own group, its parent's (twice the weight), its children's (half)
     g.source_start.assign(n + 1, 0);
     g.source.clear();
-    g.weight.clear();
-    g.offset.clear();
     for (std::uint32_t j = 0; j < n; ++j) {
-        g.source_start[j] = static_cast<std::uint32_t>(g.source.size());
+        const auto first = static_cast<std::uint32_t>(g.source.size());
+        g.source_start[j] = first;
+        double W = 0;
         auto add = [&](std::uint32_t i, double w) {
             if (!alive_[i]) return;
-            g.source.push_back(i);
-            g.weight.push_back(w);
-            g.offset.push_back(rest_x_[j] - g.rest_center[i]);
+            g.source.push_back({i, w, rest_x_[j] - g.rest_center[i]});
+            W += w;
         };
-        add(j, m_[j]);
-        if (parent_[j] != kNone) add(parent_[j], 2.0 * m_[j]);
-        for (std::uint32_t c : children_[j]) add(c, 0.5 * m_[j]);
+        // Eq. 4's weights are all j's mass times these factors; divided by their sum the mass
+        // drops out (and a massless particle still has a goal)
+        add(j, 1.0);
+        if (parent_[j] != kNone) add(parent_[j], 2.0);
+        for (std::uint32_t c : children_[j]) add(c, 0.5);
+        for (std::size_t k = first; k < g.source.size(); ++k) g.source[k].weight /= W;
     }
     g.source_start[n] = static_cast<std::uint32_t>(g.source.size());
 }
 
-void World::match_shapes(std::vector<Frame>& frames, std::vector<glm::dmat3>& moments, int iterations,
+void World::match_shapes(std::vector<Frame>& frames, const std::vector<glm::dmat3>& moments, int iterations,
                          const Groups& g) const {
     const std::size_t n = x_.size();
     frames.resize(n);
-    moments.resize(n);
-    const int threads = settings_.threads;
-    // Eq. 15's moment R D R̄ᵀ: the rest part D R̄ᵀ (with the mass) is fixed within a step and
-    // computed once in step(); here only the current rotation changes
-    const bool cached = !groups_stale_ && scratch_.rest_moment.size() == n;
-    parallel_ranges(n, threads, 2048, [&](std::size_t b, std::size_t e) {
-        for (std::size_t j = b; j < e; ++j) {
-            if (!alive_[j]) continue;
-            moments[j] = cached ? glm::mat3_cast(q_[j]) * scratch_.rest_moment[j]
-                                : ellipsoid_moment(static_cast<std::uint32_t>(j));
-        }
-    });
-    parallel_ranges(n, threads, 2048, [&](std::size_t b, std::size_t e) {
+    parallel_ranges(n, settings_.threads, 2048, [&](std::size_t b, std::size_t e) {
         for (std::size_t k = b; k < e; ++k) {
             const auto i = static_cast<std::uint32_t>(k);
             if (!alive_[i]) continue;
             // warm start from the last pass's rotation when there is one, else from the
             // particle's own rotation from rest
             const glm::dquat warm = frames[i].valid ? frames[i].R : rotation_from_rest(i);
-            frames[i] = group_frame(i, warm, moments, iterations, g);
+            group_frame(i, warm, moments[i], iterations, g, frames[i]);
         }
     });
 }
@@ -328,21 +352,23 @@ glm::dvec3 World::goal_of(std::uint32_t j, const std::vector<Frame>& frames, con
     // Eq. 3: the target of particle j in group i is R_i (x̄_j - c̄_i) + c_i; Eq. 4: j's goal is
     // their mass-weighted mean over the groups j belongs to (its own, its parent's, its
     // children's), its parent's group counting twice as much as its own and its children's half.
+    // The weights are divided by their sum already (build_groups); a particle always has its
+    // own group.
     glm::dvec3 sum(0.0);
-    double wsum = 0;
-    for (std::uint32_t k = g.source_start[j]; k < g.source_start[j + 1]; ++k) {
-        const Frame& f = frames[g.source[k]];
-        sum += g.weight[k] * (f.R * g.offset[k] + f.c);
-        wsum += g.weight[k];
+    const Groups::Source* end = g.source.data() + g.source_start[j + 1];
+    for (const auto* k = g.source.data() + g.source_start[j]; k < end; ++k) {
+        const Frame& f = frames[k->group];
+        sum += k->weight * (f.M * k->offset + f.c);
     }
-    return wsum > 0 ? sum / wsum : x_[j];
+    return sum;
 }
 
 std::vector<glm::dvec3> World::goals() const {
     std::vector<Frame> frames;
-    std::vector<glm::dmat3> moments;
+    std::vector<glm::dmat3> each, moments;
     Groups groups;
     build_groups(groups);
+    group_moments(groups, each, moments);
     match_shapes(frames, moments, 20, groups);
     std::vector<glm::dvec3> goal(x_.size());
     for (std::uint32_t j = 0; j < x_.size(); ++j) goal[j] = goal_of(j, frames, groups);
@@ -373,12 +399,13 @@ void World::step() {
         x_[a.particle] += a.phi * (a.point - x_[a.particle]);
         ++k;
     }
-    // shape matching on the predictions; small overlapping groups pass a correction on by one
-    // particle per iteration, so a chain needs several to hold its shape. The scratch is kept
+    // Shape matching on the predictions. Small overlapping groups pass a correction on by one
+    // particle per pass, so a chain needs several passes to hold its shape; the positions move
+    // in every pass, the orientations once, after the last. The ellipsoid moments (Eq. 15) read
+    // only the orientations, so they are summed per group once a step. The scratch is kept
     // across steps: no allocation in a step, and each group's rotation is warm-started from the
     // last pass, also the previous step's.
     auto& frames = scratch_.frames;
-    auto& moments = scratch_.moments;
     if (groups_stale_) { // kept from the last step when nothing grew, broke or was cut
         auto& rest_moments = scratch_.rest_moment;
         rest_moments.resize(n);
@@ -387,8 +414,13 @@ void World::step() {
         build_groups(scratch_.groups);
         groups_stale_ = false;
     }
-    for (int it = 0; it < settings_.iterations; ++it) {
-        match_shapes(frames, moments, settings_.rotation_iterations, scratch_.groups);
+    auto& stiff = scratch_.stiffness; // ages change only after the passes
+    stiff.resize(n);
+    for (std::uint32_t i = 0; i < n; ++i) stiff[i] = stiffness(i);
+    group_moments(scratch_.groups, scratch_.moments, scratch_.group_moment);
+    const int passes = settings_.iterations;
+    for (int it = 0; it < passes; ++it) {
+        match_shapes(frames, scratch_.group_moment, settings_.rotation_iterations, scratch_.groups);
         // each particle's goal, and the move toward it: the goals read only the frames, so a
         // particle can move as soon as its own goal is known
         parallel_ranges(n, settings_.threads, 2048, [&](std::size_t b, std::size_t e) {
@@ -399,15 +431,18 @@ void World::step() {
                     continue;
                 }
                 // x'_g = x_p + s (x_g - x_p) (section 4.3)
-                const double st = stiffness(static_cast<std::uint32_t>(i));
+                const double st = stiff[i];
                 const glm::dvec3 goal = goal_of(static_cast<std::uint32_t>(i), frames, scratch_.groups);
                 x_[i] = x_[i] + st * (goal - x_[i]);
-                // normalized linear blend toward the goal orientation, on the short arc: the
+                if (it + 1 < passes) continue;
+                // after the last pass, the orientation goes as far toward its goal as `passes`
+                // blends by s would take it: a normalized linear blend on the short arc. The
                 // steps are small, where it and slerp agree to second order, and it needs no
-                // trigonometry
+                // trigonometry.
+                const double so = 1.0 - std::pow(1.0 - st, passes);
                 glm::dquat target = glm::normalize(frames[i].R * rest_q_[i]);
                 if (glm::dot(q_[i], target) < 0) target = -target;
-                q_[i] = glm::normalize(q_[i] * (1.0 - st) + target * st);
+                q_[i] = glm::normalize(q_[i] * (1.0 - so) + target * so);
             }
         });
         for (const auto& [i, target] : pulls_) x_[i] = target; // a dragged particle goes where it is dragged
@@ -578,10 +613,17 @@ void World::separate_particles() {
             const glm::i64vec3 c = glm::i64vec3(glm::floor(u));
             const glm::dvec3 frac = u - glm::floor(u);
             const glm::i64vec3 side(frac.x < 0.5 ? -1 : 1, frac.y < 0.5 ? -1 : 1, frac.z < 0.5 ? -1 : 1);
+            // the hash's three terms for the two cells along each axis
+            const std::uint64_t hx[2] = {static_cast<std::uint64_t>(c.x * 73856093),
+                                         static_cast<std::uint64_t>((c.x + side.x) * 73856093)};
+            const std::uint64_t hy[2] = {static_cast<std::uint64_t>(c.y * 19349663),
+                                         static_cast<std::uint64_t>((c.y + side.y) * 19349663)};
+            const std::uint64_t hz[2] = {static_cast<std::uint64_t>(c.z * 83492791),
+                                         static_cast<std::uint64_t>((c.z + side.z) * 83492791)};
             for (int dz = 0; dz <= 1; ++dz)
                 for (int dy = 0; dy <= 1; ++dy)
                     for (int dx = 0; dx <= 1; ++dx) {
-                        const std::uint64_t k = hash(c + glm::i64vec3(dx, dy, dz) * side);
+                        const std::uint64_t k = hx[dx] ^ hy[dy] ^ hz[dz];
                         std::size_t slot = k & (size - 1);
                         while (table[slot].end != table[slot].begin && table[slot].key != k) slot = (slot + 1) & (size - 1);
                         const Cell& run = table[slot];

@@ -205,10 +205,11 @@ private:
     static constexpr std::uint32_t kNone = ~0u; // no parent
     // The particle's own rotation from rest: a warm start for its group's rotation.
     glm::dquat rotation_from_rest(std::uint32_t i) const { return glm::normalize(q_[i] * glm::inverse(rest_q_[i])); }
-    // A group's mass centers now and at rest, and its rotation (Eq. 14-15).
+    // A group's mass center now and its rotation (Eq. 14-15), also as a matrix for the goals.
     struct Frame {
-        glm::dvec3 c{0.0}, rc{0.0};
+        glm::dvec3 c{0.0};
         glm::dquat R{1, 0, 0, 0};
+        glm::dmat3 M{1.0};
         bool valid = false;
     };
     // A particle's mass inside group sums: a fixed root's is effectively infinite.
@@ -220,27 +221,37 @@ private:
     // What shape matching reads of the groups that does not change within a step, flattened:
     // each group's members (parent, itself, children) with their masses and rest offsets from
     // the group's rest center, and each particle's goal sources (the groups it belongs to, with
-    // Eq. 4's weights and its rest offset in each). Built once a step instead of walked through
-    // the child lists and recomputed in every pass; the sums keep their order, so the numbers
-    // are the same.
+    // Eq. 4's weights and its rest offset in each). Built when growth, a cut or a break changes
+    // them instead of walked through the child lists in every pass; the fixed factors (masses
+    // over the group's, Eq. 4's weights over their sum) are applied here once.
     struct Groups {
-        std::vector<std::uint32_t> start, member; // group i: member[start[i] .. start[i + 1])
-        std::vector<double> mass;                 // per member entry: matching_mass
-        std::vector<glm::dvec3> rest_off;         // per member entry: rest position - rest center
-        std::vector<double> total;                // per group: M
-        std::vector<glm::dvec3> rest_center;      // per group: c̄
-        std::vector<std::uint32_t> source_start, source; // particle j: groups source[source_start[j] ..]
-        std::vector<double> weight;               // per source entry
-        std::vector<glm::dvec3> offset;           // per source entry: x̄_j - c̄_i
+        struct Member {
+            std::uint32_t particle;
+            double share;   // m_j / M_i, for the mass center
+            glm::dvec3 mr;  // m_j (x̄_j - c̄_i), for Eq. 14's sum
+        };
+        struct Source {
+            std::uint32_t group;
+            double weight;     // Eq. 4's weight over the sum of j's weights
+            glm::dvec3 offset; // x̄_j - c̄_i
+        };
+        std::vector<std::uint32_t> start;  // group i: member[start[i] .. start[i + 1])
+        std::vector<Member> member;
+        std::vector<std::uint32_t> source_start; // particle j: source[source_start[j] .. source_start[j + 1])
+        std::vector<Source> source;
+        std::vector<glm::dvec3> rest_center; // per group: c̄, while building
     };
     void build_groups(Groups& g) const;
-    // Group i's frame from every particle's ellipsoid moment (`moments`, indexed by particle),
-    // with at most `iterations` rotation-extraction iterations warm-started from `warm`.
-    Frame group_frame(std::uint32_t i, const glm::dquat& warm, const std::vector<glm::dmat3>& moments,
-                      int iterations, const Groups& groups) const;
+    // Eq. 15's ellipsoid moments of every particle (`each`) and their sums over each group.
+    void group_moments(const Groups& groups, std::vector<glm::dmat3>& each, std::vector<glm::dmat3>& sums) const;
+    // Group i's frame, given the sum of its members' ellipsoid moments, with at most
+    // `iterations` rotation-extraction iterations warm-started from `warm`.
+    void group_frame(std::uint32_t i, glm::dquat warm, const glm::dmat3& moment, int iterations, const Groups& groups,
+                     Frame& out) const;
     // One shape-matching pass: every group's frame (Eq. 14-15, warm-started from `frames`),
-    // with at most `iterations` rotation-extraction iterations per group; `moments` is scratch.
-    void match_shapes(std::vector<Frame>& frames, std::vector<glm::dmat3>& moments, int iterations,
+    // with at most `iterations` rotation-extraction iterations per group; `moments` holds each
+    // group's moment sum (group_moments).
+    void match_shapes(std::vector<Frame>& frames, const std::vector<glm::dmat3>& moments, int iterations,
                       const Groups& groups) const;
     // Particle j's goal from the groups' frames (Eq. 3-4).
     glm::dvec3 goal_of(std::uint32_t j, const std::vector<Frame>& frames, const Groups& groups) const;
@@ -277,13 +288,14 @@ private:
     bool groups_stale_ = true;
     struct Scratch {
         std::vector<Frame> frames;
-        std::vector<glm::dmat3> moments;
+        std::vector<glm::dmat3> moments, group_moment; // per particle, and summed per group
         std::vector<glm::dvec3> old;
         std::vector<Cell> table;                  // the collision pass's cells
         std::vector<std::uint32_t> slot_of, members; // particles grouped by table slot
         std::vector<double> thin;                                   // each particle's thinnest radius
         std::vector<glm::dmat3> rest_moment;                        // 0.2 m D R̄ᵀ, while the groups are current
         std::vector<glm::dvec3> push;
+        std::vector<double> stiffness; // each particle's s, during a step
         Groups groups;
     } scratch_;
 };
