@@ -37,6 +37,7 @@ const std::vector<EnvMethod>& Climber::methods() const {
             {"wind", {V}, N, "set the wind (vec3(0, 0, 0): off)", false},
             {"move", {N, V}, N, "move obstacle k (in the order declared: spheres, boxes, planes, meshes) by a vector", false},
             {"seed", {N}, N, "seed a new branch at module id: ivy.seeded(id) holds in the next step", false},
+            {"emit", {N, V}, N, "set emitter k's air velocity (in the order declared; vec3(0, 0, 0): off)", false},
         };
         for (std::size_t k = 5; k < v.size(); ++k) v[k].hook_only = true;
         return v;
@@ -86,6 +87,9 @@ void Climber::call(std::size_t method, const double* a, double* r) const {
         if (std::isfinite(a[0]) && a[0] >= 0 && a[0] < 1e9) moves_.emplace_back(static_cast<std::size_t>(a[0]), vec(a + 1));
         return;
     case 9: seed_requests_.push_back(id_of(a[0])); return;
+    case 10:
+        if (std::isfinite(a[0]) && a[0] >= 0 && a[0] < 1e9) emits_.emplace_back(static_cast<std::size_t>(a[0]), vec(a + 1));
+        return;
     default: r[0] = 0;
     }
 }
@@ -131,6 +135,7 @@ void Climber::reset() {
     moves_.clear();
     seed_requests_.clear();
     seeded_.clear();
+    emits_.clear();
     wind_changed_ = false;
     grid_.clear();
     grid_n_ = glm::ivec3(0);
@@ -207,6 +212,10 @@ void Climber::advance() {
     seed_requests_.clear();
     for (const auto& [k, delta] : moves_) world_.move_obstacle(k, delta);
     moves_.clear();
+    auto& emitters = fluid_.settings().emitters;
+    for (const auto& [k, velocity] : emits_)
+        if (k < emitters.size()) emitters[k].velocity = velocity;
+    emits_.clear();
     if (wind_changed_) {
         if (config_.air) fluid_.settings().wind = wind_;
         else world_.set_wind(wind_);
@@ -347,8 +356,8 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
     physics::Settings s;
     s.fixed_stiffness = 1.0; // the paper used s = 1 for most results
     Climber::Config c;
-    std::vector<glm::dvec3> sphere, box_min, box_max, plane_p, plane_n, attract;
-    std::vector<double> sphere_r, attract_r, attract_s;
+    std::vector<glm::dvec3> sphere, box_min, box_max, plane_p, plane_n, attract, emit_at, emit_v;
+    std::vector<double> sphere_r, attract_r, attract_s, emit_r;
     double friction = 0.5, elasticity = 0.0, break_threshold = 0;
     glm::dvec3 wind(0.0);
     std::vector<std::string> meshes;
@@ -358,9 +367,9 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
                                     "anchor", "anchor_range", "anchor_release", "friction", "elasticity",
                                     "sphere_radius", "attractor_radius", "attractor_strength", "threads",
                                     "light_cell", "opacity", "air_spacing", "air_density", "air_viscosity",
-                                    "air_stiffness", "air_coupling", "mesh_cell", "attractor_reach"};
+                                    "air_stiffness", "air_coupling", "mesh_cell", "attractor_reach", "emitter_radius"};
     static const char* vectors[] = {"gravity", "light", "wind", "sphere", "box_min", "box_max", "plane_point",
-                                    "plane_normal", "attractor", "air_min", "air_max"};
+                                    "plane_normal", "attractor", "air_min", "air_max", "emitter", "emitter_velocity"};
     bool air_min = false, air_max = false;
     for (const auto& a : args) {
         if (a.key == "mesh") {
@@ -415,6 +424,9 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
         else if (a.key == "plane_point") plane_p.push_back(v);
         else if (a.key == "plane_normal") plane_n.push_back(v);
         else if (a.key == "attractor") attract.push_back(v);
+        else if (a.key == "emitter") emit_at.push_back(v);
+        else if (a.key == "emitter_velocity") emit_v.push_back(v);
+        else if (a.key == "emitter_radius") emit_r.push_back(std::max(x, 1e-3));
         else if (a.key == "air_min") c.fluid.domain_lo = v, air_min = true;
         else if (a.key == "air_max") c.fluid.domain_hi = v, air_max = true;
         else if (a.key == "air_spacing") c.fluid.spacing = std::max(x, 1e-3), c.fluid.support = 2 * c.fluid.spacing;
@@ -437,6 +449,16 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
         error = "climber: give both air_min and air_max for SPH air, or neither";
         return nullptr;
     }
+    if (emit_v.size() != emit_at.size() || emit_r.size() > emit_at.size()) {
+        error = "climber: give each emitter an emitter_velocity (and at most one emitter_radius)";
+        return nullptr;
+    }
+    if (!emit_at.empty() && !air_min) {
+        error = "climber: an emitter blows SPH air: give air_min and air_max too";
+        return nullptr;
+    }
+    for (std::size_t i = 0; i < emit_at.size(); ++i)
+        c.fluid.emitters.push_back({emit_at[i], i < emit_r.size() ? emit_r[i] : 0.2, emit_v[i]});
     if (air_min) {
         c.air = true;
         const glm::dvec3 lo = glm::min(c.fluid.domain_lo, c.fluid.domain_hi), hi = glm::max(c.fluid.domain_lo, c.fluid.domain_hi);

@@ -16,12 +16,14 @@
 //
 // Methods: grow_dir(p, h) (h turned by surface adaption, Eq. 6, by painted attractors and by
 // phototropism weighted by occlusion, Eq. 7), occlusion(p), anchored(id), particles(), seeded(id);
-// in hooks only: pull(id, target), cut(id), wind(a), move(k, delta), seed(id).
+// in hooks only: pull(id, target), cut(id), wind(a), move(k, delta), seed(id), emit(k, velocity).
 //
 // With air_min and air_max the climber also runs SPH air in that box (section 5.3): each 25 ms
 // physics step runs ten 2.5 ms air steps coupled both ways with the full-grown particles, and
 // `wind` (argument and hook method) is the air's inflow velocity in m/s instead of a steady
-// acceleration.
+// acceleration. `emitter: vec3(...)` with `emitter_velocity: vec3(...)` (and optionally
+// `emitter_radius: r`, default 0.2) places a wind stream in the air (physics::Emitter); repeat
+// the three for more emitters, and switch one with `ivy.emit(k, velocity)` from a hook.
 #pragma once
 
 #include "plant/environment.hpp"
@@ -128,6 +130,7 @@ private:
     mutable std::vector<ModuleId> cuts_;
     mutable std::vector<std::pair<std::size_t, glm::dvec3>> moves_;
     mutable std::vector<ModuleId> seed_requests_;
+    mutable std::vector<std::pair<std::size_t, glm::dvec3>> emits_; // emitter, its new velocity
     std::set<ModuleId> seeded_;
     mutable glm::dvec3 wind_{0.0};
     mutable bool wind_changed_ = false;

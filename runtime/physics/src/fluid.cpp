@@ -335,6 +335,13 @@ void Fluid::step(World* plant) {
         // the fan: a wind draws the air toward its velocity (and the air keeps moving once it
         // is switched off, until viscosity and the walls stop it)
         if (windy) a_[i] += (s_.wind - v_[i]) * s_.drive;
+        for (const Emitter& e : s_.emitters) {
+            const glm::dvec3 d = x_[i] - e.point;
+            const double r2 = glm::dot(d, d);
+            if (!(e.radius > 0) || r2 >= e.radius * e.radius) continue;
+            // weight 1 at the centre, 0 at the edge
+            a_[i] += (e.velocity - v_[i]) * (s_.emitter_drive * (1.0 - std::sqrt(r2) / e.radius));
+        }
         v_[i] += a_[i] * dt;
         x_[i] += v_[i] * dt;
         for (int k = 0; k < 3; ++k) {

@@ -285,3 +285,28 @@ rules {{
     CHECK(highest(shoot(0)) < 0.8);   // never used up: the shoot circles the sample
     CHECK(highest(shoot(0.1)) > 1.2); // used up once reached: the shoot grows on
 }
+
+TEST_CASE("climber: an emitter's wind stream bends a stem in it, and a hook switches it", "[climber]") {
+    // a stem in a box of still air, an emitter 0.3 m upwind of it blowing along +x; `emit`
+    // switches the emitter off before the first step, or on from off
+    auto stem = [](const std::string& velocity, const std::string& hook) {
+        return grow(fmt::format(R"(
+env ivy = climber(stiffness: 0.3, gravity: vec3(0, 0, 0), substeps: 4,
+                  air_min: vec3(-0.5, 0, -0.3), air_max: vec3(0.5, 0.6, 0.3), air_spacing: 0.05,
+                  emitter: vec3(-0.3, 0.3, 0), emitter_velocity: {}, emitter_radius: 0.15);
+module Seg(len, r) bound ivy;
+derive 6;
+axiom: Seg(0.1, 0.02) Seg(0.1, 0.02) Seg(0.1, 0.02) Seg(0.1, 0.02) Seg(0.1, 0.02) ?P(0, 0, 0);
+{}
+)",
+                                velocity, hook));
+    };
+    auto tip_x = [](const Grown& g) { return g.skeleton.axes.at(0).points.back().position.x; };
+    const double blown = tip_x(stem("vec3(3, 0, 0)", "")), calm = tip_x(stem("vec3(0, 0, 0)", ""));
+    const double off = tip_x(stem("vec3(3, 0, 0)", "on start { ivy.emit(0, vec3(0, 0, 0)); }"));
+    const double on = tip_x(stem("vec3(0, 0, 0)", "on start { ivy.emit(0, vec3(3, 0, 0)); }"));
+    INFO("blown " << blown << " calm " << calm << " switched off " << off << " switched on " << on);
+    CHECK(blown > calm + 0.005); // downstream
+    CHECK(off == calm);          // switched off before any air step: as if it had never blown
+    CHECK(on == blown);          // and switched on: as if declared blowing
+}

@@ -18,6 +18,16 @@
 
 namespace plant::physics {
 
+// A wind stream placed in the scene (section 5.3: "an emitter can be used to create a wind stream
+// that affects the plant"): air within `radius` of `point` is driven toward `velocity`, fully at
+// the centre and less toward the edge. The stream it starts carries on through the air, which is
+// what reaches the plant.
+struct Emitter {
+    glm::dvec3 point{0.0};
+    double radius = 0.2;
+    glm::dvec3 velocity{0.0};
+};
+
 struct FluidSettings {
     double spacing = 0.05;        // initial distance between particles (m)
     double support = 0.1;         // h: kernel support radius (2 spacings)
@@ -28,6 +38,8 @@ struct FluidSettings {
     glm::dvec3 domain_lo{-1, 0, -1}, domain_hi{1, 2, 1};
     glm::dvec3 wind{0.0};         // the wind's velocity: particles leaving the domain re-enter upwind
     double drive = 5.0;           // 1/s: how fast a wind brings the air to its velocity
+    std::vector<Emitter> emitters;
+    double emitter_drive = 40.0;  // 1/s: how fast an emitter brings the air at its centre to its velocity
     double coupling = 1.0;        // scales the forces between air and plant
     int threads = 1;
 };
@@ -44,7 +56,8 @@ public:
         for (auto& p : x_) p.y = s_.domain_lo.y + (p.y - s_.domain_lo.y) * factor;
     }
     // One step of dt: densities, pressures, pressure and viscosity forces (Eq. 11-12), coupling
-    // with `plant` (may be null), symplectic Euler, domain walls and the wind's re-entry.
+    // with `plant` (may be null), the wind and the emitters, symplectic Euler, domain walls and
+    // the wind's re-entry.
     void step(World* plant = nullptr);
 
     std::size_t size() const { return x_.size(); }
