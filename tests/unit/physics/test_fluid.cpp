@@ -18,6 +18,18 @@ FluidSettings box_settings() {
     return s;
 }
 
+// An upright stem of n particles 10 cm apart on a fixed root at `base`, soft and weightless, so
+// that only the air bends it. Returns its tip.
+Handle upright_stem(World& w, const glm::dvec3& base, int n) {
+    w.settings().fixed_stiffness = 0.3;
+    w.settings().gravity = glm::dvec3(0.0);
+    const glm::dquat up(1, 0, 0, 0);
+    const glm::dvec3 radii(0.02, 0.05, 0.02);
+    Handle h = w.add_root(base, up, radii);
+    for (int k = 1; k <= n; ++k) h = w.add_particle(h, base + glm::dvec3(0, 0.1 * k, 0), up, radii);
+    return h;
+}
+
 } // namespace
 
 TEST_CASE("fluid: Müller kernels integrate to one over their support", "[fluid]") {
@@ -77,11 +89,7 @@ TEST_CASE("fluid: interior density stays within 1 percent of rest in a closed bo
 TEST_CASE("fluid: wind pushes a branch downwind and the branch slows the air", "[fluid]") {
     auto run = [](double coupling, double& tip_x, double& mean_vx) {
         World w;
-        w.settings().fixed_stiffness = 0.3;
-        w.settings().gravity = glm::dvec3(0.0);
-        glm::dquat up(1, 0, 0, 0);
-        Handle h = w.add_root(glm::dvec3(0.3, 0.0, 0.3), up, glm::dvec3(0.02, 0.05, 0.02));
-        for (int k = 1; k <= 6; ++k) h = w.add_particle(h, glm::dvec3(0.3, 0.1 * k, 0.3), up, glm::dvec3(0.02, 0.05, 0.02));
+        const Handle h = upright_stem(w, glm::dvec3(0.3, 0.0, 0.3), 6);
         FluidSettings s = box_settings();
         s.domain_hi = glm::dvec3(0.6, 0.8, 0.6);
         s.wind = glm::dvec3(2, 0, 0);
@@ -123,11 +131,7 @@ TEST_CASE("fluid: an emitter starts a wind stream that carries on downstream and
     // the stream 0.4 m downstream of it
     auto run = [](const glm::dvec3& velocity, double& tip_x, double& stream_vx, double& aside_vx) {
         World w;
-        w.settings().fixed_stiffness = 0.3;
-        w.settings().gravity = glm::dvec3(0.0);
-        glm::dquat up(1, 0, 0, 0);
-        Handle h = w.add_root(glm::dvec3(0.6, 0.0, 0.2), up, glm::dvec3(0.02, 0.05, 0.02));
-        for (int k = 1; k <= 4; ++k) h = w.add_particle(h, glm::dvec3(0.6, 0.1 * k, 0.2), up, glm::dvec3(0.02, 0.05, 0.02));
+        const Handle h = upright_stem(w, glm::dvec3(0.6, 0.0, 0.2), 4);
         FluidSettings s = box_settings();
         s.domain_hi = glm::dvec3(1.2, 0.6, 0.4);
         s.emitters.push_back({glm::dvec3(0.2, 0.25, 0.2), 0.15, velocity});
