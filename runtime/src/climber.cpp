@@ -137,8 +137,7 @@ void Climber::reset() {
     seeded_.clear();
     emits_.clear();
     wind_changed_ = false;
-    grid_.clear();
-    grid_n_ = glm::ivec3(0);
+    light_.clear();
 }
 
 void Climber::begin_sync() {
@@ -254,62 +253,15 @@ void Climber::advance() {
 }
 
 void Climber::rebuild_occupancy() {
-    grid_.clear();
-    grid_n_ = glm::ivec3(0);
-    if (particle_of_.empty()) return;
-    glm::dvec3 lo(1e300), hi(-1e300);
-    for (const auto& [id, h] : particle_of_) {
-        if (!finite(world_.position(h))) continue;
-        lo = glm::min(lo, world_.position(h));
-        hi = glm::max(hi, world_.position(h));
-    }
-    if (!(lo.x <= hi.x)) return; // no particle with a finite position
-    double cell = config_.light_cell;
-    glm::dvec3 n = glm::floor((hi - lo) / cell) + 1.0;
-    while (n.x * n.y * n.z > 4e6) {
-        cell *= 2;
-        n = glm::floor((hi - lo) / cell) + 1.0;
-    }
-    if (!finite(n)) return;
-    grid_cell_ = cell;
-    grid_lo_ = lo;
-    grid_n_ = glm::ivec3(n);
-    grid_.assign(static_cast<std::size_t>(grid_n_.x) * grid_n_.y * grid_n_.z, 0);
-    for (const auto& [id, h] : particle_of_) {
-        if (!finite(world_.position(h))) continue;
-        glm::ivec3 c = glm::ivec3(glm::floor((world_.position(h) - lo) / cell));
-        c = glm::clamp(c, glm::ivec3(0), grid_n_ - 1);
-        ++grid_[(static_cast<std::size_t>(c.z) * grid_n_.y + c.y) * grid_n_.x + c.x];
-    }
+    std::vector<glm::dvec3> points;
+    points.reserve(particle_of_.size());
+    for (const auto& [id, h] : particle_of_) points.push_back(world_.position(h));
+    light_.build(points, config_.light_cell);
 }
 
 double Climber::occlusion(const glm::dvec3& p) const {
-    // particles in the cells between p and the light (Eq. 7's O), its own cell excluded
-    if (grid_.empty() || !finite(p)) return 0;
-    const glm::dvec3 dir = glm::normalize(config_.light);
-    const double cell = grid_cell_;
-    glm::dvec3 q = p;
-    glm::ivec3 own = glm::ivec3(glm::floor((p - grid_lo_) / cell));
-    double count = 0;
-    glm::ivec3 last = own;
-    const glm::dvec3 extent = glm::dvec3(grid_n_) * cell;
-    for (int k = 0; k < 4 * (grid_n_.x + grid_n_.y + grid_n_.z); ++k) {
-        q += dir * (cell * 0.5);
-        glm::dvec3 rel = q - grid_lo_;
-        if (rel.x < 0 || rel.y < 0 || rel.z < 0 || rel.x >= extent.x || rel.y >= extent.y || rel.z >= extent.z) {
-            // outside the grid: nothing more in the way once moving away from it
-            bool leaving = (rel.x < 0 && dir.x <= 0) || (rel.y < 0 && dir.y <= 0) || (rel.z < 0 && dir.z <= 0) ||
-                           (rel.x >= extent.x && dir.x >= 0) || (rel.y >= extent.y && dir.y >= 0) ||
-                           (rel.z >= extent.z && dir.z >= 0);
-            if (leaving) break;
-            continue;
-        }
-        glm::ivec3 c = glm::clamp(glm::ivec3(glm::floor(rel / cell)), glm::ivec3(0), grid_n_ - 1);
-        if (c == own || c == last) continue;
-        last = c;
-        count += grid_[(static_cast<std::size_t>(c.z) * grid_n_.y + c.y) * grid_n_.x + c.x];
-    }
-    return 1.0 - std::exp(-config_.opacity * count);
+    // Eq. 7's O from the particles in the cells between p and the light
+    return light_.occlusion(p, glm::normalize(config_.light), config_.opacity);
 }
 
 glm::dvec3 Climber::grow_dir(const glm::dvec3& p, const glm::dvec3& h) const {

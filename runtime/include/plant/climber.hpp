@@ -28,6 +28,7 @@
 
 #include "plant/environment.hpp"
 #include "plant/physics/fluid.hpp"
+#include "plant/physics/light.hpp"
 #include "plant/physics/world.hpp"
 #include "plant/turtle.hpp"
 
@@ -134,11 +135,7 @@ private:
     std::set<ModuleId> seeded_;
     mutable glm::dvec3 wind_{0.0};
     mutable bool wind_changed_ = false;
-    // occupancy grid of particles for occlusion
-    glm::dvec3 grid_lo_{0.0};
-    double grid_cell_ = 0.1;
-    glm::ivec3 grid_n_{0};
-    std::vector<std::uint32_t> grid_;
+    physics::LightGrid light_; // the particles, for occlusion
 };
 
 // Makes a climber from `env name = climber(key: value, ...)`; null and a message on bad input.

@@ -2,6 +2,7 @@
 #include "plant/physics/world.hpp"
 
 #include "parallel.hpp"
+#include "plant/physics/light.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -512,6 +513,20 @@ glm::dquat heading_to(const glm::dvec3& forward) {
 void World::grow() {
     const Growth& g = settings_.growth;
     const std::size_t n = x_.size();
+    // the plant's shade as it stands before this growth (Eq. 7's O), counted when the first
+    // apex of this call turns: most calls only lengthen apices
+    LightGrid shade;
+    bool shade_counted = false;
+    auto occlusion = [&](const glm::dvec3& p) {
+        if (!shade_counted) {
+            std::vector<glm::dvec3> points;
+            for (std::size_t k = 0; k < n; ++k)
+                if (alive_[k]) points.push_back(x_[k]);
+            shade.build(points, g.light_cell);
+            shade_counted = true;
+        }
+        return shade.occlusion(p, glm::normalize(g.to_light), g.opacity);
+    };
     for (std::uint32_t i = 0; i < n && x_.size() < g.max_particles; ++i) {
         if (!alive_[i] || !children_[i].empty()) continue;
         length_[i] += g.speed * settings_.dt;
@@ -528,13 +543,15 @@ void World::grow() {
             }
             if (near) f = surface_adaption(f, -near->normal(x_[i]), g.adaption, settings_.dt * 40);
         }
-        // Eq. 7 (occlusion by other plants is not modelled yet: O = 0)
-        if (g.phototropism > 0) f = phototropism(f, g.to_light, 0.0, g.phototropism, settings_.dt * 40);
+        // Eq. 7, turning less in the plant's shade
+        if (g.phototropism > 0) {
+            f = phototropism(f, g.to_light, occlusion(x_[i]), g.phototropism, settings_.dt * 40);
+        }
         glm::dvec3 pos = x_[i] + f * g.segment_length;
         for (const auto& o : obstacles_) // never grow into an obstacle
             if (o.distance(pos) < radii_[i].x) pos -= o.normal(pos) * (o.distance(pos) - radii_[i].x);
         Handle parent{i, generation_[i]};
-        add_particle(parent, pos, heading_to(f), radii_[i]);
+        add_grown(parent, pos, heading_to(f), radii_[i]);
         // lateral branching with probability BP, at most B buds per particle
         for (int b = 0; b < g.max_lateral && x_.size() < g.max_particles; ++b) {
             if (random_unit(g.seed, i, 3 * static_cast<std::uint64_t>(b)) >= g.branch_probability) continue;
@@ -544,7 +561,7 @@ void World::grow() {
             glm::dvec3 side = glm::normalize(glm::cross(f, std::fabs(f.y) < 0.9 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0)));
             glm::dvec3 axis = glm::angleAxis(around, f) * side;
             glm::dvec3 lf = glm::angleAxis(angle, axis) * f;
-            add_particle(parent, x_[i] + lf * g.segment_length, heading_to(lf), radii_[i] * g.falloff);
+            add_grown(parent, x_[i] + lf * g.segment_length, heading_to(lf), radii_[i] * g.falloff);
             ++laterals_[i];
         }
     }

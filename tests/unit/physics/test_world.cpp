@@ -359,3 +359,72 @@ TEST_CASE("plant-plant collision: crossing branches of two plants end apart, and
     CHECK(closest(false) < -0.02);  // the branches run through each other
     CHECK(closest(true) > -0.004);  // they end (nearly) apart: within a tenth of the contact distance
 }
+
+TEST_CASE("growth: a new particle's rest state continues its parent's, also when the parent sags (Eq. 9-10)", "[physics]") {
+    Settings s;
+    s.collisions = false;
+    s.fixed_stiffness = 0.2; // soft: the stem sags well away from its rest shape while it grows
+    s.growth.speed = 1.0;
+    s.growth.segment_length = 0.1;
+    s.growth.max_particles = 40;
+    World w(s);
+    w.add_root({0, 0, 0}, glm::rotation(glm::dvec3(0, 1, 0), glm::dvec3(1, 0, 0)), {0.02, 0.05, 0.02});
+    for (int k = 0; k < 60; ++k) {
+        w.step();
+        w.grow();
+    }
+    REQUIRE(w.size() > 10);
+    double sag = 0, worst = 0;
+    for (std::uint32_t i = 1; i < w.size(); ++i) {
+        Handle h = w.handle(i), p = w.handle(w.parent(h));
+        sag = std::max(sag, glm::length(w.position(h) - w.rest_position(h)));
+        // the rest link is as long as the segment it grew, wherever the parent hung
+        worst = std::max(worst, std::fabs(glm::length(w.rest_position(h) - w.rest_position(p)) - 0.1));
+    }
+    INFO("largest sag " << sag << ", largest rest link error " << worst);
+    CHECK(sag > 0.05);
+    CHECK(worst < 1e-9);
+}
+
+TEST_CASE("growth: phototropism turns an apex toward the light less in the plant's own shade (Eq. 7)", "[physics]") {
+    // an apex growing along +x, the light above; in the second world a dense layer of the
+    // plant's particles hangs between the apex and the light
+    auto rise = [](bool shaded) {
+        Settings s;
+        s.gravity = glm::dvec3(0.0);
+        s.collisions = false;
+        s.growth.speed = 1.0;
+        s.growth.segment_length = 0.1;
+        s.growth.phototropism = 0.2;
+        s.growth.opacity = 0.5;
+        s.growth.to_light = glm::dvec3(0, 1, 0);
+        s.growth.max_particles = 2000;
+        World w(s);
+        const glm::dquat along_x = glm::rotation(glm::dvec3(0, 1, 0), glm::dvec3(1, 0, 0));
+        Handle apex = w.add_root({0, 0, 0}, along_x, {0.02, 0.05, 0.02});
+        if (shaded)
+            for (int a = -5; a <= 20; ++a)
+                for (int b = -5; b <= 5; ++b) w.add_root({0.05 * a, 0.3, 0.05 * b}, along_x, {0.02, 0.05, 0.02});
+        const std::uint32_t first = apex.index;
+        for (int k = 0; k < 20; ++k) {
+            w.step();
+            w.grow();
+        }
+        // the apex's own shoot: follow the first child chain from its root
+        Handle h = w.handle(first);
+        for (bool more = true; more;) {
+            more = false;
+            for (std::uint32_t j = 0; j < w.size(); ++j)
+                if (w.parent(w.handle(j)) == h.index) {
+                    h = w.handle(j);
+                    more = true;
+                    break;
+                }
+        }
+        return w.forward(h).y;
+    };
+    const double open = rise(false), shaded = rise(true);
+    INFO("forward.y of the tip: in the open " << open << ", in the shade " << shaded);
+    CHECK(open > 0.1);           // turned toward the light
+    CHECK(shaded < 0.5 * open);  // much less under the layer
+}

@@ -35,6 +35,8 @@ struct Growth {
     double phototropism = 0;        // eta (Eq. 7)
     double adaption = 0;            // tau (Eq. 6)
     double adaption_range = 0.3;    // obstacles nearer than this steer the apex
+    double opacity = 0.15;          // Eq. 7's O = 1 - exp(-opacity * particles between the apex and the light)
+    double light_cell = 0.1;        // the cells those particles are counted in
     std::uint64_t seed = 1;
 };
 
@@ -135,9 +137,10 @@ public:
     glm::dvec3 radii(Handle h) const { return radii_[h.index]; }
 
     // Apical growth: every apex (a particle without children) lengthens; each segment_length a
-    // new particle continues it, turned by surface adaption and phototropism (Eq. 6-8), and with
-    // probability BP a lateral bud starts beside it, turned by up to V * 90 degrees. Random draws
-    // depend on the seed and the particles' indices only.
+    // new particle continues it, turned by surface adaption and phototropism weighted by the
+    // plant's own shade (Eq. 6-8), and with probability BP a lateral bud starts beside it, turned
+    // by up to V * 90 degrees. New particles enter the rest state as add_grown places them
+    // (Eq. 9-10). Random draws depend on the seed and the particles' indices only.
     void grow();
     // The unit forward vector of a particle (its orientation's +y).
     glm::dvec3 forward(Handle h) const { return q_[h.index] * glm::dvec3(0, 1, 0); }
