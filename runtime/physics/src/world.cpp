@@ -587,10 +587,11 @@ void World::separate_particles() {
         }
     if (reach <= 0 || n < 2) return;
     const double cell = 2 * reach; // twice the widest contact: a 2 x 2 x 2 block of cells holds every partner
-    auto hash = [](const glm::i64vec3& c) {
-        return static_cast<std::uint64_t>(c.x * 73856093) ^ static_cast<std::uint64_t>(c.y * 19349663) ^
-               static_cast<std::uint64_t>(c.z * 83492791);
-    };
+    // a cell's key: one term per axis, xor-ed
+    auto term_x = [](std::int64_t x) { return static_cast<std::uint64_t>(x * 73856093); };
+    auto term_y = [](std::int64_t y) { return static_cast<std::uint64_t>(y * 19349663); };
+    auto term_z = [](std::int64_t z) { return static_cast<std::uint64_t>(z * 83492791); };
+    auto hash = [&](const glm::i64vec3& c) { return term_x(c.x) ^ term_y(c.y) ^ term_z(c.z); };
     // an open-addressing table from a cell's key to its run of particles in `members` (in index
     // order), built by counting: no sort. A slot holds the key and the run's bounds together, so
     // a lookup touches one cache line.
@@ -633,12 +634,9 @@ void World::separate_particles() {
             const glm::dvec3 frac = u - glm::floor(u);
             const glm::i64vec3 side(frac.x < 0.5 ? -1 : 1, frac.y < 0.5 ? -1 : 1, frac.z < 0.5 ? -1 : 1);
             // the hash's three terms for the two cells along each axis
-            const std::uint64_t hx[2] = {static_cast<std::uint64_t>(c.x * 73856093),
-                                         static_cast<std::uint64_t>((c.x + side.x) * 73856093)};
-            const std::uint64_t hy[2] = {static_cast<std::uint64_t>(c.y * 19349663),
-                                         static_cast<std::uint64_t>((c.y + side.y) * 19349663)};
-            const std::uint64_t hz[2] = {static_cast<std::uint64_t>(c.z * 83492791),
-                                         static_cast<std::uint64_t>((c.z + side.z) * 83492791)};
+            const std::uint64_t hx[2] = {term_x(c.x), term_x(c.x + side.x)};
+            const std::uint64_t hy[2] = {term_y(c.y), term_y(c.y + side.y)};
+            const std::uint64_t hz[2] = {term_z(c.z), term_z(c.z + side.z)};
             for (int dz = 0; dz <= 1; ++dz)
                 for (int dy = 0; dy <= 1; ++dy)
                     for (int dx = 0; dx <= 1; ++dx) {
