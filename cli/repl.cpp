@@ -421,7 +421,7 @@ void Session::evaluate(const std::string& expr) {
         out_ << format_double(r[0]) << "\n";
 }
 
-void Session::back_to(int k) {
+bool Session::back_to(int k) {
     history_.resize(std::min(history_.size(), static_cast<std::size_t>(k) + 1));
     // what was chosen or done after step k belongs to the steps undone
     std::erase_if(uses_, [&](const auto& u) { return u.first > k; });
@@ -435,7 +435,7 @@ void Session::back_to(int k) {
     // derive again up to step k; the earlier string alone would not bring its state back
     bool evolves = std::any_of(program_->environments.begin(), program_->environments.end(),
                                [](const auto& e) { return e && e->evolves(); });
-    if (evolves || edits_.size() < before) rebuild(k);
+    return (evolves || edits_.size() < before) && rebuild(k);
 }
 
 void Session::edit(std::string statements) {
@@ -543,8 +543,9 @@ bool Session::command(const std::string& name, const std::string& rest) {
             out_ << fmt::format("step {}: {}\n", current().steps_done(), modules(current().string().size()));
         }
     } else if (name == "reset") {
-        if (need_derivation()) back_to(0);
-        if (!history_.empty() && rebuild(0)) out_ << fmt::format("step 0: {}\n", modules(current().string().size()));
+        // back_to derives again only when it has to; :reset always starts afresh
+        if (need_derivation() && (back_to(0) || rebuild(0)))
+            out_ << fmt::format("step 0: {}\n", modules(current().string().size()));
     } else if (name == "show") {
         show(rest);
     } else if (name == "find") {

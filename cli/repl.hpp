@@ -58,8 +58,9 @@ private:
     void list_edits();
     // A line calling a hook-only environment method (ivy.cut(12)): an edit, not an expression.
     bool is_edit(const std::string& line) const;
-    // Going back to step k: uses and edits made after it are forgotten.
-    void back_to(int k);
+    // Going back to step k: uses and edits made after it are forgotten. Whether it derived again
+    // (it does when an environment evolves or edits were undone).
+    bool back_to(int k);
     Derivation& current() { return *history_.back(); }
     DeriveOptions options() const;
 
