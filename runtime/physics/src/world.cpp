@@ -19,11 +19,6 @@ namespace {
 
 constexpr double kFixedMass = 1e12; // "effectively infinite" inside group sums (PLANTS.md pitfall)
 
-glm::dmat3 outer(const glm::dvec3& a, const glm::dvec3& b) {
-    // glm is column-major: column j is a * b[j]
-    return glm::dmat3(a * b.x, a * b.y, a * b.z);
-}
-
 } // namespace
 
 glm::dvec3 surface_adaption(const glm::dvec3& forward, const glm::dvec3& to_surface, double tau, double dt) {
@@ -111,22 +106,74 @@ std::size_t World::components() const {
 namespace {
 
 // Müller et al. 2016, Eq. 10-12: turn R toward the columns of A about omega. Also gives R as a
-// matrix: the last one computed when the iterations stop on convergence.
-glm::dquat rotation_of(const glm::dmat3& A, glm::dquat q, int iterations, glm::dmat3& matrix) {
-    bool current = false; // whether `matrix` is q's
+// matrix: the last one computed when the iterations stop on convergence. With `have_matrix`,
+// `matrix` holds q's already (a warm start from the last pass keeps it).
+glm::dquat rotation_of(const glm::dmat3& A, glm::dquat q, int iterations, glm::dmat3& matrix, bool have_matrix = false) {
+    bool current = have_matrix; // whether `matrix` is q's
     for (int k = 0; k < iterations; ++k) {
-        matrix = glm::mat3_cast(q);
+        if (!current) matrix = glm::mat3_cast(q);
         current = true;
         glm::dvec3 omega = glm::cross(matrix[0], A[0]) + glm::cross(matrix[1], A[1]) + glm::cross(matrix[2], A[2]);
         double denom = std::fabs(glm::dot(matrix[0], A[0]) + glm::dot(matrix[1], A[1]) + glm::dot(matrix[2], A[2])) + 1e-9;
-        omega /= denom;
-        double w = glm::length(omega);
-        if (!(w >= 1e-9)) break; // converged, or nothing to match (zero A), or NaN
-        q = glm::normalize(glm::angleAxis(w, omega / w) * q);
+        omega *= 1.0 / denom;
+        const double w2 = glm::dot(omega, omega);
+        if (!(w2 >= 1e-18)) break; // |omega| below 1e-9: converged, or nothing to match (zero A), or NaN
+        // the turn by |omega| about omega as a quaternion (cos(w/2), sin(w/2) omega / w). Warm
+        // started, the turns are small; there the series to w^6 is exact to double precision
+        // (the next terms are below 1e-22 for w < 0.01) and needs neither sqrt nor sincos.
+        double cw, sw; // cos(w/2) and sin(w/2) / w
+        if (w2 < 1e-4) {
+            cw = 1.0 - w2 * (1.0 / 8.0 - w2 * (1.0 / 384.0 - w2 * (1.0 / 46080.0)));
+            sw = 0.5 - w2 * (1.0 / 48.0 - w2 * (1.0 / 3840.0 - w2 * (1.0 / 645120.0)));
+        } else {
+            const double w = std::sqrt(w2);
+            cw = std::cos(0.5 * w);
+            sw = std::sin(0.5 * w) / w;
+        }
+        q = glm::normalize(glm::dquat(cw, omega.x * sw, omega.y * sw, omega.z * sw) * q);
         current = false;
     }
     if (!current) matrix = glm::mat3_cast(q);
     return q;
+}
+
+} // namespace
+
+namespace {
+
+// Two lanes of doubles (SSE2 on x86-64, NEON on arm64; GCC and Clang vector extensions). Each
+// lane does exactly the scalar code's operations in the same order, so results do not depend on
+// which groups go through here: IEEE arithmetic, division and square root round the same in a
+// lane as alone, and the build forbids fusing a multiply and an add (-ffp-contract=off).
+using v2 = double __attribute__((vector_size(16)));
+using m2 = long long __attribute__((vector_size(16)));
+
+inline v2 both(double a) { return v2{a, a}; }
+
+struct Quat2 {
+    v2 w, x, y, z;
+};
+struct Mat2 {
+    v2 m[3][3]; // column-major, as glm: m[column][row]
+};
+
+// glm::mat3_cast, lane by lane
+inline Mat2 mat3_cast2(const Quat2& q) {
+    const v2 one = both(1.0), two = both(2.0);
+    const v2 qxx = q.x * q.x, qyy = q.y * q.y, qzz = q.z * q.z;
+    const v2 qxz = q.x * q.z, qxy = q.x * q.y, qyz = q.y * q.z;
+    const v2 qwx = q.w * q.x, qwy = q.w * q.y, qwz = q.w * q.z;
+    Mat2 r;
+    r.m[0][0] = one - two * (qyy + qzz);
+    r.m[0][1] = two * (qxy + qwz);
+    r.m[0][2] = two * (qxz - qwy);
+    r.m[1][0] = two * (qxy - qwz);
+    r.m[1][1] = one - two * (qxx + qzz);
+    r.m[1][2] = two * (qyz + qwx);
+    r.m[2][0] = two * (qxz + qwy);
+    r.m[2][1] = two * (qyz - qwx);
+    r.m[2][2] = one - two * (qxx + qyy);
+    return r;
 }
 
 } // namespace
@@ -247,10 +294,31 @@ void World::group_moments(const Groups& g, std::vector<glm::dmat3>& each, std::v
     // Eq. 15's moment R D R̄ᵀ: the rest part D R̄ᵀ (with the mass) changes only with growth and
     // is kept with the groups (step()); here only the current rotation enters
     const bool cached = !groups_stale_ && scratch_.rest_moment.size() == n;
+    auto one = [&](std::size_t j) {
+        if (alive_[j])
+            each[j] = cached ? glm::mat3_cast(q_[j]) * scratch_.rest_moment[j] : ellipsoid_moment(static_cast<std::uint32_t>(j));
+    };
     parallel_ranges(n, settings_.threads, 2048, [&](std::size_t b, std::size_t e) {
-        for (std::size_t j = b; j < e; ++j)
-            if (alive_[j])
-                each[j] = cached ? glm::mat3_cast(q_[j]) * scratch_.rest_moment[j] : ellipsoid_moment(static_cast<std::uint32_t>(j));
+        std::size_t j = b;
+        if (cached) // two particles at a time, lane by lane as the line above
+            for (; j + 1 < e; j += 2) {
+                if (!alive_[j] || !alive_[j + 1]) {
+                    one(j), one(j + 1);
+                    continue;
+                }
+                const glm::dquat &qa = q_[j], &qb = q_[j + 1];
+                const Mat2 R = mat3_cast2({v2{qa.w, qb.w}, v2{qa.x, qb.x}, v2{qa.y, qb.y}, v2{qa.z, qb.z}});
+                const glm::dmat3 &ra = scratch_.rest_moment[j], &rb = scratch_.rest_moment[j + 1];
+                for (int c = 0; c < 3; ++c) {
+                    const v2 b0{ra[c][0], rb[c][0]}, b1{ra[c][1], rb[c][1]}, b2{ra[c][2], rb[c][2]};
+                    for (int r = 0; r < 3; ++r) { // glm's mat3 * mat3
+                        const v2 m = R.m[0][r] * b0 + R.m[1][r] * b1 + R.m[2][r] * b2;
+                        each[j][c][r] = m[0];
+                        each[j + 1][c][r] = m[1];
+                    }
+                }
+            }
+        for (; j < e; ++j) one(j);
     });
     parallel_ranges(n, settings_.threads, 2048, [&](std::size_t b, std::size_t e) {
         for (std::size_t i = b; i < e; ++i) {
@@ -262,17 +330,35 @@ void World::group_moments(const Groups& g, std::vector<glm::dmat3>& each, std::v
 }
 
 void World::group_frame(std::uint32_t i, glm::dquat warm, const glm::dmat3& moment, int iterations, const Groups& g,
-                        Frame& out) const {
+                        Frame& out, bool warm_matrix) const {
     // Eq. 14 with Eq. 15's ellipsoid moments (summed over the group already), positions
     // relative to the centers to keep the sums well conditioned
     const Groups::Member* from = g.member.data() + g.start[i];
     const Groups::Member* to = g.member.data() + g.start[i + 1];
-    glm::dvec3 c(0.0);
-    for (const auto* k = from; k < to; ++k) c += k->share * x_[k->particle];
-    glm::dmat3 A = moment;
-    for (const auto* k = from; k < to; ++k) A += outer(x_[k->particle] - c, k->mr);
-    out.c = c;
-    out.R = rotation_of(A, warm, iterations, out.M);
+    // (In local variables: written through glm's operators into `out`, every sum is stored
+    // and loaded again, since `out` might alias the positions.)
+    const glm::dvec3* x = x_.data();
+    double cx = 0, cy = 0, cz = 0;
+    for (const auto* k = from; k < to; ++k) {
+        const glm::dvec3& p = x[k->particle];
+        cx += k->share * p.x;
+        cy += k->share * p.y;
+        cz += k->share * p.z;
+    }
+    glm::dmat3 A = moment; // += outer(x_k - c, mr_k), column j being (x_k - c) mr_k[j]
+    double a00 = A[0][0], a01 = A[0][1], a02 = A[0][2], a10 = A[1][0], a11 = A[1][1], a12 = A[1][2], a20 = A[2][0],
+           a21 = A[2][1], a22 = A[2][2];
+    for (const auto* k = from; k < to; ++k) {
+        const glm::dvec3& p = x[k->particle];
+        const double dx = p.x - cx, dy = p.y - cy, dz = p.z - cz;
+        const glm::dvec3& mr = k->mr;
+        a00 += dx * mr.x, a01 += dy * mr.x, a02 += dz * mr.x;
+        a10 += dx * mr.y, a11 += dy * mr.y, a12 += dz * mr.y;
+        a20 += dx * mr.z, a21 += dy * mr.z, a22 += dz * mr.z;
+    }
+    A = glm::dmat3(a00, a01, a02, a10, a11, a12, a20, a21, a22);
+    out.c = glm::dvec3(cx, cy, cz);
+    out.R = rotation_of(A, warm, iterations, out.M, warm_matrix);
     out.valid = true;
 }
 
@@ -333,19 +419,127 @@ void World::build_groups(Groups& g) const {
     g.source_start[n] = static_cast<std::uint32_t>(g.source.size());
 }
 
+
+void World::frame_pair(const std::uint32_t (&group)[2], const std::vector<glm::dmat3>& moments, const Groups& g,
+                       std::vector<Frame>& frames) const {
+    // group_frame with one rotation iteration from the last pass's frame, for two groups with
+    // the same number of members at once (equal counts: no lane needs padding)
+    const Groups::Member* from[2] = {g.member.data() + g.start[group[0]], g.member.data() + g.start[group[1]]};
+    const std::uint32_t count = g.start[group[0] + 1] - g.start[group[0]];
+    const glm::dvec3* x = x_.data();
+    v2 cx = both(0), cy = both(0), cz = both(0);
+    for (std::uint32_t k = 0; k < count; ++k) {
+        const Groups::Member &a = from[0][k], &b = from[1][k];
+        const glm::dvec3 &pa = x[a.particle], &pb = x[b.particle];
+        const v2 share{a.share, b.share};
+        cx += share * v2{pa.x, pb.x};
+        cy += share * v2{pa.y, pb.y};
+        cz += share * v2{pa.z, pb.z};
+    }
+    v2 A[3][3];
+    for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r) A[c][r] = v2{moments[group[0]][c][r], moments[group[1]][c][r]};
+    for (std::uint32_t k = 0; k < count; ++k) {
+        const Groups::Member &a = from[0][k], &b = from[1][k];
+        const glm::dvec3 &pa = x[a.particle], &pb = x[b.particle];
+        const v2 d[3] = {v2{pa.x, pb.x} - cx, v2{pa.y, pb.y} - cy, v2{pa.z, pb.z} - cz};
+        const v2 mr[3] = {v2{a.mr.x, b.mr.x}, v2{a.mr.y, b.mr.y}, v2{a.mr.z, b.mr.z}};
+        for (int c = 0; c < 3; ++c)
+            for (int r = 0; r < 3; ++r) A[c][r] += d[r] * mr[c];
+    }
+    // rotation_of, one iteration, warm-started from the frames' rotations and their matrices
+    Frame* f[2] = {&frames[group[0]], &frames[group[1]]};
+    Quat2 q{v2{f[0]->R.w, f[1]->R.w}, v2{f[0]->R.x, f[1]->R.x}, v2{f[0]->R.y, f[1]->R.y}, v2{f[0]->R.z, f[1]->R.z}};
+    Mat2 M;
+    for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r) M.m[c][r] = v2{f[0]->M[c][r], f[1]->M[c][r]};
+    v2 omega[3] = {both(0), both(0), both(0)};
+    v2 dots = both(0);
+    for (int c = 0; c < 3; ++c) {
+        const v2* m = M.m[c];
+        const v2* a = A[c];
+        // glm::cross(m, a), summed column after column as (c0 + c1) + c2
+        const v2 cr[3] = {m[1] * a[2] - a[1] * m[2], m[2] * a[0] - a[2] * m[0], m[0] * a[1] - a[0] * m[1]};
+        const v2 dt = (m[0] * a[0] + m[1] * a[1]) + m[2] * a[2];
+        for (int r = 0; r < 3; ++r) omega[r] = c == 0 ? cr[r] : omega[r] + cr[r];
+        dots = c == 0 ? dt : dots + dt;
+    }
+    const v2 denom = v2{std::fabs(dots[0]), std::fabs(dots[1])} + both(1e-9);
+    const v2 inv = both(1.0) / denom;
+    for (auto& o : omega) o *= inv;
+    const v2 w2 = (omega[0] * omega[0] + omega[1] * omega[1]) + omega[2] * omega[2];
+    const m2 turn = w2 >= both(1e-18); // false: converged or NaN, the lane keeps its frame
+    if (!turn[0] && !turn[1]) {
+        for (int l = 0; l < 2; ++l) {
+            f[l]->c = glm::dvec3(cx[l], cy[l], cz[l]);
+            f[l]->valid = true;
+        }
+        return;
+    }
+    v2 cw = both(1.0) - w2 * (both(1.0 / 8.0) - w2 * (both(1.0 / 384.0) - w2 * both(1.0 / 46080.0)));
+    v2 sw = both(0.5) - w2 * (both(1.0 / 48.0) - w2 * (both(1.0 / 3840.0) - w2 * both(1.0 / 645120.0)));
+    for (int l = 0; l < 2; ++l)
+        if (turn[l] && !(w2[l] < 1e-4)) { // a large turn: as rotation_of computes it
+            const double w = std::sqrt(w2[l]);
+            cw[l] = std::cos(0.5 * w);
+            sw[l] = std::sin(0.5 * w) / w;
+        }
+    const Quat2 p{cw, omega[0] * sw, omega[1] * sw, omega[2] * sw};
+    // p * q as glm multiplies quaternions, then glm::normalize
+    Quat2 n{p.w * q.w - p.x * q.x - p.y * q.y - p.z * q.z, p.w * q.x + p.x * q.w + p.y * q.z - p.z * q.y,
+            p.w * q.y + p.y * q.w + p.z * q.x - p.x * q.z, p.w * q.z + p.z * q.w + p.x * q.y - p.y * q.x};
+    const v2 len2 = (n.w * n.w + n.x * n.x) + (n.y * n.y + n.z * n.z);
+    const v2 len{std::sqrt(len2[0]), std::sqrt(len2[1])};
+    const v2 one_over = both(1.0) / len;
+    n = {n.w * one_over, n.x * one_over, n.y * one_over, n.z * one_over};
+    const Mat2 nm = mat3_cast2(n);
+    for (int l = 0; l < 2; ++l) {
+        Frame& out = *f[l];
+        out.c = glm::dvec3(cx[l], cy[l], cz[l]);
+        out.valid = true;
+        if (!turn[l]) continue;
+        if (!(len[l] > 0)) { // glm::normalize's answer to a zero quaternion
+            out.R = glm::dquat(1, 0, 0, 0);
+            out.M = glm::mat3_cast(out.R);
+            continue;
+        }
+        out.R = glm::dquat(n.w[l], n.x[l], n.y[l], n.z[l]);
+        for (int c = 0; c < 3; ++c)
+            for (int r = 0; r < 3; ++r) out.M[c][r] = nm.m[c][r][l];
+    }
+}
+
 void World::match_shapes(std::vector<Frame>& frames, const std::vector<glm::dmat3>& moments, int iterations,
                          const Groups& g) const {
     const std::size_t n = x_.size();
     frames.resize(n);
     parallel_ranges(n, settings_.threads, 2048, [&](std::size_t b, std::size_t e) {
+        // groups warm-started with one iteration go two at a time (frame_pair), paired by their
+        // number of members: a group waits in `pending` for a partner of its size
+        constexpr std::uint32_t kMaxPaired = 8, kNoGroup = ~0u;
+        std::uint32_t pending[kMaxPaired + 1];
+        std::fill(std::begin(pending), std::end(pending), kNoGroup);
         for (std::size_t k = b; k < e; ++k) {
             const auto i = static_cast<std::uint32_t>(k);
             if (!alive_[i]) continue;
             // warm start from the last pass's rotation when there is one, else from the
-            // particle's own rotation from rest
-            const glm::dquat warm = frames[i].valid ? frames[i].R : rotation_from_rest(i);
-            group_frame(i, warm, moments[i], iterations, g, frames[i]);
+            // particle's own rotation from rest; the last pass's matrix goes with its rotation
+            const bool last = frames[i].valid;
+            const std::uint32_t size = g.start[i + 1] - g.start[i];
+            if (last && iterations == 1 && size <= kMaxPaired) {
+                if (pending[size] == kNoGroup) {
+                    pending[size] = i;
+                } else {
+                    frame_pair({pending[size], i}, moments, g, frames);
+                    pending[size] = kNoGroup;
+                }
+                continue;
+            }
+            const glm::dquat warm = last ? frames[i].R : rotation_from_rest(i);
+            group_frame(i, warm, moments[i], iterations, g, frames[i], last);
         }
+        for (std::uint32_t i : pending)
+            if (i != kNoGroup) group_frame(i, frames[i].R, moments[i], iterations, g, frames[i], true);
     });
 }
 
@@ -355,13 +549,20 @@ glm::dvec3 World::goal_of(std::uint32_t j, const std::vector<Frame>& frames, con
     // children's), its parent's group counting twice as much as its own and its children's half.
     // The weights are divided by their sum already (build_groups); a particle always has its
     // own group.
-    glm::dvec3 sum(0.0);
+    double sx = 0, sy = 0, sz = 0; // in local variables, as in group_frame
     const Groups::Source* end = g.source.data() + g.source_start[j + 1];
     for (const auto* k = g.source.data() + g.source_start[j]; k < end; ++k) {
         const Frame& f = frames[k->group];
-        sum += k->weight * (f.M * k->offset + f.c);
+        const glm::dvec3& o = k->offset;
+        // glm's M * o + c, column by column
+        const double gx = f.M[0][0] * o.x + f.M[1][0] * o.y + f.M[2][0] * o.z + f.c.x;
+        const double gy = f.M[0][1] * o.x + f.M[1][1] * o.y + f.M[2][1] * o.z + f.c.y;
+        const double gz = f.M[0][2] * o.x + f.M[1][2] * o.y + f.M[2][2] * o.z + f.c.z;
+        sx += k->weight * gx;
+        sy += k->weight * gy;
+        sz += k->weight * gz;
     }
-    return sum;
+    return {sx, sy, sz};
 }
 
 std::vector<glm::dvec3> World::goals() const {
@@ -592,6 +793,19 @@ void World::separate_particles() {
     auto term_y = [](std::int64_t y) { return static_cast<std::uint64_t>(y * 19349663); };
     auto term_z = [](std::int64_t z) { return static_cast<std::uint64_t>(z * 83492791); };
     auto hash = [&](const glm::i64vec3& c) { return term_x(c.x) ^ term_y(c.y) ^ term_z(c.z); };
+    // each particle's cell, once: floor by truncation and correction (the baseline x86-64 has
+    // no rounding instruction, and std::floor is a call)
+    auto floor_of = [](double u) {
+        const auto t = static_cast<std::int64_t>(u);
+        return t - static_cast<std::int64_t>(static_cast<double>(t) > u);
+    };
+    auto& cell_of = scratch_.cell_of;
+    cell_of.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+        if (alive_[i]) {
+            const glm::dvec3 u = x_[i] / cell;
+            cell_of[i] = glm::i64vec3(floor_of(u.x), floor_of(u.y), floor_of(u.z));
+        }
     // an open-addressing table from a cell's key to its run of particles in `members` (in index
     // order), built by counting: no sort. A slot holds the key and the run's bounds together, so
     // a lookup touches one cache line.
@@ -603,7 +817,7 @@ void World::separate_particles() {
     slot_of.assign(n, ~0u);
     for (std::uint32_t i = 0; i < n; ++i) {
         if (!alive_[i]) continue;
-        const std::uint64_t k = hash(glm::i64vec3(glm::floor(x_[i] / cell)));
+        const std::uint64_t k = hash(cell_of[i]);
         std::size_t slot = k & (size - 1);
         while (table[slot].end != 0 && table[slot].key != k) slot = (slot + 1) & (size - 1);
         table[slot].key = k;
@@ -629,33 +843,34 @@ void World::separate_particles() {
             const glm::dvec3 xi = x_[i];
             // only the 2 x 2 x 2 block of cells on the side of each axis the particle is nearer
             // to can hold a partner
-            const glm::dvec3 u = xi / cell;
-            const glm::i64vec3 c = glm::i64vec3(glm::floor(u));
-            const glm::dvec3 frac = u - glm::floor(u);
+            const glm::i64vec3 c = cell_of[i];
+            const glm::dvec3 frac = xi / cell - glm::dvec3(c);
             const glm::i64vec3 side(frac.x < 0.5 ? -1 : 1, frac.y < 0.5 ? -1 : 1, frac.z < 0.5 ? -1 : 1);
             // the hash's three terms for the two cells along each axis
             const std::uint64_t hx[2] = {term_x(c.x), term_x(c.x + side.x)};
             const std::uint64_t hy[2] = {term_y(c.y), term_y(c.y + side.y)};
             const std::uint64_t hz[2] = {term_z(c.z), term_z(c.z + side.z)};
-            for (int dz = 0; dz <= 1; ++dz)
-                for (int dy = 0; dy <= 1; ++dy)
-                    for (int dx = 0; dx <= 1; ++dx) {
-                        const std::uint64_t k = hx[dx] ^ hy[dy] ^ hz[dz];
-                        std::size_t slot = k & (size - 1);
-                        while (table[slot].end != table[slot].begin && table[slot].key != k) slot = (slot + 1) & (size - 1);
-                        const Cell& run = table[slot];
-                        for (std::uint32_t at = run.begin; at < run.end; ++at) {
-                            const std::uint32_t j = members[at];
-                            const glm::dvec3 d = xi - x_[j];
-                            const double dist2 = glm::dot(d, d), want = ri + thin[j];
-                            if (dist2 >= want * want || dist2 < 1e-24) continue; // apart, or itself
-                            // joined particles (parent and child, children of one parent) do not collide
-                            const std::uint32_t pi = parent_[i], pj = parent_[j];
-                            if (pi == j || pj == i || (pi != kNone && pi == pj)) continue;
-                            const double dist = std::sqrt(dist2);
-                            push[i] += d / dist * ((want - dist) * (fixed_[j] ? 1.0 : 0.5));
-                        }
-                    }
+            // the block's eight keys, z slowest (the order the pushes are summed in)
+            std::uint64_t keys[8];
+            for (int q = 0; q < 8; ++q) keys[q] = hx[q & 1] ^ hy[(q >> 1) & 1] ^ hz[q >> 2];
+            glm::dvec3 pushed(0.0);
+            for (const std::uint64_t k : keys) {
+                std::size_t slot = k & (size - 1);
+                while (table[slot].end != table[slot].begin && table[slot].key != k) slot = (slot + 1) & (size - 1);
+                const Cell& run = table[slot];
+                for (std::uint32_t at = run.begin; at < run.end; ++at) {
+                    const std::uint32_t j = members[at];
+                    const glm::dvec3 d = xi - x_[j];
+                    const double dist2 = glm::dot(d, d), want = ri + thin[j];
+                    if (dist2 >= want * want || dist2 < 1e-24) continue; // apart, or itself
+                    // joined particles (parent and child, children of one parent) do not collide
+                    const std::uint32_t pi = parent_[i], pj = parent_[j];
+                    if (pi == j || pj == i || (pi != kNone && pi == pj)) continue;
+                    const double dist = std::sqrt(dist2);
+                    pushed += d / dist * ((want - dist) * (fixed_[j] ? 1.0 : 0.5));
+                }
+            }
+            push[i] = pushed;
         }
     });
     for (std::size_t i = 0; i < n; ++i) x_[i] += push[i];

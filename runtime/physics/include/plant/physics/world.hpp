@@ -248,9 +248,14 @@ private:
     // Eq. 15's ellipsoid moments of every particle (`each`) and their sums over each group.
     void group_moments(const Groups& groups, std::vector<glm::dmat3>& each, std::vector<glm::dmat3>& sums) const;
     // Group i's frame, given the sum of its members' ellipsoid moments, with at most
-    // `iterations` rotation-extraction iterations warm-started from `warm`.
+    // `iterations` rotation-extraction iterations warm-started from `warm`; with `warm_matrix`,
+    // out.M is warm's rotation matrix already.
     void group_frame(std::uint32_t i, glm::dquat warm, const glm::dmat3& moment, int iterations, const Groups& groups,
-                     Frame& out) const;
+                     Frame& out, bool warm_matrix = false) const;
+    // group_frame for two groups with the same number of members, each warm-started from its
+    // frame with one iteration: the same results, computed two lanes at a time.
+    void frame_pair(const std::uint32_t (&group)[2], const std::vector<glm::dmat3>& moments, const Groups& groups,
+                    std::vector<Frame>& frames) const;
     // One shape-matching pass: every group's frame (Eq. 14-15, warm-started from `frames`),
     // with at most `iterations` rotation-extraction iterations per group; `moments` holds each
     // group's moment sum (group_moments).
@@ -295,6 +300,7 @@ private:
         std::vector<glm::dvec3> old;
         std::vector<Cell> table;                  // the collision pass's cells
         std::vector<std::uint32_t> slot_of, members; // particles grouped by table slot
+        std::vector<glm::i64vec3> cell_of;          // each particle's collision cell
         std::vector<double> thin;                                   // each particle's thinnest radius
         std::vector<glm::dmat3> rest_moment;                        // 0.2 m D R̄ᵀ, while the groups are current
         std::vector<glm::dvec3> push;
