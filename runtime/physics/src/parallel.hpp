@@ -1,27 +1,38 @@
 // Splitting a loop over threads without changing its result (internal to plant_physics).
 #pragma once
 
-#include <algorithm>
 #include <cstddef>
-#include <thread>
-#include <vector>
 
 namespace plant::physics {
+
+// Runs job(context, k) for k in [0, parts): part 0 on the calling thread, the others on threads
+// kept alive between calls (a step calls this about a dozen times; starting threads each time
+// cost more than the work they shared). When the kept threads are busy (a call from inside a
+// job, or from two threads at once), the parts run on threads started for this call instead.
+void run_parts(std::size_t parts, void (*job)(void* context, std::size_t k), void* context);
 
 // Runs f(begin, end) over [0, n) split into at most `threads` contiguous ranges of at least
 // `grain` indices. Each index is handled by exactly one call and writes only its own slots, so
 // the result does not depend on the thread count.
 template <class F> void parallel_ranges(std::size_t n, int threads, std::size_t grain, F&& f) {
-    const std::size_t t = std::clamp<std::size_t>(static_cast<std::size_t>(std::max(threads, 1)), 1, n / grain + 1);
-    if (t == 1) {
+    const std::size_t want = threads > 1 ? static_cast<std::size_t>(threads) : 1;
+    const std::size_t most = n / grain + 1;
+    const std::size_t t = want < most ? want : most;
+    if (t <= 1) {
         f(std::size_t{0}, n);
         return;
     }
-    std::vector<std::thread> pool;
-    pool.reserve(t - 1);
-    for (std::size_t k = 1; k < t; ++k) pool.emplace_back([&f, k, t, n] { f(n * k / t, n * (k + 1) / t); });
-    f(std::size_t{0}, n / t);
-    for (auto& th : pool) th.join();
+    struct Context {
+        F* f;
+        std::size_t n, t;
+    } context{&f, n, t};
+    run_parts(
+        t,
+        [](void* c, std::size_t k) {
+            const auto& x = *static_cast<Context*>(c);
+            (*x.f)(x.n * k / x.t, x.n * (k + 1) / x.t);
+        },
+        &context);
 }
 
 } // namespace plant::physics

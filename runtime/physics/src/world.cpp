@@ -584,13 +584,17 @@ void World::step() {
     const double dt = settings_.dt;
     const std::size_t n = x_.size();
     std::vector<glm::dvec3>& old = scratch_.old;
-    old = x_;
+    old.resize(n);
     // Eq. 1: predicted positions; a_e is the steady wind plus what the fluid pushed (Fluid::step)
     if (external_.size() < n) external_.resize(n, glm::dvec3(0.0));
-    for (std::size_t i = 0; i < n; ++i)
-        if (alive_[i] && !fixed_[i])
-            x_[i] = x_[i] + v_[i] * dt + (settings_.gravity + wind_ + external_[i]) * (dt * dt / 2);
-    std::fill(external_.begin(), external_.end(), glm::dvec3(0.0));
+    parallel_ranges(n, settings_.threads, 2048, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) {
+            old[i] = x_[i];
+            if (alive_[i] && !fixed_[i])
+                x_[i] = x_[i] + v_[i] * dt + (settings_.gravity + wind_ + external_[i]) * (dt * dt / 2);
+            external_[i] = glm::dvec3(0.0);
+        }
+    });
     // Eq. 5: anchors pull their particles in; one too far away lets go
     for (std::size_t k = 0; k < anchors_.size();) {
         Anchor& a = anchors_[k];
@@ -618,7 +622,9 @@ void World::step() {
     }
     auto& stiff = scratch_.stiffness; // ages change only after the passes
     stiff.resize(n);
-    for (std::uint32_t i = 0; i < n; ++i) stiff[i] = stiffness(i);
+    parallel_ranges(n, settings_.threads, 2048, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) stiff[i] = stiffness(static_cast<std::uint32_t>(i));
+    });
     group_moments(scratch_.groups, scratch_.moments, scratch_.group_moment);
     const int passes = settings_.iterations;
     for (int it = 0; it < passes; ++it) {
@@ -658,22 +664,24 @@ void World::step() {
     // (its radius off it), its velocity losing the normal part (or bouncing by the elasticity)
     // and some of the tangential part (friction)
     t0 = clock::now();
-    for (std::uint32_t i = 0; i < n; ++i) {
-        if (!alive_[i]) continue;
-        v_[i] = fixed_[i] ? glm::dvec3(0.0) : (x_[i] - old[i]) / dt * (1.0 - settings_.damping);
-        age_[i] += dt;
-        if (fixed_[i]) continue;
-        const double r = std::min({radii_[i].x, radii_[i].y, radii_[i].z});
-        for (const auto& o : obstacles_) {
-            double d = o.distance(x_[i]) - r;
-            if (d >= 0) continue;
-            glm::dvec3 nrm = o.normal(x_[i]);
-            x_[i] -= nrm * d;
-            double vn = glm::dot(v_[i], nrm);
-            glm::dvec3 tangential = v_[i] - nrm * vn;
-            v_[i] = tangential * (1 - o.friction) + (vn < 0 ? -vn * o.elasticity : vn) * nrm;
+    parallel_ranges(n, settings_.threads, 2048, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) {
+            if (!alive_[i]) continue;
+            v_[i] = fixed_[i] ? glm::dvec3(0.0) : (x_[i] - old[i]) / dt * (1.0 - settings_.damping);
+            age_[i] += dt;
+            if (fixed_[i]) continue;
+            const double r = std::min({radii_[i].x, radii_[i].y, radii_[i].z});
+            for (const auto& o : obstacles_) {
+                double d = o.distance(x_[i]) - r;
+                if (d >= 0) continue;
+                glm::dvec3 nrm = o.normal(x_[i]);
+                x_[i] -= nrm * d;
+                double vn = glm::dot(v_[i], nrm);
+                glm::dvec3 tangential = v_[i] - nrm * vn;
+                v_[i] = tangential * (1 - o.friction) + (vn < 0 ? -vn * o.elasticity : vn) * nrm;
+            }
         }
-    }
+    });
     collision_ms += std::chrono::duration<double, std::milli>(clock::now() - t0).count();
     // breaking: a connection stretched past the threshold lets its child go (section 4.3)
     if (break_threshold_ > 0) {
