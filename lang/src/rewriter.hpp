@@ -472,21 +472,40 @@ public:
             out.poff.resize(m + 1);
             out.params.resize(p);
         };
-        open(m + Mmax, p + Pmax);
-        std::size_t next_check = b + 65536;
+        // The room left is checked for a run of modules at a time rather than per module: a
+        // module writes at most `per_module` modules and, copied, its own parameters or,
+        // rewritten, at most Pmax, so the next k modules fit in `per_module` k modules and their
+        // own parameters plus Pmax k. A run is as long as the room opened lets it be (the arrays
+        // grow only when not even one module fits), and it ends at `next_check`, where the
+        // interrupt and the limits are looked at too.
+        const std::size_t per_module = std::max<std::size_t>(Mmax, 1);
+        std::size_t next_limits = b + 65536, next_check = b;
         std::size_t i = b;
+        auto run_length = [&] {
+            std::size_t k = std::min({e - i, next_limits - i, std::size_t{4096}, (mcap - m) / per_module});
+            while (k > 0 && p + (in.poff[i + k] - in.poff[i]) + Pmax * k > pcap) k /= 2;
+            return k;
+        };
+        open(m + per_module, p + Pmax);
         while (i < e) {
             if (i >= next_check) {
-                next_check = i + 65536;
-                if (env.interrupt && env.interrupt->load()) throw RuntimeError{Span{}, "interrupted"};
-                if (m > env.max_output || p > env.max_params) {
-                    close();
-                    limit_error(w);
+                if (i >= next_limits) {
+                    next_limits = i + 65536;
+                    if (env.interrupt && env.interrupt->load()) throw RuntimeError{Span{}, "interrupted"};
+                    if (m > env.max_output || p > env.max_params) {
+                        close();
+                        limit_error(w);
+                    }
                 }
+                std::size_t k = run_length();
+                if (k == 0) {
+                    open(m + per_module, p + (in.poff[i + 1] - in.poff[i]) + Pmax);
+                    k = run_length(); // at least 1 now
+                }
+                next_check = i + k;
             }
             const SymbolId sym = in.sym[i];
             const std::uint32_t arity = in.poff[i + 1] - in.poff[i];
-            if (m + Mmax > mcap || p + arity + Pmax > pcap) open(m + Mmax, p + arity + Pmax);
             const Production* pr = nullptr;
             if (plan.has_prod[sym]) {
                 pr = plan.direct[sym];
@@ -510,7 +529,8 @@ public:
                     i += used;
                     m = out.size();
                     p = out.params.size();
-                    open(m + Mmax, p + Pmax);
+                    open(m + per_module, p + Pmax);
+                    next_check = i; // room is made again from here
                     continue;
                 }
             }
