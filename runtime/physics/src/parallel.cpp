@@ -1,8 +1,9 @@
 #include "parallel.hpp"
 
 #include <atomic>
-#include <cstdint>
 #include <condition_variable>
+#include <cstdint>
+#include <exception>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -11,44 +12,67 @@ namespace plant::physics {
 
 namespace {
 
-// Threads that wait for parts to run. A call hands out parts 1..parts-1 by raising `round`;
-// each thread takes the part of its own number, if there is one, and counts itself done.
+inline void cpu_relax() {
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#endif
+}
+
+// Runs one part, keeping what it throws in `error` (the first part to throw wins).
+void run_part(void (*job)(void*, std::size_t), void* context, std::size_t k, std::exception_ptr& error,
+              std::mutex& error_mutex) {
+    try {
+        job(context, k);
+    } catch (...) {
+        std::lock_guard lock(error_mutex);
+        if (!error) error = std::current_exception();
+    }
+}
+
+// Threads that wait for parts to run. A call hands out parts 1..parts-1 by raising `round_`;
+// each thread takes the part of its own number, if there is one, and counts itself done. The
+// crew is made once and never destroyed: its threads sleep through the process's exit, and no
+// static destructor can find it gone.
 class Crew {
 public:
-    ~Crew() {
-        {
-            std::lock_guard lock(mutex_);
-            stop_ = true;
-        }
-        wake_.notify_all();
-        for (auto& t : threads_) t.join();
-    }
-
-    // false when the crew is busy with another call
+    // false when the crew is busy with another call (from another thread, or from inside a part)
     bool run(std::size_t parts, void (*job)(void*, std::size_t), void* context) {
-        std::unique_lock busy(busy_, std::try_to_lock);
-        if (!busy.owns_lock()) return false;
+        bool expected = false;
+        if (!busy_.compare_exchange_strong(expected, true, std::memory_order_acquire)) return false;
         {
             std::lock_guard lock(mutex_);
-            while (threads_.size() + 1 < parts) {
-                const std::size_t number = threads_.size() + 1;
-                threads_.emplace_back([this, number] { serve(number); });
+            try {
+                while (threads_.size() + 1 < parts) {
+                    const std::size_t number = threads_.size() + 1;
+                    threads_.emplace_back([this, number] { serve(number); });
+                }
+            } catch (...) { // no thread to be had: the crew stays usable for fewer parts
+                busy_.store(false, std::memory_order_release);
+                throw;
             }
             job_ = job;
             context_ = context;
             parts_ = parts;
+            error_ = nullptr;
             done_.store(0, std::memory_order_relaxed);
             round_.fetch_add(1, std::memory_order_release);
         }
         wake_.notify_all();
-        job(context, 0);
-        // the others are usually about as far along: wait for them briefly before sleeping
+        std::exception_ptr mine;
+        std::mutex unused;
+        run_part(job, context, 0, mine, unused);
+        // every part finishes before this returns, also when part 0 threw: the others use the
+        // caller's data. They are usually about as far along, so look briefly before sleeping.
         const std::size_t others = parts - 1;
-        for (int spin = 0; spin < 4096 && done_.load(std::memory_order_acquire) < others; ++spin) std::this_thread::yield();
+        for (int spin = 0; spin < 4096 && done_.load(std::memory_order_acquire) < others; ++spin) cpu_relax();
         if (done_.load(std::memory_order_acquire) < others) {
             std::unique_lock lock(mutex_);
             finished_.wait(lock, [&] { return done_.load(std::memory_order_acquire) >= others; });
         }
+        std::exception_ptr error = mine ? mine : error_;
+        error_ = nullptr;
+        busy_.store(false, std::memory_order_release);
+        if (error) std::rethrow_exception(error);
         return true;
     }
 
@@ -56,24 +80,22 @@ private:
     void serve(std::size_t number) {
         std::uint64_t seen = 0;
         for (;;) {
+            // a step hands out parts a dozen times in quick succession: look for the next round
+            // for a little while before sleeping, since waking a sleeping thread takes longer
+            for (int spin = 0; spin < (1 << 14) && round_.load(std::memory_order_acquire) == seen; ++spin) cpu_relax();
             void (*job)(void*, std::size_t) = nullptr;
             void* context = nullptr;
             std::size_t parts = 0;
-            // a step hands out parts a dozen times in quick succession: look for the next round
-            // for a little while before sleeping, since waking a sleeping thread takes longer
-            for (int spin = 0; spin < (1 << 14) && round_.load(std::memory_order_acquire) == seen; ++spin) {
-            }
             {
                 std::unique_lock lock(mutex_);
-                wake_.wait(lock, [&] { return stop_ || round_.load(std::memory_order_relaxed) != seen; });
-                if (stop_) return;
+                wake_.wait(lock, [&] { return round_.load(std::memory_order_relaxed) != seen; });
                 seen = round_.load(std::memory_order_relaxed);
                 job = job_;
                 context = context_;
                 parts = parts_;
             }
             if (number >= parts) continue; // not needed this round: do not count
-            job(context, number);
+            run_part(job, context, number, error_, error_mutex_);
             if (done_.fetch_add(1, std::memory_order_acq_rel) + 1 == parts - 1) {
                 std::lock_guard lock(mutex_); // the caller may be between its check and its wait
                 finished_.notify_one();
@@ -81,21 +103,22 @@ private:
         }
     }
 
-    std::mutex busy_;  // one call at a time
-    std::mutex mutex_; // guards what follows, except done_
+    std::atomic<bool> busy_{false}; // one call at a time
+    std::mutex mutex_;              // guards what follows, except the atomics
     std::condition_variable wake_, finished_;
     std::vector<std::thread> threads_;
     void (*job_)(void*, std::size_t) = nullptr;
     void* context_ = nullptr;
     std::size_t parts_ = 0;
     std::atomic<std::uint64_t> round_{0}; // written under mutex_, also read without it
-    bool stop_ = false;
     std::atomic<std::size_t> done_{0};
+    std::mutex error_mutex_;
+    std::exception_ptr error_; // the first part (after part 0) that threw, this call
 };
 
 Crew& crew() {
-    static Crew c;
-    return c;
+    static Crew* c = new Crew; // never destroyed (see Crew)
+    return *c;
 }
 
 } // namespace
@@ -106,11 +129,16 @@ void run_parts(std::size_t parts, void (*job)(void*, std::size_t), void* context
         return;
     }
     if (crew().run(parts, job, context)) return;
-    std::vector<std::thread> pool;
-    pool.reserve(parts - 1);
-    for (std::size_t k = 1; k < parts; ++k) pool.emplace_back([job, context, k] { job(context, k); });
-    job(context, 0);
-    for (auto& t : pool) t.join();
+    std::exception_ptr error;
+    std::mutex error_mutex;
+    {
+        std::vector<std::jthread> pool;
+        pool.reserve(parts - 1);
+        for (std::size_t k = 1; k < parts; ++k)
+            pool.emplace_back([&, k] { run_part(job, context, k, error, error_mutex); });
+        run_part(job, context, 0, error, error_mutex);
+    } // joined here
+    if (error) std::rethrow_exception(error);
 }
 
 } // namespace plant::physics

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <type_traits>
 
 namespace plant::physics {
 
@@ -9,21 +10,22 @@ namespace plant::physics {
 // kept alive between calls (a step calls this about a dozen times; starting threads each time
 // cost more than the work they shared). When the kept threads are busy (a call from inside a
 // job, or from two threads at once), the parts run on threads started for this call instead.
+// Returns when every part has finished; if parts threw, rethrows the first part's exception.
 void run_parts(std::size_t parts, void (*job)(void* context, std::size_t k), void* context);
 
 // Runs f(begin, end) over [0, n) split into at most `threads` contiguous ranges of at least
-// `grain` indices. Each index is handled by exactly one call and writes only its own slots, so
-// the result does not depend on the thread count.
+// `grain` indices (one range when n is below twice the grain). Each index is handled by exactly
+// one call and writes only its own slots, so the result does not depend on the thread count.
 template <class F> void parallel_ranges(std::size_t n, int threads, std::size_t grain, F&& f) {
     const std::size_t want = threads > 1 ? static_cast<std::size_t>(threads) : 1;
-    const std::size_t most = n / grain + 1;
+    const std::size_t most = grain > 0 ? n / grain : n;
     const std::size_t t = want < most ? want : most;
     if (t <= 1) {
         f(std::size_t{0}, n);
         return;
     }
     struct Context {
-        F* f;
+        std::remove_reference_t<F>* f;
         std::size_t n, t;
     } context{&f, n, t};
     run_parts(

@@ -498,7 +498,7 @@ void World::frame_pair(const std::uint32_t (&group)[2], const std::vector<glm::d
         out.c = glm::dvec3(cx[l], cy[l], cz[l]);
         out.valid = true;
         if (!turn[l]) continue;
-        if (!(len[l] > 0)) { // glm::normalize's answer to a zero quaternion
+        if (len[l] <= 0) { // glm::normalize's answer to a zero quaternion (a NaN length stays NaN, as there)
             out.R = glm::dquat(1, 0, 0, 0);
             out.M = glm::mat3_cast(out.R);
             continue;

@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include <atomic>
+#include <stdexcept>
 #include <thread>
 #include <vector>
 
@@ -52,4 +53,21 @@ TEST_CASE("parallel: a split loop inside a part, and two callers at once") {
     a.join();
     b.join();
     CHECK(failures.load() == 0);
+}
+
+TEST_CASE("parallel: a part that throws") {
+    // every part still runs to its end, the exception comes out of the call, and the next call
+    // works as before
+    for (std::size_t bad : {0u, 1u}) {
+        INFO("throwing part " << bad);
+        std::atomic<int> ran{0};
+        CHECK_THROWS_AS(parallel_ranges(4096, 2, 16,
+                                        [&](std::size_t b, std::size_t) {
+                                            ran.fetch_add(1);
+                                            if ((b == 0) == (bad == 0)) throw std::runtime_error("part");
+                                        }),
+                        std::runtime_error);
+        CHECK(ran.load() == 2);
+        CHECK(covers_once(4096, 2, 16));
+    }
 }
