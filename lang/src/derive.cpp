@@ -237,9 +237,7 @@ bool Derivation::rewrite_direct(Rewriter& rw, const ModuleString& in, ModuleStri
                                 const Setup& setup) const {
     const std::size_t n = in.size();
     const auto T = static_cast<std::size_t>(threads);
-    Rewriter::Counts counts_one; // one thread: no allocation
-    std::vector<Rewriter::Counts> counts_many(T > 1 ? T : 0);
-    Rewriter::Counts* counts = T > 1 ? counts_many.data() : &counts_one;
+    std::vector<Rewriter::Counts> counts(T);
     auto bounds = [&](std::size_t t) { return std::pair{n * t / T, n * (t + 1) / T}; };
     auto parallel = [&](auto&& body) {
         if (T == 1) {
@@ -254,8 +252,7 @@ bool Derivation::rewrite_direct(Rewriter& rw, const ModuleString& in, ModuleStri
         counts[t] = rw.count_direct(b, e);
     });
     std::size_t modules = 0, params = 0;
-    for (std::size_t t = 0; t < T; ++t) {
-        const Rewriter::Counts& c = counts[t];
+    for (const auto& c : counts) {
         if (!c.ok) return false;
         modules += c.modules;
         params += c.params;
