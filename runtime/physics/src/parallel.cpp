@@ -58,9 +58,7 @@ public:
             round_.fetch_add(1, std::memory_order_release);
         }
         wake_.notify_all();
-        std::exception_ptr mine;
-        std::mutex unused;
-        run_part(job, context, 0, mine, unused);
+        run_part(job, context, 0, error_, error_mutex_);
         // every part finishes before this returns, also when part 0 threw: the others use the
         // caller's data. They are usually about as far along, so look briefly before sleeping.
         const std::size_t others = parts - 1;
@@ -69,7 +67,7 @@ public:
             std::unique_lock lock(mutex_);
             finished_.wait(lock, [&] { return done_.load(std::memory_order_acquire) >= others; });
         }
-        std::exception_ptr error = mine ? mine : error_;
+        std::exception_ptr error = error_;
         error_ = nullptr;
         busy_.store(false, std::memory_order_release);
         if (error) std::rethrow_exception(error);
@@ -113,7 +111,7 @@ private:
     std::atomic<std::uint64_t> round_{0}; // written under mutex_, also read without it
     std::atomic<std::size_t> done_{0};
     std::mutex error_mutex_;
-    std::exception_ptr error_; // the first part (after part 0) that threw, this call
+    std::exception_ptr error_; // what the first part to throw threw, this call
 };
 
 Crew& crew() {

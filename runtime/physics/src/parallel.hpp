@@ -10,7 +10,7 @@ namespace plant::physics {
 // kept alive between calls (a step calls this about a dozen times; starting threads each time
 // cost more than the work they shared). When the kept threads are busy (a call from inside a
 // job, or from two threads at once), the parts run on threads started for this call instead.
-// Returns when every part has finished; if parts threw, rethrows the first part's exception.
+// Returns when every part has finished; if parts threw, rethrows what the first to throw threw.
 void run_parts(std::size_t parts, void (*job)(void* context, std::size_t k), void* context);
 
 // Runs f(begin, end) over [0, n) split into at most `threads` contiguous ranges of at least

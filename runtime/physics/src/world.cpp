@@ -105,6 +105,21 @@ std::size_t World::components() const {
 
 namespace {
 
+// The turn by |omega| about omega as a quaternion (cos(w/2), sin(w/2) omega / w), given
+// w2 = |omega|^2: cw = cos(w/2), sw = sin(w/2) / w. Warm-started, the turns are small; below
+// w2 = 1e-4 the series to w^6 is exact to double precision (the next terms are below 1e-22)
+// and needs neither sqrt nor sincos. A template so that frame_pair's lanes (v2) compute it with
+// the same operations as the scalar code.
+template <class T> void small_turn(T w2, T& cw, T& sw) {
+    cw = 1.0 - w2 * (1.0 / 8.0 - w2 * (1.0 / 384.0 - w2 * (1.0 / 46080.0)));
+    sw = 0.5 - w2 * (1.0 / 48.0 - w2 * (1.0 / 3840.0 - w2 * (1.0 / 645120.0)));
+}
+void large_turn(double w2, double& cw, double& sw) {
+    const double w = std::sqrt(w2);
+    cw = std::cos(0.5 * w);
+    sw = std::sin(0.5 * w) / w;
+}
+
 // Müller et al. 2016, Eq. 10-12: turn R toward the columns of A about omega. Also gives R as a
 // matrix: the last one computed when the iterations stop on convergence. With `have_matrix`,
 // `matrix` holds q's already (a warm start from the last pass keeps it).
@@ -118,28 +133,17 @@ glm::dquat rotation_of(const glm::dmat3& A, glm::dquat q, int iterations, glm::d
         omega *= 1.0 / denom;
         const double w2 = glm::dot(omega, omega);
         if (!(w2 >= 1e-18)) break; // |omega| below 1e-9: converged, or nothing to match (zero A), or NaN
-        // the turn by |omega| about omega as a quaternion (cos(w/2), sin(w/2) omega / w). Warm
-        // started, the turns are small; there the series to w^6 is exact to double precision
-        // (the next terms are below 1e-22 for w < 0.01) and needs neither sqrt nor sincos.
-        double cw, sw; // cos(w/2) and sin(w/2) / w
-        if (w2 < 1e-4) {
-            cw = 1.0 - w2 * (1.0 / 8.0 - w2 * (1.0 / 384.0 - w2 * (1.0 / 46080.0)));
-            sw = 0.5 - w2 * (1.0 / 48.0 - w2 * (1.0 / 3840.0 - w2 * (1.0 / 645120.0)));
-        } else {
-            const double w = std::sqrt(w2);
-            cw = std::cos(0.5 * w);
-            sw = std::sin(0.5 * w) / w;
-        }
+        double cw, sw;
+        if (w2 < 1e-4)
+            small_turn(w2, cw, sw);
+        else
+            large_turn(w2, cw, sw);
         q = glm::normalize(glm::dquat(cw, omega.x * sw, omega.y * sw, omega.z * sw) * q);
         current = false;
     }
     if (!current) matrix = glm::mat3_cast(q);
     return q;
 }
-
-} // namespace
-
-namespace {
 
 // Two lanes of doubles (SSE2 on x86-64, NEON on arm64; GCC and Clang vector extensions). Each
 // lane does exactly the scalar code's operations in the same order, so results do not depend on
@@ -345,9 +349,9 @@ void World::group_frame(std::uint32_t i, glm::dquat warm, const glm::dmat3& mome
         cy += k->share * p.y;
         cz += k->share * p.z;
     }
-    glm::dmat3 A = moment; // += outer(x_k - c, mr_k), column j being (x_k - c) mr_k[j]
-    double a00 = A[0][0], a01 = A[0][1], a02 = A[0][2], a10 = A[1][0], a11 = A[1][1], a12 = A[1][2], a20 = A[2][0],
-           a21 = A[2][1], a22 = A[2][2];
+    // A = moment + the sum of outer(x_k - c, mr_k), column j being (x_k - c) mr_k[j]
+    double a00 = moment[0][0], a01 = moment[0][1], a02 = moment[0][2], a10 = moment[1][0], a11 = moment[1][1],
+           a12 = moment[1][2], a20 = moment[2][0], a21 = moment[2][1], a22 = moment[2][2];
     for (const auto* k = from; k < to; ++k) {
         const glm::dvec3& p = x[k->particle];
         const double dx = p.x - cx, dy = p.y - cy, dz = p.z - cz;
@@ -356,7 +360,7 @@ void World::group_frame(std::uint32_t i, glm::dquat warm, const glm::dmat3& mome
         a10 += dx * mr.y, a11 += dy * mr.y, a12 += dz * mr.y;
         a20 += dx * mr.z, a21 += dy * mr.z, a22 += dz * mr.z;
     }
-    A = glm::dmat3(a00, a01, a02, a10, a11, a12, a20, a21, a22);
+    const glm::dmat3 A(a00, a01, a02, a10, a11, a12, a20, a21, a22);
     out.c = glm::dvec3(cx, cy, cz);
     out.R = rotation_of(A, warm, iterations, out.M, warm_matrix);
     out.valid = true;
@@ -419,7 +423,6 @@ void World::build_groups(Groups& g) const {
     g.source_start[n] = static_cast<std::uint32_t>(g.source.size());
 }
 
-
 void World::frame_pair(const std::uint32_t (&group)[2], const std::vector<glm::dmat3>& moments, const Groups& g,
                        std::vector<Frame>& frames) const {
     // group_frame with one rotation iteration from the last pass's frame, for two groups with
@@ -469,30 +472,24 @@ void World::frame_pair(const std::uint32_t (&group)[2], const std::vector<glm::d
     for (auto& o : omega) o *= inv;
     const v2 w2 = (omega[0] * omega[0] + omega[1] * omega[1]) + omega[2] * omega[2];
     const m2 turn = w2 >= both(1e-18); // false: converged or NaN, the lane keeps its frame
-    if (!turn[0] && !turn[1]) {
-        for (int l = 0; l < 2; ++l) {
-            f[l]->c = glm::dvec3(cx[l], cy[l], cz[l]);
-            f[l]->valid = true;
-        }
-        return;
+    Quat2 n{};
+    Mat2 nm{};
+    v2 len{};
+    if (turn[0] || turn[1]) {
+        v2 cw, sw;
+        small_turn(w2, cw, sw);
+        for (int l = 0; l < 2; ++l)
+            if (turn[l] && !(w2[l] < 1e-4)) large_turn(w2[l], cw[l], sw[l]); // as rotation_of
+        const Quat2 p{cw, omega[0] * sw, omega[1] * sw, omega[2] * sw};
+        // p * q as glm multiplies quaternions, then glm::normalize
+        n = {p.w * q.w - p.x * q.x - p.y * q.y - p.z * q.z, p.w * q.x + p.x * q.w + p.y * q.z - p.z * q.y,
+             p.w * q.y + p.y * q.w + p.z * q.x - p.x * q.z, p.w * q.z + p.z * q.w + p.x * q.y - p.y * q.x};
+        const v2 len2 = (n.w * n.w + n.x * n.x) + (n.y * n.y + n.z * n.z);
+        len = v2{std::sqrt(len2[0]), std::sqrt(len2[1])};
+        const v2 one_over = both(1.0) / len;
+        n = {n.w * one_over, n.x * one_over, n.y * one_over, n.z * one_over};
+        nm = mat3_cast2(n);
     }
-    v2 cw = both(1.0) - w2 * (both(1.0 / 8.0) - w2 * (both(1.0 / 384.0) - w2 * both(1.0 / 46080.0)));
-    v2 sw = both(0.5) - w2 * (both(1.0 / 48.0) - w2 * (both(1.0 / 3840.0) - w2 * both(1.0 / 645120.0)));
-    for (int l = 0; l < 2; ++l)
-        if (turn[l] && !(w2[l] < 1e-4)) { // a large turn: as rotation_of computes it
-            const double w = std::sqrt(w2[l]);
-            cw[l] = std::cos(0.5 * w);
-            sw[l] = std::sin(0.5 * w) / w;
-        }
-    const Quat2 p{cw, omega[0] * sw, omega[1] * sw, omega[2] * sw};
-    // p * q as glm multiplies quaternions, then glm::normalize
-    Quat2 n{p.w * q.w - p.x * q.x - p.y * q.y - p.z * q.z, p.w * q.x + p.x * q.w + p.y * q.z - p.z * q.y,
-            p.w * q.y + p.y * q.w + p.z * q.x - p.x * q.z, p.w * q.z + p.z * q.w + p.x * q.y - p.y * q.x};
-    const v2 len2 = (n.w * n.w + n.x * n.x) + (n.y * n.y + n.z * n.z);
-    const v2 len{std::sqrt(len2[0]), std::sqrt(len2[1])};
-    const v2 one_over = both(1.0) / len;
-    n = {n.w * one_over, n.x * one_over, n.y * one_over, n.z * one_over};
-    const Mat2 nm = mat3_cast2(n);
     for (int l = 0; l < 2; ++l) {
         Frame& out = *f[l];
         out.c = glm::dvec3(cx[l], cy[l], cz[l]);
