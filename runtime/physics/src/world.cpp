@@ -804,13 +804,6 @@ void World::separate_particles() {
         const auto t = static_cast<std::int64_t>(u);
         return t - static_cast<std::int64_t>(static_cast<double>(t) > u);
     };
-    auto& cell_of = scratch_.cell_of;
-    cell_of.resize(n);
-    for (std::size_t i = 0; i < n; ++i)
-        if (alive_[i]) {
-            const glm::dvec3 u = x_[i] / cell;
-            cell_of[i] = glm::i64vec3(floor_of(u.x), floor_of(u.y), floor_of(u.z));
-        }
     // an open-addressing table from a cell's key to its run of particles in `members` (in index
     // order), built by counting: no sort. A slot holds the key and the run's bounds together, so
     // a lookup touches one cache line.
@@ -820,8 +813,12 @@ void World::separate_particles() {
     table.assign(size, Cell{});
     auto& slot_of = scratch_.slot_of;
     slot_of.assign(n, ~0u);
+    auto& cell_of = scratch_.cell_of;
+    cell_of.resize(n);
     for (std::uint32_t i = 0; i < n; ++i) {
         if (!alive_[i]) continue;
+        const glm::dvec3 u = x_[i] / cell;
+        cell_of[i] = glm::i64vec3(floor_of(u.x), floor_of(u.y), floor_of(u.z));
         const std::uint64_t k = hash(cell_of[i]);
         std::size_t slot = k & (size - 1);
         while (table[slot].end != 0 && table[slot].key != k) slot = (slot + 1) & (size - 1);
