@@ -87,6 +87,9 @@ const RulePlan& Derivation::step_plan() const {
 
 void Derivation::rewrite(const ModuleString& in, ModuleString& out, const RulePlan& plan, std::uint64_t phase,
                          int step_for_env) const {
+    const std::size_t n = in.size();
+    int threads = std::max(1, opt_.threads);
+    if (plan.sequential() || n < 20000) threads = 1;
     Rewriter rw(plan, in, &brackets_);
     auto setup = [&](Worker& w) {
         w.env.prog = &prog_;
@@ -99,15 +102,15 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const RulePl
         w.env.interrupt = opt_.interrupt;
         w.out.keep_ids = in.keep_ids;
     };
-    const std::size_t n = in.size();
-    int threads = std::max(1, opt_.threads);
-    if (rw.sequential() || n < 20000) threads = 1;
     out.clear();
     out.keep_ids = in.keep_ids;
-    if (!rw.sequential() && rewrite_direct(rw, in, out, threads, setup)) {
+    // The direct path needs every module's successor to be a direct template: a plan with
+    // symbols rewritten otherwise would find one in nearly every string, after counting up to it.
+    if (!rw.sequential() && plan.all_direct && rewrite_direct(rw, in, out, threads, setup)) {
         // done
     } else if (threads == 1) {
         Worker w;
+        w.out.swap(out); // writes into the arrays `out` has
         setup(w);
         w.env.id_base = next_id_; // one thread numbers new modules in string order directly
         w.out.sym.reserve(static_cast<std::size_t>(n * growth_ * 1.02) + 16);
@@ -428,11 +431,13 @@ bool Derivation::step() {
     // the turtle pass fills query modules and shows the environments the plant as it is now
     if ((plan.queries || !prog_.environments.empty()) && opt_.queries) opt_.queries->fill_queries(*this, current_);
     ModuleString next;
+    next.swap(spare_.s);
     ++step_;
     try {
         rewrite(current_, next, plan, static_cast<std::uint64_t>(step_) << 16, step_);
         current_.swap(next);
-        { ModuleString().swap(next); }
+        if (next.bytes() <= Spare::kMaxBytes) next.swap(spare_.s);
+        { ModuleString().swap(next); } // a large one is freed before decomposition
         decompose(current_, step_);
         apply_cut(current_);
     } catch (RuntimeError& e) {

@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <optional>
@@ -29,6 +30,7 @@ struct Worker {
     // context neighbours of the module at ctx_at, found once for all its productions
     std::size_t ctx_at = ~std::size_t{0};
     std::int64_t ctx_left = kUnknown, ctx_right = kUnknown;
+    std::vector<std::uint8_t> keys; // Rewriter::run_symbols's saved left keys past a depth of 64
 };
 
 // Whether some production of `rs` names a query module (?P, ?H, ...) in its predecessor or
@@ -78,6 +80,7 @@ struct RulePlan {
                     direct[s] = &pr;
                 break;
             }
+            all_direct = all_direct && (!has_prod[s] || direct[s]);
         }
         if (brackets && !multi && !left_new && !right_new) build_context_table();
         // Whether every symbol with productions is rewritten by a direct template or by the
@@ -99,7 +102,36 @@ struct RulePlan {
                 templated = false;
             }
         }
+        if (templated && max_params_out == 0 && max_modules_out <= SymbolSucc::kMax && !ctx_block.empty())
+            build_symbol_kernel();
+        if (!symbol_kernel) {
+            sym_rows.clear();
+            succ_at.clear();
+            succs.clear();
+        }
     }
+
+    // The symbol kernel's tables (see Rewriter::run_symbols). Every symbol has a row, and a
+    // block of successors: one (itself when copied, its direct template) or, for a symbol of
+    // the context table, one per pair of neighbour keys.
+    struct SymbolSucc { // symbols padded to kMax, so that writing one is one fixed-size copy
+        static constexpr std::size_t kMax = 8;
+        SymbolId syms[kMax] = {};
+        std::uint32_t len = 0;
+        std::uint32_t fresh = 0; // modules that get new identities
+    };
+    static constexpr std::uint8_t kIgnored = 1, kOpen = 2, kClose = 3; // shapes; 0: context sees it
+    struct SymbolRow {
+        std::uint32_t block = 0;           // its successors start at succ_at[block]
+        std::uint8_t lmask = 0, rmask = 0; // 0xff: the block is indexed by that neighbour's key
+        std::uint8_t shape : 4 = 0;
+        std::uint8_t table : 4 = 0;        // lmask or rmask is set
+        std::uint8_t key = 0;              // ctx_key
+    };
+    bool symbol_kernel = false; // Rewriter::run_symbols can rewrite strings without parameters
+    std::vector<SymbolRow> sym_rows;
+    std::vector<std::uint32_t> succ_at; // blocks of indices into succs
+    std::vector<SymbolSucc> succs;
 
     const Program& P;
     std::vector<const RuleSet*> sets;
@@ -116,10 +148,65 @@ struct RulePlan {
     bool brackets = false, multi = false, left_new = false, right_new = false;
     bool queries = false; // some pattern names a query module: the turtle pass fills them first
     bool templated = false;              // see the end of the constructor
+    bool all_direct = true;              // every symbol with productions has a direct template
+    // Whether a step must rewrite on one thread, left to right (or right to left for `>>`).
+    bool sequential() const { return multi || left_new || right_new; }
     std::size_t max_modules_out = 1;     // the longest template's modules (at least 1: a copy)
     std::size_t max_params_out = 0;      // and the most parameters a template holds
 
 private:
+    // The symbol kernel's tables. It needs every rewritten symbol to be parameterless: a direct
+    // template whose pattern takes no parameters, or a context table.
+    void build_symbol_kernel() {
+        const std::size_t S = P.symbols.size(), K = ctx_keys;
+        auto add = [&](const SuccessorTemplate& t) {
+            SymbolSucc su;
+            std::copy(t.syms.begin(), t.syms.end(), su.syms);
+            su.len = static_cast<std::uint32_t>(t.syms.size());
+            su.fresh = su.len - (t.keep >= 0 ? 1 : 0);
+            succs.push_back(su);
+            return static_cast<std::uint32_t>(succs.size() - 1);
+        };
+        std::vector<std::pair<const Production*, std::uint32_t>> seen; // each production once
+        auto add_production = [&](const Production& pr) {
+            for (const auto& [q, at] : seen)
+                if (q == &pr) return at;
+            seen.emplace_back(&pr, add(pr.tmpl));
+            return seen.back().second;
+        };
+        sym_rows.assign(S, SymbolRow{});
+        for (SymbolId sym = 0; sym < S; ++sym) {
+            SymbolRow& row = sym_rows[sym];
+            row.shape = sym == P.symbols.close_bracket ? kClose
+                      : sym == P.symbols.open_bracket  ? kOpen
+                      : P.ignored[sym]                 ? kIgnored
+                                                       : 0;
+            row.key = ctx_key[sym];
+            row.block = static_cast<std::uint32_t>(succ_at.size());
+            SymbolSucc self;
+            self.syms[0] = sym;
+            self.len = 1;
+            if (!has_prod[sym]) {
+                succs.push_back(self);
+                succ_at.push_back(static_cast<std::uint32_t>(succs.size() - 1));
+            } else if (direct[sym]) {
+                if (direct[sym]->strict[0].width != 0) return; // a pattern with parameters
+                succ_at.push_back(add_production(*direct[sym]));
+            } else { // templated: the context table has it
+                succs.push_back(self);
+                const auto self_at = static_cast<std::uint32_t>(succs.size() - 1);
+                row.lmask = ctx_sides[sym] & 1 ? 0xff : 0;
+                row.rmask = ctx_sides[sym] & 2 ? 0xff : 0;
+                row.table = (row.lmask | row.rmask) != 0;
+                for (std::size_t k = 0; k < K * K; ++k) {
+                    const Production* pr = ctx_entries[static_cast<std::size_t>(ctx_block[sym]) + k];
+                    succ_at.push_back(pr ? add_production(*pr) : self_at);
+                }
+            }
+        }
+        symbol_kernel = true;
+    }
+
     // The context table. When every production of a symbol is `l < s > r -> successor` with
     // modules that carry no parameters, at most one context module a side and no condition,
     // weight or new context (ABOP's Fig. 1.31 and other signal-propagation systems), which
@@ -209,7 +296,10 @@ public:
         return plan.ctx_entries[static_cast<std::size_t>(plan.ctx_block[sym]) + lk * plan.ctx_keys + rk];
     }
 
-    bool sequential() const { return plan.multi || plan.left_new || plan.right_new; }
+    bool sequential() const { return plan.sequential(); }
+
+    // Whether run_range rewrites this string with the symbol kernel (run_symbols).
+    bool kernel_applies() const { return plan.symbol_kernel && in.params.empty() && !in.keep_ids; }
 
     // Whether production `pr` (pattern, context and condition) matches at module i: the REPL's
     // :find. Binds the worker's frame.
@@ -382,6 +472,10 @@ public:
 
     // Rewrites modules [b, e) into w.out.
     void run_range(Worker& w, std::size_t b, std::size_t e) {
+        if (kernel_applies()) {
+            run_symbols(w, b, e);
+            return;
+        }
         if (plan.templated) {
             if (w.out.keep_ids)
                 run_templates<true>(w, b, e);
@@ -561,6 +655,114 @@ public:
         }
         close();
         if (out.size() > env.max_output || out.params.size() > env.max_params) limit_error(w);
+    }
+
+    // run_range for strings without parameters or identities under a plan with a symbol kernel
+    // (parameterless context-sensitive systems such as ABOP's Fig. 1.31). A module's successor
+    // comes from its symbol's block: itself, its direct template, or the context table's entry
+    // for its neighbours' keys; it is written as one fixed-size copy of padded symbols, and
+    // parameter offsets are all zero. The left neighbour is carried along the scan instead of
+    // searched for: the key of the last module context sees, saved at each '[' and taken back
+    // at its ']' (left_step settles a ']' whose '[' lies before b). The right one is found by a
+    // right_step that reads the symbols' shapes.
+    void run_symbols(Worker& w, std::size_t b, std::size_t e) {
+        using Plan = RulePlan;
+        ModuleString& out = w.out;
+        EvalEnv& env = w.env;
+        const SymbolId* in_sym = in.sym.data();
+        const Plan::SymbolRow* rows = plan.sym_rows.data();
+        const std::uint32_t* succ_at = plan.succ_at.data();
+        const Plan::SymbolSucc* succs = plan.succs.data();
+        const std::size_t K = plan.ctx_keys;
+        const std::size_t Mmax = plan.max_modules_out;
+        constexpr std::size_t kPad = Plan::SymbolSucc::kMax;
+        auto key_of = [&](std::int64_t j) -> std::size_t { return j < 0 ? 0 : rows[in_sym[j]].key; };
+        // (members copied to locals: the compiler need not reload them after each store)
+        const std::size_t N = n;
+        const std::uint32_t* const M = match;
+        auto right_key = [rows, in_sym, N, M](std::size_t j) -> std::size_t { // right_step(j)'s key
+            while (j < N) {
+                const Plan::SymbolRow r = rows[in_sym[j]];
+                if (r.shape == 0) return r.key;
+                if (r.shape == Plan::kOpen) {
+                    if (M[j] >= N) return 0;
+                    j = M[j] + 1;
+                } else if (r.shape == Plan::kClose) {
+                    return 0;
+                } else {
+                    ++j;
+                }
+            }
+            return 0;
+        };
+
+        const std::size_t p_end = out.params.size(); // every module written here has none
+        std::size_t m = out.size();
+        std::size_t left = b > 0 ? key_of(left_step(static_cast<std::int64_t>(b) - 1)) : 0;
+        // the left keys at the open '['s: here up to a depth of 64, deeper in w.keys
+        std::uint32_t saved[64];
+        std::size_t depth = 0;
+        w.keys.clear();
+        std::uint64_t fresh = 0;
+        std::size_t i = b, next_check = b + 65536;
+        out.sym.resize(std::max(out.sym.capacity(), m)); // the room reserved is written in place
+        while (i < e) {
+            // the modules that fit: each writes at most Mmax, and a copy writes kPad
+            std::size_t room = out.sym.size() >= m + kPad ? (out.sym.size() - m - kPad) / Mmax : 0;
+            if (room == 0) {
+                out.sym.resize(std::max(m + Mmax + kPad, 2 * out.sym.size()));
+                continue;
+            }
+            if (i >= next_check) {
+                next_check = i + 65536;
+                if (env.interrupt && env.interrupt->load()) throw RuntimeError{Span{}, "interrupted"};
+                if (m > env.max_output) {
+                    out.sym.resize(m);
+                    limit_error(w);
+                }
+            }
+            const std::size_t stop = std::min({e, i + room, next_check});
+            SymbolId* S = out.sym.data();
+            for (; i < stop; ++i) {
+                const Plan::SymbolRow row = rows[in_sym[i]];
+                std::size_t at = row.block;
+                if (row.table) at += (left & row.lmask) * K + (row.rmask ? right_key(i + 1) : 0);
+                const Plan::SymbolSucc& su = succs[succ_at[at]];
+                std::memcpy(S + m, su.syms, sizeof su.syms);
+                m += su.len;
+                fresh += su.fresh;
+                if (row.shape == 0) {
+                    left = row.key;
+                } else if (row.shape == Plan::kOpen) {
+                    if (depth < 64)
+                        saved[depth] = static_cast<std::uint32_t>(left);
+                    else
+                        w.keys.push_back(static_cast<std::uint8_t>(left));
+                    ++depth;
+                } else if (row.shape == Plan::kClose) {
+                    if (depth == 0) { // a branch opened before b, or never
+                        left = key_of(left_step(static_cast<std::int64_t>(i)));
+                        continue;
+                    }
+                    --depth;
+                    if (depth < 64) {
+                        left = saved[depth];
+                    } else {
+                        left = w.keys.back();
+                        w.keys.pop_back();
+                    }
+                }
+            }
+        }
+        if (m > env.max_output) {
+            out.sym.resize(m);
+            limit_error(w);
+        }
+        out.sym.resize(m);
+        const std::size_t m0 = out.poff.size();
+        out.poff.resize(m + 1);
+        std::fill(out.poff.begin() + static_cast<std::ptrdiff_t>(m0), out.poff.end(), static_cast<std::uint32_t>(p_end));
+        env.new_count += static_cast<ModuleId>(fresh);
     }
 
     // Backward processing for `>>`: modules right to left; each successor becomes a piece and

@@ -124,6 +124,16 @@ private:
     mutable std::vector<std::shared_ptr<const RulePlan>> plans_;
     mutable std::vector<const RulePlan*> step_plans_; // per group + 1 (index 0: no group), from plans_
     mutable std::vector<std::uint32_t> brackets_;     // the bracket table, kept from step to step
+    // The string a step replaced, when small, kept for the next step to write its output into:
+    // small strings would otherwise pay a round of allocations a step. Copies start without one.
+    struct Spare {
+        static constexpr std::size_t kMaxBytes = std::size_t{1} << 20;
+        ModuleString s;
+        Spare() = default;
+        Spare(const Spare&) {}
+        Spare& operator=(const Spare&) { return *this; }
+    };
+    Spare spare_;
 };
 
 // The positions where the first production of `rules` matches in the derivation's current string

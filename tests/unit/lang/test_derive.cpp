@@ -1,4 +1,5 @@
 #include "helpers.hpp"
+#include "rewriter.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -228,6 +229,87 @@ TEST_CASE("without identities: every rewriting route, on one and two threads", "
             o.threads = threads;
             same_without_identities(*c->program, o);
         }
+}
+
+// Strings without parameters under parameterless context rules go through the symbol kernel
+// (Rewriter::run_symbols) when identities are dropped, and through the general templated route
+// when they are kept: the two must agree module for module.
+TEST_CASE("the symbol kernel writes what the general route writes", "[derive][ids][kernel]") {
+    const char* grammars[] = {
+        // ABOP Fig. 1.31b and e at depth: the right context skips lateral branches
+        "ignore: + - F; axiom: F b F b F b; derive 30; "
+        "rules { a < a > a -> b; a < a > b -> b [ - F b F b ]; a < b > a -> b; a < b > b -> b; "
+        "        b < a > a -> a; b < a > b -> b F b; b < b > a -> b; b < b > b -> a; + -> -; - -> +; }",
+        "ignore: + - F; axiom: F b F b F b; derive 30; "
+        "rules { a < a > a -> b; a < a > b -> a [ + F b F b ]; a < b > a -> a; a < b > b -> a; "
+        "        b < a > a -> a; b < a > b -> b F b; b < b > a -> b; b < b > b -> a; + -> -; - -> +; }",
+        // unbalanced brackets: a ']' without its '[' and a '[' without its ']'
+        "axiom: b a ] a b [ a b a [ b; derive 8; rules { a < a -> b; b < a > b -> a a; a > b -> b [ a ]; b > a -> a; }",
+        // a left context only, a right context only, ignored symbols that are rewritten
+        "ignore: x; axiom: a x b x a; derive 12; rules { a < b -> b x a; b > a -> a; x -> y; y -> x x; }",
+    };
+    // nesting past the 64 levels the kernel keeps on its stack: a [ b [ b ... b ] b ] b ..., where
+    // each b after a ']' has for left neighbour the b before that branch's '['
+    std::string deep = "axiom: a";
+    for (int k = 0; k < 80; ++k) deep += " [ b";
+    for (int k = 0; k < 80; ++k) deep += " ] b";
+    deep += "; derive 5; rules { a < b -> b a; b < b -> c; c < b -> b [ c ]; c -> b; }";
+    std::vector<std::string> all(std::begin(grammars), std::end(grammars));
+    all.push_back(deep);
+    for (const std::string& g : all) {
+        INFO(g);
+        auto c = test::compile(g);
+        REQUIRE(c->program);
+        RulePlan plan(*c->program, {&c->program->rules});
+        CHECK(plan.symbol_kernel);
+        same_without_identities(*c->program, {});
+    }
+    // a string with parameters under such rules goes the general way: F(1) is stepped over
+    CHECK(derive("ignore: F; axiom: a F(1) b; derive 4; rules { a < b -> b a; b > a -> a; }") ==
+          "aF(1)baaaa");
+}
+
+// Two threads split a step's string in two; the kernel then settles the brackets whose partners
+// lie outside its stretch with the bracket table. Every split must give the whole run's output.
+TEST_CASE("the symbol kernel writes the same for any split of the string", "[derive][kernel]") {
+    const char* grammars[] = {
+        "ignore: + - F; axiom: F b F b F b; derive 14; "
+        "rules { a < a > a -> a; a < a > b -> b [ + F b F b ]; a < b > a -> b; a < b > b -> b; "
+        "        b < a > a -> a; b < a > b -> b F b; b < b > a -> a; b < b > b -> a; + -> -; - -> +; }",
+        "axiom: b a ] a b [ a b a [ b; derive 5; rules { a < a -> b; b < a > b -> a a; a > b -> b [ a ]; b > a -> a; }",
+    };
+    for (const char* g : grammars) {
+        INFO(g);
+        auto c = test::compile(g);
+        REQUIRE(c->program);
+        DeriveOptions o;
+        o.identities = false;
+        Derivation d(*c->program, o);
+        d.run();
+        const ModuleString& in = d.string();
+        RulePlan plan(*c->program, {&c->program->rules});
+        REQUIRE(plan.symbol_kernel);
+        auto run = [&](std::size_t b, std::size_t e) {
+            Rewriter rw(plan, in);
+            Worker w;
+            w.env.prog = c->program.get();
+            w.env.max_output = 1u << 30;
+            w.env.max_params = 1u << 30;
+            w.out.keep_ids = false;
+            rw.run_range(w, b, e);
+            return std::vector<SymbolId>(w.out.sym.begin(), w.out.sym.end());
+        };
+        const auto whole = run(0, in.size());
+        REQUIRE(in.size() >= 10);
+        REQUIRE(whole != std::vector<SymbolId>(in.sym.begin(), in.sym.end())); // the step rewrites
+        for (std::size_t k = 1; k < in.size(); ++k) {
+            auto split = run(0, k);
+            const auto rest = run(k, in.size());
+            split.insert(split.end(), rest.begin(), rest.end());
+            INFO("split at " << k);
+            CHECK(split == whole);
+        }
+    }
 }
 
 TEST_CASE("identities are kept when the program reads them, whatever the options say", "[derive][ids]") {
