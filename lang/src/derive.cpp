@@ -90,7 +90,7 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const RulePl
     const std::size_t n = in.size();
     int threads = std::max(1, opt_.threads);
     if (plan.sequential() || n < 20000) threads = 1;
-    Rewriter rw(plan, in, &brackets_);
+    Rewriter rw(plan, in, &brackets_, &kernel_scratch_, threads == 1);
     auto setup = [&](Worker& w) {
         w.env.prog = &prog_;
         w.env.globals = const_cast<double*>(globals_.data()); // read-only during rewriting

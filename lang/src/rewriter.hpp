@@ -30,7 +30,8 @@ struct Worker {
     // context neighbours of the module at ctx_at, found once for all its productions
     std::size_t ctx_at = ~std::size_t{0};
     std::int64_t ctx_left = kUnknown, ctx_right = kUnknown;
-    std::vector<std::uint8_t> keys; // Rewriter::run_symbols's saved left keys past a depth of 64
+    std::vector<std::uint8_t> keys;     // Rewriter::run_symbols's saved left keys past a depth of 64
+    std::vector<std::uint16_t> scratch; // and its right keys, when the rewriter has no buffer for them
 };
 
 // Whether some production of `rs` names a query module (?P, ?H, ...) in its predecessor or
@@ -271,8 +272,12 @@ class Rewriter {
 public:
     // `brackets`: where to build the bracket table (a buffer kept from step to step saves an
     // allocation each step); null: a buffer of the rewriter's own.
-    Rewriter(const RulePlan& rule_plan, const ModuleString& in, std::vector<std::uint32_t>* brackets = nullptr)
-        : plan(rule_plan), P(rule_plan.P), in(in), n(in.size()) {
+    // `whole`: run_range will be called once, for the whole string, by one thread. Then the
+    // symbol kernel needs no bracket table, and keeps its right keys in `scratch`.
+    Rewriter(const RulePlan& rule_plan, const ModuleString& in, std::vector<std::uint32_t>* brackets = nullptr,
+             std::vector<std::uint16_t>* scratch = nullptr, bool whole = false)
+        : plan(rule_plan), P(rule_plan.P), in(in), n(in.size()), kernel_scratch(whole ? scratch : nullptr) {
+        if (whole && kernel_applies()) return;
         if (plan.brackets) {
             std::vector<std::uint32_t>& table = brackets ? *brackets : own_match;
             bracket_table(in, P.symbols.open_bracket, P.symbols.close_bracket, table);
@@ -473,7 +478,10 @@ public:
     // Rewrites modules [b, e) into w.out.
     void run_range(Worker& w, std::size_t b, std::size_t e) {
         if (kernel_applies()) {
-            run_symbols(w, b, e);
+            if (match)
+                run_symbols<false>(w, b, e);
+            else
+                run_symbols<true>(w, b, e); // the whole string, with no bracket table
             return;
         }
         if (plan.templated) {
@@ -665,7 +673,7 @@ public:
     // searched for: the key of the last module context sees, saved at each '[' and taken back
     // at its ']' (left_step settles a ']' whose '[' lies before b). The right one is found by a
     // right_step that reads the symbols' shapes.
-    void run_symbols(Worker& w, std::size_t b, std::size_t e) {
+    template <bool Whole> void run_symbols(Worker& w, std::size_t b, std::size_t e) {
         using Plan = RulePlan;
         ModuleString& out = w.out;
         EvalEnv& env = w.env;
@@ -695,6 +703,33 @@ public:
             }
             return 0;
         };
+
+        // Over the whole string, the right neighbours' keys come from a right-to-left pass
+        // instead (there is no bracket table then): the key of the last module context sees,
+        // saved at each ']' and taken back at its '[' (going leftwards, a branch is entered at
+        // its ']'). A bracket without a partner has none.
+        const std::uint16_t* rkey = nullptr;
+        if constexpr (Whole) {
+            std::vector<std::uint16_t>& scratch = kernel_scratch ? *kernel_scratch : w.scratch;
+            scratch.resize(2 * n + 1);
+            std::uint16_t* keys = scratch.data();
+            std::uint16_t* stack = keys + n;
+            std::uint16_t right = 0;
+            std::size_t depth = 0;
+            for (std::size_t j = n; j-- > 0;) {
+                const Plan::SymbolRow r = rows[in_sym[j]];
+                keys[j] = right;
+                if (r.shape == 0) {
+                    right = r.key;
+                } else if (r.shape == Plan::kClose) {
+                    stack[depth++] = right;
+                    right = 0;
+                } else if (r.shape == Plan::kOpen) {
+                    right = depth ? stack[--depth] : 0;
+                }
+            }
+            rkey = keys;
+        }
 
         const std::size_t p_end = out.params.size(); // every module written here has none
         std::size_t m = out.size();
@@ -726,7 +761,10 @@ public:
             for (; i < stop; ++i) {
                 const Plan::SymbolRow row = rows[in_sym[i]];
                 std::size_t at = row.block;
-                if (row.table) at += (left & row.lmask) * K + (row.rmask ? right_key(i + 1) : 0);
+                if constexpr (Whole)
+                    at += (left & row.lmask) * K + (rkey[i] & row.rmask);
+                else if (row.table)
+                    at += (left & row.lmask) * K + (row.rmask ? right_key(i + 1) : 0);
                 const Plan::SymbolSucc& su = succs[succ_at[at]];
                 std::memcpy(S + m, su.syms, sizeof su.syms);
                 m += su.len;
@@ -741,7 +779,7 @@ public:
                     ++depth;
                 } else if (row.shape == Plan::kClose) {
                     if (depth == 0) { // a branch opened before b, or never
-                        left = key_of(left_step(static_cast<std::int64_t>(i)));
+                        left = Whole ? 0 : key_of(left_step(static_cast<std::int64_t>(i)));
                         continue;
                     }
                     --depth;
@@ -1183,6 +1221,7 @@ private:
     const ModuleString& in;
     const std::size_t n;
     std::vector<std::uint32_t> own_match;
+    std::vector<std::uint16_t>* kernel_scratch = nullptr; // run_symbols's right keys, kept from step to step
     const std::uint32_t* match = nullptr; // the bracket table (see bracket_table)
     std::vector<std::size_t> piece_starts;
 };

@@ -124,6 +124,7 @@ private:
     mutable std::vector<std::shared_ptr<const RulePlan>> plans_;
     mutable std::vector<const RulePlan*> step_plans_; // per group + 1 (index 0: no group), from plans_
     mutable std::vector<std::uint32_t> brackets_;     // the bracket table, kept from step to step
+    mutable std::vector<std::uint16_t> kernel_scratch_; // the symbol kernel's right keys (Rewriter::run_symbols)
     // The string a step replaced, when small, kept for the next step to write its output into:
     // small strings would otherwise pay a round of allocations a step. Copies start without one.
     struct Spare {
