@@ -109,8 +109,7 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const RulePl
     if (!rw.sequential() && plan.all_direct && rewrite_direct(rw, in, out, threads, setup)) {
         // done
     } else if (threads == 1) {
-        Worker w;
-        w.out.swap(out); // writes into the arrays `out` has
+        Worker w(std::move(out)); // writes into the arrays `out` has
         setup(w);
         w.env.id_base = next_id_; // one thread numbers new modules in string order directly
         w.out.sym.reserve(static_cast<std::size_t>(n * growth_ * 1.02) + 16);
@@ -134,7 +133,7 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const RulePl
                 check_limits(w.out);
             throw;
         }
-        out.swap(w.out);
+        out = std::move(w.out);
         next_id_ += w.env.new_count;
     } else {
         // Worker 0 writes into buffers sized for the whole output and numbers its new modules
@@ -430,14 +429,17 @@ bool Derivation::step() {
     const RulePlan& plan = step_plan();
     // the turtle pass fills query modules and shows the environments the plant as it is now
     if ((plan.queries || !prog_.environments.empty()) && opt_.queries) opt_.queries->fill_queries(*this, current_);
-    ModuleString next;
-    next.swap(spare_.s);
+    // (moved rather than swapped: an empty ModuleString would allocate its first offset; a
+    // moved-from one is only ever cleared, which restores it)
+    ModuleString next(std::move(spare_.s));
     ++step_;
     try {
         rewrite(current_, next, plan, static_cast<std::uint64_t>(step_) << 16, step_);
         current_.swap(next);
-        if (next.bytes() <= Spare::kMaxBytes) next.swap(spare_.s);
-        { ModuleString().swap(next); } // a large one is freed before decomposition
+        if (next.bytes() <= Spare::kMaxBytes)
+            spare_.s = std::move(next);
+        else
+            ModuleString().swap(next); // a large one is freed before decomposition
         decompose(current_, step_);
         apply_cut(current_);
     } catch (RuntimeError& e) {

@@ -23,6 +23,8 @@ constexpr std::uint64_t kChoiceDraw = 0xffffffffULL; // draw index of the stocha
 constexpr std::int64_t kUnknown = -2;
 
 struct Worker {
+    Worker() = default;
+    explicit Worker(ModuleString&& o) : out(std::move(o)) {}
     EvalEnv env;
     std::vector<double> frame;
     ModuleString out;
