@@ -112,10 +112,13 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const RulePl
         Worker w(std::move(out)); // writes into the arrays `out` has
         setup(w);
         w.env.id_base = next_id_; // one thread numbers new modules in string order directly
-        w.out.sym.reserve(static_cast<std::size_t>(n * growth_ * 1.02) + 16);
+        // A small string reserves twice what it expects: its arrays come back as the spare two
+        // steps on (see Derivation::step), and then still fit, instead of being reallocated.
+        auto room = [](std::size_t want) { return want < 65536 ? 2 * want : want; };
+        w.out.sym.reserve(room(static_cast<std::size_t>(n * growth_ * 1.02) + 16));
         if (w.out.keep_ids) w.out.ids.reserve(w.out.sym.capacity());
         w.out.poff.reserve(w.out.sym.capacity() + 1);
-        w.out.params.reserve(static_cast<std::size_t>(in.params.size() * param_growth_ * 1.02) + 16);
+        w.out.params.reserve(room(static_cast<std::size_t>(in.params.size() * param_growth_ * 1.02) + 16));
         try {
             if (plan.right_new) {
                 // right to left: new modules are marked, then numbered in string order
