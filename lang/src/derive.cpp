@@ -106,7 +106,7 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const RulePl
     out.keep_ids = in.keep_ids;
     // The direct path needs every module's successor to be a direct template: a plan with
     // symbols rewritten otherwise would find one in nearly every string, after counting up to it.
-    if (!rw.sequential() && plan.all_direct && rewrite_direct(rw, in, out, threads, setup)) {
+    if (!plan.sequential() && plan.all_direct && rewrite_direct(rw, in, out, threads, setup)) {
         // done
     } else if (threads == 1) {
         Worker w(std::move(out)); // writes into the arrays `out` has

@@ -32,8 +32,7 @@ struct Worker {
     // context neighbours of the module at ctx_at, found once for all its productions
     std::size_t ctx_at = ~std::size_t{0};
     std::int64_t ctx_left = kUnknown, ctx_right = kUnknown;
-    std::vector<std::uint8_t> keys;     // Rewriter::run_symbols's saved left keys past a depth of 64
-    std::vector<std::uint16_t> scratch; // and its right keys, when the rewriter has no buffer for them
+    std::vector<std::uint16_t> scratch; // Rewriter::run_symbols's keys, when the rewriter has no buffer for them
 };
 
 // Whether some production of `rs` names a query module (?P, ?H, ...) in its predecessor or
@@ -107,11 +106,6 @@ struct RulePlan {
         }
         if (templated && max_params_out == 0 && max_modules_out <= SymbolSucc::kMax && !ctx_block.empty())
             build_symbol_kernel();
-        if (!symbol_kernel) {
-            sym_rows.clear();
-            succ_at.clear();
-            succs.clear();
-        }
     }
 
     // The symbol kernel's tables (see Rewriter::run_symbols). Every symbol has a row, and a
@@ -127,8 +121,7 @@ struct RulePlan {
     struct SymbolRow {
         std::uint32_t block = 0;           // its successors start at succ_at[block]
         std::uint8_t lmask = 0, rmask = 0; // 0xff: the block is indexed by that neighbour's key
-        std::uint8_t shape : 4 = 0;
-        std::uint8_t table : 4 = 0;        // lmask or rmask is set
+        std::uint8_t shape = 0;
         std::uint8_t key = 0;              // ctx_key
     };
     bool symbol_kernel = false; // Rewriter::run_symbols can rewrite strings without parameters
@@ -162,6 +155,8 @@ private:
     // template whose pattern takes no parameters, or a context table.
     void build_symbol_kernel() {
         const std::size_t S = P.symbols.size(), K = ctx_keys;
+        for (SymbolId sym = 0; sym < S; ++sym)
+            if (has_prod[sym] && direct[sym] && direct[sym]->strict[0].width != 0) return; // a pattern with parameters
         auto add = [&](const SuccessorTemplate& t) {
             SymbolSucc su;
             std::copy(t.syms.begin(), t.syms.end(), su.syms);
@@ -193,14 +188,12 @@ private:
                 succs.push_back(self);
                 succ_at.push_back(static_cast<std::uint32_t>(succs.size() - 1));
             } else if (direct[sym]) {
-                if (direct[sym]->strict[0].width != 0) return; // a pattern with parameters
                 succ_at.push_back(add_production(*direct[sym]));
             } else { // templated: the context table has it
                 succs.push_back(self);
                 const auto self_at = static_cast<std::uint32_t>(succs.size() - 1);
                 row.lmask = ctx_sides[sym] & 1 ? 0xff : 0;
                 row.rmask = ctx_sides[sym] & 2 ? 0xff : 0;
-                row.table = (row.lmask | row.rmask) != 0;
                 for (std::size_t k = 0; k < K * K; ++k) {
                     const Production* pr = ctx_entries[static_cast<std::size_t>(ctx_block[sym]) + k];
                     succ_at.push_back(pr ? add_production(*pr) : self_at);
@@ -302,8 +295,6 @@ public:
         }
         return plan.ctx_entries[static_cast<std::size_t>(plan.ctx_block[sym]) + lk * plan.ctx_keys + rk];
     }
-
-    bool sequential() const { return plan.sequential(); }
 
     // Whether run_range rewrites this string with the symbol kernel (run_symbols).
     bool kernel_applies() const { return plan.symbol_kernel && in.params.empty() && !in.keep_ids; }
@@ -671,10 +662,11 @@ public:
     // (parameterless context-sensitive systems such as ABOP's Fig. 1.31). A module's successor
     // comes from its symbol's block: itself, its direct template, or the context table's entry
     // for its neighbours' keys; it is written as one fixed-size copy of padded symbols, and
-    // parameter offsets are all zero. The left neighbour is carried along the scan instead of
-    // searched for: the key of the last module context sees, saved at each '[' and taken back
-    // at its ']' (left_step settles a ']' whose '[' lies before b). The right one is found by a
-    // right_step that reads the symbols' shapes.
+    // parameter offsets are all zero. Neighbours are carried along rather than searched for:
+    // - the left key: the key of the last module context sees, saved at each '[' and taken back
+    //   at its ']' (left_step settles a ']' whose '[' lies before b);
+    // - over the whole string (Whole), the right keys come from one right-to-left pass that does
+    //   the same mirrored, and there is no bracket table; on a stretch, right_step finds them.
     template <bool Whole> void run_symbols(Worker& w, std::size_t b, std::size_t e) {
         using Plan = RulePlan;
         ModuleString& out = w.out;
@@ -687,35 +679,18 @@ public:
         const std::size_t Mmax = plan.max_modules_out;
         constexpr std::size_t kPad = Plan::SymbolSucc::kMax;
         auto key_of = [&](std::int64_t j) -> std::size_t { return j < 0 ? 0 : rows[in_sym[j]].key; };
-        // (members copied to locals: the compiler need not reload them after each store)
-        const std::size_t N = n;
-        const std::uint32_t* const M = match;
-        auto right_key = [rows, in_sym, N, M](std::size_t j) -> std::size_t { // right_step(j)'s key
-            while (j < N) {
-                const Plan::SymbolRow r = rows[in_sym[j]];
-                if (r.shape == 0) return r.key;
-                if (r.shape == Plan::kOpen) {
-                    if (M[j] >= N) return 0;
-                    j = M[j] + 1;
-                } else if (r.shape == Plan::kClose) {
-                    return 0;
-                } else {
-                    ++j;
-                }
-            }
-            return 0;
-        };
 
-        // Over the whole string, the right neighbours' keys come from a right-to-left pass
-        // instead (there is no bracket table then): the key of the last module context sees,
-        // saved at each ']' and taken back at its '[' (going leftwards, a branch is entered at
-        // its ']'). A bracket without a partner has none.
+        // The right-to-left pass: the key of the last module context sees, saved at each ']'
+        // and taken back at its '[' (going leftwards, a branch is entered at its ']'). A bracket
+        // without a partner has none.
+        // Both passes keep their saved keys on `stack`, which is as deep as the stretch is long.
         const std::uint16_t* rkey = nullptr;
+        std::uint16_t* stack = nullptr;
         if constexpr (Whole) {
             std::vector<std::uint16_t>& scratch = kernel_scratch ? *kernel_scratch : w.scratch;
             scratch.resize(2 * n + 1);
             std::uint16_t* keys = scratch.data();
-            std::uint16_t* stack = keys + n;
+            stack = keys + n;
             std::uint16_t right = 0;
             std::size_t depth = 0;
             for (std::size_t j = n; j-- > 0;) {
@@ -731,15 +706,15 @@ public:
                 }
             }
             rkey = keys;
+        } else {
+            w.scratch.resize(e - b + 1);
+            stack = w.scratch.data();
         }
 
         const std::size_t p_end = out.params.size(); // every module written here has none
         std::size_t m = out.size();
         std::size_t left = b > 0 ? key_of(left_step(static_cast<std::int64_t>(b) - 1)) : 0;
-        // the left keys at the open '['s: here up to a depth of 64, deeper in w.keys
-        std::uint32_t saved[64];
-        std::size_t depth = 0;
-        w.keys.clear();
+        std::size_t depth = 0; // the left keys at the open '['s are on the stack
         std::uint64_t fresh = 0;
         std::size_t i = b, next_check = b + 65536;
         out.sym.resize(std::max(out.sym.capacity(), m)); // the room reserved is written in place
@@ -763,10 +738,12 @@ public:
             for (; i < stop; ++i) {
                 const Plan::SymbolRow row = rows[in_sym[i]];
                 std::size_t at = row.block;
-                if constexpr (Whole)
+                if constexpr (Whole) {
                     at += (left & row.lmask) * K + (rkey[i] & row.rmask);
-                else if (row.table)
-                    at += (left & row.lmask) * K + (row.rmask ? right_key(i + 1) : 0);
+                } else if (row.lmask | row.rmask) {
+                    const std::size_t j = row.rmask ? right_step(i + 1) : n;
+                    at += (left & row.lmask) * K + (j < n ? rows[in_sym[j]].key : 0);
+                }
                 const Plan::SymbolSucc& su = succs[succ_at[at]];
                 std::memcpy(S + m, su.syms, sizeof su.syms);
                 m += su.len;
@@ -774,23 +751,12 @@ public:
                 if (row.shape == 0) {
                     left = row.key;
                 } else if (row.shape == Plan::kOpen) {
-                    if (depth < 64)
-                        saved[depth] = static_cast<std::uint32_t>(left);
-                    else
-                        w.keys.push_back(static_cast<std::uint8_t>(left));
-                    ++depth;
+                    stack[depth++] = static_cast<std::uint16_t>(left);
                 } else if (row.shape == Plan::kClose) {
-                    if (depth == 0) { // a branch opened before b, or never
+                    if (depth == 0) // a branch opened before b, or never
                         left = Whole ? 0 : key_of(left_step(static_cast<std::int64_t>(i)));
-                        continue;
-                    }
-                    --depth;
-                    if (depth < 64) {
-                        left = saved[depth];
-                    } else {
-                        left = w.keys.back();
-                        w.keys.pop_back();
-                    }
+                    else
+                        left = stack[--depth];
                 }
             }
         }

@@ -248,7 +248,7 @@ TEST_CASE("the symbol kernel writes what the general route writes", "[derive][id
         // a left context only, a right context only, ignored symbols that are rewritten
         "ignore: x; axiom: a x b x a; derive 12; rules { a < b -> b x a; b > a -> a; x -> y; y -> x x; }",
     };
-    // nesting past the 64 levels the kernel keeps on its stack: a [ b [ b ... b ] b ] b ..., where
+    // deep nesting, 80 levels of saved left keys: a [ b [ b ... b ] b ] b ..., where
     // each b after a ']' has for left neighbour the b before that branch's '['
     std::string deep = "axiom: a";
     for (int k = 0; k < 80; ++k) deep += " [ b";
