@@ -3,7 +3,7 @@ BUILD ?= build
 JOBS ?= 2
 CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
 
-.PHONY: all deps configure build demo test bench format clean
+.PHONY: all deps configure build demo test bench format format-check clean
 
 all: build
 
@@ -22,14 +22,21 @@ demo: build
 	@mkdir -p out
 	bash scripts/demo
 
-test: build
+test: build format-check
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
 bench: build
 	bash bench/run
 
+# Every tracked C++ file, formatted by .clang-format (Debian's clang-format 14, from install-deps).
+FORMAT_FILES = git ls-files -z -- '*.cpp' '*.hpp' '*.h'
+
 format:
-	find lang cli runtime tests bench -name '*.cpp' -o -name '*.hpp' | xargs clang-format -i
+	$(FORMAT_FILES) | xargs -0 clang-format -i
+
+format-check: | deps
+	@$(FORMAT_FILES) | xargs -0 clang-format --dry-run --Werror \
+	  || { echo "format-check: run 'make format' and commit the result" >&2; exit 1; }
 
 clean:
 	rm -rf $(BUILD) out

@@ -9,9 +9,9 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
-#include <vector>
 #include <sys/resource.h>
 #include <unistd.h>
+#include <vector>
 
 namespace plant::cli {
 
@@ -57,10 +57,12 @@ int derive_main(const DeriveCmd& c) {
         double total_ms = 0;
         for (const StepStats& s : steps) {
             total_ms += s.ms;
-            stats_out += fmt::format("step {} modules={} bytes={} ms={:.4f}\n", s.step, s.modules, s.bytes, s.ms);
+            stats_out +=
+                fmt::format("step {} modules={} bytes={} ms={:.4f}\n", s.step, s.modules, s.bytes, s.ms);
         }
-        stats_out += fmt::format("total steps={} modules={} bytes={} ms={:.4f} peak_rss_kb={}\n", d.steps_done(),
-                                 d.string().size(), d.string().bytes(), total_ms, peak_rss_kb());
+        stats_out +=
+            fmt::format("total steps={} modules={} bytes={} ms={:.4f} peak_rss_kb={}\n", d.steps_done(),
+                        d.string().size(), d.string().bytes(), total_ms, peak_rss_kb());
         std::fwrite(stats_out.data(), 1, stats_out.size(), stdout);
         return kOk;
     }

@@ -35,11 +35,12 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 int run_main(RunCmd& c) {
     // check the outputs before doing any work
     int width = 0, height = 0;
-    if (std::sscanf(c.size.c_str(), "%dx%d", &width, &height) != 2 || width < 16 || height < 16 || width > 16384 ||
-        height > 16384 || static_cast<long long>(width) * height > 64LL * 1000 * 1000) {
-        std::cerr << fmt::format("plant: --size expects WIDTHxHEIGHT, each from 16 to 16384 and at most 64 million "
-                                 "pixels, found '{}'\n",
-                                 c.size);
+    if (std::sscanf(c.size.c_str(), "%dx%d", &width, &height) != 2 || width < 16 || height < 16 ||
+        width > 16384 || height > 16384 || static_cast<long long>(width) * height > 64LL * 1000 * 1000) {
+        std::cerr << fmt::format(
+            "plant: --size expects WIDTHxHEIGHT, each from 16 to 16384 and at most 64 million "
+            "pixels, found '{}'\n",
+            c.size);
         return kUsage;
     }
     if (c.outputs.empty()) {
@@ -48,7 +49,8 @@ int run_main(RunCmd& c) {
     }
     for (const auto& o : c.outputs) {
         if (!format_of(o)) {
-            std::cerr << fmt::format("plant: cannot tell the format of '{}': use {}\n", o, known_extensions());
+            std::cerr << fmt::format("plant: cannot tell the format of '{}': use {}\n", o,
+                                     known_extensions());
             return kUsage;
         }
     }
@@ -92,7 +94,8 @@ int run_main(RunCmd& c) {
 
 void setup_run(CLI::App& app, int& exit_code) {
     auto c = std::make_shared<RunCmd>();
-    CLI::App* cmd = app.add_subcommand("run", "Grow a grammar and write meshes, images, skeletons or strings");
+    CLI::App* cmd =
+        app.add_subcommand("run", "Grow a grammar and write meshes, images, skeletons or strings");
     add_grammar_options(*cmd, c->g, true);
     cmd->add_option("-o,--output", c->outputs,
                     "Output file, chosen by extension: .glb .gltf .obj .ply .off .png .svg .txt .skel.json "

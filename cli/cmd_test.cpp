@@ -18,11 +18,11 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <fcntl.h>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <regex>
-#include <fcntl.h>
 #include <spawn.h>
 #include <sstream>
 #include <sys/wait.h>
@@ -152,20 +152,23 @@ Expectations read_expectations(const std::string& text) {
 }
 
 // Diagnostics from stderr as "LINE:COL: message" (or the bare message when it has no place).
-void parse_diagnostics(const std::string& err, std::vector<std::string>& errors, std::vector<std::string>& warnings) {
+void parse_diagnostics(const std::string& err, std::vector<std::string>& errors,
+                       std::vector<std::string>& warnings) {
     static const std::regex placed(R"(^.*?:(\d+):(\d+): (error|warning): (.*)$)");
     static const std::regex bare(R"(^plant: (error|warning): (.*)$)");
     for (const auto& line : lines_of(err)) {
         std::smatch m;
         if (std::regex_match(line, m, placed)) {
-            (m[3] == "error" ? errors : warnings).push_back(fmt::format("{}:{}: {}", m[1].str(), m[2].str(), m[4].str()));
+            (m[3] == "error" ? errors : warnings)
+                .push_back(fmt::format("{}:{}: {}", m[1].str(), m[2].str(), m[4].str()));
         } else if (std::regex_match(line, m, bare)) {
             (m[1] == "error" ? errors : warnings).push_back(m[2].str());
         }
     }
 }
 
-std::string compare_lists(const char* what, const std::vector<std::string>& want, const std::vector<std::string>& got) {
+std::string compare_lists(const char* what, const std::vector<std::string>& want,
+                          const std::vector<std::string>& got) {
     std::string msg;
     for (std::size_t i = 0; i < std::max(want.size(), got.size()); ++i) {
         if (i < want.size() && i < got.size() && want[i] == got[i]) continue;
@@ -184,8 +187,9 @@ std::string first_difference(const std::string& want, const std::string& got) {
         std::replace(e.begin(), e.end(), '\n', ' ');
         return e;
     };
-    return fmt::format("  differs at byte {} (expected {} bytes, got {})\n    expected: ...{}\n    got:      ...{}\n", i,
-                       want.size(), got.size(), excerpt(want), excerpt(got));
+    return fmt::format(
+        "  differs at byte {} (expected {} bytes, got {})\n    expected: ...{}\n    got:      ...{}\n", i,
+        want.size(), got.size(), excerpt(want), excerpt(got));
 }
 
 bool write_atomically(const fs::path& path, const std::string& text) {
@@ -210,7 +214,8 @@ std::string run_one(const fs::path& file, bool bless, bool& blessed) {
         parse_diagnostics(o.err, errors, warnings);
         std::string msg;
         int want_exit = e.exit_code ? *e.exit_code : (e.errors.empty() ? 0 : 65);
-        if (o.exit_code != want_exit) msg += fmt::format("  exit code: expected {}, got {}\n", want_exit, o.exit_code);
+        if (o.exit_code != want_exit)
+            msg += fmt::format("  exit code: expected {}, got {}\n", want_exit, o.exit_code);
         msg += compare_lists("error", e.errors, errors);
         msg += compare_lists("warning", e.warnings, warnings);
         if (!e.out.empty() || o.exit_code == 0) {
@@ -254,12 +259,15 @@ std::string run_one(const fs::path& file, bool bless, bool& blessed) {
     }
     std::string want;
     if (!read_file(sidecar.string(), want))
-        return fmt::format("  no expectations: add '# expect' comments or create {} with --bless\n", sidecar.string());
+        return fmt::format("  no expectations: add '# expect' comments or create {} with --bless\n",
+                           sidecar.string());
     if (want != o.out) return first_difference(want, o.out);
     if (fs::exists(mesh_sidecar)) {
         std::string want_mesh;
         read_file(mesh_sidecar.string(), want_mesh);
-        if (want_mesh != mesh) return "  mesh summary (" + mesh_sidecar.filename().string() + ") differs\n" + first_difference(want_mesh, mesh);
+        if (want_mesh != mesh)
+            return "  mesh summary (" + mesh_sidecar.filename().string() + ") differs\n" +
+                   first_difference(want_mesh, mesh);
     }
     return {};
 }
@@ -279,7 +287,8 @@ int test_main(const TestCmd& c) {
             fs::recursive_directory_iterator it(p, fs::directory_options::skip_permission_denied, ec), end;
             for (; !ec && it != end; it.increment(ec)) {
                 std::error_code fe;
-                if (it->is_regular_file(fe) && it->path().extension() == ".plant") files.push_back(it->path());
+                if (it->is_regular_file(fe) && it->path().extension() == ".plant")
+                    files.push_back(it->path());
             }
         } else if (fs::exists(p, ec)) {
             files.emplace_back(p);
@@ -306,7 +315,8 @@ int test_main(const TestCmd& c) {
             std::cout << "FAIL " << f.string() << "\n" << msg;
         }
     }
-    if (c.bless) std::cout << fmt::format("{} sidecar{} rewritten\n", blessed_count, blessed_count == 1 ? "" : "s");
+    if (c.bless)
+        std::cout << fmt::format("{} sidecar{} rewritten\n", blessed_count, blessed_count == 1 ? "" : "s");
     std::cout << fmt::format("{} passed, {} failed\n", passed, failed);
     return failed == 0 && !files.empty() ? kOk : kFailed;
 }
@@ -317,7 +327,8 @@ void setup_test(CLI::App& app, int& exit_code) {
     auto c = std::make_shared<TestCmd>();
     CLI::App* cmd = app.add_subcommand("test", "Run golden-file and script tests of grammars");
     cmd->add_option("PATH", c->paths, "Grammar files or directories (default: grammars)");
-    cmd->add_flag("--bless", c->bless, "Rewrite the golden sidecars from the current output (review the diff!)");
+    cmd->add_flag("--bless", c->bless,
+                  "Rewrite the golden sidecars from the current output (review the diff!)");
     cmd->add_flag("-v,--verbose", c->verbose, "List passing tests too");
     cmd->callback([c, &exit_code] { exit_code = test_main(*c); });
 }

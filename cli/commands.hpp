@@ -13,7 +13,15 @@ namespace plant::cli {
 
 // Exit codes (sysexits.h): usage 64, unreadable input 66, grammar error 65, runtime error 70.
 // 73: an output file cannot be created.
-enum Exit { kOk = 0, kFailed = 1, kUsage = 64, kGrammar = 65, kNoInput = 66, kRuntime = 70, kCantCreate = 73 };
+enum Exit {
+    kOk = 0,
+    kFailed = 1,
+    kUsage = 64,
+    kGrammar = 65,
+    kNoInput = 66,
+    kRuntime = 70,
+    kCantCreate = 73
+};
 
 // Options shared by the commands that compile and derive a grammar.
 struct GrammarOptions {

@@ -15,16 +15,20 @@ void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation) {
     cmd.add_option("FILE", o.file, "The .plant grammar")->required();
     cmd.add_option("-D,--define", o.defines, "Override a param: -D name=value (value is an expression)")
         ->type_name("NAME=VALUE");
-    cmd.add_option("-I,--include", o.include_dirs, "Add a directory to the library search path")->type_name("DIR");
+    cmd.add_option("-I,--include", o.include_dirs, "Add a directory to the library search path")
+        ->type_name("DIR");
     if (derivation) {
-        cmd.add_option("-n,--steps", o.steps, "Number of derivation steps (default: the grammar's 'derive N;')")
+        cmd.add_option("-n,--steps", o.steps,
+                       "Number of derivation steps (default: the grammar's 'derive N;')")
             ->check(CLI::Range(0, 1000000));
         cmd.add_option("--seed", o.seed, "Random seed (default: the grammar's 'seed S;', else 0)");
-        cmd.add_option("--threads", o.threads, "Rewriting threads; 0 means one per core. The result never depends "
-                                               "on it")
+        cmd.add_option("--threads", o.threads,
+                       "Rewriting threads; 0 means one per core. The result never depends "
+                       "on it")
             ->check(CLI::Range(0, 256));
-        cmd.add_option("--max-modules", o.max_modules, "Stop with an error when the string grows past this many "
-                                                       "modules")
+        cmd.add_option("--max-modules", o.max_modules,
+                       "Stop with an error when the string grows past this many "
+                       "modules")
             ->check(CLI::PositiveNumber);
     }
     o.color = isatty(2) != 0 && std::getenv("NO_COLOR") == nullptr;
@@ -58,7 +62,8 @@ std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& so
     auto program = compile_source(sources, id, co, diags);
     std::cerr << render_all(diags, sources, o.color);
     if (diags.error_count() > diags.all().size())
-        std::cerr << fmt::format("plant: {} more errors not shown\n", diags.error_count() - diags.all().size());
+        std::cerr << fmt::format("plant: {} more errors not shown\n",
+                                 diags.error_count() - diags.all().size());
     if (!program) exit_code = kGrammar;
     return program;
 }
@@ -67,7 +72,8 @@ DeriveOptions derive_options(const GrammarOptions& o) {
     DeriveOptions d;
     d.steps = o.steps;
     d.seed = o.seed;
-    d.threads = o.threads > 0 ? o.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    d.threads =
+        o.threads > 0 ? o.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     d.max_modules = o.max_modules;
     return d;
 }

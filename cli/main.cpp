@@ -8,9 +8,10 @@
 
 int main(int argc, char** argv) {
     using namespace plant::cli;
-    CLI::App app{"plant: an interpreter for the .plant L-system language.\n"
-                 "Grammars are parametric, context-sensitive and stochastic L-systems (see docs/language.md).",
-                 "plant"};
+    CLI::App app{
+        "plant: an interpreter for the .plant L-system language.\n"
+        "Grammars are parametric, context-sensitive and stochastic L-systems (see docs/language.md).",
+        "plant"};
     app.require_subcommand(1);
     app.set_help_all_flag("--help-all", "Show help for every command");
     int exit_code = kOk;

@@ -25,17 +25,19 @@ std::string mesh_summary(const Scene& s) {
         vertices += p.positions.size();
         triangles += p.triangle_count();
     }
-    return fmt::format("vertices {}\ntriangles {}\nprototypes {}\ninstances {}\nbounds {:.4f} {:.4f} {:.4f} {:.4f} "
-                       "{:.4f} {:.4f}\n",
-                       vertices, triangles, s.prototypes.size(), s.instances.size(), s.bounds_min.x, s.bounds_min.y,
-                       s.bounds_min.z, s.bounds_max.x, s.bounds_max.y, s.bounds_max.z);
+    return fmt::format(
+        "vertices {}\ntriangles {}\nprototypes {}\ninstances {}\nbounds {:.4f} {:.4f} {:.4f} {:.4f} "
+        "{:.4f} {:.4f}\n",
+        vertices, triangles, s.prototypes.size(), s.instances.size(), s.bounds_min.x, s.bounds_min.y,
+        s.bounds_min.z, s.bounds_max.x, s.bounds_max.y, s.bounds_max.z);
 }
 
 } // namespace
 
 std::optional<Format> format_of(const std::string& given) {
     std::string path = given;
-    std::transform(path.begin(), path.end(), path.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    std::transform(path.begin(), path.end(), path.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
     auto ends = [&](const char* ext) {
         std::string e = ext;
         return path.size() > e.size() && path.compare(path.size() - e.size(), e.size(), e) == 0;
@@ -53,8 +55,9 @@ std::optional<Format> format_of(const std::string& given) {
     return std::nullopt;
 }
 
-
-const char* known_extensions() { return ".glb .gltf .obj .ply .off .png .svg .txt .skel.json or .mesh.txt"; }
+const char* known_extensions() {
+    return ".glb .gltf .obj .ply .off .png .svg .txt .skel.json or .mesh.txt";
+}
 
 // The environments' obstacles as one more prototype, placed once where it is: flat-shaded
 // triangles in a stone grey.
@@ -84,16 +87,18 @@ static void add_environments(const Program& program, Scene& scene) {
     part.primitives.push_back(Primitive{0, static_cast<std::uint32_t>(part.indices.size()), material});
     scene.prototypes.push_back(std::move(part));
     scene.prototype_names.push_back("obstacles");
-    scene.instances.push_back(Instance{static_cast<std::uint32_t>(scene.prototypes.size() - 1), glm::mat4(1.0f)});
+    scene.instances.push_back(
+        Instance{static_cast<std::uint32_t>(scene.prototypes.size() - 1), glm::mat4(1.0f)});
     scene.update_bounds();
 }
 
-OutputSummary write_outputs(const Program& program, const Derivation& d, const std::vector<std::string>& paths,
-                            const OutputOptions& options) {
+OutputSummary write_outputs(const Program& program, const Derivation& d,
+                            const std::vector<std::string>& paths, const OutputOptions& options) {
     std::vector<Format> formats;
     for (const auto& p : paths) {
         auto f = format_of(p);
-        if (!f) throw ExportError(fmt::format("cannot tell the format of '{}': use {}", p, known_extensions()));
+        if (!f)
+            throw ExportError(fmt::format("cannot tell the format of '{}': use {}", p, known_extensions()));
         formats.push_back(*f);
     }
     bool need_skeleton = false, need_scene = false;
@@ -103,9 +108,7 @@ OutputSummary write_outputs(const Program& program, const Derivation& d, const s
     }
     Skeleton skeleton;
     Scene scene;
-    if (need_skeleton)
-        skeleton = build_skeleton(program, d.interpreted(d.string()),
-                                  turtle_options(d));
+    if (need_skeleton) skeleton = build_skeleton(program, d.interpreted(d.string()), turtle_options(d));
     if (need_scene) {
         MeshOptions mo;
         mo.sides = options.sides;
@@ -122,34 +125,49 @@ OutputSummary write_outputs(const Program& program, const Derivation& d, const s
         }
     };
     try {
-    for (std::size_t k = 0; k < formats.size(); ++k) {
-        const fs::path target(paths[k]);
-        fs::path parent = target.parent_path();
-        std::error_code ec;
-        if (!parent.empty()) fs::create_directories(parent, ec);
-        std::string name = target.filename().string();
-        std::string path = (parent / ("." + name + ".plant-tmp" + std::to_string(::getpid()) + "-" + std::to_string(k) +
-                                      name.substr(name.find('.') == std::string::npos ? name.size() : name.find('.'))))
-                               .string();
-        temps.push_back(path);
-        switch (formats[k]) {
-        case Format::Glb:
-        case Format::Gltf: write_gltf(scene, path); break;
-        case Format::Obj:
-        case Format::Ply:
-        case Format::Off: write_mesh_file(scene, path); break;
-        case Format::Png: write_png(scene, path, options.width, options.height); break;
-        case Format::Svg: write_svg(skeleton, path); break;
-        case Format::Skeleton: write_skeleton_json(skeleton, path); break;
-        case Format::Txt: write_file_atomically(path, format_string(program, d.string()) + "\n"); break;
-        case Format::MeshSummary: write_file_atomically(path, mesh_summary(scene)); break;
+        for (std::size_t k = 0; k < formats.size(); ++k) {
+            const fs::path target(paths[k]);
+            fs::path parent = target.parent_path();
+            std::error_code ec;
+            if (!parent.empty()) fs::create_directories(parent, ec);
+            std::string name = target.filename().string();
+            std::string path =
+                (parent / ("." + name + ".plant-tmp" + std::to_string(::getpid()) + "-" + std::to_string(k) +
+                           name.substr(name.find('.') == std::string::npos ? name.size() : name.find('.'))))
+                    .string();
+            temps.push_back(path);
+            switch (formats[k]) {
+            case Format::Glb:
+            case Format::Gltf:
+                write_gltf(scene, path);
+                break;
+            case Format::Obj:
+            case Format::Ply:
+            case Format::Off:
+                write_mesh_file(scene, path);
+                break;
+            case Format::Png:
+                write_png(scene, path, options.width, options.height);
+                break;
+            case Format::Svg:
+                write_svg(skeleton, path);
+                break;
+            case Format::Skeleton:
+                write_skeleton_json(skeleton, path);
+                break;
+            case Format::Txt:
+                write_file_atomically(path, format_string(program, d.string()) + "\n");
+                break;
+            case Format::MeshSummary:
+                write_file_atomically(path, mesh_summary(scene));
+                break;
+            }
         }
-    }
-    for (std::size_t k = 0; k < temps.size(); ++k) {
-        std::error_code ec;
-        fs::rename(temps[k], paths[k], ec);
-        if (ec) throw ExportError(fmt::format("cannot write '{}': {}", paths[k], ec.message()));
-    }
+        for (std::size_t k = 0; k < temps.size(); ++k) {
+            std::error_code ec;
+            fs::rename(temps[k], paths[k], ec);
+            if (ec) throw ExportError(fmt::format("cannot write '{}': {}", paths[k], ec.message()));
+        }
     } catch (...) {
         discard();
         throw;

@@ -26,7 +26,7 @@ struct OutputOptions {
 struct OutputSummary {
     std::size_t triangles = 0, organs = 0;
 };
-OutputSummary write_outputs(const Program& program, const Derivation& d, const std::vector<std::string>& paths,
-                            const OutputOptions& options);
+OutputSummary write_outputs(const Program& program, const Derivation& d,
+                            const std::vector<std::string>& paths, const OutputOptions& options);
 
 } // namespace plant::cli

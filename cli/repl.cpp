@@ -32,7 +32,9 @@ std::optional<std::uint64_t> whole_number(const std::string& text) {
     return v;
 }
 
-std::string modules(std::size_t n) { return fmt::format("{} module{}", n, n == 1 ? "" : "s"); }
+std::string modules(std::size_t n) {
+    return fmt::format("{} module{}", n, n == 1 ? "" : "s");
+}
 
 std::string trim(const std::string& s) {
     std::size_t b = s.find_first_not_of(" \t\r\n"), e = s.find_last_not_of(" \t\r\n");
@@ -47,21 +49,27 @@ struct CommandInfo {
 
 const CommandInfo kCommands[] = {
     {"load", ":load FILE", "read a grammar file; the session starts again at step 0"},
-    {"reload", ":reload", "read the file again, keep :set values and typed rules, replay the same number of steps"},
+    {"reload", ":reload",
+     "read the file again, keep :set values and typed rules, replay the same number of steps"},
     {"step", ":step [N]", "derive N more steps (default 1)"},
-    {"back", ":back [N]", "undo the last N steps (default 1), with the edits (:do) made in them and the :use choices made after the step it goes back to"},
+    {"back", ":back [N]",
+     "undo the last N steps (default 1), with the edits (:do) made in them and the :use choices made after "
+     "the step it goes back to"},
     {"reset", ":reset", "go back to the axiom (step 0)"},
     {"show", ":show [A..B] [--ids]", "print the string, or modules A to B; long strings are shortened"},
-    {"find", ":find PATTERN", "list the modules a name or predecessor pattern matches (A, A(x) : x > 2, B < A(x)), with positions and identities"},
+    {"find", ":find PATTERN",
+     "list the modules a name or predecessor pattern matches (A, A(x) : x > 2, B < A(x)), with positions and "
+     "identities"},
     {"set", ":set NAME VALUE", "change a param (VALUE is an expression) and replay"},
     {"params", ":params", "list the params and vars with their current values"},
     {"seed", ":seed S", "change the random seed and replay"},
     {"rules", ":rules", "list the productions, typed ones included"},
     {"use", ":use GROUP", "select a rule group for the next steps (:use none to clear)"},
-    {"do", ":do STATEMENTS", "run statements as an on before_step hook would before the next step: a climber's edits "
-                             "(ivy.cut(ID), ivy.pull(ID, vec3(X, Y, Z)), ivy.wind(vec3(X, Y, Z)), ivy.seed(ID), "
-                             "ivy.move(K, vec3(X, Y, Z))), or assigning vars; such a call typed alone needs no :do. "
-                             "Kept with the step for replays; :back undoes it"},
+    {"do", ":do STATEMENTS",
+     "run statements as an on before_step hook would before the next step: a climber's edits "
+     "(ivy.cut(ID), ivy.pull(ID, vec3(X, Y, Z)), ivy.wind(vec3(X, Y, Z)), ivy.seed(ID), "
+     "ivy.move(K, vec3(X, Y, Z))), or assigning vars; such a call typed alone needs no :do. "
+     "Kept with the step for replays; :back undoes it"},
     {"edits", ":edits", "list the edits (:do) and the steps they run before"},
     {"stats", ":stats", "modules per symbol, branch depth, steps and the time of the last step"},
     {"time", ":time", "the time of the last step"},
@@ -100,7 +108,8 @@ std::string Session::session_source(const std::string* extra_fn) const {
     if (!edits_.empty()) {
         // each edit on lines of its own, so that an error points into what the user typed
         s += "on before_step {\n";
-        for (const auto& [at, statements] : edits_) s += fmt::format("if step() == {} {{\n{}\n}}\n", at, statements);
+        for (const auto& [at, statements] : edits_)
+            s += fmt::format("if step() == {} {{\n{}\n}}\n", at, statements);
         s += "}\n";
     }
     if (extra_fn) s += *extra_fn + "\n";
@@ -122,7 +131,9 @@ Diagnostics Session::news(const Diagnostics& diags, const SourceManager& sources
     for (const auto& d : diags.all()) {
         // by message and source line, not position: the session's own lines move as it grows
         std::string key = d.message;
-        if (d.span.valid()) key += "|" + std::string(sources.file(d.span.file).line_text(sources.file(d.span.file).line_col(d.span.begin).line));
+        if (d.span.valid())
+            key += "|" + std::string(sources.file(d.span.file)
+                                         .line_text(sources.file(d.span.file).line_col(d.span.begin).line));
         if (d.severity == Severity::Error || shown_.insert(key).second) out.add(d);
     }
     return out;
@@ -154,7 +165,8 @@ bool Session::rebuild(int steps, const std::string* extra_fn) {
             int before = next->steps_done();
             auto t0 = std::chrono::steady_clock::now();
             next->step();
-            last_step_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+            last_step_ms_ =
+                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
             if (next->steps_done() == before) break; // a hook said stop
             apply_uses(*next);
             history.push_back(std::move(next));
@@ -217,15 +229,16 @@ bool Session::step(int n) {
                 error() << fmt::format("interrupted; still at step {}\n", current().steps_done());
             return false;
         }
-        last_step_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        last_step_ms_ =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         if (next->steps_done() == before) {
             out_ << fmt::format("the derivation has stopped (a hook said stop) at step {}\n", before);
             return true;
         }
         history_.push_back(std::move(next));
     }
-    out_ << fmt::format("step {}: {} ({:.3f} ms)\n", current().steps_done(), modules(current().string().size()),
-                        last_step_ms_);
+    out_ << fmt::format("step {}: {} ({:.3f} ms)\n", current().steps_done(),
+                        modules(current().string().size()), last_step_ms_);
     return true;
 }
 
@@ -280,7 +293,8 @@ void Session::find(const std::string& pattern) {
         for (std::size_t k = 0; k < found.size() && k < 50; ++k) {
             ModuleString one;
             one.append_range(s, found[k], found[k] + 1);
-            out_ << fmt::format("  {:>8}  #{:<8} {}\n", found[k], s.id(found[k]), format_string(*program_, one));
+            out_ << fmt::format("  {:>8}  #{:<8} {}\n", found[k], s.id(found[k]),
+                                format_string(*program_, one));
         }
         if (found.size() > 50) out_ << fmt::format("  ... and {} more\n", found.size() - 50);
         out_ << fmt::format("{} {}{}\n", found.size(), what, found.size() == 1 ? "" : "es");
@@ -299,7 +313,8 @@ void Session::find(const std::string& pattern) {
     std::string group = fmt::format("rules __find__ {{\n{} -> ;\n}}", pattern);
     auto sources = std::make_unique<SourceManager>();
     Diagnostics diags;
-    auto program = compile_source(*sources, sources->add("<session>", session_source(&group)), compile_options(), diags);
+    auto program =
+        compile_source(*sources, sources->add("<session>", session_source(&group)), compile_options(), diags);
     Diagnostics errors;
     for (const auto& d : diags.all())
         if (d.severity == Severity::Error) errors.add(d);
@@ -335,7 +350,8 @@ void Session::stats() {
     }
     std::vector<std::pair<std::size_t, SymbolId>> sorted;
     for (auto [sym, n] : counts) sorted.emplace_back(n, sym);
-    std::sort(sorted.begin(), sorted.end(), [](auto a, auto b) { return a.first != b.first ? a.first > b.first : a.second < b.second; });
+    std::sort(sorted.begin(), sorted.end(),
+              [](auto a, auto b) { return a.first != b.first ? a.first > b.first : a.second < b.second; });
     out_ << fmt::format("step {}, {} modules, {} parameters, branch depth {}, last step {:.3f} ms\n",
                         current().steps_done(), s.size(), s.params.size(), max_depth, last_step_ms_);
     for (std::size_t k = 0; k < sorted.size() && k < 20; ++k)
@@ -358,9 +374,9 @@ void Session::rules() {
         const ast::File& f = **it;
         const bool typed = sources_->file(f.source).name() == "<session>";
         for (const auto& rb : f.rule_blocks) {
-            const char* kind = rb.kind == ast::RuleKind::Rules ? "rules" : rb.kind == ast::RuleKind::Decompose
-                                                                             ? "decompose"
-                                                                             : "interpret";
+            const char* kind = rb.kind == ast::RuleKind::Rules       ? "rules"
+                               : rb.kind == ast::RuleKind::Decompose ? "decompose"
+                                                                     : "interpret";
             out_ << kind << (rb.group.empty() ? "" : " " + rb.group) << (typed ? " (typed)" : "") << ":\n";
             for (const auto& p : rb.productions) out_ << "  " << text_of(p.span) << "\n";
         }
@@ -371,10 +387,9 @@ void Session::params() {
     if (!need_derivation()) return;
     for (const auto& gl : program_->globals) {
         const double* v = current().globals().data() + gl.slot;
-        std::string value = gl.type == ValueType::Vec3
-                                ? fmt::format("vec3({}, {}, {})", format_double(v[0]), format_double(v[1]),
-                                              format_double(v[2]))
-                                : format_double(v[0]);
+        std::string value = gl.type == ValueType::Vec3 ? fmt::format("vec3({}, {}, {})", format_double(v[0]),
+                                                                     format_double(v[1]), format_double(v[2]))
+                                                       : format_double(v[0]);
         out_ << fmt::format("  {} {} = {}\n", gl.kind == GlobalKind::Param ? "param" : "var", gl.name, value);
     }
 }
@@ -414,7 +429,8 @@ void Session::evaluate(const std::string& expr) {
         return;
     }
     if (f->result == ValueType::Vec3)
-        out_ << fmt::format("vec3({}, {}, {})\n", format_double(r[0]), format_double(r[1]), format_double(r[2]));
+        out_ << fmt::format("vec3({}, {}, {})\n", format_double(r[0]), format_double(r[1]),
+                            format_double(r[2]));
     else if (f->result == ValueType::Bool)
         out_ << (r[0] != 0 ? "true" : "false") << "\n";
     else
@@ -456,7 +472,8 @@ void Session::edit(std::string statements) {
 
 void Session::list_edits() {
     if (edits_.empty()) out_ << "no edits\n";
-    for (const auto& [at, statements] : edits_) out_ << fmt::format("  before step {}: {}\n", at + 1, statements);
+    for (const auto& [at, statements] : edits_)
+        out_ << fmt::format("  before step {}: {}\n", at + 1, statements);
 }
 
 bool Session::is_edit(const std::string& line) const {
@@ -464,7 +481,8 @@ bool Session::is_edit(const std::string& line) const {
     std::size_t dot = line.find('.'), paren = line.find('(');
     if (dot == std::string::npos || paren == std::string::npos || paren < dot) return false;
     std::string env = trim(line.substr(0, dot)), method = trim(line.substr(dot + 1, paren - dot - 1));
-    for (std::size_t k = 0; k < program_->environment_names.size() && k < program_->environments.size(); ++k) {
+    for (std::size_t k = 0; k < program_->environment_names.size() && k < program_->environments.size();
+         ++k) {
         if (program_->environment_names[k] != env || !program_->environments[k]) continue;
         for (const auto& m : program_->environments[k]->methods())
             if (m.name == method) return m.hook_only;
@@ -514,8 +532,10 @@ bool Session::command(const std::string& name, const std::string& rest) {
     if (name == "help" || name == "h" || name == "?") {
         help(rest);
     } else if (name == "load") {
-        if (rest.empty()) error() << "':load' expects a file name\n";
-        else load(rest);
+        if (rest.empty())
+            error() << "':load' expects a file name\n";
+        else
+            load(rest);
     } else if (name == "reload") {
         if (file_.empty()) {
             error() << "nothing to reload: :load a file first\n";
@@ -525,7 +545,8 @@ bool Session::command(const std::string& name, const std::string& rest) {
             if (!read_file(file_, file_text_)) {
                 error() << fmt::format("plant: cannot read '{}'\n", file_);
             } else if (rebuild(steps)) {
-                out_ << fmt::format("reloaded; step {}: {}\n", current().steps_done(), modules(current().string().size()));
+                out_ << fmt::format("reloaded; step {}: {}\n", current().steps_done(),
+                                    modules(current().string().size()));
             } else {
                 file_text_ = saved;
             }
@@ -559,7 +580,8 @@ bool Session::command(const std::string& name, const std::string& rest) {
         value = trim(value);
         if (pname.empty() || value.empty()) {
             error() << "':set' expects NAME VALUE, as in :set r1 0.8\n";
-        } else if (program_ && std::none_of(program_->globals.begin(), program_->globals.end(), [&](const Global& g) {
+        } else if (program_ &&
+                   std::none_of(program_->globals.begin(), program_->globals.end(), [&](const Global& g) {
                        return g.kind == GlobalKind::Param && g.name == pname;
                    })) {
             error() << fmt::format("no param '{}'; :params lists them\n", pname);
@@ -580,8 +602,10 @@ bool Session::command(const std::string& name, const std::string& rest) {
             auto saved = seed_;
             seed_ = *v;
             int steps = history_.empty() ? 0 : current().steps_done();
-            if (history_.empty() || rebuild(steps)) out_ << fmt::format("seed {}\n", *seed_);
-            else seed_ = saved;
+            if (history_.empty() || rebuild(steps))
+                out_ << fmt::format("seed {}\n", *seed_);
+            else
+                seed_ = saved;
         } else {
             error() << fmt::format("':seed' expects a whole number, found '{}'\n", rest);
         }
@@ -590,7 +614,8 @@ bool Session::command(const std::string& name, const std::string& rest) {
     } else if (name == "use") {
         if (need_derivation()) {
             int g = rest == "none" ? -1 : program_->group_index(rest);
-            if (g < 0 && rest != "none") error() << fmt::format("no rule group '{}'\n", rest);
+            if (g < 0 && rest != "none")
+                error() << fmt::format("no rule group '{}'\n", rest);
             else {
                 current().use_group(g);
                 // remembered with its step, for replays; later choices at the same step win
@@ -611,8 +636,10 @@ bool Session::command(const std::string& name, const std::string& rest) {
         std::istringstream in(rest);
         std::vector<std::string> paths;
         for (std::string p; in >> p;) paths.push_back(p);
-        if (paths.empty()) error() << "':export' expects one or more file names\n";
-        else export_files(paths);
+        if (paths.empty())
+            error() << "':export' expects one or more file names\n";
+        else
+            export_files(paths);
     } else if (name == "render") {
         export_files({rest.empty() ? std::string("out/repl.png") : rest});
     } else {
@@ -641,16 +668,21 @@ bool Session::execute(const std::string& raw) {
         std::string a = trim(line.substr(6));
         if (!a.empty() && a.back() == ';') a.pop_back();
         axiom_ = a;
-        if (rebuild(steps)) out_ << fmt::format("axiom set; step {}: {}\n", current().steps_done(), modules(current().string().size()));
-        else axiom_ = saved;
+        if (rebuild(steps))
+            out_ << fmt::format("axiom set; step {}: {}\n", current().steps_done(),
+                                modules(current().string().size()));
+        else
+            axiom_ = saved;
         return true;
     }
-    bool production = line.find("->") != std::string::npos || (line.back() == '}' && line.find('{') != std::string::npos);
+    bool production =
+        line.find("->") != std::string::npos || (line.back() == '}' && line.find('{') != std::string::npos);
     if (production) {
         if (line.back() != ';' && line.back() != '}') line += ';';
         extra_rules_.push_back(line);
         if (rebuild(steps))
-            out_ << fmt::format("rule added; step {}: {}\n", current().steps_done(), modules(current().string().size()));
+            out_ << fmt::format("rule added; step {}: {}\n", current().steps_done(),
+                                modules(current().string().size()));
         else
             extra_rules_.pop_back();
         return true;

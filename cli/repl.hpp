@@ -10,15 +10,15 @@
 #include <map>
 #include <memory>
 #include <optional>
-#include <set>
 #include <ostream>
+#include <set>
 #include <string>
 #include <vector>
 
 namespace plant::cli {
 
 class Session {
-public:
+  public:
     Session(std::ostream& out, std::ostream& err, bool color);
     // Runs one input line: a :command, `axiom: ...`, a production, or an expression.
     // Returns false when the session should end (:quit).
@@ -34,7 +34,7 @@ public:
         return f;
     }
 
-private:
+  private:
     bool command(const std::string& name, const std::string& rest);
     void help(const std::string& topic);
     // Recompiles the session's grammar and replays `steps` steps. Keeps the previous state and
@@ -69,10 +69,10 @@ private:
     bool color_;
     const std::atomic<bool>* interrupt_ = nullptr;
 
-    std::string file_;                         // the loaded grammar's path, as given
-    std::string file_text_;                    // its text as :load or :reload read it
-    std::optional<std::string> axiom_;         // typed `axiom: ...`
-    std::vector<std::string> extra_rules_;     // typed productions
+    std::string file_;                          // the loaded grammar's path, as given
+    std::string file_text_;                     // its text as :load or :reload read it
+    std::optional<std::string> axiom_;          // typed `axiom: ...`
+    std::vector<std::string> extra_rules_;      // typed productions
     std::map<std::string, std::string> params_; // :set NAME VALUE
     std::optional<std::uint64_t> seed_;
     std::vector<std::pair<int, std::string>> uses_; // :use GROUP at step N, replayed by rebuilds

@@ -19,7 +19,9 @@ namespace {
 std::atomic<bool> g_interrupt{false};
 Session* g_session = nullptr;
 
-extern "C" void on_sigint(int) { g_interrupt.store(true); }
+extern "C" void on_sigint(int) {
+    g_interrupt.store(true);
+}
 
 std::vector<std::string> g_matches;
 
@@ -105,12 +107,14 @@ int repl_main(const std::string& file, bool color) {
 
 void setup_repl(CLI::App& app, int& exit_code) {
     auto file = std::make_shared<std::string>();
-    CLI::App* cmd = app.add_subcommand("repl", "An interactive session: step a derivation, inspect the string, change "
-                                               "rules and params, look at the plant");
+    CLI::App* cmd =
+        app.add_subcommand("repl", "An interactive session: step a derivation, inspect the string, change "
+                                   "rules and params, look at the plant");
     cmd->add_option("FILE", *file, "A grammar to load");
     cmd->footer("Reads commands from standard input without a prompt when it is not a terminal:\n"
                 "  plant repl grammar.plant < script");
-    cmd->callback([file, &exit_code] { exit_code = repl_main(*file, isatty(2) != 0 && !std::getenv("NO_COLOR")); });
+    cmd->callback(
+        [file, &exit_code] { exit_code = repl_main(*file, isatty(2) != 0 && !std::getenv("NO_COLOR")); });
 }
 
 } // namespace plant::cli

@@ -41,12 +41,13 @@ int main(int argc, char** argv) {
         Derivation d(*program, o);
         auto t0 = std::chrono::steady_clock::now();
         d.run();
-        ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+        ms.push_back(
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
         modules = d.string().size();
     }
     const double first = ms.front();
     std::sort(ms.begin(), ms.end());
-    std::printf("derive modules=%zu first_ms=%.4f best_ms=%.4f median_ms=%.4f repeats=%d threads=%d\n", modules,
-                first, ms.front(), ms[ms.size() / 2], repeats, threads);
+    std::printf("derive modules=%zu first_ms=%.4f best_ms=%.4f median_ms=%.4f repeats=%d threads=%d\n",
+                modules, first, ms.front(), ms[ms.size() / 2], repeats, threads);
     return 0;
 }

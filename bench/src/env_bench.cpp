@@ -39,7 +39,8 @@ int main(int argc, char** argv) {
     auto* prox = dynamic_cast<SkeletonEnvironment*>(env.get());
     auto t0 = std::chrono::steady_clock::now();
     prox->update(sk);
-    double update_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    double update_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     // query points spread over the plant's bounding box, asked for by modules of the plant
     std::uint64_t x = 88172645463325252ULL;
     double sum = 0;
@@ -53,7 +54,8 @@ int main(int argc, char** argv) {
         sum += res[0];
     }
     double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::printf("proximity segments=%zu radius=%.3f update_ms=%.2f queries=%ld mq_per_s=%.2f (checksum %.3f)\n", segments,
-                radius, update_ms, queries, queries / s / 1e6, sum);
+    std::printf(
+        "proximity segments=%zu radius=%.3f update_ms=%.2f queries=%ld mq_per_s=%.2f (checksum %.3f)\n",
+        segments, radius, update_ms, queries, queries / s / 1e6, sum);
     return 0;
 }

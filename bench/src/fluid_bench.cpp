@@ -48,10 +48,12 @@ int main(int argc, char** argv) {
         World plant;
         plant.settings().fixed_stiffness = 1.0;
         glm::dquat up(1, 0, 0, 0);
-        Handle h = plant.add_root(glm::dvec3(s.domain_hi.x / 2, 0, side / 2), up, glm::dvec3(0.01, 0.025, 0.01));
+        Handle h =
+            plant.add_root(glm::dvec3(s.domain_hi.x / 2, 0, side / 2), up, glm::dvec3(0.01, 0.025, 0.01));
         for (int j = 1; j < 200; ++j)
-            h = plant.add_particle(h, glm::dvec3(s.domain_hi.x / 2 + 0.3 * std::sin(j * 0.1), side * j / 200.0, side / 2), up,
-                                   glm::dvec3(0.01, 0.025, 0.01));
+            h = plant.add_particle(
+                h, glm::dvec3(s.domain_hi.x / 2 + 0.3 * std::sin(j * 0.1), side * j / 200.0, side / 2), up,
+                glm::dvec3(0.01, 0.025, 0.01));
         for (int w = 0; w < 5; ++w) f.step(&plant); // warm up
         auto t0 = std::chrono::steady_clock::now();
         for (int t = 0; t < steps; ++t) f.step(&plant);

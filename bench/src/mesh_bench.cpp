@@ -35,9 +35,11 @@ int main(int argc, char** argv) {
     }
     const MeshPart& t = scene.tubes;
     double tris = static_cast<double>(t.triangle_count());
-    double bytes = static_cast<double>(t.positions.capacity() * sizeof(glm::vec3) + t.normals.capacity() * sizeof(glm::vec3) +
-                                       t.uvs.capacity() * sizeof(glm::vec2) + t.indices.capacity() * sizeof(std::uint32_t));
-    std::printf("meshing modules=%zu axes=%zu triangles=%.0f best_ms=%.3f mtri_per_s=%.2f bytes_per_triangle=%.1f\n",
-                g.modules, sk.axes.size(), tris, best * 1e3, tris / best / 1e6, bytes / tris);
+    double bytes = static_cast<double>(
+        t.positions.capacity() * sizeof(glm::vec3) + t.normals.capacity() * sizeof(glm::vec3) +
+        t.uvs.capacity() * sizeof(glm::vec2) + t.indices.capacity() * sizeof(std::uint32_t));
+    std::printf(
+        "meshing modules=%zu axes=%zu triangles=%.0f best_ms=%.3f mtri_per_s=%.2f bytes_per_triangle=%.1f\n",
+        g.modules, sk.axes.size(), tris, best * 1e3, tris / best / 1e6, bytes / tris);
     return 0;
 }

@@ -35,8 +35,9 @@ int main(int argc, char** argv) {
     const long air = argc > 4 ? std::atol(argv[4]) : 0;
     const bool per_step = argc > 5 && std::string(argv[5]) == "--per-step";
     if (want < 100 || steps < 1 || threads < 1 || air < 0) {
-        std::fprintf(stderr, "usage: plant_physics_bench [PARTICLES >= 100] [STEPS >= 1] [THREADS >= 1] [AIR >= 0] "
-                             "[--per-step]\n");
+        std::fprintf(stderr,
+                     "usage: plant_physics_bench [PARTICLES >= 100] [STEPS >= 1] [THREADS >= 1] [AIR >= 0] "
+                     "[--per-step]\n");
         return 64;
     }
     const long lateral = 99;
@@ -100,9 +101,11 @@ int main(int argc, char** argv) {
             std::printf("step %d: physics %.3f ms (collision %.3f), growth %.3f ms, sph %.3f ms\n", i + 1, p,
                         w.last_step_times().collision, g, a);
     }
-    std::printf("particles=%zu air=%zu threads=%d grown=%zu steps=%d physics_ms=%.3f growth_ms=%.3f collision_ms=%.3f "
+    std::printf("particles=%zu air=%zu threads=%d grown=%zu steps=%d physics_ms=%.3f growth_ms=%.3f "
+                "collision_ms=%.3f "
                 "sph_ms=%.3f total_ms=%.3f hash=%016llx\n",
-                start, fluid.size(), threads, w.size() - start, steps, physics / steps, growth / steps, collision / steps,
-                sph / steps, (physics + growth) / steps, static_cast<unsigned long long>(w.state_hash()));
+                start, fluid.size(), threads, w.size() - start, steps, physics / steps, growth / steps,
+                collision / steps, sph / steps, (physics + growth) / steps,
+                static_cast<unsigned long long>(w.state_hash()));
     return 0;
 }

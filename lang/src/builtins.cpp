@@ -50,15 +50,22 @@ constexpr BuiltinInfo table[] = {
 };
 } // namespace
 
-std::span<const BuiltinInfo> builtin_table() { return table; }
+std::span<const BuiltinInfo> builtin_table() {
+    return table;
+}
 
 const char* value_type_name(ValueType t) {
     switch (t) {
-    case ValueType::Number: return "number";
-    case ValueType::Bool: return "bool";
-    case ValueType::Vec3: return "vec3";
-    case ValueType::String: return "string";
-    case ValueType::Void: return "nothing";
+    case ValueType::Number:
+        return "number";
+    case ValueType::Bool:
+        return "bool";
+    case ValueType::Vec3:
+        return "vec3";
+    case ValueType::String:
+        return "string";
+    case ValueType::Void:
+        return "nothing";
     }
     return "?";
 }

@@ -12,10 +12,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <sstream>
 
 namespace plant {
@@ -44,8 +44,10 @@ std::size_t edit_distance(std::string_view a, std::string_view b) {
     for (std::size_t i = 1; i <= a.size(); ++i) {
         for (std::size_t j = 1; j <= b.size(); ++j) {
             std::size_t cost = a[i - 1] == b[j - 1] ? 0 : 1;
-            std::size_t v = std::min({d[(i - 1) * w + j] + 1, d[i * w + j - 1] + 1, d[(i - 1) * w + j - 1] + cost});
-            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) v = std::min(v, d[(i - 2) * w + j - 2] + 1);
+            std::size_t v =
+                std::min({d[(i - 1) * w + j] + 1, d[i * w + j - 1] + 1, d[(i - 1) * w + j - 1] + cost});
+            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1])
+                v = std::min(v, d[(i - 2) * w + j - 2] + 1);
             d[i * w + j] = v;
         }
     }
@@ -90,24 +92,68 @@ void Compiler::emit(Ctx& c, Op op, std::int32_t a, int n, Span span, std::uint16
     c.code->spans.push_back(span);
     // stack effect, conservative along both branches of a jump
     switch (op) {
-    case Op::Const: case Op::LoadMulConst: case Op::LoadAddConst: c.depth += 1; break;
-    case Op::Const3: c.depth += 3; break;
-    case Op::LoadLocal: case Op::LoadGlobal: c.depth += n; break;
-    case Op::StoreLocal: case Op::StoreGlobal: case Op::Pop: case Op::Emit: case Op::Print: c.depth -= n; break;
-    case Op::Add: case Op::Sub: case Op::Mul: case Op::Div: case Op::Mod: case Op::Lt: case Op::Le: case Op::Gt:
-    case Op::Ge: case Op::Eq: case Op::Ne: case Op::JumpIfZero: case Op::JumpIfZeroKeep: case Op::JumpIfNonZeroKeep:
-    case Op::VMulS: case Op::VSMul: case Op::VDivS: c.depth -= 1; break;
-    case Op::VAdd: case Op::VSub: c.depth -= 3; break;
-    case Op::VEq: case Op::VNe: c.depth -= 5; break;
-    case Op::Member: c.depth -= 2; break;
-    case Op::Builtin: c.depth += b - n; break; // b: width of the result
-    case Op::EnvCall: c.depth += 3 - n; break; // at most a vec3
+    case Op::Const:
+    case Op::LoadMulConst:
+    case Op::LoadAddConst:
+        c.depth += 1;
+        break;
+    case Op::Const3:
+        c.depth += 3;
+        break;
+    case Op::LoadLocal:
+    case Op::LoadGlobal:
+        c.depth += n;
+        break;
+    case Op::StoreLocal:
+    case Op::StoreGlobal:
+    case Op::Pop:
+    case Op::Emit:
+    case Op::Print:
+        c.depth -= n;
+        break;
+    case Op::Add:
+    case Op::Sub:
+    case Op::Mul:
+    case Op::Div:
+    case Op::Mod:
+    case Op::Lt:
+    case Op::Le:
+    case Op::Gt:
+    case Op::Ge:
+    case Op::Eq:
+    case Op::Ne:
+    case Op::JumpIfZero:
+    case Op::JumpIfZeroKeep:
+    case Op::JumpIfNonZeroKeep:
+    case Op::VMulS:
+    case Op::VSMul:
+    case Op::VDivS:
+        c.depth -= 1;
+        break;
+    case Op::VAdd:
+    case Op::VSub:
+        c.depth -= 3;
+        break;
+    case Op::VEq:
+    case Op::VNe:
+        c.depth -= 5;
+        break;
+    case Op::Member:
+        c.depth -= 2;
+        break;
+    case Op::Builtin:
+        c.depth += b - n;
+        break; // b: width of the result
+    case Op::EnvCall:
+        c.depth += 3 - n;
+        break; // at most a vec3
     case Op::Call: {
         const Function& fn = P_.functions[static_cast<std::size_t>(a)];
         c.depth += std::max(1, value_width(fn.result)) - fn.param_width;
         break;
     }
-    default: break;
+    default:
+        break;
     }
     if (c.depth > kMaxStack && !c.stack_error) {
         c.stack_error = true;
@@ -121,8 +167,12 @@ void Compiler::emit_const(Ctx& c, double v, Span span) {
     emit(c, Op::Const, static_cast<std::int32_t>(c.code->consts.size() - 1), 1, span);
 }
 
-std::size_t Compiler::here(Ctx& c) const { return c.code->instrs.size(); }
-void Compiler::patch(Ctx& c, std::size_t at) { c.code->instrs[at].a = static_cast<std::int32_t>(here(c)); }
+std::size_t Compiler::here(Ctx& c) const {
+    return c.code->instrs.size();
+}
+void Compiler::patch(Ctx& c, std::size_t at) {
+    c.code->instrs[at].a = static_cast<std::int32_t>(here(c));
+}
 
 // ---- constant folding ----------------------------------------------------------------------
 
@@ -166,7 +216,8 @@ std::optional<ConstVal> Compiler::eval_const(const ast::Expr& e, const char* wha
 std::optional<double> Compiler::fold_number(const ast::Expr& e) {
     switch (e.kind) {
     case ast::ExprKind::Number:
-    case ast::ExprKind::Bool: return e.number;
+    case ast::ExprKind::Bool:
+        return e.number;
     case ast::ExprKind::Name: {
         auto it = consts_.find(e.text);
         if (it != consts_.end() && it->second.type != ValueType::Vec3) return it->second.v[0];
@@ -196,7 +247,8 @@ std::optional<double> Compiler::fold_number(const ast::Expr& e) {
         if (op == "||") return double(*a != 0 || *b != 0);
         return std::nullopt;
     }
-    default: return std::nullopt;
+    default:
+        return std::nullopt;
     }
 }
 
@@ -210,7 +262,8 @@ const LocalVar* Compiler::find_local(Ctx& c, const std::string& name) const {
 
 std::uint16_t Compiler::add_local(Ctx& c, const std::string& name, ValueType t) {
     if (c.next_slot > 60000) {
-        if (c.next_slot < 60004) diags_->error(Span{}, fmt::format("too many local variables (at '{}')", name));
+        if (c.next_slot < 60004)
+            diags_->error(Span{}, fmt::format("too many local variables (at '{}')", name));
         c.next_slot = 60004;
         return 0;
     }
@@ -237,16 +290,22 @@ void Compiler::unknown_name(Ctx& c, const std::string& name, Span span, const ch
     }
     std::string near = nearest_name(name, names);
     diags_->error(span, near.empty() ? fmt::format("unknown {} '{}'", what, name)
-                                    : fmt::format("unknown {} '{}'; did you mean '{}'?", what, name, near));
+                                     : fmt::format("unknown {} '{}'; did you mean '{}'?", what, name, near));
 }
 
-static bool numeric(ValueType t) { return t == ValueType::Number || t == ValueType::Bool; }
+static bool numeric(ValueType t) {
+    return t == ValueType::Number || t == ValueType::Bool;
+}
 
 ValueType Compiler::compile_expr(Ctx& c, const ast::Expr& e) {
     using K = ast::ExprKind;
     switch (e.kind) {
-    case K::Number: emit_const(c, e.number, e.span); return ValueType::Number;
-    case K::Bool: emit_const(c, e.number, e.span); return ValueType::Bool;
+    case K::Number:
+        emit_const(c, e.number, e.span);
+        return ValueType::Number;
+    case K::Bool:
+        emit_const(c, e.number, e.span);
+        return ValueType::Bool;
     case K::String:
         diags_->error(e.span, "a string is allowed only as an argument of print(...) or load(...)");
         emit_const(c, 0, e.span);
@@ -271,8 +330,10 @@ ValueType Compiler::compile_expr(Ctx& c, const ast::Expr& e) {
             return ValueType::Number;
         }
         if (env_names_.count(e.text)) {
-            diags_->error(e.span, fmt::format("environment '{}' can only be queried with a method, as in '{}.contains(p)'",
-                                             e.text, e.text));
+            diags_->error(
+                e.span,
+                fmt::format("environment '{}' can only be queried with a method, as in '{}.contains(p)'",
+                            e.text, e.text));
         } else {
             unknown_name(c, e.text, e.span, "name");
         }
@@ -298,7 +359,8 @@ ValueType Compiler::compile_expr(Ctx& c, const ast::Expr& e) {
         emit(c, Op::Not, 0, 0, e.span);
         return ValueType::Bool;
     }
-    case K::Binary: return compile_binary(c, e);
+    case K::Binary:
+        return compile_binary(c, e);
     case K::Ternary: {
         ValueType ct = compile_expr(c, *e.args[0]);
         if (!numeric(ct)) diags_->error(e.args[0]->span, "the condition of '?:' must be a number or bool");
@@ -315,17 +377,19 @@ ValueType Compiler::compile_expr(Ctx& c, const ast::Expr& e) {
         if (a == ValueType::Void) a = b = ValueType::Number;
         if (value_width(a) != value_width(b)) {
             diags_->error(e.span, fmt::format("the two branches of '?:' have different types ({} and {})",
-                                             value_type_name(a), value_type_name(b)));
+                                              value_type_name(a), value_type_name(b)));
         }
         return a == b ? a : (numeric(a) && numeric(b) ? ValueType::Number : a);
     }
-    case K::Call: return compile_call(c, e);
+    case K::Call:
+        return compile_call(c, e);
     case K::Member: {
         ValueType t = compile_expr(c, *e.args[0]);
         int comp = e.text == "x" ? 0 : e.text == "y" ? 1 : e.text == "z" ? 2 : -1;
         if (t != ValueType::Vec3 || comp < 0) {
-            diags_->error(e.span, comp < 0 ? fmt::format("unknown member '.{}': vectors have .x, .y and .z", e.text)
-                                          : fmt::format("'.{}' needs a vec3, found a {}", e.text, value_type_name(t)));
+            diags_->error(
+                e.span, comp < 0 ? fmt::format("unknown member '.{}': vectors have .x, .y and .z", e.text)
+                                 : fmt::format("'.{}' needs a vec3, found a {}", e.text, value_type_name(t)));
             if (t == ValueType::Vec3) emit(c, Op::Member, 0, 0, e.span);
             return ValueType::Number;
         }
@@ -340,15 +404,17 @@ ValueType Compiler::compile_expr(Ctx& c, const ast::Expr& e) {
                 if (P_.environment_names[k] == obj.text && P_.environments[k]) env = k;
         if (env < P_.environments.size()) return compile_env_call(c, e, env);
         if (obj.kind == K::Name && env_names_.count(obj.text)) {
-            diags_->error(e.span, opts_.environments
-                                      ? fmt::format("environment '{}' is not available: its declaration has an error",
-                                                    obj.text)
-                                      : fmt::format("environment '{}' (kind '{}') cannot be queried here: no runtime "
-                                                    "provides environments to this compilation",
-                                                    obj.text, env_names_[obj.text]));
+            diags_->error(
+                e.span,
+                opts_.environments
+                    ? fmt::format("environment '{}' is not available: its declaration has an error", obj.text)
+                    : fmt::format("environment '{}' (kind '{}') cannot be queried here: no runtime "
+                                  "provides environments to this compilation",
+                                  obj.text, env_names_[obj.text]));
         } else {
-            diags_->error(e.span, fmt::format("'.{}(...)' is a method call, and only environment objects have methods",
-                                             e.text));
+            diags_->error(
+                e.span, fmt::format("'.{}(...)' is a method call, and only environment objects have methods",
+                                    e.text));
         }
         emit_const(c, 0, e.span);
         return ValueType::Number;
@@ -359,7 +425,7 @@ ValueType Compiler::compile_expr(Ctx& c, const ast::Expr& e) {
 
 void Compiler::type_error(Span span, const std::string& op, ValueType a, ValueType b) {
     diags_->error(span, fmt::format("operator '{}' cannot be applied to {} and {}", op, value_type_name(a),
-                                   value_type_name(b)));
+                                    value_type_name(b)));
 }
 
 ValueType Compiler::compile_binary(Ctx& c, const ast::Expr& e) {
@@ -383,9 +449,9 @@ ValueType Compiler::compile_binary(Ctx& c, const ast::Expr& e) {
     bool na = numeric(a), nb = numeric(b);
     bool va = a == ValueType::Vec3, vb = b == ValueType::Vec3;
     if (na && nb) {
-        static const std::pair<const char*, Op> ops[] = {{"+", Op::Add}, {"-", Op::Sub}, {"*", Op::Mul}, {"/", Op::Div},
-                                                         {"%", Op::Mod}, {"<", Op::Lt},  {"<=", Op::Le}, {">", Op::Gt},
-                                                         {">=", Op::Ge}, {"==", Op::Eq}, {"!=", Op::Ne}};
+        static const std::pair<const char*, Op> ops[] = {
+            {"+", Op::Add}, {"-", Op::Sub}, {"*", Op::Mul}, {"/", Op::Div}, {"%", Op::Mod}, {"<", Op::Lt},
+            {"<=", Op::Le}, {">", Op::Gt},  {">=", Op::Ge}, {"==", Op::Eq}, {"!=", Op::Ne}};
         for (const auto& [name, o] : ops) {
             if (op == name) {
                 emit(c, o, 0, 0, e.span);
@@ -395,14 +461,35 @@ ValueType Compiler::compile_binary(Ctx& c, const ast::Expr& e) {
         }
     }
     if (va && vb) {
-        if (op == "+") { emit(c, Op::VAdd, 0, 0, e.span); return ValueType::Vec3; }
-        if (op == "-") { emit(c, Op::VSub, 0, 0, e.span); return ValueType::Vec3; }
-        if (op == "==") { emit(c, Op::VEq, 0, 0, e.span); return ValueType::Bool; }
-        if (op == "!=") { emit(c, Op::VNe, 0, 0, e.span); return ValueType::Bool; }
+        if (op == "+") {
+            emit(c, Op::VAdd, 0, 0, e.span);
+            return ValueType::Vec3;
+        }
+        if (op == "-") {
+            emit(c, Op::VSub, 0, 0, e.span);
+            return ValueType::Vec3;
+        }
+        if (op == "==") {
+            emit(c, Op::VEq, 0, 0, e.span);
+            return ValueType::Bool;
+        }
+        if (op == "!=") {
+            emit(c, Op::VNe, 0, 0, e.span);
+            return ValueType::Bool;
+        }
     }
-    if (va && nb && op == "*") { emit(c, Op::VMulS, 0, 0, e.span); return ValueType::Vec3; }
-    if (va && nb && op == "/") { emit(c, Op::VDivS, 0, 0, e.span); return ValueType::Vec3; }
-    if (na && vb && op == "*") { emit(c, Op::VSMul, 0, 0, e.span); return ValueType::Vec3; }
+    if (va && nb && op == "*") {
+        emit(c, Op::VMulS, 0, 0, e.span);
+        return ValueType::Vec3;
+    }
+    if (va && nb && op == "/") {
+        emit(c, Op::VDivS, 0, 0, e.span);
+        return ValueType::Vec3;
+    }
+    if (na && vb && op == "*") {
+        emit(c, Op::VSMul, 0, 0, e.span);
+        return ValueType::Vec3;
+    }
     type_error(e.span, op, a, b);
     return ValueType::Number;
 }
@@ -417,9 +504,10 @@ ValueType Compiler::compile_env_call(Ctx& c, const ast::Expr& e, std::size_t env
         std::vector<std::string> names;
         for (const auto& mm : methods) names.push_back(mm.name);
         std::string near = nearest_name(e.text, names);
-        diags_->error(e.span, near.empty() ? fmt::format("environment '{}' has no method '{}'", env_name, e.text)
-                                           : fmt::format("environment '{}' has no method '{}'; did you mean '{}'?",
-                                                         env_name, e.text, near));
+        diags_->error(e.span, near.empty()
+                                  ? fmt::format("environment '{}' has no method '{}'", env_name, e.text)
+                                  : fmt::format("environment '{}' has no method '{}'; did you mean '{}'?",
+                                                env_name, e.text, near));
         emit_const(c, 0, e.span);
         return ValueType::Number;
     }
@@ -430,8 +518,8 @@ ValueType Compiler::compile_env_call(Ctx& c, const ast::Expr& e, std::size_t env
                                           env_name, e.text));
     const std::size_t given = e.args.size() - 1;
     if (given != method.args.size()) {
-        diags_->error(e.span, fmt::format("'{}.{}' takes {} argument{}, given {}", env_name, e.text, method.args.size(),
-                                          method.args.size() == 1 ? "" : "s", given));
+        diags_->error(e.span, fmt::format("'{}.{}' takes {} argument{}, given {}", env_name, e.text,
+                                          method.args.size(), method.args.size() == 1 ? "" : "s", given));
         emit_const(c, 0, e.span);
         return ValueType::Number;
     }
@@ -440,9 +528,9 @@ ValueType Compiler::compile_env_call(Ctx& c, const ast::Expr& e, std::size_t env
         ValueType t = compile_expr(c, *e.args[i + 1]);
         bool fits = method.args[i] == ValueType::Vec3 ? t == ValueType::Vec3 : numeric(t);
         if (!fits)
-            diags_->error(e.args[i + 1]->span, fmt::format("argument {} of '{}.{}' must be a {}, found a {}", i + 1,
-                                                           env_name, e.text, value_type_name(method.args[i]),
-                                                           value_type_name(t)));
+            diags_->error(e.args[i + 1]->span,
+                          fmt::format("argument {} of '{}.{}' must be a {}, found a {}", i + 1, env_name,
+                                      e.text, value_type_name(method.args[i]), value_type_name(t)));
         width += value_width(t);
     }
     emit(c, Op::EnvCall, static_cast<std::int32_t>(env), width, e.span, static_cast<std::uint16_t>(m));
@@ -464,22 +552,24 @@ ValueType Compiler::compile_call(Ctx& c, const ast::Expr& e) {
         if (!inferring_ || fn_state_[it->second] != 0) ensure_function_compiled(it->second);
         if (fn_random_[it->second]) {
             if (c.kind == CtxKind::Global)
-                diags_->error(e.span, fmt::format("'{}' draws random numbers, so it cannot be used where the value "
-                                                  "must be known before the derivation starts",
-                                                  name));
+                diags_->error(e.span,
+                              fmt::format("'{}' draws random numbers, so it cannot be used where the value "
+                                          "must be known before the derivation starts",
+                                          name));
             if (c.function >= 0) fn_random_[static_cast<std::size_t>(c.function)] = true;
         }
         if (e.args.size() != fn.param_types.size()) {
-            diags_->error(e.span, fmt::format("function '{}' takes {} argument{}, given {} (declared at {})", name,
-                                             fn.param_types.size(), fn.param_types.size() == 1 ? "" : "s",
-                                             e.args.size(), where(fn.span)));
+            diags_->error(e.span,
+                          fmt::format("function '{}' takes {} argument{}, given {} (declared at {})", name,
+                                      fn.param_types.size(), fn.param_types.size() == 1 ? "" : "s",
+                                      e.args.size(), where(fn.span)));
         }
         for (std::size_t i = 0; i < e.args.size(); ++i) {
             ValueType t = compile_expr(c, *e.args[i]);
             if (i < fn.param_types.size() && value_width(t) != value_width(fn.param_types[i]))
-                diags_->error(e.args[i]->span, fmt::format("argument {} of '{}' must be a {}, found a {}", i + 1,
-                                                          name, value_type_name(fn.param_types[i]),
-                                                          value_type_name(t)));
+                diags_->error(e.args[i]->span,
+                              fmt::format("argument {} of '{}' must be a {}, found a {}", i + 1, name,
+                                          value_type_name(fn.param_types[i]), value_type_name(t)));
         }
         if (e.args.size() == fn.param_types.size())
             emit(c, Op::Call, static_cast<std::int32_t>(it->second), 0, e.span);
@@ -520,9 +610,10 @@ ValueType Compiler::compile_call(Ctx& c, const ast::Expr& e) {
         if ((b.id == BuiltinId::Uniform || b.id == BuiltinId::Normal || b.id == BuiltinId::Chance ||
              b.id == BuiltinId::Id) &&
             c.kind == CtxKind::Global) {
-            diags_->error(e.span, fmt::format("'{}' depends on the module being rewritten and cannot be used where "
-                                             "the value must be known before the derivation starts",
-                                             name));
+            diags_->error(e.span,
+                          fmt::format("'{}' depends on the module being rewritten and cannot be used where "
+                                      "the value must be known before the derivation starts",
+                                      name));
         }
         if ((b.id == BuiltinId::Uniform || b.id == BuiltinId::Normal || b.id == BuiltinId::Chance ||
              b.id == BuiltinId::Id) &&
@@ -540,7 +631,7 @@ ValueType Compiler::compile_call(Ctx& c, const ast::Expr& e) {
         for (const auto& b : builtin_table())
             if (name == b.name) counts += (counts.empty() ? "" : " or ") + std::to_string(b.nargs);
         diags_->error(e.span, fmt::format("'{}' takes {} argument{}, given {}", name, counts,
-                                         counts == "1" ? "" : "s", e.args.size()));
+                                          counts == "1" ? "" : "s", e.args.size()));
     } else {
         std::string got;
         for (auto t : types) got += (got.empty() ? "" : ", ") + std::string(value_type_name(t));
@@ -559,7 +650,8 @@ void Compiler::declare_function(const ast::FnDecl& fd) {
     }
     for (const auto& b : builtin_table()) {
         if (fd.name == b.name) {
-            diags_->error(fd.span, fmt::format("'{}' is a built-in function and cannot be redefined", fd.name));
+            diags_->error(fd.span,
+                          fmt::format("'{}' is a built-in function and cannot be redefined", fd.name));
             return;
         }
     }
@@ -595,11 +687,13 @@ ValueType Compiler::compile_function_body(std::uint32_t index, Code& code, std::
     c.code = &code;
     c.kind = CtxKind::Function;
     c.function = static_cast<int>(index);
-    for (std::size_t i = 0; i < fd.params.size(); ++i) add_local(c, fd.params[i].name, P_.functions[index].param_types[i]);
+    for (std::size_t i = 0; i < fd.params.size(); ++i)
+        add_local(c, fd.params[i].name, P_.functions[index].param_types[i]);
     ValueType result = ValueType::Number;
     if (fd.expr) {
         result = compile_expr(c, *fd.expr);
-        emit(c, Op::Return, 0, value_width(result == ValueType::Void ? ValueType::Number : result), fd.expr->span);
+        emit(c, Op::Return, 0, value_width(result == ValueType::Void ? ValueType::Number : result),
+             fd.expr->span);
     } else {
         c.fn_result = &result;
         c.fn_result_known = false;
@@ -609,7 +703,8 @@ ValueType Compiler::compile_function_body(std::uint32_t index, Code& code, std::
         // falling off the end returns zero
         for (int k = 0; k < value_width(fall); ++k) emit_const(c, 0, fd.span);
         emit(c, Op::Return, 0, value_width(fall), fd.span);
-        for (std::size_t at : c.void_returns) code.instrs[at].n = static_cast<std::uint8_t>(value_width(fall));
+        for (std::size_t at : c.void_returns)
+            code.instrs[at].n = static_cast<std::uint8_t>(value_width(fall));
     }
     frame_size = c.next_slot;
     return result;
@@ -640,8 +735,8 @@ void Compiler::ensure_function_compiled(std::uint32_t index) {
     if (result == ValueType::Void) result = ValueType::Number;
     Function& fn = P_.functions[index];
     if (value_width(result) != value_width(fn.result))
-        diags_->error(fn.span, fmt::format("function '{}' gives a {} on some paths and a {} on others", fn.name,
-                                           value_type_name(fn.result), value_type_name(result)));
+        diags_->error(fn.span, fmt::format("function '{}' gives a {} on some paths and a {} on others",
+                                           fn.name, value_type_name(fn.result), value_type_name(result)));
     fn.code = std::move(code);
     fn.result = result;
     fn.frame_size = frame;
@@ -666,7 +761,9 @@ void Compiler::compile_stmt(Ctx& c, const ast::Stmt& s) {
         emit(c, Op::StoreLocal, slot, value_width(t), s.span);
         break;
     }
-    case K::Assign: compile_assign(c, s); break;
+    case K::Assign:
+        compile_assign(c, s);
+        break;
     case K::If: {
         ValueType t = compile_expr(c, *s.expr);
         if (!numeric(t)) diags_->error(s.expr->span, "the condition of 'if' must be a number or bool");
@@ -691,7 +788,8 @@ void Compiler::compile_stmt(Ctx& c, const ast::Stmt& s) {
         std::uint16_t var = add_local(c, s.name, ValueType::Number);
         emit(c, Op::StoreLocal, var, 1, s.span);
         ValueType tb = compile_expr(c, *s.expr2);
-        if (!numeric(ta) || !numeric(tb)) diags_->error(s.span, "the bounds of a 'for' range must be numbers");
+        if (!numeric(ta) || !numeric(tb))
+            diags_->error(s.span, "the bounds of a 'for' range must be numbers");
         std::uint16_t end = add_local(c, " end", ValueType::Number);
         emit(c, Op::StoreLocal, end, 1, s.span);
         std::uint16_t guard = add_local(c, " guard", ValueType::Number);
@@ -718,7 +816,7 @@ void Compiler::compile_stmt(Ctx& c, const ast::Stmt& s) {
     case K::NProduce:
         if (c.kind != CtxKind::Production) {
             diags_->error(s.span, fmt::format("'{}' is allowed only in the body of a production",
-                                             s.kind == K::Produce ? "produce" : "nproduce"));
+                                              s.kind == K::Produce ? "produce" : "nproduce"));
             break;
         }
         compile_successor(c, s.successor, s.span);
@@ -735,7 +833,8 @@ void Compiler::compile_stmt(Ctx& c, const ast::Stmt& s) {
             for (const auto& rs : P_.groups) names.push_back(rs.name);
             std::string near = nearest_name(s.name, names);
             diags_->error(s.span, near.empty() ? fmt::format("unknown rule group '{}'", s.name)
-                                              : fmt::format("unknown rule group '{}'; did you mean '{}'?", s.name, near));
+                                               : fmt::format("unknown rule group '{}'; did you mean '{}'?",
+                                                             s.name, near));
         }
         used_groups_.insert(s.name);
         emit(c, Op::Use, g, 0, s.span);
@@ -818,7 +917,7 @@ void Compiler::compile_assign(Ctx& c, const ast::Stmt& s) {
             if (t == ValueType::Void) t = ValueType::Number;
             if (value_width(t) != value_width(target))
                 diags_->error(s.expr->span, fmt::format("cannot assign a {} to '{}', which holds a {}",
-                                                       value_type_name(t), s.name, value_type_name(target)));
+                                                        value_type_name(t), s.name, value_type_name(target)));
             return;
         }
         // compound: load, value, op
@@ -841,8 +940,9 @@ void Compiler::compile_assign(Ctx& c, const ast::Stmt& s) {
     };
     if (const LocalVar* l = find_local(c, s.name)) {
         if (l->bound) {
-            diags_->error(s.span, fmt::format("'{}' is bound by the predecessor and cannot be assigned; use 'let'",
-                                             s.name));
+            diags_->error(
+                s.span,
+                fmt::format("'{}' is bound by the predecessor and cannot be assigned; use 'let'", s.name));
             return;
         }
         LocalVar copy = *l;
@@ -852,15 +952,15 @@ void Compiler::compile_assign(Ctx& c, const ast::Stmt& s) {
     }
     if (auto it = consts_.find(s.name); it != consts_.end()) {
         diags_->error(s.span, fmt::format("'{}' is a const and cannot be assigned (defined at {})", s.name,
-                                         where(it->second.span)));
+                                          where(it->second.span)));
         return;
     }
     if (auto it = P_.global_index.find(s.name); it != P_.global_index.end()) {
         const Global g = P_.globals[it->second];
         if (c.kind != CtxKind::Hook) {
             diags_->error(s.span, fmt::format("'{}' is a {}: it can be assigned only in hooks (on start, on "
-                                             "before_step, on after_step, on end)",
-                                             s.name, g.kind == GlobalKind::Param ? "param" : "var"));
+                                              "before_step, on after_step, on end)",
+                                              s.name, g.kind == GlobalKind::Param ? "param" : "var"));
             return;
         }
         compile_value(g.type);
@@ -888,7 +988,8 @@ std::vector<std::pair<std::string, Span>> Compiler::split_run(const ast::ModuleR
     while (i < s.size()) {
         std::size_t best = 1;
         for (std::size_t len = std::min(s.size() - i, max_declared_len_); len > 1; --len) {
-            if (auto id = P_.symbols.find(std::string_view(s).substr(i, len)); id && P_.symbols[*id].declared) {
+            if (auto id = P_.symbols.find(std::string_view(s).substr(i, len));
+                id && P_.symbols[*id].declared) {
                 best = len;
                 break;
             }
@@ -929,8 +1030,9 @@ void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list, Span span)
             if (info.arity >= 0 && (last ? m.has_args || info.arity > 0 : info.arity > 0) &&
                 static_cast<int>(nargs) != info.arity) {
                 diags_->error(last ? m.span : Span{parts[k].second},
-                             fmt::format("module '{}' takes {} parameter{}, given {} (declared at {})", info.name,
-                                         info.arity, info.arity == 1 ? "" : "s", nargs, where(info.decl_span)));
+                              fmt::format("module '{}' takes {} parameter{}, given {} (declared at {})",
+                                          info.name, info.arity, info.arity == 1 ? "" : "s", nargs,
+                                          where(info.decl_span)));
             }
             if (sym == P_.symbols.open_bracket || sym == P_.symbols.close_bracket) {
                 if (nargs) diags_->error(m.span, "brackets take no parameters");
@@ -948,7 +1050,8 @@ void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list, Span span)
                         for (std::size_t e = 0; e < P_.environment_names.size(); ++e)
                             if (P_.environment_names[e] == a.text) env = e;
                     if (env == P_.environment_names.size()) {
-                        diags_->error(a.span, "the first argument of ?E names an environment, as in ?E(sun, 0)");
+                        diags_->error(a.span,
+                                      "the first argument of ?E names an environment, as in ?E(sun, 0)");
                         emit_const(c, -1, a.span);
                     } else {
                         emit_const(c, static_cast<double>(env), a.span);
@@ -963,8 +1066,9 @@ void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list, Span span)
                 if (info.arity >= 0 && i < info.param_types.size() &&
                     value_width(t) != value_width(info.param_types[i])) {
                     diags_->error(m.args[i]->span,
-                                 fmt::format("parameter '{}' of '{}' is a {}, found a {}", info.param_names[i],
-                                             info.name, value_type_name(info.param_types[i]), value_type_name(t)));
+                                  fmt::format("parameter '{}' of '{}' is a {}, found a {}",
+                                              info.param_names[i], info.name,
+                                              value_type_name(info.param_types[i]), value_type_name(t)));
                 }
                 width += value_width(t);
             }
@@ -977,7 +1081,8 @@ void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list, Span span)
                 c.code->arg_spans.push_back(std::move(arg_spans));
                 spans_index = static_cast<std::uint16_t>(c.code->arg_spans.size());
             }
-            emit(c, Op::Emit, static_cast<std::int32_t>(sym), width, last ? m.span : parts[k].second, spans_index);
+            emit(c, Op::Emit, static_cast<std::int32_t>(sym), width, last ? m.span : parts[k].second,
+                 spans_index);
         }
     }
 }
@@ -996,15 +1101,16 @@ std::vector<PatternModule> Compiler::compile_pattern(Ctx& c, const ast::ModuleLi
             bool bracket = pm.sym == P_.symbols.open_bracket || pm.sym == P_.symbols.close_bracket;
             if (bracket && role != PatternRole::Right) {
                 diags_->error(m.span, role == PatternRole::Strict
-                                         ? "a predecessor cannot contain '[' or ']'"
-                                         : "brackets are allowed only in a right context");
+                                          ? "a predecessor cannot contain '[' or ']'"
+                                          : "brackets are allowed only in a right context");
             }
             std::size_t nargs = last ? m.args.size() : 0;
             if (info.arity >= 0 && static_cast<int>(nargs) != info.arity) {
-                diags_->error(last ? m.span : pm.span,
-                             fmt::format("module '{}' takes {} parameter{}, the pattern gives {} (declared at {})",
-                                         info.name, info.arity, info.arity == 1 ? "" : "s", nargs,
-                                         where(info.decl_span)));
+                diags_->error(
+                    last ? m.span : pm.span,
+                    fmt::format("module '{}' takes {} parameter{}, the pattern gives {} (declared at {})",
+                                info.name, info.arity, info.arity == 1 ? "" : "s", nargs,
+                                where(info.decl_span)));
             }
             for (std::size_t i = 0; i < nargs; ++i) {
                 const ast::Expr& a = *m.args[i];
@@ -1020,7 +1126,8 @@ std::vector<PatternModule> Compiler::compile_pattern(Ctx& c, const ast::ModuleLi
                     } else {
                         for (const auto& l : c.locals) {
                             if (l.name == a.text) {
-                                diags_->error(a.span, fmt::format("'{}' is bound twice in this production", a.text));
+                                diags_->error(a.span,
+                                              fmt::format("'{}' is bound twice in this production", a.text));
                                 break;
                             }
                         }
@@ -1030,7 +1137,8 @@ std::vector<PatternModule> Compiler::compile_pattern(Ctx& c, const ast::ModuleLi
                 } else if (auto v = fold_number(a)) {
                     pa.bind = false;
                     pa.value = *v;
-                    if (t == ValueType::Vec3) diags_->error(a.span, "a vec3 parameter cannot be matched against a number");
+                    if (t == ValueType::Vec3)
+                        diags_->error(a.span, "a vec3 parameter cannot be matched against a number");
                 } else {
                     diags_->error(a.span, "a pattern argument must be a name to bind or a constant value");
                 }

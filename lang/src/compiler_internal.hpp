@@ -37,7 +37,7 @@ struct Ctx {
     std::vector<std::size_t> void_returns; // Return instructions whose width is not known yet
     int depth = 0;                         // operand stack depth after the last instruction
     bool stack_error = false;
-    int function = -1;                     // the function being compiled, if any
+    int function = -1; // the function being compiled, if any
 };
 
 struct ConstVal {
@@ -62,8 +62,9 @@ std::size_t edit_distance(std::string_view a, std::string_view b);
 std::string nearest_name(std::string_view name, const std::vector<std::string>& candidates);
 
 class Compiler {
-public:
-    Compiler(SourceManager& sm, const CompileOptions& opts, Diagnostics& diags) : sm_(sm), opts_(opts), diags_(&diags) {}
+  public:
+    Compiler(SourceManager& sm, const CompileOptions& opts, Diagnostics& diags)
+        : sm_(sm), opts_(opts), diags_(&diags) {}
     std::unique_ptr<Program> compile(std::uint32_t main_file);
 
     // expressions (compiler.cpp)
@@ -85,11 +86,12 @@ public:
     ValueType compile_function_body(std::uint32_t index, Code& code, std::uint16_t& frame_size);
     ValueType param_type(const ast::ParamName& p);
 
-private:
+  private:
     // program structure (compiler_program.cpp)
     void load(std::uint32_t file_id, std::map<std::string, std::pair<const ast::Expr*, Span>> overrides,
               std::vector<std::string>& stack);
-    std::string resolve_import(const ast::Import& im, std::uint32_t from_file, std::vector<std::string>& searched);
+    std::string resolve_import(const ast::Import& im, std::uint32_t from_file,
+                               std::vector<std::string>& searched);
     void declare_modules(const ast::File& f);
     void declare_values(const LoadedFile& lf);
     void compile_rules(const ast::File& f);
@@ -134,7 +136,7 @@ private:
     std::vector<const ast::FnDecl*> fn_decls_;
     std::vector<int> fn_state_; // 0 pending, 1 compiling, 2 done
     std::vector<bool> fn_result_known_;
-    std::vector<bool> fn_random_; // the function (or one it calls) draws random numbers
+    std::vector<bool> fn_random_;                  // the function (or one it calls) draws random numbers
     std::map<std::string, std::string> env_names_; // env name -> kind
     std::set<std::string> curve_names_;
     std::set<std::string> used_groups_;

@@ -23,14 +23,15 @@ namespace fs = std::filesystem;
 
 SymbolTable::SymbolTable() {
     // Turtle symbols of LANGUAGE.md section 10 and the query modules of section 8.
-    static const char* turtle[] = {"F",  "f",  "G",  "+",  "-",       "&",   "^",   "\\",  "/",  "|",
-                                   "$",  "[",  "]",  "!",  ";",       "~",   "%",   "@O",  "@R", "SetHead",
-                                   "@M", "@Tp", "@Ts", "SetColor"};
+    static const char* turtle[] = {"F", "f",  "G",  "+",       "-",  "&",   "^",   "\\",
+                                   "/", "|",  "$",  "[",       "]",  "!",   ";",   "~",
+                                   "%", "@O", "@R", "SetHead", "@M", "@Tp", "@Ts", "SetColor"};
     for (const char* t : turtle) {
         SymbolId id = intern(t);
         infos_[id].turtle = true;
         // multi-letter turtle names are declared so letter runs do not split them
-        infos_[id].declared = std::string_view(t).size() > 1 && std::isalpha(static_cast<unsigned char>(t[0]));
+        infos_[id].declared =
+            std::string_view(t).size() > 1 && std::isalpha(static_cast<unsigned char>(t[0]));
     }
     for (const char* q : {"?P", "?H", "?U", "?L", "?E"}) {
         SymbolId id = intern(q);
@@ -62,7 +63,8 @@ std::optional<SymbolId> SymbolTable::find(std::string_view name) const {
 
 void RuleSet::index(std::size_t symbols) {
     by_symbol.assign(symbols, {});
-    for (std::uint32_t i = 0; i < productions.size(); ++i) by_symbol[productions[i].strict[0].sym].push_back(i);
+    for (std::uint32_t i = 0; i < productions.size(); ++i)
+        by_symbol[productions[i].strict[0].sym].push_back(i);
 }
 
 int Program::group_index(std::string_view name) const {
@@ -73,7 +75,8 @@ int Program::group_index(std::string_view name) const {
 
 // ---- imports -------------------------------------------------------------------------------
 
-std::string Compiler::resolve_import(const ast::Import& im, std::uint32_t from_file, std::vector<std::string>& searched) {
+std::string Compiler::resolve_import(const ast::Import& im, std::uint32_t from_file,
+                                     std::vector<std::string>& searched) {
     fs::path from_dir = fs::path(sm_.file(from_file).name()).parent_path();
     std::error_code ec;
     if (im.is_path) {
@@ -114,16 +117,17 @@ void Compiler::load(std::uint32_t file_id, std::map<std::string, std::pair<const
         std::vector<std::string> searched;
         std::string path = resolve_import(im, file_id, searched);
         if (path.empty()) {
-            diags_->error(im.span, im.is_path ? fmt::format("cannot find imported file '{}' (looked for {})", im.target,
-                                                           searched.empty() ? "?" : searched[0])
-                                             : fmt::format("cannot find library '{}' (searched {})", im.target,
-                                                           fmt::join(searched, ", ")));
+            diags_->error(im.span, im.is_path ? fmt::format("cannot find imported file '{}' (looked for {})",
+                                                            im.target, searched.empty() ? "?" : searched[0])
+                                              : fmt::format("cannot find library '{}' (searched {})",
+                                                            im.target, fmt::join(searched, ", ")));
             continue;
         }
         if (std::find(stack.begin(), stack.end(), path) != stack.end()) {
-            diags_->error(im.span, fmt::format("import cycle: '{}' imports '{}', which is already being imported "
-                                              "(chain: {})",
-                                              self, path, fmt::join(stack, " -> ")));
+            diags_->error(im.span,
+                          fmt::format("import cycle: '{}' imports '{}', which is already being imported "
+                                      "(chain: {})",
+                                      self, path, fmt::join(stack, " -> ")));
             continue;
         }
         if (loaded_paths_.count(path)) continue; // imported already through another path
@@ -163,7 +167,9 @@ void Compiler::declare_modules(const ast::File& f) {
             names.push_back(p.name);
         }
         if (info.turtle || info.query) {
-            diags_->error(m.span, fmt::format("'{}' is a built-in turtle or query module and cannot be declared", m.name));
+            diags_->error(
+                m.span,
+                fmt::format("'{}' is a built-in turtle or query module and cannot be declared", m.name));
             continue;
         }
         if (info.arity >= 0) {
@@ -190,7 +196,9 @@ void Compiler::declare_values(const LoadedFile& lf) {
         Span prev;
         if (auto it = value_spans_.find(v.name); it != value_spans_.end()) prev = it->second;
         if (prev.valid()) {
-            duplicate(v.kind == ast::DeclKind::Const ? "const" : v.kind == ast::DeclKind::Param ? "param" : "var",
+            duplicate(v.kind == ast::DeclKind::Const   ? "const"
+                      : v.kind == ast::DeclKind::Param ? "param"
+                                                       : "var",
                       v.name, v.name_span, prev);
             continue;
         }
@@ -198,8 +206,9 @@ void Compiler::declare_values(const LoadedFile& lf) {
         const ast::Expr* value = v.value.get();
         if (auto it = lf.overrides.find(v.name); it != lf.overrides.end()) {
             if (v.kind != ast::DeclKind::Param)
-                diags_->error(it->second.second, fmt::format("'{}' is a {}, and only params can be overridden",
-                                                            v.name, v.kind == ast::DeclKind::Const ? "const" : "var"));
+                diags_->error(it->second.second,
+                              fmt::format("'{}' is a {}, and only params can be overridden", v.name,
+                                          v.kind == ast::DeclKind::Const ? "const" : "var"));
             else
                 value = it->second.first;
         }
@@ -240,7 +249,7 @@ void Compiler::compile_settings(const ast::File& f) {
             continue;
         }
         seen[s.key] = s.span;
-        Code* target = s.key == "derive" ? &P_.setting_derive
+        Code* target = s.key == "derive"  ? &P_.setting_derive
                        : s.key == "angle" ? &P_.setting_angle
                        : s.key == "step"  ? &P_.setting_step
                        : s.key == "width" ? &P_.setting_width
@@ -251,17 +260,20 @@ void Compiler::compile_settings(const ast::File& f) {
         c.kind = CtxKind::Global;
         ValueType t = compile_expr(c, *s.value);
         if (t != ValueType::Number && t != ValueType::Bool)
-            diags_->error(s.value->span, fmt::format("'{}' needs a number, found a {}", s.key, value_type_name(t)));
+            diags_->error(s.value->span,
+                          fmt::format("'{}' needs a number, found a {}", s.key, value_type_name(t)));
         emit(c, Op::Halt, 0, 1, s.value->span);
         // settings made of constants are checked now, so `plant check` sees them
         if (auto v = fold_number(*s.value)) {
             bool whole = *v == std::floor(*v);
             if (s.key == "derive" && (!whole || *v < 0 || *v > 1e6))
-                diags_->error(s.value->span, fmt::format("the number of steps must be a whole number from 0 to "
-                                                        "1000000, found {}",
-                                                        *v));
+                diags_->error(s.value->span,
+                              fmt::format("the number of steps must be a whole number from 0 to "
+                                          "1000000, found {}",
+                                          *v));
             if (s.key == "seed" && (!whole || *v < 0))
-                diags_->error(s.value->span, fmt::format("the seed must be a whole number >= 0, found {}", *v));
+                diags_->error(s.value->span,
+                              fmt::format("the seed must be a whole number >= 0, found {}", *v));
         }
     }
     // ignore / consider
@@ -273,8 +285,10 @@ void Compiler::compile_settings(const ast::File& f) {
                 (void)sp;
             }
         }
-        if (ss.ignore) has_ignore_ = true;
-        else has_consider_ = true;
+        if (ss.ignore)
+            has_ignore_ = true;
+        else
+            has_consider_ = true;
         if (has_ignore_ && has_consider_)
             diags_->error(ss.span, "a grammar can have 'ignore:' or 'consider:', not both");
     }
@@ -313,14 +327,15 @@ void Compiler::compile_production(const ast::Production& p, RuleSet& set, bool i
         ValueType t = compile_expr(c, *p.condition);
         if (t != ValueType::Number && t != ValueType::Bool)
             diags_->error(p.condition->span, fmt::format("a condition must be a bool or number, found a {}",
-                                                        value_type_name(t)));
+                                                         value_type_name(t)));
         emit(c, Op::Halt, 0, 1, p.condition->span);
     }
     if (p.weight) {
         c.code = &cp.weight;
         ValueType t = compile_expr(c, *p.weight);
         if (t != ValueType::Number && t != ValueType::Bool)
-            diags_->error(p.weight->span, fmt::format("a weight must be a number, found a {}", value_type_name(t)));
+            diags_->error(p.weight->span,
+                          fmt::format("a weight must be a number, found a {}", value_type_name(t)));
         emit(c, Op::Halt, 0, 1, p.weight->span);
     }
     c.code = &cp.body;
@@ -338,7 +353,8 @@ void Compiler::compile_production(const ast::Production& p, RuleSet& set, bool i
     if (!cp.left_new.empty()) set.uses_left_new = true;
     if (!cp.right_new.empty()) set.uses_right_new = true;
     if (set.uses_left_new && set.uses_right_new)
-        diags_->error(p.span, "one rule set cannot read both the forward (<<) and the backward (>>) new context");
+        diags_->error(p.span,
+                      "one rule set cannot read both the forward (<<) and the backward (>>) new context");
     // shadowing: an earlier production that always applies to the same predecessor
     for (const auto& q : set.productions) {
         bool same = q.strict.size() == cp.strict.size();
@@ -349,18 +365,21 @@ void Compiler::compile_production(const ast::Production& p, RuleSet& set, bool i
         bool always = same && q.condition.empty() && q.weight.empty() && !q.body_form && !q.has_context() &&
                       !q.has_new_context();
         if (always && cp.weight.empty()) {
-            Diagnostic d{Severity::Warning, p.span,
-                         fmt::format("this production can never apply: the production at {} always applies first "
-                                     "to '{}'",
-                                     where(q.span), P_.symbols[cp.strict[0].sym].name),
-                         {}};
+            Diagnostic d{
+                Severity::Warning,
+                p.span,
+                fmt::format("this production can never apply: the production at {} always applies first "
+                            "to '{}'",
+                            where(q.span), P_.symbols[cp.strict[0].sym].name),
+                {}};
             diags_->add(std::move(d));
             break;
         }
     }
     if (p.condition) {
         if (auto v = fold_number(*p.condition); v && *v == 0)
-            diags_->warning(p.condition->span, "this production can never apply: its condition is always false");
+            diags_->warning(p.condition->span,
+                            "this production can never apply: its condition is always false");
     }
     set.productions.push_back(std::move(cp));
 }
@@ -412,18 +431,20 @@ void Compiler::check_raw_runs() {
         bool meaningful = false;
         for (const auto& l : run.letters) {
             auto id = P_.symbols.find(l);
-            if (id && (has_rule[*id] || P_.symbols[*id].turtle || P_.symbols[*id].declared)) meaningful = true;
+            if (id && (has_rule[*id] || P_.symbols[*id].turtle || P_.symbols[*id].declared))
+                meaningful = true;
         }
         if (meaningful || !reported.insert({run.span.file, run.span.begin}).second) continue;
         std::string near = nearest_name(run.text, declared);
-        diags_->warning(run.span,
-                       near.empty()
-                           ? fmt::format("'{}' is not a declared module and is read as {} separate letters, none of "
-                                         "which has a rule or a turtle meaning; declare it with 'module {}(...);'",
-                                         run.text, run.letters.size(), run.text)
-                           : fmt::format("'{}' is not a declared module and is read as {} separate letters, none of "
-                                         "which has a rule or a turtle meaning; did you mean '{}'?",
-                                         run.text, run.letters.size(), near));
+        diags_->warning(
+            run.span,
+            near.empty()
+                ? fmt::format("'{}' is not a declared module and is read as {} separate letters, none of "
+                              "which has a rule or a turtle meaning; declare it with 'module {}(...);'",
+                              run.text, run.letters.size(), run.text)
+                : fmt::format("'{}' is not a declared module and is read as {} separate letters, none of "
+                              "which has a rule or a turtle meaning; did you mean '{}'?",
+                              run.text, run.letters.size(), near));
     }
 }
 
@@ -432,9 +453,10 @@ void Compiler::check_never_applying() {
         for (const auto& p : rs.productions) {
             SymbolId s = p.strict[0].sym;
             if (!produced_.count(s)) {
-                diags_->warning(p.span, fmt::format("this production can never apply: neither the axiom nor any "
-                                                   "successor produces '{}'",
-                                                   P_.symbols[s].name));
+                diags_->warning(p.span,
+                                fmt::format("this production can never apply: neither the axiom nor any "
+                                            "successor produces '{}'",
+                                            P_.symbols[s].name));
             }
         }
     };
@@ -445,11 +467,14 @@ void Compiler::check_never_applying() {
     for (const auto& [name, span, dummy] : group_decls_) {
         (void)dummy;
         if (!used_groups_.count(name))
-            diags_->warning(span, fmt::format("rule group '{}' is never selected: no hook says 'use {};'", name, name));
+            diags_->warning(
+                span, fmt::format("rule group '{}' is never selected: no hook says 'use {};'", name, name));
     }
 }
 
-void Compiler::finish_rule_set(RuleSet& set) { set.index(P_.symbols.size()); }
+void Compiler::finish_rule_set(RuleSet& set) {
+    set.index(P_.symbols.size());
+}
 
 void Compiler::compile_environment(const ast::ShapeDecl& s) {
     for (const ast::ShapeDecl* other : P_.deferred.envs) {
@@ -460,7 +485,7 @@ void Compiler::compile_environment(const ast::ShapeDecl& s) {
         }
     }
     P_.environment_names.push_back(s.name);
-    P_.environments.emplace_back(); // null until made
+    P_.environments.emplace_back();  // null until made
     if (!opts_.environments) return; // no runtime: using it is reported where it is used
     std::vector<EnvArg> args;
     for (std::size_t i = 0; i < s.args.size(); ++i) {
@@ -487,7 +512,8 @@ void Compiler::compile_environment(const ast::ShapeDecl& s) {
     std::string error;
     auto env = opts_.environments(s.kind, args, error);
     if (!env) {
-        diags_->error(s.kind_span, error.empty() ? fmt::format("unknown environment kind '{}'", s.kind) : error);
+        diags_->error(s.kind_span,
+                      error.empty() ? fmt::format("unknown environment kind '{}'", s.kind) : error);
         return;
     }
     P_.environments.back() = std::shared_ptr<Environment>(std::move(env));
@@ -504,7 +530,8 @@ void Compiler::compile_curve(const ast::ShapeDecl& s) {
         }
     }
     if (s.kind != "linear" && s.kind != "bezier") {
-        diags_->error(s.kind_span, fmt::format("unknown curve kind '{}': expected linear(...) or bezier(...)", s.kind));
+        diags_->error(s.kind_span,
+                      fmt::format("unknown curve kind '{}': expected linear(...) or bezier(...)", s.kind));
         return;
     }
     def.bezier = s.kind == "bezier";
@@ -529,7 +556,8 @@ void Compiler::compile_curve(const ast::ShapeDecl& s) {
         for (std::size_t i = 0; i < def.xs.size(); ++i) def.xs[i] = double(i) / double(def.xs.size() - 1);
     for (std::size_t i = 1; i < def.xs.size(); ++i) {
         if (def.xs[i] < def.xs[i - 1]) {
-            diags_->error(s.args[i]->span, "the x of a curve's points must not decrease (x is t, from 0 to 1)");
+            diags_->error(s.args[i]->span,
+                          "the x of a curve's points must not decrease (x is t, from 0 to 1)");
             return;
         }
     }
@@ -563,7 +591,8 @@ void Compiler::compile_surface(const ast::ShapeDecl& s) {
             def.points.push_back({v->v[0], v->v[1], v->v[2]});
         }
         if (def.points.size() < 3) {
-            diags_->error(s.span, fmt::format("polygon '{}' needs at least 3 corners, found {}", s.name, def.points.size()));
+            diags_->error(s.span, fmt::format("polygon '{}' needs at least 3 corners, found {}", s.name,
+                                              def.points.size()));
             return;
         }
     } else if (s.kind == "load") {
@@ -575,11 +604,15 @@ void Compiler::compile_surface(const ast::ShapeDecl& s) {
         if (p.is_relative()) p = fs::path(sm_.file(s.span.file).name()).parent_path() / p;
         def.path = p.lexically_normal().string();
     } else {
-        diags_->error(s.kind_span, fmt::format("unknown surface kind '{}': expected polygon(...) or load(\"file\")", s.kind));
+        diags_->error(
+            s.kind_span,
+            fmt::format("unknown surface kind '{}': expected polygon(...) or load(\"file\")", s.kind));
         return;
     }
-    if (replace < P_.surfaces.size()) P_.surfaces[replace] = std::move(def);
-    else P_.surfaces.push_back(std::move(def));
+    if (replace < P_.surfaces.size())
+        P_.surfaces[replace] = std::move(def);
+    else
+        P_.surfaces.push_back(std::move(def));
 }
 
 // Splits an arrow-form body (argument code, Emit, argument code, Emit, ..., ProduceEnd) into a
@@ -605,19 +638,22 @@ void Compiler::build_template(Production& p) {
         if (constant) {
             for (std::size_t k = seg_begin; k < pc; ++k) t.params.push_back(body.consts[body.instrs[k].a]);
         } else {
-            const auto shift = static_cast<std::int64_t>(t.values.instrs.size()) - static_cast<std::int64_t>(seg_begin);
+            const auto shift =
+                static_cast<std::int64_t>(t.values.instrs.size()) - static_cast<std::int64_t>(seg_begin);
             for (std::size_t k = seg_begin; k < pc; ++k) {
                 Instr J = body.instrs[k];
                 if (J.op == Op::Jump || J.op == Op::JumpIfZero || J.op == Op::JumpIfZeroKeep ||
                     J.op == Op::JumpIfNonZeroKeep)
                     J.a = static_cast<std::int32_t>(J.a + shift);
-                if (J.op == Op::Emit || J.op == Op::ProduceEnd || J.op == Op::Return || J.op == Op::Halt) return;
+                if (J.op == Op::Emit || J.op == Op::ProduceEnd || J.op == Op::Return || J.op == Op::Halt)
+                    return;
                 t.values.instrs.push_back(J);
                 t.values.spans.push_back(body.spans[k]);
             }
             for (int k = 0; k < I.n; ++k) {
                 t.holes.push_back(first + static_cast<std::uint32_t>(k));
-                t.hole_spans.push_back(I.b > 0 ? body.arg_spans[I.b - 1][static_cast<std::size_t>(k)] : body.spans[pc]);
+                t.hole_spans.push_back(I.b > 0 ? body.arg_spans[I.b - 1][static_cast<std::size_t>(k)]
+                                               : body.spans[pc]);
                 t.params.push_back(0);
             }
         }
@@ -650,7 +686,6 @@ void Compiler::build_template(Production& p) {
     t.valid = true;
     p.tmpl = std::move(t);
 }
-
 
 // ---- the whole compilation -----------------------------------------------------------------
 
@@ -708,10 +743,10 @@ std::unique_ptr<Program> Compiler::compile(std::uint32_t main_file) {
             for (const auto& g : P_.globals)
                 if (g.kind == GlobalKind::Param) params.push_back(g.name);
             std::string near = nearest_name(name, params);
-            diags_->error(Span{},
-                         near.empty() ? fmt::format("-D {}: the grammar has no param '{}'", name, name)
-                                      : fmt::format("-D {}: the grammar has no param '{}'; did you mean '{}'?", name,
-                                                    name, near));
+            diags_->error(
+                Span{}, near.empty() ? fmt::format("-D {}: the grammar has no param '{}'", name, name)
+                                     : fmt::format("-D {}: the grammar has no param '{}'; did you mean '{}'?",
+                                                   name, name, near));
         }
     }
     for (const ast::ShapeDecl* s : P_.deferred.curves) compile_curve(*s); // before the code that calls them
@@ -721,13 +756,15 @@ std::unique_ptr<Program> Compiler::compile(std::uint32_t main_file) {
         if (info.bound_to.empty()) continue;
         auto it = env_names_.find(info.bound_to);
         if (it == env_names_.end())
-            diags_->error(info.decl_span, fmt::format("module '{}' is bound to '{}', which is not an environment; "
-                                                      "declare it first, as in env {} = climber(...);",
-                                                      info.name, info.bound_to, info.bound_to));
+            diags_->error(info.decl_span,
+                          fmt::format("module '{}' is bound to '{}', which is not an environment; "
+                                      "declare it first, as in env {} = climber(...);",
+                                      info.name, info.bound_to, info.bound_to));
         else if (it->second != "climber")
-            diags_->error(info.decl_span, fmt::format("module '{}' is bound to '{}', which is not a climber (it is "
-                                                      "'{}'); only a climber can hold segments",
-                                                      info.name, info.bound_to, it->second));
+            diags_->error(info.decl_span,
+                          fmt::format("module '{}' is bound to '{}', which is not a climber (it is "
+                                      "'{}'); only a climber can hold segments",
+                                      info.name, info.bound_to, it->second));
     }
     for (std::uint32_t i = 0; i < P_.functions.size(); ++i) ensure_function_compiled(i);
     for (const ast::ShapeDecl* s : P_.deferred.surfaces) compile_surface(*s);
@@ -755,18 +792,22 @@ std::unique_ptr<Program> Compiler::compile(std::uint32_t main_file) {
     P_.ignored.assign(P_.symbols.size(), 0);
     for (SymbolId s = 0; s < P_.symbols.size(); ++s) {
         if (s == P_.symbols.open_bracket || s == P_.symbols.close_bracket) continue;
-        if (has_consider_) P_.ignored[s] = consider_syms_.count(s) ? 0 : 1;
-        else P_.ignored[s] = ignore_syms_.count(s) ? 1 : 0;
+        if (has_consider_)
+            P_.ignored[s] = consider_syms_.count(s) ? 0 : 1;
+        else
+            P_.ignored[s] = ignore_syms_.count(s) ? 1 : 0;
     }
     P_.uses_cut = produced_.count(P_.symbols.cut) > 0;
     // a named group runs together with the unnamed one: together they may read only one
     // direction of new context
     for (const auto& g : P_.groups) {
-        bool left = g.uses_left_new || P_.rules.uses_left_new, right = g.uses_right_new || P_.rules.uses_right_new;
+        bool left = g.uses_left_new || P_.rules.uses_left_new,
+             right = g.uses_right_new || P_.rules.uses_right_new;
         if (left && right)
-            diags_->error(g.span, fmt::format("rule group '{}' and the unnamed rules together read both the forward "
-                                              "(<<) and the backward (>>) new context; use one direction",
-                                              g.name));
+            diags_->error(g.span,
+                          fmt::format("rule group '{}' and the unnamed rules together read both the forward "
+                                      "(<<) and the backward (>>) new context; use one direction",
+                                      g.name));
     }
     finish_rule_set(P_.rules);
     for (auto& g : P_.groups) finish_rule_set(g);
@@ -780,21 +821,22 @@ std::unique_ptr<Program> Compiler::compile(std::uint32_t main_file) {
     return std::move(program_);
 }
 
-std::unique_ptr<Program> compile_source(SourceManager& sources, std::uint32_t file_id, const CompileOptions& options,
-                                        Diagnostics& diags) {
+std::unique_ptr<Program> compile_source(SourceManager& sources, std::uint32_t file_id,
+                                        const CompileOptions& options, Diagnostics& diags) {
     Compiler c(sources, options, diags);
     try {
         return c.compile(file_id);
     } catch (const SymbolTable::Full&) {
-        diags.error(Span{file_id, 0, 0}, fmt::format("the program names more than {} different modules, the most "
-                                                     "plant can tell apart",
-                                                     kNoSymbol - 1));
+        diags.error(Span{file_id, 0, 0},
+                    fmt::format("the program names more than {} different modules, the most "
+                                "plant can tell apart",
+                                kNoSymbol - 1));
         return nullptr;
     }
 }
 
-std::unique_ptr<Program> compile_file(SourceManager& sources, const std::string& path, const CompileOptions& options,
-                                      Diagnostics& diags) {
+std::unique_ptr<Program> compile_file(SourceManager& sources, const std::string& path,
+                                      const CompileOptions& options, Diagnostics& diags) {
     std::string text;
     if (!read_file(path, text)) {
         diags.error(Span{}, fmt::format("cannot read '{}'", path));

@@ -40,29 +40,35 @@ double now_ms() {
 
 } // namespace
 
-
 // ---- Derivation ------------------------------------------------------------------------------
 
-Derivation::Derivation(const Program& program, DeriveOptions options) : prog_(program), opt_(std::move(options)) {
+Derivation::Derivation(const Program& program, DeriveOptions options)
+    : prog_(program), opt_(std::move(options)) {
     globals_ = prog_.global_values;
 }
 
-Derivation::~Derivation() { big_pages::trim(); }
+Derivation::~Derivation() {
+    big_pages::trim();
+}
 
-void Derivation::check_limits(const ModuleString& s) const { check_limits(s.size(), s.params.size()); }
+void Derivation::check_limits(const ModuleString& s) const {
+    check_limits(s.size(), s.params.size());
+}
 
 void Derivation::check_limits(std::size_t modules, std::size_t params) const {
     if (modules > opt_.max_modules)
-        throw RuntimeError{Span{}, fmt::format("step {}: the string grew past the limit of {} modules (raise it "
-                                               "with --max-modules)",
-                                               step_, opt_.max_modules)};
-    std::size_t estimate = modules * (sizeof(SymbolId) + sizeof(std::uint32_t) +
-                                      (current_.keep_ids ? sizeof(ModuleId) : 0)) +
-                           params * sizeof(double);
+        throw RuntimeError{Span{},
+                           fmt::format("step {}: the string grew past the limit of {} modules (raise it "
+                                       "with --max-modules)",
+                                       step_, opt_.max_modules)};
+    std::size_t estimate =
+        modules * (sizeof(SymbolId) + sizeof(std::uint32_t) + (current_.keep_ids ? sizeof(ModuleId) : 0)) +
+        params * sizeof(double);
     if (estimate > opt_.max_bytes)
-        throw RuntimeError{Span{}, fmt::format("step {}: the string needs about {:.1f} GiB, more than the limit of "
-                                               "{:.1f} GiB",
-                                               step_, estimate / double(1 << 30), opt_.max_bytes / double(1 << 30))};
+        throw RuntimeError{Span{},
+                           fmt::format("step {}: the string needs about {:.1f} GiB, more than the limit of "
+                                       "{:.1f} GiB",
+                                       step_, estimate / double(1 << 30), opt_.max_bytes / double(1 << 30))};
 }
 
 const RulePlan& Derivation::plan_for(const std::vector<const RuleSet*>& sets) const {
@@ -151,7 +157,8 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const RulePl
                     setup(w);
                     std::size_t b = n * static_cast<std::size_t>(t) / static_cast<std::size_t>(threads);
                     std::size_t e = n * static_cast<std::size_t>(t + 1) / static_cast<std::size_t>(threads);
-                    std::size_t modules = (t == 0 ? n : e - b), params = in.params.size() * (e - b) / std::max<std::size_t>(n, 1);
+                    std::size_t modules = (t == 0 ? n : e - b),
+                                params = in.params.size() * (e - b) / std::max<std::size_t>(n, 1);
                     if (t == 0) {
                         params = in.params.size();
                         w.env.id_base = next_id_;
@@ -171,7 +178,8 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const RulePl
         std::size_t total = 0, total_params = 0;
         for (auto& w : workers) {
             if (w.error) {
-                if (w.error->message == "module limit" || w.error->message == "the string outgrew the module limit")
+                if (w.error->message == "module limit" ||
+                    w.error->message == "the string outgrew the module limit")
                     check_limits(w.out);
                 throw *w.error;
             }
@@ -203,7 +211,8 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const RulePl
             for (std::size_t t = 1; t < workers.size(); ++t) {
                 pool.emplace_back([&, t] {
                     ModuleString& src = workers[t].out;
-                    std::copy(src.sym.begin(), src.sym.end(), out.sym.begin() + static_cast<std::ptrdiff_t>(mod_at[t]));
+                    std::copy(src.sym.begin(), src.sym.end(),
+                              out.sym.begin() + static_cast<std::ptrdiff_t>(mod_at[t]));
                     std::copy(src.params.begin(), src.params.end(),
                               out.params.begin() + static_cast<std::ptrdiff_t>(par_at[t]));
                     for (std::size_t i = 0; i < src.size(); ++i) {
@@ -221,7 +230,10 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const RulePl
     }
     if (n > 0) {
         growth_ = std::max(0.5, std::min(16.0, double(out.size()) / double(n)));
-        param_growth_ = in.params.empty() ? growth_ : std::max(0.5, std::min(16.0, double(out.params.size()) / double(in.params.size())));
+        param_growth_ =
+            in.params.empty()
+                ? growth_
+                : std::max(0.5, std::min(16.0, double(out.params.size()) / double(in.params.size())));
     }
     check_limits(out);
 }
@@ -303,9 +315,11 @@ void Derivation::decompose(ModuleString& s, int step_for_env) {
         if (!any_candidate(s, prog_.decompose)) break;
         ModuleString next;
         ModuleId before = next_id_;
-        rewrite(s, next, plan_for(sets), (static_cast<std::uint64_t>(step_for_env) << 16) | static_cast<std::uint64_t>(pass + 1),
+        rewrite(s, next, plan_for(sets),
+                (static_cast<std::uint64_t>(step_for_env) << 16) | static_cast<std::uint64_t>(pass + 1),
                 step_for_env);
-        bool changed = next_id_ != before || next.size() != s.size() || next.sym != s.sym || next.params != s.params;
+        bool changed =
+            next_id_ != before || next.size() != s.size() || next.sym != s.sym || next.params != s.params;
         s.swap(next);
         if (!changed) break;
     }
@@ -313,7 +327,8 @@ void Derivation::decompose(ModuleString& s, int step_for_env) {
 
 void Derivation::apply_cut(ModuleString& s) const {
     if (!prog_.uses_cut) return;
-    const SymbolId cut = prog_.symbols.cut, open = prog_.symbols.open_bracket, close = prog_.symbols.close_bracket;
+    const SymbolId cut = prog_.symbols.cut, open = prog_.symbols.open_bracket,
+                   close = prog_.symbols.close_bracket;
     bool any = false;
     for (SymbolId x : s.sym)
         if (x == cut) {
@@ -332,7 +347,8 @@ ModuleString Derivation::interpreted(const ModuleString& s) const {
     for (int pass = 0; pass < prog_.interpret.max_depth; ++pass) {
         if (!any_candidate(cur, prog_.interpret)) break;
         ModuleString next;
-        rewrite(cur, next, plan_for(sets), (static_cast<std::uint64_t>(step_) << 16) | 0x8000u | static_cast<std::uint64_t>(pass),
+        rewrite(cur, next, plan_for(sets),
+                (static_cast<std::uint64_t>(step_) << 16) | 0x8000u | static_cast<std::uint64_t>(pass),
                 step_);
         bool changed = next.sym != cur.sym || next.params != cur.params;
         cur.swap(next);
@@ -373,11 +389,14 @@ void Derivation::start() {
     EvalEnv env;
     env.prog = &prog_;
     env.globals = globals_.data();
-    auto setting = [&](const Code& c, double fallback) { return c.empty() ? fallback : eval_number(c, nullptr, env); };
+    auto setting = [&](const Code& c, double fallback) {
+        return c.empty() ? fallback : eval_number(c, nullptr, env);
+    };
     double steps = opt_.steps ? *opt_.steps : setting(prog_.setting_derive, 0);
     if (steps < 0 || steps > 1e6 || steps != std::floor(steps))
-        throw RuntimeError{prog_.setting_derive.spans.empty() ? Span{} : prog_.setting_derive.spans.back(),
-                           fmt::format("the number of steps must be a whole number from 0 to 1000000, found {}", steps)};
+        throw RuntimeError{
+            prog_.setting_derive.spans.empty() ? Span{} : prog_.setting_derive.spans.back(),
+            fmt::format("the number of steps must be a whole number from 0 to 1000000, found {}", steps)};
     target_ = static_cast<int>(steps);
     double seed = setting(prog_.setting_seed, 0);
     if (!(seed >= 0 && seed < 9.0e18) || seed != std::floor(seed))
@@ -431,7 +450,8 @@ bool Derivation::step() {
     if (stopped_) return false;
     const RulePlan& plan = step_plan();
     // the turtle pass fills query modules and shows the environments the plant as it is now
-    if ((plan.queries || !prog_.environments.empty()) && opt_.queries) opt_.queries->fill_queries(*this, current_);
+    if ((plan.queries || !prog_.environments.empty()) && opt_.queries)
+        opt_.queries->fill_queries(*this, current_);
     // (moved rather than swapped: an empty ModuleString would allocate its first offset; a
     // moved-from one is only ever cleared, which restores it)
     ModuleString next(std::move(spare_.s));
@@ -454,7 +474,9 @@ bool Derivation::step() {
     return !stopped_ && step_ < target_;
 }
 
-void Derivation::finish() { run_hook(HookKind::End); }
+void Derivation::finish() {
+    run_hook(HookKind::End);
+}
 
 void Derivation::run() {
     start();

@@ -16,9 +16,12 @@ namespace {
 
 const char* severity_name(Severity s) {
     switch (s) {
-    case Severity::Note: return "note";
-    case Severity::Warning: return "warning";
-    case Severity::Error: return "error";
+    case Severity::Note:
+        return "note";
+    case Severity::Warning:
+        return "warning";
+    case Severity::Error:
+        return "error";
     }
     return "error";
 }
@@ -32,18 +35,20 @@ std::string printable(std::string_view s) {
     return out;
 }
 
-void render_one(std::string& out, Severity sev, Span span, const std::string& message, const SourceManager& sources,
-                bool color) {
+void render_one(std::string& out, Severity sev, Span span, const std::string& message,
+                const SourceManager& sources, bool color) {
     const char* on = "";
     const char* off = color ? "\x1b[0m" : "";
-    if (color) on = sev == Severity::Error ? "\x1b[1;31m" : sev == Severity::Warning ? "\x1b[1;35m" : "\x1b[1;36m";
+    if (color)
+        on = sev == Severity::Error ? "\x1b[1;31m" : sev == Severity::Warning ? "\x1b[1;35m" : "\x1b[1;36m";
     if (!span.valid()) {
         out += fmt::format("plant: {}{}:{} {}\n", on, severity_name(sev), off, message);
         return;
     }
     const SourceFile& f = sources.file(span.file);
     LineCol lc = f.line_col(span.begin);
-    out += fmt::format("{}:{}:{}: {}{}:{} {}\n", f.name(), lc.line, lc.col, on, severity_name(sev), off, message);
+    out += fmt::format("{}:{}:{}: {}{}:{} {}\n", f.name(), lc.line, lc.col, on, severity_name(sev), off,
+                       message);
     std::string line = printable(f.line_text(lc.line));
     if (line.size() > 200) line = line.substr(0, 200);
     out += fmt::format("{:5} | {}\n", lc.line, line);

@@ -79,7 +79,8 @@ struct name : pad<identifier> {};
 struct expr;
 // number <- [0-9]+ ('.' [0-9]+)? exponent? | '.' [0-9]+ exponent?
 struct exponent : seq<one<'e', 'E'>, opt<one<'+', '-'>>, plus<digit>> {};
-struct number : seq<sor<seq<plus<digit>, opt<one<'.'>, plus<digit>>>, seq<one<'.'>, plus<digit>>>, opt<exponent>> {};
+struct number
+    : seq<sor<seq<plus<digit>, opt<one<'.'>, plus<digit>>>, seq<one<'.'>, plus<digit>>>, opt<exponent>> {};
 // string <- '"' ('\' . | [^"\n])* '"'
 struct string_char : sor<seq<one<'\\'>, not_one<'\n'>>, not_one<'"', '\n'>> {};
 struct string_body : until<one<'"'>, string_char> {};
@@ -92,7 +93,8 @@ struct call_args : if_must<open_paren, arg_list, close_paren> {};
 struct paren_expr : if_must<open_paren, expr, close_paren> {};
 struct call : seq<name, call_args> {};
 struct name_ref : name {};
-struct primary : sor<seq<number, ws>, seq<string_lit, ws>, true_lit, false_lit, paren_expr, call, name_ref> {};
+struct primary : sor<seq<number, ws>, seq<string_lit, ws>, true_lit, false_lit, paren_expr, call, name_ref> {
+};
 // postfix <- primary ('.' identifier args?)*
 struct member : seq<one<'.'>, not_at<one<'.'>>, name, opt<call_args>> {};
 struct postfix : seq<primary, star<member>> {};
@@ -106,7 +108,8 @@ struct mul_op : sor<one<'*'>, seq<one<'/'>, not_at<one<'*'>>>, one<'%'>> {};
 struct mul : seq<unary, star<pad<mul_op>, must<operand>>> {};
 struct add_op : sor<one<'+'>, seq<one<'-'>, not_at<one<'>'>>>> {};
 struct add : seq<mul, star<pad<add_op>, must<mul>>> {};
-struct rel_op : sor<string<'<', '='>, string<'>', '='>, seq<one<'<'>, not_at<one<'<'>>>, seq<one<'>'>, not_at<one<'>'>>>> {};
+struct rel_op : sor<string<'<', '='>, string<'>', '='>, seq<one<'<'>, not_at<one<'<'>>>,
+                    seq<one<'>'>, not_at<one<'>'>>>> {};
 struct rel : seq<add, opt<pad<rel_op>, must<add>>> {};
 struct eq_op : sor<string<'=', '='>, string<'!', '='>> {};
 struct eqx : seq<rel, opt<pad<eq_op>, must<rel>>> {};
@@ -178,8 +181,8 @@ struct use_stmt : if_must<kw_use, name, semi> {};
 struct stop_stmt : if_must<kw_stop, semi> {};
 struct return_stmt : if_must<kw_return, opt<expr>, semi> {};
 struct expr_stmt : seq<expr, must<semi>> {};
-struct statement : sor<let_stmt, if_stmt, for_stmt, produce_stmt, nproduce_stmt, use_stmt, stop_stmt, return_stmt,
-                       assign_stmt, expr_stmt> {};
+struct statement : sor<let_stmt, if_stmt, for_stmt, produce_stmt, nproduce_stmt, use_stmt, stop_stmt,
+                       return_stmt, assign_stmt, expr_stmt> {};
 
 // ---- top-level items (section 3) -----------------------------------------------------------
 

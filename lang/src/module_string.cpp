@@ -80,7 +80,8 @@ std::string format_double(double v) {
     return s;
 }
 
-std::string format_string(const Program& program, const ModuleString& s, bool with_ids, std::size_t max_chars) {
+std::string format_string(const Program& program, const ModuleString& s, bool with_ids,
+                          std::size_t max_chars) {
     std::string out;
     out.reserve(s.size() * 2);
     // Prefixes of declared multi-letter names: "F" then "b" must be spaced when "Fb..." is declared.
@@ -91,7 +92,8 @@ std::string format_string(const Program& program, const ModuleString& s, bool wi
     const std::string* prev = nullptr; // name of the previous module when it ends in a letter run
     for (std::size_t i = 0; i < s.size() && out.size() <= max_chars; ++i) {
         const std::string& name = program.symbols[s.sym[i]].name;
-        bool letter_start = !name.empty() && (std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_');
+        bool letter_start =
+            !name.empty() && (std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_');
         // a space only where reading back would merge two names
         if (prev && letter_start) {
             if (prev->size() > 1 || *prev == "~" || prefixes.count(*prev + name[0])) out += ' ';
@@ -108,14 +110,16 @@ std::string format_string(const Program& program, const ModuleString& s, bool wi
             out += ')';
         }
         if (with_ids) out += fmt::format("#{}", s.id(i));
-        bool ends_letters = !name.empty() && (std::isalnum(static_cast<unsigned char>(name.back())) || name.back() == '_');
+        bool ends_letters =
+            !name.empty() && (std::isalnum(static_cast<unsigned char>(name.back())) || name.back() == '_');
         // a bare '~' followed by a letter would read back as one surface name
         prev = (k == 0 && !with_ids && (ends_letters || name == "~")) ? &name : nullptr;
     }
     return out;
 }
 
-void cut_branches(ModuleString& s, SymbolId open, SymbolId close, const std::function<bool(std::size_t)>& cuts) {
+void cut_branches(ModuleString& s, SymbolId open, SymbolId close,
+                  const std::function<bool(std::size_t)>& cuts) {
     ModuleString out;
     out.keep_ids = s.keep_ids;
     const std::size_t n = s.size();
@@ -130,7 +134,8 @@ void cut_branches(ModuleString& s, SymbolId open, SymbolId close, const std::fun
         int depth = 0;
         ++i;
         while (i < n) {
-            if (s.sym[i] == open) ++depth;
+            if (s.sym[i] == open)
+                ++depth;
             else if (s.sym[i] == close) {
                 if (depth == 0) break;
                 --depth;

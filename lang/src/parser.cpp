@@ -20,21 +20,20 @@ using Node = pt::node;
 template <typename Rule>
 using selector = pt::selector<
     Rule,
-    pt::store_content::on<g::identifier, g::number, g::string_lit, g::true_lit, g::false_lit, g::call, g::call_args,
-                          g::name_ref, g::paren_expr, g::member, g::unary_expr, g::unary_op, g::mul_op, g::add_op, g::rel_op,
-                          g::eq_op, g::and_op, g::or_op, g::module_ref, g::module_name, g::module_args,
-                          g::bracket_open, g::bracket_close, g::wildcard, g::successor, g::pattern,
-                          g::production, g::ctx_part, g::ctx_op, g::condition, g::arrow_form, g::weight, g::block,
-                          g::let_stmt, g::assign_stmt, g::assign_op, g::if_stmt, g::else_part, g::for_stmt,
-                          g::produce_stmt, g::nproduce_stmt, g::use_stmt, g::stop_stmt, g::return_stmt, g::expr_stmt,
-                          g::param_item, g::const_item, g::var_item, g::module_item, g::module_decl, g::param_list,
-                          g::param_decl, g::bound_clause, g::fn_item, g::fn_expr_body, g::curve_item,
-                          g::surface_item, g::shape_kind, g::env_item, g::key_args, g::key_arg,
-                          g::instance_item, g::instance_body, g::setting_item, g::setting_key, g::axiom_item,
-                          g::symbol_set_item, g::symbol_set_kind, g::rules_item, g::group_name, g::rules_body,
-                          g::decompose_item, g::interpret_item, g::max_depth_clause, g::hook_item, g::hook_name,
-                          g::import_item, g::import_target, g::with_clause, g::override_block,
-                          g::override_item>,
+    pt::store_content::on<
+        g::identifier, g::number, g::string_lit, g::true_lit, g::false_lit, g::call, g::call_args,
+        g::name_ref, g::paren_expr, g::member, g::unary_expr, g::unary_op, g::mul_op, g::add_op, g::rel_op,
+        g::eq_op, g::and_op, g::or_op, g::module_ref, g::module_name, g::module_args, g::bracket_open,
+        g::bracket_close, g::wildcard, g::successor, g::pattern, g::production, g::ctx_part, g::ctx_op,
+        g::condition, g::arrow_form, g::weight, g::block, g::let_stmt, g::assign_stmt, g::assign_op,
+        g::if_stmt, g::else_part, g::for_stmt, g::produce_stmt, g::nproduce_stmt, g::use_stmt, g::stop_stmt,
+        g::return_stmt, g::expr_stmt, g::param_item, g::const_item, g::var_item, g::module_item,
+        g::module_decl, g::param_list, g::param_decl, g::bound_clause, g::fn_item, g::fn_expr_body,
+        g::curve_item, g::surface_item, g::shape_kind, g::env_item, g::key_args, g::key_arg, g::instance_item,
+        g::instance_body, g::setting_item, g::setting_key, g::axiom_item, g::symbol_set_item,
+        g::symbol_set_kind, g::rules_item, g::group_name, g::rules_body, g::decompose_item, g::interpret_item,
+        g::max_depth_clause, g::hook_item, g::hook_name, g::import_item, g::import_target, g::with_clause,
+        g::override_block, g::override_item>,
     pt::fold_one::on<g::postfix, g::mul, g::add, g::rel, g::eqx, g::and_x, g::or_x, g::ternary>>;
 
 namespace {
@@ -42,7 +41,7 @@ namespace {
 constexpr std::size_t kMaxChain = 1000;
 
 class Lowering {
-public:
+  public:
     Lowering(std::uint32_t file, Diagnostics& diags) : file_(file), diags_(diags) {}
 
     Span span(const Node& n) const {
@@ -86,8 +85,9 @@ public:
             ast::ExprPtr inner = expr(*n.children.at(0));
             std::string_view text = n.string_view();
             auto close = text.rfind(')');
-            inner->span = {file_, static_cast<std::uint32_t>(n.begin().byte),
-                           static_cast<std::uint32_t>(n.begin().byte + (close == text.npos ? text.size() : close + 1))};
+            inner->span = {
+                file_, static_cast<std::uint32_t>(n.begin().byte),
+                static_cast<std::uint32_t>(n.begin().byte + (close == text.npos ? text.size() : close + 1))};
             return inner;
         } else if (n.is_type<g::ternary>()) {
             e->kind = ast::ExprKind::Ternary;
@@ -115,7 +115,8 @@ public:
             // operand (op operand)*, left associative; the tree is as deep as the chain is long,
             // and everything that walks it recurses, so very long chains are refused
             if (n.children.size() > 2 * kMaxChain) {
-                diags_.error(e->span, fmt::format("more than {} operands in a row; split the expression", kMaxChain));
+                diags_.error(e->span,
+                             fmt::format("more than {} operands in a row; split the expression", kMaxChain));
                 return e;
             }
             ast::ExprPtr cur = expr(*n.children.at(0));
@@ -169,7 +170,8 @@ public:
             // the argument node includes the whitespace after ')'; end the span at the ')'
             std::string_view a = n.children[1]->string_view();
             auto close = a.rfind(')');
-            m.span.end = static_cast<std::uint32_t>(n.children[1]->begin().byte + (close == a.npos ? a.size() : close + 1));
+            m.span.end = static_cast<std::uint32_t>(n.children[1]->begin().byte +
+                                                    (close == a.npos ? a.size() : close + 1));
         } else {
             m.span = m.name_span;
         }
@@ -261,7 +263,8 @@ public:
             bool wildcard = list.size() == 1 && list[0].name == "*";
             if (!wildcard)
                 for (const auto& m : list)
-                    if (m.name == "*") diags_.error(m.span, "'*' stands for a whole context, not for one module in it");
+                    if (m.name == "*")
+                        diags_.error(m.span, "'*' stands for a whole context, not for one module in it");
             std::string role;
             if (k < strict) {
                 role = parts[k + 1].op_before; // the operator after this part says what it is
@@ -272,9 +275,10 @@ public:
             }
             int order = role == "<" ? 0 : role == "<<" ? 1 : role == "strict" ? 2 : role == ">" ? 3 : 4;
             if (order < seen_order || (order == seen_order && k > 0 && role != "strict")) {
-                diags_.error(span(pat), fmt::format("context '{}' is out of place: the order is left < left_new << "
-                                                    "predecessor > right >> right_new",
-                                                    role));
+                diags_.error(span(pat),
+                             fmt::format("context '{}' is out of place: the order is left < left_new << "
+                                         "predecessor > right >> right_new",
+                                         role));
             }
             seen_order = order;
             if (role == "strict") {
@@ -450,8 +454,9 @@ public:
             h.when = n.children.at(0)->children.at(0)->string();
             h.body = block(*n.children.at(1));
             if (h.when != "start" && h.when != "before_step" && h.when != "after_step" && h.when != "end")
-                diags_.error(h.span, fmt::format("unknown hook '{}': expected start, before_step, after_step or end",
-                                                 h.when));
+                diags_.error(
+                    h.span,
+                    fmt::format("unknown hook '{}': expected start, before_step, after_step or end", h.when));
             f.hooks.push_back(std::move(h));
         } else if (n.is_type<g::import_item>()) {
             ast::Import im;
@@ -473,7 +478,7 @@ public:
         }
     }
 
-private:
+  private:
     std::uint32_t file_;
     Diagnostics& diags_;
 };
@@ -514,10 +519,10 @@ void report(const g::GrammarError& e, const SourceFile& src, std::uint32_t file_
 // error (the error may be the keyword itself, as when a ';' is missing at the end of the line
 // before), but always after `item_start` so that parsing makes progress.
 std::size_t resync(const std::string& text, std::size_t from, std::size_t item_start) {
-    static const char* keywords[] = {"param ",   "const ",     "var ",       "module ", "fn ",      "curve ",
-                                     "surface ", "env ",       "instance ",  "derive ", "angle ",   "step ",
-                                     "width ",   "seed ",      "axiom",      "ignore",  "consider", "rules",
-                                     "decompose", "interpret", "on ",        "import ", "/*"};
+    static const char* keywords[] = {"param ",    "const ",    "var ",      "module ", "fn ",      "curve ",
+                                     "surface ",  "env ",      "instance ", "derive ", "angle ",   "step ",
+                                     "width ",    "seed ",     "axiom",     "ignore",  "consider", "rules",
+                                     "decompose", "interpret", "on ",       "import ", "/*"};
     std::size_t b = from;
     while (b > 0 && text[b - 1] != '\n') --b; // start of the error's line
     while (b < text.size()) {
@@ -535,7 +540,8 @@ std::size_t resync(const std::string& text, std::size_t from, std::size_t item_s
 
 } // namespace
 
-std::unique_ptr<ast::File> parse_file(const SourceManager& sources, std::uint32_t file_id, Diagnostics& diags) {
+std::unique_ptr<ast::File> parse_file(const SourceManager& sources, std::uint32_t file_id,
+                                      Diagnostics& diags) {
     const SourceFile& src = sources.file(file_id);
     const std::string& text = src.text();
     auto file = std::make_unique<ast::File>();
@@ -545,8 +551,8 @@ std::unique_ptr<ast::File> parse_file(const SourceManager& sources, std::uint32_
     std::size_t errors = 0;
     while (offset <= text.size()) {
         LineCol lc = src.line_col(static_cast<std::uint32_t>(offset));
-        tao::pegtl::memory_input<> in(text.data() + offset, text.data() + text.size(), src.name(), offset, lc.line,
-                                      lc.col);
+        tao::pegtl::memory_input<> in(text.data() + offset, text.data() + text.size(), src.name(), offset,
+                                      lc.line, lc.col);
         g::ParseState state;
         try {
             auto root = pt::parse<g::item_or_end, selector, tao::pegtl::nothing, g::control>(in, state);
@@ -571,9 +577,8 @@ ast::ExprPtr parse_expression(const SourceManager& sources, std::uint32_t file_i
     tao::pegtl::memory_input<> in(src.text(), src.name());
     g::ParseState state;
     try {
-        auto root =
-            pt::parse<tao::pegtl::seq<g::ws, g::expr, tao::pegtl::eof>, selector, tao::pegtl::nothing, g::control>(
-                in, state);
+        auto root = pt::parse<tao::pegtl::seq<g::ws, g::expr, tao::pegtl::eof>, selector, tao::pegtl::nothing,
+                              g::control>(in, state);
         if (!root || root->children.empty()) {
             diags.error({file_id, 0, 1}, "expected an expression");
             return nullptr;

@@ -32,7 +32,8 @@ struct Worker {
     // context neighbours of the module at ctx_at, found once for all its productions
     std::size_t ctx_at = ~std::size_t{0};
     std::int64_t ctx_left = kUnknown, ctx_right = kUnknown;
-    std::vector<std::uint16_t> scratch; // Rewriter::run_symbols's keys, when the rewriter has no buffer for them
+    std::vector<std::uint16_t>
+        scratch; // Rewriter::run_symbols's keys, when the rewriter has no buffer for them
 };
 
 // Whether some production of `rs` names a query module (?P, ?H, ...) in its predecessor or
@@ -122,7 +123,7 @@ struct RulePlan {
         std::uint32_t block = 0;           // its successors start at succ_at[block]
         std::uint8_t lmask = 0, rmask = 0; // 0xff: the block is indexed by that neighbour's key
         std::uint8_t shape = 0;
-        std::uint8_t key = 0;              // ctx_key
+        std::uint8_t key = 0; // ctx_key
     };
     bool symbol_kernel = false; // Rewriter::run_symbols can rewrite strings without parameters
     std::vector<SymbolRow> sym_rows;
@@ -142,21 +143,22 @@ struct RulePlan {
     std::vector<const Production*> ctx_entries; // nullptr: no production applies
     std::size_t frame_size = 1;
     bool brackets = false, multi = false, left_new = false, right_new = false;
-    bool queries = false; // some pattern names a query module: the turtle pass fills them first
-    bool templated = false;              // see the end of the constructor
-    bool all_direct = true;              // every symbol with productions has a direct template
+    bool queries = false;   // some pattern names a query module: the turtle pass fills them first
+    bool templated = false; // see the end of the constructor
+    bool all_direct = true; // every symbol with productions has a direct template
     // Whether a step must rewrite on one thread, left to right (or right to left for `>>`).
     bool sequential() const { return multi || left_new || right_new; }
-    std::size_t max_modules_out = 1;     // the longest template's modules (at least 1: a copy)
-    std::size_t max_params_out = 0;      // and the most parameters a template holds
+    std::size_t max_modules_out = 1; // the longest template's modules (at least 1: a copy)
+    std::size_t max_params_out = 0;  // and the most parameters a template holds
 
-private:
+  private:
     // The symbol kernel's tables. It needs every rewritten symbol to be parameterless: a direct
     // template whose pattern takes no parameters, or a context table.
     void build_symbol_kernel() {
         const std::size_t S = P.symbols.size(), K = ctx_keys;
         for (SymbolId sym = 0; sym < S; ++sym)
-            if (has_prod[sym] && direct[sym] && direct[sym]->strict[0].width != 0) return; // a pattern with parameters
+            if (has_prod[sym] && direct[sym] && direct[sym]->strict[0].width != 0)
+                return; // a pattern with parameters
         auto add = [&](const SuccessorTemplate& t) {
             SymbolSucc su;
             std::copy(t.syms.begin(), t.syms.end(), su.syms);
@@ -175,10 +177,10 @@ private:
         sym_rows.assign(S, SymbolRow{});
         for (SymbolId sym = 0; sym < S; ++sym) {
             SymbolRow& row = sym_rows[sym];
-            row.shape = sym == P.symbols.close_bracket ? kClose
-                      : sym == P.symbols.open_bracket  ? kOpen
-                      : P.ignored[sym]                 ? kIgnored
-                                                       : 0;
+            row.shape = sym == P.symbols.close_bracket  ? kClose
+                        : sym == P.symbols.open_bracket ? kOpen
+                        : P.ignored[sym]                ? kIgnored
+                                                        : 0;
             row.key = ctx_key[sym];
             row.block = static_cast<std::uint32_t>(succ_at.size());
             SymbolSucc self;
@@ -216,7 +218,8 @@ private:
         ctx_key.assign(S, 0);
         std::vector<std::vector<const Production*>> cands(S);
         auto plain = [&](const PatternModule& m) {
-            return m.width == 0 && m.args.empty() && m.sym != P.symbols.open_bracket && m.sym != P.symbols.close_bracket;
+            return m.width == 0 && m.args.empty() && m.sym != P.symbols.open_bracket &&
+                   m.sym != P.symbols.close_bracket;
         };
         std::vector<SymbolId> eligible;
         for (SymbolId sym = 0; sym < S; ++sym) {
@@ -227,8 +230,8 @@ private:
                     const Production& pr = rs->productions[pi];
                     ok = ok && pr.strict.size() == 1 && plain(pr.strict[0]) && pr.left.size() <= 1 &&
                          pr.right.size() <= 1 && (pr.left.empty() || plain(pr.left[0])) &&
-                         (pr.right.empty() || plain(pr.right[0])) && pr.condition.empty() && pr.weight.empty() &&
-                         !pr.has_new_context() && pr.tmpl.valid;
+                         (pr.right.empty() || plain(pr.right[0])) && pr.condition.empty() &&
+                         pr.weight.empty() && !pr.has_new_context() && pr.tmpl.valid;
                     cands[sym].push_back(&pr);
                 }
             if (!ok) continue;
@@ -264,13 +267,14 @@ private:
 };
 
 class Rewriter {
-public:
+  public:
     // `brackets`: where to build the bracket table (a buffer kept from step to step saves an
     // allocation each step); null: a buffer of the rewriter's own.
     // `whole`: run_range will be called once, for the whole string, by one thread. Then the
     // symbol kernel needs no bracket table, and keeps its right keys in `scratch`.
-    Rewriter(const RulePlan& rule_plan, const ModuleString& in, std::vector<std::uint32_t>* brackets = nullptr,
-             std::vector<std::uint16_t>* scratch = nullptr, bool whole = false)
+    Rewriter(const RulePlan& rule_plan, const ModuleString& in,
+             std::vector<std::uint32_t>* brackets = nullptr, std::vector<std::uint16_t>* scratch = nullptr,
+             bool whole = false)
         : plan(rule_plan), P(rule_plan.P), in(in), n(in.size()), kernel_scratch(whole ? scratch : nullptr) {
         if (whole && kernel_applies()) return;
         if (plan.brackets) {
@@ -287,7 +291,8 @@ public:
         std::size_t lk = 0, rk = 0;
         if (plan.ctx_sides[sym] & 1) {
             const std::int64_t j = left_step(static_cast<std::int64_t>(i) - 1);
-            if (j >= 0 && in.arity(static_cast<std::size_t>(j)) == 0) lk = plan.ctx_key[in.sym[static_cast<std::size_t>(j)]];
+            if (j >= 0 && in.arity(static_cast<std::size_t>(j)) == 0)
+                lk = plan.ctx_key[in.sym[static_cast<std::size_t>(j)]];
         }
         if (plan.ctx_sides[sym] & 2) {
             const std::size_t j = right_step(i + 1);
@@ -343,16 +348,16 @@ public:
     // arrays are already sized; new identities are numbered from id_at.
     // Identities are written only when `out` keeps them (Ids, a template argument so that the
     // loop has no test for it).
-    void write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at, std::size_t p_at,
-                      ModuleId id_at) {
+    void write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at,
+                      std::size_t p_at, ModuleId id_at) {
         if (out.keep_ids)
             write_direct<true>(w, b, e, out, m_at, p_at, id_at);
         else
             write_direct<false>(w, b, e, out, m_at, p_at, id_at);
     }
     template <bool Ids>
-    void write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at, std::size_t p_at,
-                      ModuleId id_at) {
+    void write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at,
+                      std::size_t p_at, ModuleId id_at) {
         w.frame.assign(plan.frame_size, 0.0);
         SymbolId* S = out.sym.data() + m_at;
         ModuleId* ID = Ids ? out.ids.data() + m_at : nullptr;
@@ -452,7 +457,9 @@ public:
         const double* f = w.frame.data();
         for (std::size_t h = 0; h < t.affine.size(); ++h) {
             const auto& a = t.affine[h];
-            values[h] = a.kind == a.Copy ? f[a.slot] : a.kind == a.Mul ? f[a.slot] * a.constant : f[a.slot] + a.constant;
+            values[h] = a.kind == a.Copy  ? f[a.slot]
+                        : a.kind == a.Mul ? f[a.slot] * a.constant
+                                          : f[a.slot] + a.constant;
         }
     }
 
@@ -462,9 +469,9 @@ public:
             std::size_t j = 0;
             while (t.param_end[j] <= t.holes[h]) ++j;
             std::uint32_t k = t.holes[h] - (j ? t.param_end[j - 1] : 0);
-            throw RuntimeError{t.hole_spans[h], fmt::format("parameter {} of '{}' is {}", k + 1,
-                                                            P.symbols[t.syms[j]].name,
-                                                            std::isnan(values[h]) ? "NaN" : "infinite")};
+            throw RuntimeError{t.hole_spans[h],
+                               fmt::format("parameter {} of '{}' is {}", k + 1, P.symbols[t.syms[j]].name,
+                                           std::isnan(values[h]) ? "NaN" : "infinite")};
         }
     }
 
@@ -614,7 +621,7 @@ public:
                     }
                 } else if (!pr && arity == 0) {
                     pr = table_lookup(i); // nullptr: no production applies, the module is copied
-                } else { // matching after all, with the arrays at their true size
+                } else {                  // matching after all, with the arrays at their true size
                     close();
                     std::size_t used = apply(w, i);
                     if (used == 0) {
@@ -648,7 +655,8 @@ public:
                 check_holes(t, values);
             }
             ModuleId next_new = env.id_base + env.new_count;
-            put_template<Ids>(t, values, p, Ids ? in.ids[i] : 0, next_new, S + m, PO + m, PA + p, Ids ? ID + m : nullptr);
+            put_template<Ids>(t, values, p, Ids ? in.ids[i] : 0, next_new, S + m, PO + m, PA + p,
+                              Ids ? ID + m : nullptr);
             env.new_count = next_new - env.id_base;
             m += t.syms.size();
             p += t.params.size();
@@ -767,7 +775,8 @@ public:
         out.sym.resize(m);
         const std::size_t m0 = out.poff.size();
         out.poff.resize(m + 1);
-        std::fill(out.poff.begin() + static_cast<std::ptrdiff_t>(m0), out.poff.end(), static_cast<std::uint32_t>(p_end));
+        std::fill(out.poff.begin() + static_cast<std::ptrdiff_t>(m0), out.poff.end(),
+                  static_cast<std::uint32_t>(p_end));
         env.new_count += static_cast<ModuleId>(fresh);
     }
 
@@ -816,11 +825,12 @@ public:
     ModuleString assemble_backward(const ModuleString& pieces) const {
         ModuleString out;
         out.keep_ids = pieces.keep_ids;
-        for (std::size_t p = piece_starts.size() - 1; p-- > 0;) out.append_range(pieces, piece_starts[p], piece_starts[p + 1]);
+        for (std::size_t p = piece_starts.size() - 1; p-- > 0;)
+            out.append_range(pieces, piece_starts[p], piece_starts[p + 1]);
         return out;
     }
 
-private:
+  private:
     [[noreturn]] void limit_error(Worker& w) const {
         (void)w;
         throw RuntimeError{Span{}, "module limit"};
@@ -908,7 +918,8 @@ private:
     }
 
     // Left context in the new string (forward processing): the output made so far.
-    bool match_left_new(const ModuleString& out, const std::vector<PatternModule>& pats, double* frame) const {
+    bool match_left_new(const ModuleString& out, const std::vector<PatternModule>& pats,
+                        double* frame) const {
         const SymbolId open = P.symbols.open_bracket, close = P.symbols.close_bracket;
         auto j = static_cast<std::int64_t>(out.size()) - 1;
         for (std::size_t k = pats.size(); k-- > 0;) {
@@ -919,8 +930,10 @@ private:
                     int depth = 0;
                     for (; j >= 0; --j) {
                         SymbolId t = out.sym[static_cast<std::size_t>(j)];
-                        if (t == close) ++depth;
-                        else if (t == open && --depth == 0) break;
+                        if (t == close)
+                            ++depth;
+                        else if (t == open && --depth == 0)
+                            break;
                     }
                     if (j < 0) return false;
                     --j;
@@ -966,7 +979,8 @@ private:
         }
     };
 
-    bool match_right_new(const ModuleString& out, const std::vector<PatternModule>& pats, double* frame) const {
+    bool match_right_new(const ModuleString& out, const std::vector<PatternModule>& pats,
+                         double* frame) const {
         const SymbolId open = P.symbols.open_bracket, close = P.symbols.close_bracket;
         PieceIter it(piece_starts);
         for (const auto& pat : pats) {
@@ -977,8 +991,10 @@ private:
                     int depth = 0;
                     for (; it.valid; it.next()) {
                         SymbolId t = out.sym[it.i];
-                        if (t == open) ++depth;
-                        else if (t == close && --depth == 0) break;
+                        if (t == open)
+                            ++depth;
+                        else if (t == close && --depth == 0)
+                            break;
                     }
                     if (!it.valid) return false;
                     it.next();
@@ -1084,7 +1100,8 @@ private:
         if (m <= 4 && t.holes.empty()) { // short constant successors: plain appends
             for (std::size_t j = 0; j < m; ++j) {
                 out.sym.push_back(t.syms[j]);
-                for (std::uint32_t k = j ? t.param_end[j - 1] : 0; k < t.param_end[j]; ++k) out.params.push_back(t.params[k]);
+                for (std::uint32_t k = j ? t.param_end[j - 1] : 0; k < t.param_end[j]; ++k)
+                    out.params.push_back(t.params[k]);
                 out.poff.push_back(static_cast<std::uint32_t>(out.params.size()));
                 const ModuleId id = static_cast<int>(j) == t.keep ? in.id(i) : env.id_base + env.new_count++;
                 if (out.keep_ids) out.ids.push_back(id);
@@ -1145,7 +1162,8 @@ private:
     }
 
     // cpfg semantics: all applicable weighted productions of the module, one drawn by weight.
-    std::size_t choose(Worker& w, std::size_t i, std::size_t set0, std::size_t cand0, std::size_t length = 0) {
+    std::size_t choose(Worker& w, std::size_t i, std::size_t set0, std::size_t cand0,
+                       std::size_t length = 0) {
         struct Option {
             const Production* pr;
             double weight;
@@ -1158,11 +1176,13 @@ private:
             const auto& cands = plan.sets[si]->by_symbol[sym];
             for (std::size_t ci = si == set0 ? cand0 : 0; ci < cands.size(); ++ci) {
                 const Production& pr = plan.sets[si]->productions[cands[ci]];
-                if (pr.weight.empty() || (length && pr.strict.size() != length) || !matches(w, i, pr)) continue;
+                if (pr.weight.empty() || (length && pr.strict.size() != length) || !matches(w, i, pr))
+                    continue;
                 double wt = eval_number(pr.weight, w.frame.data(), w.env);
                 if (!(wt >= 0) || !std::isfinite(wt))
-                    throw RuntimeError{pr.weight.spans.empty() ? pr.span : pr.weight.spans.back(),
-                                       fmt::format("a production weight must be a finite number >= 0, found {}", wt)};
+                    throw RuntimeError{
+                        pr.weight.spans.empty() ? pr.span : pr.weight.spans.back(),
+                        fmt::format("a production weight must be a finite number >= 0, found {}", wt)};
                 if (wt == 0 || count == 64) continue;
                 options[count++] = {&pr, wt};
                 total += wt;
@@ -1190,9 +1210,8 @@ private:
     const std::size_t n;
     std::vector<std::uint32_t> own_match;
     std::vector<std::uint16_t>* kernel_scratch = nullptr; // run_symbols's right keys, kept from step to step
-    const std::uint32_t* match = nullptr; // the bracket table (see bracket_table)
+    const std::uint32_t* match = nullptr;                 // the bracket table (see bracket_table)
     std::vector<std::size_t> piece_starts;
 };
-
 
 } // namespace plant

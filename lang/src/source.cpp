@@ -19,7 +19,8 @@ LineCol SourceFile::line_col(std::uint32_t offset) const {
 std::string_view SourceFile::line_text(std::uint32_t line) const {
     if (line == 0 || line > line_starts_.size()) return {};
     std::uint32_t b = line_starts_[line - 1];
-    std::uint32_t e = line < line_starts_.size() ? line_starts_[line] : static_cast<std::uint32_t>(text_.size());
+    std::uint32_t e =
+        line < line_starts_.size() ? line_starts_[line] : static_cast<std::uint32_t>(text_.size());
     std::string_view s(text_.data() + b, e - b);
     while (!s.empty() && (s.back() == '\n' || s.back() == '\r')) s.remove_suffix(1);
     return s;
@@ -27,10 +28,13 @@ std::string_view SourceFile::line_text(std::uint32_t line) const {
 
 std::uint32_t SourceFile::offset_of(std::uint32_t line, std::uint32_t col) const {
     if (line == 0 || line > line_starts_.size()) return static_cast<std::uint32_t>(text_.size());
-    return std::min<std::uint32_t>(line_starts_[line - 1] + col - 1, static_cast<std::uint32_t>(text_.size()));
+    return std::min<std::uint32_t>(line_starts_[line - 1] + col - 1,
+                                   static_cast<std::uint32_t>(text_.size()));
 }
 
-SourceManager::SourceManager() { files_.push_back(std::make_unique<SourceFile>("<none>", "")); }
+SourceManager::SourceManager() {
+    files_.push_back(std::make_unique<SourceFile>("<none>", ""));
+}
 
 std::uint32_t SourceManager::add(std::string name, std::string text) {
     files_.push_back(std::make_unique<SourceFile>(std::move(name), std::move(text)));

@@ -6,8 +6,8 @@
 
 #include <fmt/format.h>
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <numbers>
 
 namespace plant {
@@ -30,50 +30,111 @@ double next_unit(EvalEnv& env) {
 // Returns the width of the result.
 int apply_builtin(BuiltinId id, const double* a, double* r, EvalEnv& env) {
     switch (id) {
-    case BuiltinId::Sin: r[0] = std::sin(a[0]); return 1;
-    case BuiltinId::Cos: r[0] = std::cos(a[0]); return 1;
-    case BuiltinId::Tan: r[0] = std::tan(a[0]); return 1;
-    case BuiltinId::Asin: r[0] = std::asin(a[0]); return 1;
-    case BuiltinId::Acos: r[0] = std::acos(a[0]); return 1;
-    case BuiltinId::Atan: r[0] = std::atan(a[0]); return 1;
-    case BuiltinId::Atan2: r[0] = std::atan2(a[0], a[1]); return 1;
-    case BuiltinId::Sqrt: r[0] = std::sqrt(a[0]); return 1;
-    case BuiltinId::Exp: r[0] = std::exp(a[0]); return 1;
-    case BuiltinId::Log: r[0] = std::log(a[0]); return 1;
-    case BuiltinId::Pow: r[0] = std::pow(a[0], a[1]); return 1;
-    case BuiltinId::Abs: r[0] = std::fabs(a[0]); return 1;
-    case BuiltinId::Min: r[0] = std::min(a[0], a[1]); return 1;
-    case BuiltinId::Max: r[0] = std::max(a[0], a[1]); return 1;
-    case BuiltinId::Clamp: r[0] = std::min(std::max(a[0], a[1]), a[2]); return 1;
-    case BuiltinId::Floor: r[0] = std::floor(a[0]); return 1;
-    case BuiltinId::Ceil: r[0] = std::ceil(a[0]); return 1;
-    case BuiltinId::Round: r[0] = std::round(a[0]); return 1;
-    case BuiltinId::Sign: r[0] = a[0] > 0 ? 1.0 : a[0] < 0 ? -1.0 : 0.0; return 1;
-    case BuiltinId::Mix: r[0] = a[0] + (a[1] - a[0]) * a[2]; return 1;
+    case BuiltinId::Sin:
+        r[0] = std::sin(a[0]);
+        return 1;
+    case BuiltinId::Cos:
+        r[0] = std::cos(a[0]);
+        return 1;
+    case BuiltinId::Tan:
+        r[0] = std::tan(a[0]);
+        return 1;
+    case BuiltinId::Asin:
+        r[0] = std::asin(a[0]);
+        return 1;
+    case BuiltinId::Acos:
+        r[0] = std::acos(a[0]);
+        return 1;
+    case BuiltinId::Atan:
+        r[0] = std::atan(a[0]);
+        return 1;
+    case BuiltinId::Atan2:
+        r[0] = std::atan2(a[0], a[1]);
+        return 1;
+    case BuiltinId::Sqrt:
+        r[0] = std::sqrt(a[0]);
+        return 1;
+    case BuiltinId::Exp:
+        r[0] = std::exp(a[0]);
+        return 1;
+    case BuiltinId::Log:
+        r[0] = std::log(a[0]);
+        return 1;
+    case BuiltinId::Pow:
+        r[0] = std::pow(a[0], a[1]);
+        return 1;
+    case BuiltinId::Abs:
+        r[0] = std::fabs(a[0]);
+        return 1;
+    case BuiltinId::Min:
+        r[0] = std::min(a[0], a[1]);
+        return 1;
+    case BuiltinId::Max:
+        r[0] = std::max(a[0], a[1]);
+        return 1;
+    case BuiltinId::Clamp:
+        r[0] = std::min(std::max(a[0], a[1]), a[2]);
+        return 1;
+    case BuiltinId::Floor:
+        r[0] = std::floor(a[0]);
+        return 1;
+    case BuiltinId::Ceil:
+        r[0] = std::ceil(a[0]);
+        return 1;
+    case BuiltinId::Round:
+        r[0] = std::round(a[0]);
+        return 1;
+    case BuiltinId::Sign:
+        r[0] = a[0] > 0 ? 1.0 : a[0] < 0 ? -1.0 : 0.0;
+        return 1;
+    case BuiltinId::Mix:
+        r[0] = a[0] + (a[1] - a[0]) * a[2];
+        return 1;
     case BuiltinId::MixV:
         for (int k = 0; k < 3; ++k) r[k] = a[k] + (a[3 + k] - a[k]) * a[6];
         return 3;
     case BuiltinId::Smoothstep: {
-        double t = a[1] == a[0] ? (a[2] < a[0] ? 0.0 : 1.0) : std::clamp((a[2] - a[0]) / (a[1] - a[0]), 0.0, 1.0);
+        double t =
+            a[1] == a[0] ? (a[2] < a[0] ? 0.0 : 1.0) : std::clamp((a[2] - a[0]) / (a[1] - a[0]), 0.0, 1.0);
         r[0] = t * t * (3 - 2 * t);
         return 1;
     }
-    case BuiltinId::Rad: r[0] = a[0] * kPi / 180.0; return 1;
-    case BuiltinId::Deg: r[0] = a[0] * 180.0 / kPi; return 1;
-    case BuiltinId::Pi: r[0] = kPi; return 1;
-    case BuiltinId::Vec3: r[0] = a[0]; r[1] = a[1]; r[2] = a[2]; return 3;
-    case BuiltinId::Vec3S: r[0] = r[1] = r[2] = a[0]; return 3;
-    case BuiltinId::Dot: r[0] = a[0] * a[3] + a[1] * a[4] + a[2] * a[5]; return 1;
+    case BuiltinId::Rad:
+        r[0] = a[0] * kPi / 180.0;
+        return 1;
+    case BuiltinId::Deg:
+        r[0] = a[0] * 180.0 / kPi;
+        return 1;
+    case BuiltinId::Pi:
+        r[0] = kPi;
+        return 1;
+    case BuiltinId::Vec3:
+        r[0] = a[0];
+        r[1] = a[1];
+        r[2] = a[2];
+        return 3;
+    case BuiltinId::Vec3S:
+        r[0] = r[1] = r[2] = a[0];
+        return 3;
+    case BuiltinId::Dot:
+        r[0] = a[0] * a[3] + a[1] * a[4] + a[2] * a[5];
+        return 1;
     case BuiltinId::Cross: {
         double x = a[1] * a[5] - a[2] * a[4], y = a[2] * a[3] - a[0] * a[5], z = a[0] * a[4] - a[1] * a[3];
-        r[0] = x; r[1] = y; r[2] = z;
+        r[0] = x;
+        r[1] = y;
+        r[2] = z;
         return 3;
     }
-    case BuiltinId::Length: r[0] = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]); return 1;
+    case BuiltinId::Length:
+        r[0] = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+        return 1;
     case BuiltinId::Normalize: {
         double l = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
         double inv = l > 0 ? 1.0 / l : 0.0;
-        r[0] = a[0] * inv; r[1] = a[1] * inv; r[2] = a[2] * inv;
+        r[0] = a[0] * inv;
+        r[1] = a[1] * inv;
+        r[2] = a[2] * inv;
         return 3;
     }
     case BuiltinId::Distance: {
@@ -81,17 +142,27 @@ int apply_builtin(BuiltinId id, const double* a, double* r, EvalEnv& env) {
         r[0] = std::sqrt(dx * dx + dy * dy + dz * dz);
         return 1;
     }
-    case BuiltinId::Uniform: r[0] = a[0] + (a[1] - a[0]) * next_unit(env); return 1;
+    case BuiltinId::Uniform:
+        r[0] = a[0] + (a[1] - a[0]) * next_unit(env);
+        return 1;
     case BuiltinId::Normal: {
         // Box-Muller from two counter-based draws
         double u1 = next_unit(env), u2 = next_unit(env);
         r[0] = a[0] + a[1] * std::sqrt(-2.0 * std::log(1.0 - u1)) * std::cos(2 * kPi * u2);
         return 1;
     }
-    case BuiltinId::Chance: r[0] = next_unit(env) < a[0] ? 1.0 : 0.0; return 1;
-    case BuiltinId::Step: r[0] = env.step; return 1;
-    case BuiltinId::Id: r[0] = static_cast<double>(env.id & ~kNewIdBit); return 1;
-    case BuiltinId::Lod: r[0] = a[2] == 0 ? a[0] : std::round(a[0] * (1 - a[1] / a[2])); return 1;
+    case BuiltinId::Chance:
+        r[0] = next_unit(env) < a[0] ? 1.0 : 0.0;
+        return 1;
+    case BuiltinId::Step:
+        r[0] = env.step;
+        return 1;
+    case BuiltinId::Id:
+        r[0] = static_cast<double>(env.id & ~kNewIdBit);
+        return 1;
+    case BuiltinId::Lod:
+        r[0] = a[2] == 0 ? a[0] : std::round(a[0] * (1 - a[1] / a[2]));
+        return 1;
     }
     return 0;
 }
@@ -125,9 +196,13 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
     for (std::size_t pc = 0; pc < n; ++pc) {
         const Instr& I = ins[pc];
         switch (I.op) {
-        case Op::Const: st[sp++] = code.consts[I.a]; break;
+        case Op::Const:
+            st[sp++] = code.consts[I.a];
+            break;
         case Op::Const3:
-            st[sp] = code.consts[I.a]; st[sp + 1] = code.consts[I.a + 1]; st[sp + 2] = code.consts[I.a + 2];
+            st[sp] = code.consts[I.a];
+            st[sp + 1] = code.consts[I.a + 1];
+            st[sp + 2] = code.consts[I.a + 2];
             sp += 3;
             break;
         case Op::LoadLocal:
@@ -144,10 +219,21 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
             sp -= I.n;
             for (int k = 0; k < I.n; ++k) env.globals[I.a + k] = st[sp + k];
             break;
-        case Op::Pop: sp -= I.n; break;
-        case Op::Add: --sp; st[sp - 1] += st[sp]; break;
-        case Op::Sub: --sp; st[sp - 1] -= st[sp]; break;
-        case Op::Mul: --sp; st[sp - 1] *= st[sp]; break;
+        case Op::Pop:
+            sp -= I.n;
+            break;
+        case Op::Add:
+            --sp;
+            st[sp - 1] += st[sp];
+            break;
+        case Op::Sub:
+            --sp;
+            st[sp - 1] -= st[sp];
+            break;
+        case Op::Mul:
+            --sp;
+            st[sp - 1] *= st[sp];
+            break;
         case Op::Div:
             --sp;
             if (st[sp] == 0) fail(code, pc, "division by zero");
@@ -158,16 +244,44 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
             if (st[sp] == 0) fail(code, pc, "remainder of a division by zero");
             st[sp - 1] = std::fmod(st[sp - 1], st[sp]);
             break;
-        case Op::Neg: st[sp - 1] = -st[sp - 1]; break;
-        case Op::Not: st[sp - 1] = st[sp - 1] == 0 ? 1.0 : 0.0; break;
-        case Op::Lt: --sp; st[sp - 1] = st[sp - 1] < st[sp]; break;
-        case Op::Le: --sp; st[sp - 1] = st[sp - 1] <= st[sp]; break;
-        case Op::Gt: --sp; st[sp - 1] = st[sp - 1] > st[sp]; break;
-        case Op::Ge: --sp; st[sp - 1] = st[sp - 1] >= st[sp]; break;
-        case Op::Eq: --sp; st[sp - 1] = st[sp - 1] == st[sp]; break;
-        case Op::Ne: --sp; st[sp - 1] = st[sp - 1] != st[sp]; break;
-        case Op::VAdd: sp -= 3; for (int k = 0; k < 3; ++k) st[sp - 3 + k] += st[sp + k]; break;
-        case Op::VSub: sp -= 3; for (int k = 0; k < 3; ++k) st[sp - 3 + k] -= st[sp + k]; break;
+        case Op::Neg:
+            st[sp - 1] = -st[sp - 1];
+            break;
+        case Op::Not:
+            st[sp - 1] = st[sp - 1] == 0 ? 1.0 : 0.0;
+            break;
+        case Op::Lt:
+            --sp;
+            st[sp - 1] = st[sp - 1] < st[sp];
+            break;
+        case Op::Le:
+            --sp;
+            st[sp - 1] = st[sp - 1] <= st[sp];
+            break;
+        case Op::Gt:
+            --sp;
+            st[sp - 1] = st[sp - 1] > st[sp];
+            break;
+        case Op::Ge:
+            --sp;
+            st[sp - 1] = st[sp - 1] >= st[sp];
+            break;
+        case Op::Eq:
+            --sp;
+            st[sp - 1] = st[sp - 1] == st[sp];
+            break;
+        case Op::Ne:
+            --sp;
+            st[sp - 1] = st[sp - 1] != st[sp];
+            break;
+        case Op::VAdd:
+            sp -= 3;
+            for (int k = 0; k < 3; ++k) st[sp - 3 + k] += st[sp + k];
+            break;
+        case Op::VSub:
+            sp -= 3;
+            for (int k = 0; k < 3; ++k) st[sp - 3 + k] -= st[sp + k];
+            break;
         case Op::VMulS: { // vec * s
             double s = st[--sp];
             for (int k = 0; k < 3; ++k) st[sp - 3 + k] *= s;
@@ -185,7 +299,9 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
             for (int k = 0; k < 3; ++k) st[sp - 3 + k] /= s;
             break;
         }
-        case Op::VNeg: for (int k = 1; k <= 3; ++k) st[sp - k] = -st[sp - k]; break;
+        case Op::VNeg:
+            for (int k = 1; k <= 3; ++k) st[sp - k] = -st[sp - k];
+            break;
         case Op::VEq:
         case Op::VNe: {
             sp -= 6;
@@ -199,17 +315,23 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
             st[sp++] = v;
             break;
         }
-        case Op::Jump: pc = static_cast<std::size_t>(I.a) - 1; break;
+        case Op::Jump:
+            pc = static_cast<std::size_t>(I.a) - 1;
+            break;
         case Op::JumpIfZero:
             if (st[--sp] == 0) pc = static_cast<std::size_t>(I.a) - 1;
             break;
         case Op::JumpIfZeroKeep:
-            if (st[sp - 1] == 0) pc = static_cast<std::size_t>(I.a) - 1;
-            else --sp;
+            if (st[sp - 1] == 0)
+                pc = static_cast<std::size_t>(I.a) - 1;
+            else
+                --sp;
             break;
         case Op::JumpIfNonZeroKeep:
-            if (st[sp - 1] != 0) pc = static_cast<std::size_t>(I.a) - 1;
-            else --sp;
+            if (st[sp - 1] != 0)
+                pc = static_cast<std::size_t>(I.a) - 1;
+            else
+                --sp;
             break;
         case Op::Builtin: {
             sp -= I.n;
@@ -246,8 +368,9 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
             const double* p = st + sp;
             for (int k = 0; k < I.n; ++k) {
                 if (!std::isfinite(p[k])) {
-                    std::string msg = fmt::format("parameter {} of '{}' is {}", k + 1, env.prog->symbols[I.a].name,
-                                                  std::isnan(p[k]) ? "NaN" : "infinite");
+                    std::string msg =
+                        fmt::format("parameter {} of '{}' is {}", k + 1, env.prog->symbols[I.a].name,
+                                    std::isnan(p[k]) ? "NaN" : "infinite");
                     if (I.b > 0 && static_cast<std::size_t>(k) < code.arg_spans[I.b - 1].size())
                         throw RuntimeError{code.arg_spans[I.b - 1][k], msg};
                     fail(code, pc, msg);
@@ -271,8 +394,12 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
                 fail(code, pc, "the string outgrew the module limit");
             break;
         }
-        case Op::ProduceEnd: env.produced = true; return RunStatus::Produced;
-        case Op::NProduceMark: env.produced = true; break;
+        case Op::ProduceEnd:
+            env.produced = true;
+            return RunStatus::Produced;
+        case Op::NProduceMark:
+            env.produced = true;
+            break;
         case Op::Use:
             if (env.effects) env.effects->use_group = I.a;
             break;
@@ -288,11 +415,13 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
             for (std::size_t c = 0; c < fmtstr.size(); ++c) {
                 if (!line.empty()) line += ' ';
                 char t = fmtstr[c];
-                if (t == 'n') line += format_number(st[sp + k++]);
-                else if (t == 'b') line += st[sp + k++] != 0 ? "true" : "false";
+                if (t == 'n')
+                    line += format_number(st[sp + k++]);
+                else if (t == 'b')
+                    line += st[sp + k++] != 0 ? "true" : "false";
                 else if (t == 'v') {
-                    line += fmt::format("vec3({}, {}, {})", format_number(st[sp + k]), format_number(st[sp + k + 1]),
-                                        format_number(st[sp + k + 2]));
+                    line += fmt::format("vec3({}, {}, {})", format_number(st[sp + k]),
+                                        format_number(st[sp + k + 1]), format_number(st[sp + k + 2]));
                     k += 3;
                 } else if (t == 's') {
                     auto e = fmtstr.find('\x1f', c + 1);
@@ -310,9 +439,15 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
             if (result)
                 for (int k = 0; k < I.n; ++k) result[k] = st[sp - I.n + k];
             return RunStatus::Finished;
-        case Op::LoadMulConst: st[sp++] = frame[I.a] * code.consts[I.b]; break;
-        case Op::LoadAddConst: st[sp++] = frame[I.a] + code.consts[I.b]; break;
-        case Op::Curve: st[sp - 1] = env.prog->curves[static_cast<std::size_t>(I.a)](st[sp - 1]); break;
+        case Op::LoadMulConst:
+            st[sp++] = frame[I.a] * code.consts[I.b];
+            break;
+        case Op::LoadAddConst:
+            st[sp++] = frame[I.a] + code.consts[I.b];
+            break;
+        case Op::Curve:
+            st[sp - 1] = env.prog->curves[static_cast<std::size_t>(I.a)](st[sp - 1]);
+            break;
         case Op::EnvCall: {
             const auto& object = *env.prog->environments[static_cast<std::size_t>(I.a)];
             sp -= I.n;
@@ -369,14 +504,16 @@ double CurveDef::operator()(double t) const {
 
 void fuse(Code& code) {
     for (const Instr& I : code.instrs)
-        if (I.op == Op::Jump || I.op == Op::JumpIfZero || I.op == Op::JumpIfZeroKeep || I.op == Op::JumpIfNonZeroKeep)
+        if (I.op == Op::Jump || I.op == Op::JumpIfZero || I.op == Op::JumpIfZeroKeep ||
+            I.op == Op::JumpIfNonZeroKeep)
             return;
     if (code.consts.size() > 65535) return;
     std::vector<Instr> out;
     std::vector<Span> spans;
     for (std::size_t i = 0; i < code.instrs.size(); ++i) {
         const Instr& I = code.instrs[i];
-        if (i + 2 < code.instrs.size() && I.op == Op::LoadLocal && I.n == 1 && code.instrs[i + 1].op == Op::Const &&
+        if (i + 2 < code.instrs.size() && I.op == Op::LoadLocal && I.n == 1 &&
+            code.instrs[i + 1].op == Op::Const &&
             (code.instrs[i + 2].op == Op::Mul || code.instrs[i + 2].op == Op::Add)) {
             Op fused = code.instrs[i + 2].op == Op::Mul ? Op::LoadMulConst : Op::LoadAddConst;
             out.push_back(Instr{fused, 0, static_cast<std::uint16_t>(code.instrs[i + 1].a), I.a});

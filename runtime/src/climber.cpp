@@ -16,28 +16,51 @@ namespace {
 constexpr ValueType N = ValueType::Number;
 constexpr ValueType V = ValueType::Vec3;
 
-glm::dvec3 vec(const double* a) { return {a[0], a[1], a[2]}; }
+glm::dvec3 vec(const double* a) {
+    return {a[0], a[1], a[2]};
+}
 
 // The frame's columns are the particle's axes: x = -left, y = heading, z = up.
-glm::dquat quat_of(const glm::dmat3& frame) { return glm::normalize(glm::quat_cast(frame)); }
+glm::dquat quat_of(const glm::dmat3& frame) {
+    return glm::normalize(glm::quat_cast(frame));
+}
 
 } // namespace
 
 const std::vector<EnvMethod>& Climber::methods() const {
     static const std::vector<EnvMethod> m = [] {
         std::vector<EnvMethod> v = {
-            {"grow_dir", {V, V}, V,
-             "heading h at p turned by surface adaption (Eq. 6), attractors and phototropism (Eq. 7)", false},
+            {"grow_dir",
+             {V, V},
+             V,
+             "heading h at p turned by surface adaption (Eq. 6), attractors and phototropism (Eq. 7)",
+             false},
             {"occlusion", {V}, N, "light occlusion at p by the plant's particles, 0 to 1", true},
             {"anchored", {N}, N, "1 when module id's particle is anchored to a surface", false},
             {"particles", {}, N, "particles in the world", false},
-            {"seeded", {N}, N, "1 in the step after a hook seeded a branch at module id (ivy.seed(id))", false},
-            {"pull", {N, V}, N, "hold module id's particle at a point through the next step's physics", false},
+            {"seeded",
+             {N},
+             N,
+             "1 in the step after a hook seeded a branch at module id (ivy.seed(id))",
+             false},
+            {"pull",
+             {N, V},
+             N,
+             "hold module id's particle at a point through the next step's physics",
+             false},
             {"cut", {N}, N, "cut the branch at module id: it leaves the string", false},
             {"wind", {V}, N, "set the wind (vec3(0, 0, 0): off)", false},
-            {"move", {N, V}, N, "move obstacle k (in the order declared: spheres, boxes, planes, meshes) by a vector", false},
+            {"move",
+             {N, V},
+             N,
+             "move obstacle k (in the order declared: spheres, boxes, planes, meshes) by a vector",
+             false},
             {"seed", {N}, N, "seed a new branch at module id: ivy.seeded(id) holds in the next step", false},
-            {"emit", {N, V}, N, "set emitter k's air velocity (in the order declared; vec3(0, 0, 0): off)", false},
+            {"emit",
+             {N, V},
+             N,
+             "set emitter k's air velocity (in the order declared; vec3(0, 0, 0): off)",
+             false},
         };
         for (std::size_t k = 5; k < v.size(); ++k) v[k].hook_only = true;
         return v;
@@ -56,7 +79,9 @@ namespace {
 ModuleId id_of(double v) {
     return std::isfinite(v) && v > 0 && v < 9.0e15 ? static_cast<ModuleId>(v) : 0;
 }
-bool finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool finite(const glm::dvec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 
 } // namespace
 
@@ -69,28 +94,43 @@ void Climber::call(std::size_t method, const double* a, double* r) const {
         r[0] = g.x, r[1] = g.y, r[2] = g.z;
         return;
     }
-    case 1: r[0] = occlusion(vec(a)); return;
+    case 1:
+        r[0] = occlusion(vec(a));
+        return;
     case 2: {
         physics::Handle h = particle(id_of(a[0]));
         r[0] = h.valid() && world_.alive(h) && world_.anchored(h) ? 1 : 0;
         return;
     }
-    case 3: r[0] = static_cast<double>(particle_of_.size()); return;
-    case 4: r[0] = seeded_.count(id_of(a[0])) ? 1 : 0; return;
-    case 5: pulls_.emplace_back(id_of(a[0]), vec(a + 1)); return;
-    case 6: cuts_.push_back(id_of(a[0])); return;
+    case 3:
+        r[0] = static_cast<double>(particle_of_.size());
+        return;
+    case 4:
+        r[0] = seeded_.count(id_of(a[0])) ? 1 : 0;
+        return;
+    case 5:
+        pulls_.emplace_back(id_of(a[0]), vec(a + 1));
+        return;
+    case 6:
+        cuts_.push_back(id_of(a[0]));
+        return;
     case 7:
         wind_ = vec(a);
         wind_changed_ = true;
         return;
     case 8:
-        if (std::isfinite(a[0]) && a[0] >= 0 && a[0] < 1e9) moves_.emplace_back(static_cast<std::size_t>(a[0]), vec(a + 1));
+        if (std::isfinite(a[0]) && a[0] >= 0 && a[0] < 1e9)
+            moves_.emplace_back(static_cast<std::size_t>(a[0]), vec(a + 1));
         return;
-    case 9: seed_requests_.push_back(id_of(a[0])); return;
+    case 9:
+        seed_requests_.push_back(id_of(a[0]));
+        return;
     case 10:
-        if (std::isfinite(a[0]) && a[0] >= 0 && a[0] < 1e9) emits_.emplace_back(static_cast<std::size_t>(a[0]), vec(a + 1));
+        if (std::isfinite(a[0]) && a[0] >= 0 && a[0] < 1e9)
+            emits_.emplace_back(static_cast<std::size_t>(a[0]), vec(a + 1));
         return;
-    default: r[0] = 0;
+    default:
+        r[0] = 0;
     }
 }
 
@@ -102,7 +142,8 @@ bool Climber::pose(ModuleId id, glm::dvec3& position, glm::dmat3& frame) const {
     return true;
 }
 
-const physics::Obstacle* Climber::nearest_obstacle(const glm::dvec3& p, double within, double& distance) const {
+const physics::Obstacle* Climber::nearest_obstacle(const glm::dvec3& p, double within,
+                                                   double& distance) const {
     const physics::Obstacle* nearest = nullptr;
     distance = within;
     for (const auto& o : world_.obstacles()) {
@@ -116,7 +157,8 @@ void Climber::geometry(std::vector<glm::dvec3>& triangles, const glm::dvec3& lo,
     const auto& obstacles = world_.obstacles();
     for (const auto& o : obstacles) obstacle_triangles(o, lo, hi, triangles);
     for (const auto& [k, mesh] : meshes_) {
-        const glm::dvec3 offset = k < obstacles.size() ? obstacles[k].a : glm::dvec3(0.0); // moved since loaded
+        const glm::dvec3 offset =
+            k < obstacles.size() ? obstacles[k].a : glm::dvec3(0.0); // moved since loaded
         for (const auto& v : mesh) triangles.push_back(v + offset);
     }
 }
@@ -216,11 +258,14 @@ void Climber::advance() {
         if (k < emitters.size()) emitters[k].velocity = velocity;
     emits_.clear();
     if (wind_changed_) {
-        if (config_.air) fluid_.settings().wind = wind_;
-        else world_.set_wind(wind_);
+        if (config_.air)
+            fluid_.settings().wind = wind_;
+        else
+            world_.set_wind(wind_);
         wind_changed_ = false;
     }
-    const int air_steps = config_.air ? std::max(1, static_cast<int>(std::lround(world_.settings().dt / config_.fluid.dt))) : 0;
+    const int air_steps =
+        config_.air ? std::max(1, static_cast<int>(std::lround(world_.settings().dt / config_.fluid.dt))) : 0;
     for (int k = 0; k < config_.substeps; ++k) {
         for (const auto& [id, target] : pulls_) {
             physics::Handle h = particle(id);
@@ -294,7 +339,8 @@ glm::dvec3 Climber::grow_dir(const glm::dvec3& p, const glm::dvec3& h) const {
     // Eq. 7: toward the light, less where the plant shades itself. On a support the shoot follows
     // the light along it: the turn does not lift it off the surface.
     if (config_.phototropism > 0) {
-        glm::dvec3 g = physics::phototropism(f, glm::normalize(config_.light), occlusion(p), config_.phototropism, time);
+        glm::dvec3 g =
+            physics::phototropism(f, glm::normalize(config_.light), occlusion(p), config_.phototropism, time);
         if (nearest) {
             glm::dvec3 kept = g + normal * (glm::dot(f, normal) - glm::dot(g, normal));
             if (glm::length(kept) > 1e-9) g = glm::normalize(kept);
@@ -314,14 +360,16 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
     glm::dvec3 wind(0.0);
     std::vector<std::string> meshes;
     double mesh_cell = 0.05;
-    static const char* numbers[] = {"substeps", "iterations", "stiffness", "stiffening_time", "break_threshold",
-                                    "damping", "density", "phototropism", "adaption", "adaption_range", "response",
-                                    "anchor", "anchor_range", "anchor_release", "friction", "elasticity",
-                                    "sphere_radius", "attractor_radius", "attractor_strength", "threads",
-                                    "light_cell", "opacity", "air_spacing", "air_density", "air_viscosity",
-                                    "air_stiffness", "air_coupling", "mesh_cell", "attractor_reach", "emitter_radius"};
-    static const char* vectors[] = {"gravity", "light", "wind", "sphere", "box_min", "box_max", "plane_point",
-                                    "plane_normal", "attractor", "air_min", "air_max", "emitter", "emitter_velocity"};
+    static const char* numbers[] = {
+        "substeps",      "iterations",    "stiffness",        "stiffening_time",    "break_threshold",
+        "damping",       "density",       "phototropism",     "adaption",           "adaption_range",
+        "response",      "anchor",        "anchor_range",     "anchor_release",     "friction",
+        "elasticity",    "sphere_radius", "attractor_radius", "attractor_strength", "threads",
+        "light_cell",    "opacity",       "air_spacing",      "air_density",        "air_viscosity",
+        "air_stiffness", "air_coupling",  "mesh_cell",        "attractor_reach",    "emitter_radius"};
+    static const char* vectors[] = {
+        "gravity",      "light",     "wind",    "sphere",  "box_min", "box_max",         "plane_point",
+        "plane_normal", "attractor", "air_min", "air_max", "emitter", "emitter_velocity"};
     bool air_min = false, air_max = false;
     for (const auto& a : args) {
         if (a.key == "mesh") {
@@ -332,8 +380,10 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
             meshes.push_back(a.text);
             continue;
         }
-        bool is_number = std::any_of(std::begin(numbers), std::end(numbers), [&](const char* k) { return a.key == k; });
-        bool is_vector = std::any_of(std::begin(vectors), std::end(vectors), [&](const char* k) { return a.key == k; });
+        bool is_number =
+            std::any_of(std::begin(numbers), std::end(numbers), [&](const char* k) { return a.key == k; });
+        bool is_vector =
+            std::any_of(std::begin(vectors), std::end(vectors), [&](const char* k) { return a.key == k; });
         if (!is_number && !is_vector) {
             error = a.key.empty() ? "climber: arguments are named, as in climber(gravity: vec3(0, -9.81, 0))"
                                   : fmt::format("climber: unknown argument '{}'", a.key);
@@ -345,52 +395,97 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
         }
         const double x = a.v[0];
         const glm::dvec3 v(a.v[0], a.v[1], a.v[2]);
-        if (a.key == "substeps") c.substeps = static_cast<int>(std::clamp(x, 0.0, 1000.0));
-        else if (a.key == "iterations") s.iterations = static_cast<int>(std::clamp(x, 1.0, 100.0));
-        else if (a.key == "stiffness") s.fixed_stiffness = x; // negative: grows with age, s = t_l / t_m
-        else if (a.key == "stiffening_time") s.stiffening_time = std::max(x, 1e-6);
-        else if (a.key == "break_threshold") break_threshold = std::max(x, 0.0);
-        else if (a.key == "damping") s.damping = std::clamp(x, 0.0, 1.0);
-        else if (a.key == "density") s.density = std::max(x, 1e-9);
-        else if (a.key == "phototropism") c.phototropism = std::max(x, 0.0);
-        else if (a.key == "adaption") c.adaption = std::clamp(x, 0.0, 1.0);
-        else if (a.key == "adaption_range") c.adaption_range = std::max(x, 0.0);
-        else if (a.key == "response") c.response = std::max(x, 0.0);
-        else if (a.key == "anchor") c.anchor = std::clamp(x, 0.0, 1.0);
-        else if (a.key == "anchor_range") c.anchor_range = std::max(x, 0.0);
-        else if (a.key == "anchor_release") c.anchor_release = std::max(x, 0.0);
-        else if (a.key == "friction") friction = std::clamp(x, 0.0, 1.0);
-        else if (a.key == "elasticity") elasticity = std::clamp(x, 0.0, 1.0);
-        else if (a.key == "sphere_radius") sphere_r.push_back(x);
-        else if (a.key == "attractor_radius") attract_r.push_back(x);
-        else if (a.key == "attractor_strength") attract_s.push_back(x);
-        else if (a.key == "threads") s.threads = static_cast<int>(std::clamp(x, 1.0, 256.0));
-        else if (a.key == "light_cell") c.light_cell = std::max(x, 1e-3);
-        else if (a.key == "opacity") c.opacity = std::max(x, 0.0);
-        else if (a.key == "gravity") s.gravity = v;
-        else if (a.key == "light") c.light = v;
-        else if (a.key == "wind") wind = v;
-        else if (a.key == "sphere") sphere.push_back(v);
-        else if (a.key == "box_min") box_min.push_back(v);
-        else if (a.key == "box_max") box_max.push_back(v);
-        else if (a.key == "plane_point") plane_p.push_back(v);
-        else if (a.key == "plane_normal") plane_n.push_back(v);
-        else if (a.key == "attractor") attract.push_back(v);
-        else if (a.key == "emitter") emit_at.push_back(v);
-        else if (a.key == "emitter_velocity") emit_v.push_back(v);
-        else if (a.key == "emitter_radius") emit_r.push_back(std::max(x, 1e-3));
-        else if (a.key == "air_min") c.fluid.domain_lo = v, air_min = true;
-        else if (a.key == "air_max") c.fluid.domain_hi = v, air_max = true;
-        else if (a.key == "air_spacing") c.fluid.spacing = std::max(x, 1e-3), c.fluid.support = 2 * c.fluid.spacing;
-        else if (a.key == "air_density") c.fluid.rest_density = std::max(x, 1e-6);
-        else if (a.key == "air_viscosity") c.fluid.viscosity = std::max(x, 0.0);
-        else if (a.key == "air_stiffness") c.fluid.stiffness = std::max(x, 1e-6);
-        else if (a.key == "air_coupling") c.fluid.coupling = std::max(x, 0.0);
-        else if (a.key == "mesh_cell") mesh_cell = std::max(x, 1e-3);
-        else if (a.key == "attractor_reach") c.attractor_reach = std::max(x, 0.0);
+        if (a.key == "substeps")
+            c.substeps = static_cast<int>(std::clamp(x, 0.0, 1000.0));
+        else if (a.key == "iterations")
+            s.iterations = static_cast<int>(std::clamp(x, 1.0, 100.0));
+        else if (a.key == "stiffness")
+            s.fixed_stiffness = x; // negative: grows with age, s = t_l / t_m
+        else if (a.key == "stiffening_time")
+            s.stiffening_time = std::max(x, 1e-6);
+        else if (a.key == "break_threshold")
+            break_threshold = std::max(x, 0.0);
+        else if (a.key == "damping")
+            s.damping = std::clamp(x, 0.0, 1.0);
+        else if (a.key == "density")
+            s.density = std::max(x, 1e-9);
+        else if (a.key == "phototropism")
+            c.phototropism = std::max(x, 0.0);
+        else if (a.key == "adaption")
+            c.adaption = std::clamp(x, 0.0, 1.0);
+        else if (a.key == "adaption_range")
+            c.adaption_range = std::max(x, 0.0);
+        else if (a.key == "response")
+            c.response = std::max(x, 0.0);
+        else if (a.key == "anchor")
+            c.anchor = std::clamp(x, 0.0, 1.0);
+        else if (a.key == "anchor_range")
+            c.anchor_range = std::max(x, 0.0);
+        else if (a.key == "anchor_release")
+            c.anchor_release = std::max(x, 0.0);
+        else if (a.key == "friction")
+            friction = std::clamp(x, 0.0, 1.0);
+        else if (a.key == "elasticity")
+            elasticity = std::clamp(x, 0.0, 1.0);
+        else if (a.key == "sphere_radius")
+            sphere_r.push_back(x);
+        else if (a.key == "attractor_radius")
+            attract_r.push_back(x);
+        else if (a.key == "attractor_strength")
+            attract_s.push_back(x);
+        else if (a.key == "threads")
+            s.threads = static_cast<int>(std::clamp(x, 1.0, 256.0));
+        else if (a.key == "light_cell")
+            c.light_cell = std::max(x, 1e-3);
+        else if (a.key == "opacity")
+            c.opacity = std::max(x, 0.0);
+        else if (a.key == "gravity")
+            s.gravity = v;
+        else if (a.key == "light")
+            c.light = v;
+        else if (a.key == "wind")
+            wind = v;
+        else if (a.key == "sphere")
+            sphere.push_back(v);
+        else if (a.key == "box_min")
+            box_min.push_back(v);
+        else if (a.key == "box_max")
+            box_max.push_back(v);
+        else if (a.key == "plane_point")
+            plane_p.push_back(v);
+        else if (a.key == "plane_normal")
+            plane_n.push_back(v);
+        else if (a.key == "attractor")
+            attract.push_back(v);
+        else if (a.key == "emitter")
+            emit_at.push_back(v);
+        else if (a.key == "emitter_velocity")
+            emit_v.push_back(v);
+        else if (a.key == "emitter_radius")
+            emit_r.push_back(std::max(x, 1e-3));
+        else if (a.key == "air_min")
+            c.fluid.domain_lo = v, air_min = true;
+        else if (a.key == "air_max")
+            c.fluid.domain_hi = v, air_max = true;
+        else if (a.key == "air_spacing")
+            c.fluid.spacing = std::max(x, 1e-3), c.fluid.support = 2 * c.fluid.spacing;
+        else if (a.key == "air_density")
+            c.fluid.rest_density = std::max(x, 1e-6);
+        else if (a.key == "air_viscosity")
+            c.fluid.viscosity = std::max(x, 0.0);
+        else if (a.key == "air_stiffness")
+            c.fluid.stiffness = std::max(x, 1e-6);
+        else if (a.key == "air_coupling")
+            c.fluid.coupling = std::max(x, 0.0);
+        else if (a.key == "mesh_cell")
+            mesh_cell = std::max(x, 1e-3);
+        else if (a.key == "attractor_reach")
+            c.attractor_reach = std::max(x, 0.0);
     }
-    if (sphere.size() != sphere_r.size() || box_min.size() != box_max.size() || plane_p.size() != plane_n.size()) {
-        error = "climber: give each sphere a sphere_radius, each box_min a box_max and each plane_point a plane_normal";
+    if (sphere.size() != sphere_r.size() || box_min.size() != box_max.size() ||
+        plane_p.size() != plane_n.size()) {
+        error = "climber: give each sphere a sphere_radius, each box_min a box_max and each plane_point a "
+                "plane_normal";
         return nullptr;
     }
     if (attract_r.size() > attract.size() || attract_s.size() > attract.size()) {
@@ -413,7 +508,8 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
         c.fluid.emitters.push_back({emit_at[i], i < emit_r.size() ? emit_r[i] : 0.2, emit_v[i]});
     if (air_min) {
         c.air = true;
-        const glm::dvec3 lo = glm::min(c.fluid.domain_lo, c.fluid.domain_hi), hi = glm::max(c.fluid.domain_lo, c.fluid.domain_hi);
+        const glm::dvec3 lo = glm::min(c.fluid.domain_lo, c.fluid.domain_hi),
+                         hi = glm::max(c.fluid.domain_lo, c.fluid.domain_hi);
         c.fluid.domain_lo = lo;
         c.fluid.domain_hi = hi;
         if (!finite(lo) || !finite(hi)) {
@@ -436,8 +532,8 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
         return nullptr;
     }
     for (std::size_t i = 0; i < attract.size(); ++i)
-        c.attractors.push_back(
-            {attract[i], i < attract_r.size() ? attract_r[i] : 0.3, i < attract_s.size() ? attract_s[i] : 1.0});
+        c.attractors.push_back({attract[i], i < attract_r.size() ? attract_r[i] : 0.3,
+                                i < attract_s.size() ? attract_s[i] : 1.0});
     auto climber = std::make_unique<Climber>(s, c);
     physics::World& w = climber->world();
     w.set_break_threshold(break_threshold);

@@ -6,7 +6,6 @@
 
 #include "triangle_mesh.hpp"
 
-
 #include <fmt/format.h>
 #include <glm/glm.hpp>
 
@@ -24,12 +23,16 @@ constexpr ValueType N = ValueType::Number;
 constexpr ValueType V = ValueType::Vec3;
 constexpr ValueType B = ValueType::Bool;
 
-glm::dvec3 vec(const EnvArg& a) { return {a.v[0], a.v[1], a.v[2]}; }
-glm::dvec3 vec(const double* a) { return {a[0], a[1], a[2]}; }
+glm::dvec3 vec(const EnvArg& a) {
+    return {a.v[0], a.v[1], a.v[2]};
+}
+glm::dvec3 vec(const double* a) {
+    return {a[0], a[1], a[2]};
+}
 
 // Reads keyword arguments of one kind, checking names and types.
 class Args {
-public:
+  public:
     Args(const std::string& kind, const std::vector<EnvArg>& args, std::string& error)
         : kind_(kind), args_(args), error_(error) {}
     const EnvArg* find(const std::string& key, ValueType type) {
@@ -50,8 +53,9 @@ public:
             if (!known) {
                 std::string list;
                 for (const char* k : keys) list += (list.empty() ? "" : ", ") + std::string(k);
-                fail(a.key.empty() ? fmt::format("{}: arguments are named ({})", kind_, list)
-                                   : fmt::format("{}: unknown argument '{}' (known: {})", kind_, a.key, list));
+                fail(a.key.empty()
+                         ? fmt::format("{}: arguments are named ({})", kind_, list)
+                         : fmt::format("{}: unknown argument '{}' (known: {})", kind_, a.key, list));
                 return false;
             }
         }
@@ -62,7 +66,7 @@ public:
     }
     bool ok() const { return error_.empty(); }
 
-private:
+  private:
     const std::string& kind_;
     const std::vector<EnvArg>& args_;
     std::string& error_;
@@ -71,14 +75,17 @@ private:
 // ---- ellipsoid -----------------------------------------------------------------------------
 
 class Ellipsoid : public Environment {
-public:
+  public:
     Ellipsoid(glm::dvec3 center, glm::dvec3 radii) : center_(center), radii_(radii) {}
     const std::vector<EnvMethod>& methods() const override {
         static const std::vector<EnvMethod> m = {
             {"contains", {V}, B, "p inside the ellipsoid"},
             {"contains_scaled", {V, N}, B, "p inside the ellipsoid scaled by g about its center", false},
             {"level", {V}, N, "|(p - center) / radii|: below 1 inside, 1 on the surface"},
-            {"distance", {V}, N, "signed distance to the surface along the ray from the center (negative inside)"},
+            {"distance",
+             {V},
+             N,
+             "signed distance to the surface along the ray from the center (negative inside)"},
         };
         return m;
     }
@@ -86,16 +93,23 @@ public:
         const glm::dvec3 p = vec(a);
         double level = glm::length((p - center_) / radii_);
         switch (method) {
-        case 0: r[0] = level <= 1.0; break;
-        case 1: r[0] = a[3] > 0 && level <= a[3]; break;
-        case 2: r[0] = level; break;
+        case 0:
+            r[0] = level <= 1.0;
+            break;
+        case 1:
+            r[0] = a[3] > 0 && level <= a[3];
+            break;
+        case 2:
+            r[0] = level;
+            break;
         default: // the surface point on the ray from the center through p is center + (p - center) / level
-            r[0] = level > 0 ? glm::length(p - center_) * (1 - 1 / level) : -std::min({radii_.x, radii_.y, radii_.z});
+            r[0] = level > 0 ? glm::length(p - center_) * (1 - 1 / level)
+                             : -std::min({radii_.x, radii_.y, radii_.z});
             break;
         }
     }
 
-private:
+  private:
     glm::dvec3 center_, radii_;
 };
 
@@ -106,13 +120,17 @@ private:
 // skipped, and so is every segment that touches the stem's branching point (its base, where its
 // parent and its siblings meet it).
 class Proximity : public SkeletonEnvironment {
-public:
+  public:
     explicit Proximity(double radius) : radius_(radius) {}
     const std::vector<EnvMethod>& methods() const override {
         static const std::vector<EnvMethod> m = {
-            {"distance", {V, N}, N,
+            {"distance",
+             {V, N},
+             N,
              "distance from p to the nearest segment of another stem than module id's (at most radius)"},
-            {"clearance", {N}, N,
+            {"clearance",
+             {N},
+             N,
              "smallest distance from a node of module id's stem to an older stem (at most radius)"},
         };
         return m;
@@ -136,7 +154,8 @@ public:
                 if (pts[k].id) axis_of_[pts[k].id] = static_cast<int>(a);
                 lo_ = glm::min(lo_, pts[k].position);
                 hi = glm::max(hi, pts[k].position);
-                if (k > 0) segments_.push_back(Segment{pts[k - 1].position, pts[k].position, static_cast<int>(a)});
+                if (k > 0)
+                    segments_.push_back(Segment{pts[k - 1].position, pts[k].position, static_cast<int>(a)});
             }
         }
         // a dense grid over the plant's box, cells at least one radius wide (wider when the box
@@ -184,7 +203,7 @@ public:
         if (n > 1) slots[1] = clearance(axis);
     }
 
-private:
+  private:
     int axis_of(double id) const {
         if (!(id > 0)) return -1;
         auto it = axis_of_.find(static_cast<ModuleId>(id));
@@ -220,7 +239,8 @@ private:
     double clearance(int own) const {
         if (own < 0) return radius_;
         double best = radius_;
-        for (std::uint32_t k = node_off_[static_cast<std::size_t>(own)]; k < node_off_[static_cast<std::size_t>(own) + 1]; ++k)
+        for (std::uint32_t k = node_off_[static_cast<std::size_t>(own)];
+             k < node_off_[static_cast<std::size_t>(own) + 1]; ++k)
             best = std::min(best, distance(nodes_[k], own, true));
         return best;
     }
@@ -245,7 +265,8 @@ private:
         return glm::ivec3(glm::clamp(c, glm::dvec3(-2.0), glm::dvec3(dims_) + 1.0));
     }
     std::size_t index(int x, int y, int z) const {
-        return (static_cast<std::size_t>(z) * static_cast<std::size_t>(dims_.y) + static_cast<std::size_t>(y)) *
+        return (static_cast<std::size_t>(z) * static_cast<std::size_t>(dims_.y) +
+                static_cast<std::size_t>(y)) *
                    static_cast<std::size_t>(dims_.x) +
                static_cast<std::size_t>(x);
     }
@@ -256,7 +277,7 @@ private:
     std::vector<Segment> segments_;
     std::vector<std::uint32_t> offsets_, entries_;
     std::unordered_map<ModuleId, int> axis_of_;
-    std::vector<glm::dvec3> base_; // where each axis starts
+    std::vector<glm::dvec3> base_;   // where each axis starts
     std::vector<ModuleId> first_id_; // identity of the module that drew each axis's first segment
     std::vector<glm::dvec3> nodes_;  // every axis's points after its first, axis after axis
     std::vector<std::uint32_t> node_off_;
@@ -265,7 +286,7 @@ private:
 // ---- obstacles -----------------------------------------------------------------------------
 
 class Obstacles : public Environment {
-public:
+  public:
     // spheres, boxes and planes as the climbers' physics has them (one distance function for both)
     std::vector<physics::Obstacle> shapes;
     std::vector<Triangle> triangles; // of loaded meshes, each a closed surface with outward faces
@@ -301,9 +322,9 @@ public:
 // Between two neighbouring peripheral points the line is a quarter ellipse; above it the crown
 // is the superellipse (r/R)^C1 + ((y - Y)/(top - Y))^C1 = 1, below it the same with C2.
 class Envelope : public Environment {
-public:
+  public:
     glm::dvec3 top, bottom;
-    double radius[4];  // +x, +z, -x, -z, from the axis through the bottom point
+    double radius[4]; // +x, +z, -x, -z, from the axis through the bottom point
     double height[4];
     double c_top = 2, c_bottom = 2;
 
@@ -346,7 +367,7 @@ public:
 // segment passes through (or an organ sits in) is occupied. A point's exposure is the fraction
 // of light left after the occupied cells between it and the light, each keeping (1 - opacity).
 class Light : public SkeletonEnvironment {
-public:
+  public:
     Light(glm::dvec3 toward_light, int resolution, double opacity)
         : dir_(glm::normalize(toward_light)), res_(resolution), opacity_(opacity) {}
     const std::vector<EnvMethod>& methods() const override {
@@ -385,13 +406,14 @@ public:
         r[0] = method == 0 ? std::pow(1 - opacity_, count) : count;
     }
 
-private:
+  private:
     bool inside(const glm::ivec3& c) const {
         return c.x >= 0 && c.y >= 0 && c.z >= 0 && c.x < res_ && c.y < res_ && c.z < res_;
     }
     glm::ivec3 cell(const glm::dvec3& p) const { return glm::ivec3(glm::floor((p - lo_) / cell_)); }
     std::size_t index(const glm::ivec3& c) const {
-        return (static_cast<std::size_t>(c.z) * res_ + static_cast<std::size_t>(c.y)) * res_ + static_cast<std::size_t>(c.x);
+        return (static_cast<std::size_t>(c.z) * res_ + static_cast<std::size_t>(c.y)) * res_ +
+               static_cast<std::size_t>(c.x);
     }
     void mark(const glm::dvec3& p) {
         glm::ivec3 c = cell(p);
@@ -413,9 +435,9 @@ private:
                 // outside the box now: nothing more can be in the way unless we are still
                 // approaching it from outside
                 glm::dvec3 q = (p + dir_ * (step * k) - lo_) / cell_;
-                bool leaving = (q.x < 0 && dir_.x <= 0) || (q.y < 0 && dir_.y <= 0) || (q.z < 0 && dir_.z <= 0) ||
-                               (q.x >= res_ && dir_.x >= 0) || (q.y >= res_ && dir_.y >= 0) ||
-                               (q.z >= res_ && dir_.z >= 0);
+                bool leaving = (q.x < 0 && dir_.x <= 0) || (q.y < 0 && dir_.y <= 0) ||
+                               (q.z < 0 && dir_.z <= 0) || (q.x >= res_ && dir_.x >= 0) ||
+                               (q.y >= res_ && dir_.y >= 0) || (q.z >= res_ && dir_.z >= 0);
                 if (leaving) break;
                 continue;
             }
@@ -434,7 +456,8 @@ private:
 } // namespace
 
 EnvironmentFactory runtime_environments() {
-    return [](const std::string& kind, const std::vector<EnvArg>& args, std::string& error) -> std::unique_ptr<Environment> {
+    return [](const std::string& kind, const std::vector<EnvArg>& args,
+              std::string& error) -> std::unique_ptr<Environment> {
         Args a(kind, args, error);
         if (kind == "ellipsoid") {
             if (!a.only({"center", "radii"})) return nullptr;
@@ -460,7 +483,8 @@ EnvironmentFactory runtime_environments() {
             return std::make_unique<Proximity>(radius);
         }
         if (kind == "obstacles") {
-            if (!a.only({"sphere", "sphere_radius", "box_min", "box_max", "plane_point", "plane_normal", "mesh"}))
+            if (!a.only(
+                    {"sphere", "sphere_radius", "box_min", "box_max", "plane_point", "plane_normal", "mesh"}))
                 return nullptr;
             auto o = std::make_unique<Obstacles>();
             // shapes pair up in the order they are written: each sphere with the next radius, ...
@@ -478,22 +502,32 @@ EnvironmentFactory runtime_environments() {
                 bool is_vec = arg.type == V;
                 bool want_vec = arg.key != "sphere_radius";
                 if (is_vec != want_vec) {
-                    error = fmt::format("obstacles: '{}' must be a {}", arg.key, want_vec ? "vec3" : "number");
+                    error =
+                        fmt::format("obstacles: '{}' must be a {}", arg.key, want_vec ? "vec3" : "number");
                     return nullptr;
                 }
-                if (arg.key == "sphere") centers.push_back(vec(arg));
-                else if (arg.key == "sphere_radius") radii.push_back(arg.v[0]);
-                else if (arg.key == "box_min") box_min.push_back(vec(arg));
-                else if (arg.key == "box_max") box_max.push_back(vec(arg));
-                else if (arg.key == "plane_point") plane_p.push_back(vec(arg));
-                else plane_n.push_back(vec(arg));
+                if (arg.key == "sphere")
+                    centers.push_back(vec(arg));
+                else if (arg.key == "sphere_radius")
+                    radii.push_back(arg.v[0]);
+                else if (arg.key == "box_min")
+                    box_min.push_back(vec(arg));
+                else if (arg.key == "box_max")
+                    box_max.push_back(vec(arg));
+                else if (arg.key == "plane_point")
+                    plane_p.push_back(vec(arg));
+                else
+                    plane_n.push_back(vec(arg));
             }
-            if (centers.size() != radii.size() || box_min.size() != box_max.size() || plane_p.size() != plane_n.size()) {
-                error = "obstacles: give each sphere a sphere_radius, each box_min a box_max and each plane_point a "
+            if (centers.size() != radii.size() || box_min.size() != box_max.size() ||
+                plane_p.size() != plane_n.size()) {
+                error = "obstacles: give each sphere a sphere_radius, each box_min a box_max and each "
+                        "plane_point a "
                         "plane_normal";
                 return nullptr;
             }
-            auto add = [&](physics::Obstacle::Kind shape_kind, const glm::dvec3& first, const glm::dvec3& second) {
+            auto add = [&](physics::Obstacle::Kind shape_kind, const glm::dvec3& first,
+                           const glm::dvec3& second) {
                 physics::Obstacle shape;
                 shape.kind = shape_kind, shape.a = first, shape.b = second;
                 o->shapes.push_back(shape);
@@ -501,7 +535,8 @@ EnvironmentFactory runtime_environments() {
             for (std::size_t i = 0; i < centers.size(); ++i)
                 add(physics::Obstacle::Sphere, centers[i], glm::dvec3(radii[i], 0, 0));
             for (std::size_t i = 0; i < box_min.size(); ++i)
-                add(physics::Obstacle::Box, glm::min(box_min[i], box_max[i]), glm::max(box_min[i], box_max[i]));
+                add(physics::Obstacle::Box, glm::min(box_min[i], box_max[i]),
+                    glm::max(box_min[i], box_max[i]));
             for (std::size_t i = 0; i < plane_p.size(); ++i) {
                 if (glm::length(plane_n[i]) == 0) {
                     error = "obstacles: a plane_normal must not be zero";
@@ -512,7 +547,8 @@ EnvironmentFactory runtime_environments() {
             return o;
         }
         if (kind == "envelope") {
-            if (!a.only({"top", "bottom", "px", "pz", "nx", "nz", "top_shape", "bottom_shape"})) return nullptr;
+            if (!a.only({"top", "bottom", "px", "pz", "nx", "nz", "top_shape", "bottom_shape"}))
+                return nullptr;
             auto e = std::make_unique<Envelope>();
             const EnvArg *t = a.find("top", V), *b = a.find("bottom", V);
             const EnvArg* side[4] = {a.find("px", V), a.find("pz", V), a.find("nx", V), a.find("nz", V)};
@@ -530,7 +566,8 @@ EnvironmentFactory runtime_environments() {
                 e->radius[k] = rad[k];
                 e->height[k] = side[k]->v[1];
                 if (!(rad[k] > 0) || e->height[k] >= e->top.y || e->height[k] <= e->bottom.y) {
-                    error = "envelope: each widest point lies on its own side of the axis through the bottom point, "
+                    error = "envelope: each widest point lies on its own side of the axis through the bottom "
+                            "point, "
                             "between the bottom and the top";
                     return nullptr;
                 }
@@ -545,21 +582,24 @@ EnvironmentFactory runtime_environments() {
         }
         if (kind == "light") {
             if (!a.only({"direction", "resolution", "opacity"})) return nullptr;
-            const EnvArg *d = a.find("direction", V), *res = a.find("resolution", N), *op = a.find("opacity", N);
+            const EnvArg *d = a.find("direction", V), *res = a.find("resolution", N),
+                         *op = a.find("opacity", N);
             if (!a.ok()) return nullptr;
             glm::dvec3 dir = d ? vec(*d) : glm::dvec3(0, 1, 0);
             int resolution = res ? static_cast<int>(res->v[0]) : 32;
             double opacity = op ? op->v[0] : 0.3;
-            if (glm::length(dir) == 0 || resolution < 1 || resolution > 512 || !(opacity >= 0 && opacity <= 1)) {
+            if (glm::length(dir) == 0 || resolution < 1 || resolution > 512 ||
+                !(opacity >= 0 && opacity <= 1)) {
                 error = "light: direction must not be zero, resolution 1 to 512, opacity 0 to 1";
                 return nullptr;
             }
             return std::make_unique<Light>(dir, resolution, opacity);
         }
         if (kind == "climber") return make_climber(args, error);
-        error = fmt::format("unknown environment kind '{}': this version has ellipsoid, envelope, proximity, light, "
-                            "obstacles and climber",
-                            kind);
+        error = fmt::format(
+            "unknown environment kind '{}': this version has ellipsoid, envelope, proximity, light, "
+            "obstacles and climber",
+            kind);
         return nullptr;
     };
 }

@@ -34,19 +34,20 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string quoted(const std::string& s) { return "'" + s + "'"; }
+std::string quoted(const std::string& s) {
+    return "'" + s + "'";
+}
 
 // Creates a new, empty file beside `path` (same directory, hidden, unique name) and returns its
 // path with `file` open for writing. Throws ExportError when the directory is not writable.
 std::string create_temp_beside(const std::string& path, std::FILE*& file) {
     static std::atomic<unsigned> counter{0};
     const fs::path target(path);
-    if (target.filename().empty())
-        throw ExportError("cannot write " + quoted(path) + ": not a file name");
+    if (target.filename().empty()) throw ExportError("cannot write " + quoted(path) + ": not a file name");
     const fs::path dir = target.parent_path();
     for (int attempt = 0;; ++attempt) {
-        const std::string name = "." + target.filename().string() + ".tmp-" +
-                                 std::to_string(::getpid()) + "-" + std::to_string(counter++);
+        const std::string name = "." + target.filename().string() + ".tmp-" + std::to_string(::getpid()) +
+                                 "-" + std::to_string(counter++);
         const std::string temp = (dir / name).string();
         // "x": fail if the file exists, so two writers never share a temporary file.
         file = std::fopen(temp.c_str(), "wbx");
@@ -54,8 +55,7 @@ std::string create_temp_beside(const std::string& path, std::FILE*& file) {
         const int err = errno;
         if (err == EEXIST && attempt < 100) continue;
         throw ExportError("cannot write " + quoted(path) + ": cannot create a file in " +
-                          quoted(dir.empty() ? std::string(".") : dir.string()) + ": " +
-                          std::strerror(err));
+                          quoted(dir.empty() ? std::string(".") : dir.string()) + ": " + std::strerror(err));
     }
 }
 
@@ -69,11 +69,11 @@ void remove_quietly(const std::string& temp) {
 void check_mesh_part(const MeshPart& part, const std::string& what) {
     const std::size_t nv = part.positions.size();
     if (!part.normals.empty() && part.normals.size() != nv)
-        throw ExportError(what + " has " + std::to_string(nv) + " positions but " + std::to_string(part.normals.size()) +
-                          " normals");
+        throw ExportError(what + " has " + std::to_string(nv) + " positions but " +
+                          std::to_string(part.normals.size()) + " normals");
     if (!part.uvs.empty() && part.uvs.size() != nv)
-        throw ExportError(what + " has " + std::to_string(nv) + " positions but " + std::to_string(part.uvs.size()) +
-                          " texture coordinates");
+        throw ExportError(what + " has " + std::to_string(nv) + " positions but " +
+                          std::to_string(part.uvs.size()) + " texture coordinates");
     if (part.indices.size() % 3 != 0)
         throw ExportError(what + " has an index count (" + std::to_string(part.indices.size()) +
                           ") that is not a multiple of 3");
@@ -159,8 +159,7 @@ struct GltfBuilder {
         return static_cast<int>(model.bufferViews.size() - 1);
     }
 
-    int add_accessor(int view, std::size_t byte_offset, std::size_t count, int type,
-                     int component_type) {
+    int add_accessor(int view, std::size_t byte_offset, std::size_t count, int type, int component_type) {
         tinygltf::Accessor a;
         a.bufferView = view;
         a.byteOffset = byte_offset;
@@ -182,7 +181,7 @@ struct GltfBuilder {
         mat.name = "material" + std::to_string(m);
         auto channel = [](float x) { return std::isfinite(x) ? tidy(std::clamp(x, 0.0f, 1.0f)) : 0.0; };
         mat.pbrMetallicRoughness.baseColorFactor = {channel(color.color.r), channel(color.color.g),
-                                                     channel(color.color.b), 1.0};
+                                                    channel(color.color.b), 1.0};
         mat.pbrMetallicRoughness.metallicFactor = 0.0;
         mat.pbrMetallicRoughness.roughnessFactor = 0.9;
         mat.doubleSided = true;
@@ -200,20 +199,18 @@ struct GltfBuilder {
 
         // A part without primitives is drawn whole with material 0.
         std::vector<Primitive> prims = part.primitives;
-        if (prims.empty())
-            prims.push_back({0, static_cast<std::uint32_t>(part.indices.size()), 0});
+        if (prims.empty()) prims.push_back({0, static_cast<std::uint32_t>(part.indices.size()), 0});
         for (const Primitive& p : prims) {
             if (std::uint64_t(p.first) + p.count > part.indices.size() || p.first % 3 != 0 ||
                 p.count % 3 != 0)
-                throw ExportError("glTF export: " + name + " has a primitive with indices [" +
-                                  std::to_string(p.first) + ", " +
-                                  std::to_string(std::uint64_t(p.first) + p.count) +
-                                  ") that does not fit its " +
-                                  std::to_string(part.indices.size()) + " indices in whole triangles");
+                throw ExportError(
+                    "glTF export: " + name + " has a primitive with indices [" + std::to_string(p.first) +
+                    ", " + std::to_string(std::uint64_t(p.first) + p.count) + ") that does not fit its " +
+                    std::to_string(part.indices.size()) + " indices in whole triangles");
         }
-        prims.erase(std::remove_if(prims.begin(), prims.end(),
-                                   [](const Primitive& p) { return p.count == 0; }),
-                    prims.end());
+        prims.erase(
+            std::remove_if(prims.begin(), prims.end(), [](const Primitive& p) { return p.count == 0; }),
+            prims.end());
         if (prims.empty() || nv == 0) return -1;
 
         tinygltf::Mesh mesh;
@@ -228,8 +225,7 @@ struct GltfBuilder {
             hi = glm::max(hi, p);
         }
         const int pos_view = add_view(part.positions.data(), nv * sizeof(glm::vec3), array_buffer);
-        const int pos = add_accessor(pos_view, 0, nv, TINYGLTF_TYPE_VEC3,
-                                     TINYGLTF_COMPONENT_TYPE_FLOAT);
+        const int pos = add_accessor(pos_view, 0, nv, TINYGLTF_TYPE_VEC3, TINYGLTF_COMPONENT_TYPE_FLOAT);
         model.accessors[std::size_t(pos)].minValues = {lo.x, lo.y, lo.z};
         model.accessors[std::size_t(pos)].maxValues = {hi.x, hi.y, hi.z};
 
@@ -254,17 +250,15 @@ struct GltfBuilder {
             uv = add_accessor(view, 0, nv, TINYGLTF_TYPE_VEC2, TINYGLTF_COMPONENT_TYPE_FLOAT);
         }
 
-        const int idx_view = add_view(part.indices.data(),
-                                      part.indices.size() * sizeof(std::uint32_t),
-                                      element_array_buffer);
+        const int idx_view =
+            add_view(part.indices.data(), part.indices.size() * sizeof(std::uint32_t), element_array_buffer);
         for (const Primitive& p : prims) {
             tinygltf::Primitive prim;
             prim.attributes["POSITION"] = pos;
             if (nrm >= 0) prim.attributes["NORMAL"] = nrm;
             if (uv >= 0) prim.attributes["TEXCOORD_0"] = uv;
-            prim.indices = add_accessor(idx_view, std::size_t(p.first) * sizeof(std::uint32_t),
-                                        p.count, TINYGLTF_TYPE_SCALAR,
-                                        TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT);
+            prim.indices = add_accessor(idx_view, std::size_t(p.first) * sizeof(std::uint32_t), p.count,
+                                        TINYGLTF_TYPE_SCALAR, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT);
             prim.material = material(p.material, name);
             prim.mode = TINYGLTF_MODE_TRIANGLES; // tinygltf 2.7 writes -1 otherwise
             mesh.primitives.push_back(std::move(prim));
@@ -295,8 +289,7 @@ struct GltfBuilder {
 
         std::vector<int> proto_mesh(scene.prototypes.size(), -1);
         for (std::size_t i = 0; i < scene.prototypes.size(); ++i) {
-            const std::string name = i < scene.prototype_names.size() &&
-                                             !scene.prototype_names[i].empty()
+            const std::string name = i < scene.prototype_names.size() && !scene.prototype_names[i].empty()
                                          ? scene.prototype_names[i]
                                          : "prototype" + std::to_string(i);
             proto_mesh[i] = add_mesh(scene.prototypes[i], name);
@@ -336,8 +329,7 @@ struct GltfBuilder {
 void write_gltf(const Scene& scene, const std::string& path) {
     const std::string ext = lower_extension(path);
     if (ext != ".glb" && ext != ".gltf")
-        throw ExportError("cannot write " + quoted(path) +
-                          ": a glTF file name must end in .glb or .gltf");
+        throw ExportError("cannot write " + quoted(path) + ": a glTF file name must end in .glb or .gltf");
     const bool binary = ext == ".glb";
 
     GltfBuilder builder(scene);

@@ -18,8 +18,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <mutex>
+#include <sstream>
 #include <system_error>
 #include <unistd.h>
 
@@ -30,7 +30,9 @@ namespace {
 namespace fs = std::filesystem;
 using Mesh = OpenMesh::TriMesh_ArrayKernelT<>;
 
-std::string quoted(const std::string& s) { return "'" + s + "'"; }
+std::string quoted(const std::string& s) {
+    return "'" + s + "'";
+}
 
 void quiet_openmesh() {
     static std::once_flag once;
@@ -47,7 +49,7 @@ glm::vec3 unit_or_up(glm::vec3 n) {
 }
 
 class Flattener {
-public:
+  public:
     explicit Flattener(Mesh& mesh) : mesh_(mesh) {}
 
     void add(const MeshPart& part, const glm::mat4& m, bool identity, const std::string& name) {
@@ -59,8 +61,7 @@ public:
         const bool mirrored = glm::determinant(glm::mat3(m)) < 0.0f; // keep the winding outward
 
         std::vector<Mesh::VertexHandle> handle(nv);
-        for (std::uint32_t i = 0; i < nv; ++i)
-            handle[i] = new_vertex(part, m, normal_matrix, identity, i);
+        for (std::uint32_t i = 0; i < nv; ++i) handle[i] = new_vertex(part, m, normal_matrix, identity, i);
 
         for (std::size_t t = 0; t + 2 < part.indices.size(); t += 3) {
             std::uint32_t a = part.indices[t], b = part.indices[t + 1], c = part.indices[t + 2];
@@ -77,7 +78,7 @@ public:
         }
     }
 
-private:
+  private:
     Mesh::VertexHandle new_vertex(const MeshPart& part, const glm::mat4& m, const glm::mat3& nm,
                                   bool identity, std::uint32_t i) {
         glm::vec3 p = part.positions[i];
@@ -137,7 +138,8 @@ void write_mesh_file(const Scene& scene, const std::string& path) {
 
     std::ostringstream out(std::ios::out | std::ios::binary);
     if (!OpenMesh::IO::write_mesh(mesh, out, ext, options, 7))
-        throw ExportError("cannot write " + quoted(path) + ": OpenMesh failed to write the " + ext.substr(1) + " file");
+        throw ExportError("cannot write " + quoted(path) + ": OpenMesh failed to write the " + ext.substr(1) +
+                          " file");
     write_file_atomically(path, out.str());
 }
 

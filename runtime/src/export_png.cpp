@@ -67,8 +67,7 @@ Box framing_box(const Scene& scene) {
     Box given;
     given.lo = glm::dvec3(scene.bounds_min);
     given.hi = glm::dvec3(scene.bounds_max);
-    if (finite3(given.lo) && finite3(given.hi) && given.valid() && given.lo != given.hi)
-        return given;
+    if (finite3(given.lo) && finite3(given.hi) && given.valid() && given.lo != given.hi) return given;
 
     Box box = part_box(scene.tubes);
     std::vector<Box> protos;
@@ -115,10 +114,9 @@ Camera make_camera(const Scene& scene, int width, int height) {
     const glm::dvec3 half = 0.5 * (box.hi - box.lo);
     // The projection of a box is symmetric about the projected center: its half-size along a
     // screen axis a is sum |a_i| * half_i.
-    const double hw = std::abs(cam.right.x) * half.x + std::abs(cam.right.y) * half.y +
-                      std::abs(cam.right.z) * half.z;
-    const double hh =
-        std::abs(cam.up.x) * half.x + std::abs(cam.up.y) * half.y + std::abs(cam.up.z) * half.z;
+    const double hw =
+        std::abs(cam.right.x) * half.x + std::abs(cam.right.y) * half.y + std::abs(cam.right.z) * half.z;
+    const double hh = std::abs(cam.up.x) * half.x + std::abs(cam.up.y) * half.y + std::abs(cam.up.z) * half.z;
     const double avail_w = 0.5 * width * (1.0 - 2.0 * kMargin);
     const double avail_h = 0.5 * height * (1.0 - 2.0 * kMargin);
     double scale = std::numeric_limits<double>::infinity();
@@ -132,8 +130,8 @@ Camera make_camera(const Scene& scene, int width, int height) {
 }
 
 struct ScreenVertex {
-    std::int32_t x = 0, y = 0; // fixed point, 1/kSub sample
-    float z = 0.0f;            // depth, larger is nearer
+    std::int32_t x = 0, y = 0;  // fixed point, 1/kSub sample
+    float z = 0.0f;             // depth, larger is nearer
     float nl = 0.0f, nv = 0.0f; // dot(normal, light), dot(normal, toward); NaN: no usable normal
     bool ok = false;
 };
@@ -160,7 +158,9 @@ double srgb8_to_linear(int c) {
 std::int64_t floor_div(std::int64_t a, std::int64_t b) {
     return a >= 0 ? a / b : -((-a + b - 1) / b);
 }
-std::int64_t ceil_div(std::int64_t a, std::int64_t b) { return -floor_div(-a, b); }
+std::int64_t ceil_div(std::int64_t a, std::int64_t b) {
+    return -floor_div(-a, b);
+}
 
 // Twice the signed area of (a, b, p) in fixed point; positive when p is on the inner side of
 // a->b for a positively oriented triangle.
@@ -268,12 +268,16 @@ void fill_triangle(Raster& r, ShadedVertex a, ShadedVertex b, ShadedVertex c,
     }
 }
 
-float clamp01(float v) { return std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f; }
+float clamp01(float v) {
+    return std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f;
+}
 
 std::array<float, 3> lut_scale_for(const Scene& scene, std::uint32_t material) {
     Material m;
-    if (material < scene.materials.size()) m = scene.materials[material];
-    else if (!scene.materials.empty()) m = scene.materials.front();
+    if (material < scene.materials.size())
+        m = scene.materials[material];
+    else if (!scene.materials.empty())
+        m = scene.materials.front();
     const float s = float(kLutSize - 1);
     return {clamp01(m.color.r) * s, clamp01(m.color.g) * s, clamp01(m.color.b) * s};
 }
@@ -368,20 +372,17 @@ struct Renderer {
         float t[3];
         for (int k = 0; k < 3; ++k)
             t[k] = kAmbient + kKey * std::max(0.0f, nl[k]) + kFill * std::max(0.0f, nv[k]);
-        fill_triangle(raster, {a.x, a.y, a.z, t[0]}, {b.x, b.y, b.z, t[1]}, {c.x, c.y, c.z, t[2]},
-                      color);
+        fill_triangle(raster, {a.x, a.y, a.z, t[0]}, {b.x, b.y, b.z, t[1]}, {c.x, c.y, c.z, t[2]}, color);
     }
 
-    void draw_range(const MeshPart& part, std::size_t first, std::size_t count,
-                    std::uint32_t material) {
+    void draw_range(const MeshPart& part, std::size_t first, std::size_t count, std::uint32_t material) {
         const std::size_t n = part.indices.size();
         if (first >= n) return;
         const std::size_t end = first + std::min(count, n - first);
         const std::array<float, 3> color = lut_scale_for(scene, material);
         const std::size_t nv = verts.size();
         for (std::size_t i = first; i + 3 <= end; i += 3) {
-            const std::uint32_t ia = part.indices[i], ib = part.indices[i + 1],
-                                ic = part.indices[i + 2];
+            const std::uint32_t ia = part.indices[i], ib = part.indices[i + 1], ic = part.indices[i + 2];
             if (ia >= nv || ib >= nv || ic >= nv) continue;
             draw_triangle(verts[ia], verts[ib], verts[ic], color);
         }
@@ -394,8 +395,7 @@ struct Renderer {
             draw_range(part, 0, part.indices.size(), 0);
             return;
         }
-        for (const Primitive& prim : part.primitives)
-            draw_range(part, prim.first, prim.count, prim.material);
+        for (const Primitive& prim : part.primitives) draw_range(part, prim.first, prim.count, prim.material);
     }
 };
 
@@ -425,7 +425,9 @@ Image render_scene(const Scene& scene, int width, int height) {
     for (int i = 0; i < kLutSize; ++i) r.encode[i] = linear_to_srgb8(double(i) / (kLutSize - 1));
 
     const Camera cam = make_camera(scene, r.width, r.height);
-    Renderer ren{scene, r, cam,
+    Renderer ren{scene,
+                 r,
+                 cam,
                  glm::dvec3(glm::dot(cam.light, cam.right), glm::dot(cam.light, cam.up),
                             glm::dot(cam.light, cam.toward)),
                  {}};
@@ -459,8 +461,8 @@ Image render_scene(const Scene& scene, int width, int height) {
                     out[x * 3 + ch] = s0[k];
                     continue;
                 }
-                const float v = 0.25f * (decode[s0[k]] + decode[s0[k + 3]] + decode[s1[k]] +
-                                         decode[s1[k + 3]]);
+                const float v =
+                    0.25f * (decode[s0[k]] + decode[s0[k + 3]] + decode[s1[k]] + decode[s1[k + 3]]);
                 out[x * 3 + ch] = r.encode[std::size_t(v * (kLutSize - 1) + 0.5f)];
             }
         }
@@ -490,10 +492,9 @@ void png_sink_write(void* context, void* data, int size) {
 void write_png(const Scene& scene, const std::string& path, int width, int height) {
     const Image img = render_scene(scene, width, height);
     PngSink sink;
-    const int ok = stbi_write_png_to_func(png_sink_write, &sink, img.width, img.height, 3,
-                                          img.rgb.data(), img.width * 3);
-    if (!ok || sink.failed || sink.bytes.empty())
-        throw ExportError("cannot encode PNG for " + path);
+    const int ok = stbi_write_png_to_func(png_sink_write, &sink, img.width, img.height, 3, img.rgb.data(),
+                                          img.width * 3);
+    if (!ok || sink.failed || sink.bytes.empty()) throw ExportError("cannot encode PNG for " + path);
     write_file_atomically(path, sink.bytes);
 }
 

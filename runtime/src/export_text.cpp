@@ -9,8 +9,12 @@ namespace plant {
 
 namespace {
 
-void vec(std::string& out, const glm::dvec3& v) { fmt::format_to(std::back_inserter(out), "[{},{},{}]", v.x, v.y, v.z); }
-void vec(std::string& out, const glm::vec3& v) { fmt::format_to(std::back_inserter(out), "[{},{},{}]", v.x, v.y, v.z); }
+void vec(std::string& out, const glm::dvec3& v) {
+    fmt::format_to(std::back_inserter(out), "[{},{},{}]", v.x, v.y, v.z);
+}
+void vec(std::string& out, const glm::vec3& v) {
+    fmt::format_to(std::back_inserter(out), "[{},{},{}]", v.x, v.y, v.z);
+}
 
 std::string json_string(const std::string& s) {
     std::string out = "\"";
@@ -46,7 +50,8 @@ std::string skeleton_json(const Skeleton& sk) {
             vec(out, p.up);
             fmt::format_to(std::back_inserter(out), ",\"radius\":{},\"color\":", p.radius);
             vec(out, p.color);
-            fmt::format_to(std::back_inserter(out), ",\"module\":{},\"id\":{}}}", json_string(p.module), p.id);
+            fmt::format_to(std::back_inserter(out), ",\"module\":{},\"id\":{}}}", json_string(p.module),
+                           p.id);
         }
         out += "]}";
     }
@@ -56,7 +61,8 @@ std::string skeleton_json(const Skeleton& sk) {
         out += o ? ",\n" : "\n";
         fmt::format_to(std::back_inserter(out), "{{\"shape\":{},\"matrix\":[", json_string(g.shape));
         for (int c = 0; c < 4; ++c)
-            for (int r = 0; r < 4; ++r) fmt::format_to(std::back_inserter(out), "{}{}", c || r ? "," : "", g.transform[c][r]);
+            for (int r = 0; r < 4; ++r)
+                fmt::format_to(std::back_inserter(out), "{}{}", c || r ? "," : "", g.transform[c][r]);
         out += "],\"color\":";
         vec(out, g.color);
         fmt::format_to(std::back_inserter(out), ",\"id\":{}}}", g.id);
@@ -78,16 +84,18 @@ std::string skeleton_svg(const Skeleton& sk) {
     double w = std::max(hi_x - lo_x, 1e-6), h = std::max(hi_y - lo_y, 1e-6);
     double margin = 0.05 * std::max(w, h);
     double stroke = 0.003 * std::max(w, h);
-    std::string out = fmt::format("<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"{} {} {} {}\" width=\"800\" "
-                                  "height=\"{}\">\n",
-                                  lo_x - margin, -hi_y - margin, w + 2 * margin, h + 2 * margin,
-                                  static_cast<int>(800 * (h + 2 * margin) / (w + 2 * margin)));
+    std::string out =
+        fmt::format("<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"{} {} {} {}\" width=\"800\" "
+                    "height=\"{}\">\n",
+                    lo_x - margin, -hi_y - margin, w + 2 * margin, h + 2 * margin,
+                    static_cast<int>(800 * (h + 2 * margin) / (w + 2 * margin)));
     out += "<rect x=\"-1e9\" y=\"-1e9\" width=\"2e9\" height=\"2e9\" fill=\"white\"/>\n";
     for (const auto& a : sk.axes) {
         if (a.points.size() < 2) continue;
         out += fmt::format("<polyline fill=\"none\" stroke=\"rgb({},{},{})\" stroke-width=\"{}\" "
                            "stroke-linecap=\"round\" stroke-linejoin=\"round\" points=\"",
-                           static_cast<int>(a.points.back().color.x * 255), static_cast<int>(a.points.back().color.y * 255),
+                           static_cast<int>(a.points.back().color.x * 255),
+                           static_cast<int>(a.points.back().color.y * 255),
                            static_cast<int>(a.points.back().color.z * 255), stroke);
         for (const auto& p : a.points) out += fmt::format("{},{} ", p.position.x, -p.position.y);
         out += "\"/>\n";
@@ -96,7 +104,11 @@ std::string skeleton_svg(const Skeleton& sk) {
     return out;
 }
 
-void write_skeleton_json(const Skeleton& s, const std::string& path) { write_file_atomically(path, skeleton_json(s)); }
-void write_svg(const Skeleton& s, const std::string& path) { write_file_atomically(path, skeleton_svg(s)); }
+void write_skeleton_json(const Skeleton& s, const std::string& path) {
+    write_file_atomically(path, skeleton_json(s));
+}
+void write_svg(const Skeleton& s, const std::string& path) {
+    write_file_atomically(path, skeleton_svg(s));
+}
 
 } // namespace plant

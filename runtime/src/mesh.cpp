@@ -42,7 +42,8 @@ glm::dvec3 transport_about(const glm::dvec3& v, const glm::dvec3& k, double phi)
 }
 
 glm::dvec3 any_perpendicular(const glm::dvec3& t) {
-    glm::dvec3 p = std::fabs(t.y) < 0.9 ? glm::cross(t, glm::dvec3(0, 1, 0)) : glm::cross(t, glm::dvec3(1, 0, 0));
+    glm::dvec3 p =
+        std::fabs(t.y) < 0.9 ? glm::cross(t, glm::dvec3(0, 1, 0)) : glm::cross(t, glm::dvec3(1, 0, 0));
     return glm::normalize(p);
 }
 
@@ -163,7 +164,8 @@ std::vector<TubePath> tube_paths(const Skeleton& skeleton, const MeshOptions& o)
         if (child.parent < 0 || static_cast<std::size_t>(child.parent) >= n || child.points.empty()) continue;
         const auto pa = static_cast<std::size_t>(child.parent);
         const SkeletonAxis& parent = skeleton.axes[pa];
-        if (parent.points.empty() || !same_point(parent.points.back().position, child.points[0].position)) continue;
+        if (parent.points.empty() || !same_point(parent.points.back().position, child.points[0].position))
+            continue;
         glm::dvec3 dp, dc;
         if (!end_direction(parent, true, dp) || !end_direction(child, false, dc)) continue;
         double cs = glm::dot(dp, dc);
@@ -257,7 +259,8 @@ void mesh_tube(const TubePath& path, const MeshOptions& o, MeshPart& part,
         idx->resize(at + 6 * static_cast<std::size_t>(sides));
         std::uint32_t* out = idx->data() + at;
         for (std::uint32_t j = 0; j < static_cast<std::uint32_t>(sides); ++j) {
-            std::uint32_t a = base + static_cast<std::uint32_t>(k) * stride + j, b = a + 1, d = a + stride, c = d + 1;
+            std::uint32_t a = base + static_cast<std::uint32_t>(k) * stride + j, b = a + 1, d = a + stride,
+                          c = d + 1;
             out[0] = a, out[1] = b, out[2] = c, out[3] = a, out[4] = c, out[5] = d;
             out += 6;
         }

@@ -16,7 +16,7 @@ namespace plant {
 namespace {
 
 class QuerySink : public TurtleSink {
-public:
+  public:
     QuerySink(const Program& p, const ModuleString& s) : program_(p), string_(s) {}
     void query(std::size_t module, const TurtleState& t) override {
         const std::string& name = program_.symbols[string_.sym[module]].name;
@@ -34,15 +34,16 @@ public:
     std::unordered_map<ModuleId, Place> positions;
     std::unordered_map<ModuleId, glm::dvec3> found;
 
-private:
+  private:
     const Program& program_;
     const ModuleString& string_;
 };
 
 // Shows each climber the segments of the modules bound to it, in string order.
 class ClimberSink : public TurtleSink {
-public:
-    ClimberSink(const ModuleString& s, const std::vector<Climber*>& by_symbol, const std::unordered_set<ModuleId>& own)
+  public:
+    ClimberSink(const ModuleString& s, const std::vector<Climber*>& by_symbol,
+                const std::unordered_set<ModuleId>& own)
         : string_(s), by_symbol_(by_symbol), own_(own) {}
     void segment(const TurtleSegment& seg) override {
         const SymbolId sym = string_.sym[seg.module];
@@ -50,15 +51,15 @@ public:
         if (!c || !own_.count(seg.id)) return;
         const TurtleState& t = *seg.state;
         const double len = string_.arity(seg.module) > 0 ? string_.args(seg.module)[0] : t.step;
-        c->observe(seg.id, t.bound_parent, seg.from, seg.to, glm::dmat3(-t.left, t.heading, t.up), t.width / 2, len);
+        c->observe(seg.id, t.bound_parent, seg.from, seg.to, glm::dmat3(-t.left, t.heading, t.up),
+                   t.width / 2, len);
     }
 
-private:
+  private:
     const ModuleString& string_;
     const std::vector<Climber*>& by_symbol_;
     const std::unordered_set<ModuleId>& own_;
 };
-
 
 // The climbers' part of a step (climber.hpp): place new bound modules' particles, run the
 // physics, and cut what broke off out of the string.
@@ -99,7 +100,7 @@ void advance_climbers(const Derivation& d, ModuleString& string) {
 
 // Feeds one turtle pass to the query sink and, when environments want the plant, a skeleton.
 class BothSinks : public TurtleSink {
-public:
+  public:
     BothSinks(TurtleSink& a, TurtleSink* b) : a_(a), b_(b) {}
     void axis_begin(int axis, int parent, const TurtleState& t) override {
         a_.axis_begin(axis, parent, t);
@@ -118,7 +119,7 @@ public:
         if (b_) b_->query(module, t);
     }
 
-private:
+  private:
     TurtleSink& a_;
     TurtleSink* b_;
 };
@@ -145,8 +146,10 @@ void TurtleQueryPass::fill_queries(const Derivation& d, ModuleString& string) {
         auto it = sink.positions.find(string.id(i));
         double* a = string.params.data() + string.poff[i];
         const auto env = static_cast<std::size_t>(a[0]);
-        if (it == sink.positions.end() || a[0] < 0 || env >= p.environments.size() || !p.environments[env]) continue;
-        p.environments[env]->communicate(it->second.position, string.id(i), it->second.axis, a + 1, string.arity(i) - 1);
+        if (it == sink.positions.end() || a[0] < 0 || env >= p.environments.size() || !p.environments[env])
+            continue;
+        p.environments[env]->communicate(it->second.position, string.id(i), it->second.axis, a + 1,
+                                         string.arity(i) - 1);
     }
     for (std::size_t i = 0; i < string.size(); ++i) {
         if (!p.symbols[string.sym[i]].query || string.arity(i) != 3) continue;

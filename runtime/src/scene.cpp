@@ -88,7 +88,8 @@ MeshPart sphere_prototype() {
     }
     for (int i = 0; i < stacks; ++i) {
         for (int j = 0; j < slices; ++j) {
-            auto a = static_cast<std::uint32_t>(i * (slices + 1) + j), b = a + 1, d = a + slices + 1, c = d + 1;
+            auto a = static_cast<std::uint32_t>(i * (slices + 1) + j), b = a + 1, d = a + slices + 1,
+                 c = d + 1;
             // counter-clockwise seen from outside; the pole rows would be degenerate
             if (i != 0) m.indices.insert(m.indices.end(), {a, b, d});
             if (i != stacks - 1) m.indices.insert(m.indices.end(), {b, c, d});
@@ -121,7 +122,8 @@ MeshPart loaded_prototype(const SurfaceDef& s) {
     }
     for (auto f : mesh.faces())
         for (auto v : mesh.fv_range(f)) m.indices.push_back(static_cast<std::uint32_t>(v.idx()));
-    if (m.indices.empty()) throw RuntimeError(s.span, fmt::format("surface '{}' loaded from '{}' has no faces", s.name, s.path));
+    if (m.indices.empty())
+        throw RuntimeError(s.span, fmt::format("surface '{}' loaded from '{}' has no faces", s.name, s.path));
     m.primitives.push_back(Primitive{0, static_cast<std::uint32_t>(m.indices.size()), 0});
     return m;
 }
@@ -155,7 +157,8 @@ Scene build_scene(const Program& program, const Skeleton& skeleton, const MeshOp
         if (by_material[m].empty()) continue;
         auto first = static_cast<std::uint32_t>(scene.tubes.indices.size());
         scene.tubes.indices.insert(scene.tubes.indices.end(), by_material[m].begin(), by_material[m].end());
-        scene.tubes.primitives.push_back(Primitive{first, static_cast<std::uint32_t>(by_material[m].size()), m});
+        scene.tubes.primitives.push_back(
+            Primitive{first, static_cast<std::uint32_t>(by_material[m].size()), m});
     }
     // organs: one prototype per (shape, color), meshed once
     std::map<std::pair<std::string, std::uint32_t>, std::uint32_t> prototype_index;
@@ -175,9 +178,10 @@ Scene build_scene(const Program& program, const Skeleton& skeleton, const MeshOp
                     for (const auto& s : program.surfaces)
                         if (s.name == organ.shape) def = &s;
                     if (!def)
-                        throw RuntimeError(Span{}, fmt::format("'~{}' places a surface that is not declared: add "
-                                                               "'surface {} = polygon(...);'",
-                                                               organ.shape, organ.shape));
+                        throw RuntimeError(Span{},
+                                           fmt::format("'~{}' places a surface that is not declared: add "
+                                                       "'surface {} = polygon(...);'",
+                                                       organ.shape, organ.shape));
                     shape = def->kind == "load" ? loaded_prototype(*def) : polygon_prototype(*def);
                 }
                 sit = shapes.emplace(organ.shape, std::move(shape)).first;
@@ -193,11 +197,12 @@ Scene build_scene(const Program& program, const Skeleton& skeleton, const MeshOp
     if (scene.materials.empty()) scene.materials.push_back(Material{});
     scene.update_bounds();
     // meshes are single precision: a plant beyond its range cannot be meshed
-    for (float v : {scene.bounds_min.x, scene.bounds_min.y, scene.bounds_min.z, scene.bounds_max.x, scene.bounds_max.y,
-                    scene.bounds_max.z})
+    for (float v : {scene.bounds_min.x, scene.bounds_min.y, scene.bounds_min.z, scene.bounds_max.x,
+                    scene.bounds_max.y, scene.bounds_max.z})
         if (!std::isfinite(v))
-            throw RuntimeError(Span{}, "the plant reaches coordinates beyond the range of single-precision numbers "
-                                       "(about 3e38) and cannot be meshed");
+            throw RuntimeError(Span{},
+                               "the plant reaches coordinates beyond the range of single-precision numbers "
+                               "(about 3e38) and cannot be meshed");
     return scene;
 }
 

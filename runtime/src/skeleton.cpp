@@ -5,7 +5,8 @@
 namespace plant {
 
 void SkeletonBuilder::axis_begin(int axis, int parent, const TurtleState& t) {
-    if (static_cast<std::size_t>(axis) >= skeleton_.axes.size()) skeleton_.axes.resize(static_cast<std::size_t>(axis) + 1);
+    if (static_cast<std::size_t>(axis) >= skeleton_.axes.size())
+        skeleton_.axes.resize(static_cast<std::size_t>(axis) + 1);
     SkeletonAxis& a = skeleton_.axes[static_cast<std::size_t>(axis)];
     a.parent = parent;
     a.points.push_back(SkeletonPoint{t.position, t.heading, t.left, t.up, t.width / 2, t.color, 0, {}});
@@ -22,7 +23,8 @@ void SkeletonBuilder::organ(const TurtleOrgan& o) {
     skeleton_.organs.push_back(SkeletonOrgan{o.shape, o.transform, o.color, o.id});
 }
 
-Skeleton build_skeleton(const Program& program, const ModuleString& interpreted, const TurtleOptions& options) {
+Skeleton build_skeleton(const Program& program, const ModuleString& interpreted,
+                        const TurtleOptions& options) {
     SkeletonBuilder b(program, interpreted);
     interpret(program, interpreted, options, b);
     return b.take();

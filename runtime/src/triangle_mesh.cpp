@@ -14,7 +14,8 @@
 
 namespace plant {
 
-bool load_triangles(const std::string& path, std::vector<Triangle>& out, const char* who, std::string& error) {
+bool load_triangles(const std::string& path, std::vector<Triangle>& out, const char* who,
+                    std::string& error) {
     using Mesh = OpenMesh::TriMesh_ArrayKernelT<>;
     Mesh mesh;
     omlog().disable();
@@ -78,8 +79,8 @@ double signed_distance(const std::vector<Triangle>& mesh, const glm::dvec3& p) {
     return sign * best;
 }
 
-std::shared_ptr<const physics::DistanceGrid> distance_grid(const std::vector<Triangle>& mesh, double cell, double margin,
-                                                           std::size_t max_points) {
+std::shared_ptr<const physics::DistanceGrid> distance_grid(const std::vector<Triangle>& mesh, double cell,
+                                                           double margin, std::size_t max_points) {
     glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
     for (const auto& t : mesh)
         for (const glm::dvec3& v : {t.a, t.b, t.c}) lo = glm::min(lo, v), hi = glm::max(hi, v);
@@ -125,7 +126,8 @@ void obstacle_triangles(const physics::Obstacle& o, const glm::dvec3& lo, const 
         const int rings = 12, segments = 24;
         const double r = o.b.x;
         auto at = [&](int i, int j) {
-            const double t = 3.14159265358979323846 * i / rings, f = 2 * 3.14159265358979323846 * j / segments;
+            const double t = 3.14159265358979323846 * i / rings,
+                         f = 2 * 3.14159265358979323846 * j / segments;
             return o.a + r * glm::dvec3(std::sin(t) * std::cos(f), std::cos(t), std::sin(t) * std::sin(f));
         };
         for (int i = 0; i < rings; ++i)
@@ -136,13 +138,16 @@ void obstacle_triangles(const physics::Obstacle& o, const glm::dvec3& lo, const 
         const glm::dvec3 n = glm::normalize(o.b);
         const glm::dvec3 centre = (lo + hi) * 0.5;
         const double half = std::max(0.4 * glm::length(hi - lo), 1e-3); // a little wider than the plant
-        const glm::dvec3 c = centre - n * glm::dot(centre - o.a, n); // the plant's centre on the plane
-        const glm::dvec3 u = glm::normalize(std::abs(n.y) < 0.9 ? glm::cross(n, glm::dvec3(0, 1, 0)) : glm::cross(n, glm::dvec3(1, 0, 0)));
+        const glm::dvec3 c = centre - n * glm::dot(centre - o.a, n);    // the plant's centre on the plane
+        const glm::dvec3 u = glm::normalize(std::abs(n.y) < 0.9 ? glm::cross(n, glm::dvec3(0, 1, 0))
+                                                                : glm::cross(n, glm::dvec3(1, 0, 0)));
         const glm::dvec3 v = glm::cross(n, u);
-        quad(c - u * half - v * half, c + u * half - v * half, c + u * half + v * half, c - u * half + v * half);
+        quad(c - u * half - v * half, c + u * half - v * half, c + u * half + v * half,
+             c - u * half + v * half);
         break;
     }
-    case physics::Obstacle::Grid: break;
+    case physics::Obstacle::Grid:
+        break;
     }
 }
 

@@ -26,8 +26,8 @@ double signed_distance(const std::vector<Triangle>& mesh, const glm::dvec3& p);
 
 // Samples signed_distance on a grid of `cell` spacing over the mesh's box grown by `margin`
 // (at most `max_points` samples: the cell grows to fit), for the particle runtime.
-std::shared_ptr<const physics::DistanceGrid> distance_grid(const std::vector<Triangle>& mesh, double cell, double margin,
-                                                           std::size_t max_points = 1u << 20);
+std::shared_ptr<const physics::DistanceGrid> distance_grid(const std::vector<Triangle>& mesh, double cell,
+                                                           double margin, std::size_t max_points = 1u << 20);
 
 // Appends triangles showing an obstacle: a box's six faces, a sphere, a plane as a square around
 // the plant's box [lo, hi] (0.8 of its diagonal across). A sampled grid shows nothing here (its mesh does).

@@ -65,15 +65,18 @@ glm::dmat4 frame_matrix(const TurtleState& t, double scale) {
 }
 
 struct Symbols {
-    SymbolId F = kNoSymbol, f = kNoSymbol, G = kNoSymbol, plus = kNoSymbol, minus = kNoSymbol, amp = kNoSymbol, caret = kNoSymbol, back = kNoSymbol, slash = kNoSymbol,
-             pipe = kNoSymbol, dollar = kNoSymbol, open = kNoSymbol, close = kNoSymbol, bang = kNoSymbol, semi = kNoSymbol, sphere = kNoSymbol, set_head = kNoSymbol,
-             set_head2 = kNoSymbol, move_to = kNoSymbol, tropism = kNoSymbol, elasticity = kNoSymbol, set_color = kNoSymbol, qP = kNoSymbol, qH = kNoSymbol,
-             qU = kNoSymbol, qL = kNoSymbol, qE = kNoSymbol;
+    SymbolId F = kNoSymbol, f = kNoSymbol, G = kNoSymbol, plus = kNoSymbol, minus = kNoSymbol,
+             amp = kNoSymbol, caret = kNoSymbol, back = kNoSymbol, slash = kNoSymbol, pipe = kNoSymbol,
+             dollar = kNoSymbol, open = kNoSymbol, close = kNoSymbol, bang = kNoSymbol, semi = kNoSymbol,
+             sphere = kNoSymbol, set_head = kNoSymbol, set_head2 = kNoSymbol, move_to = kNoSymbol,
+             tropism = kNoSymbol, elasticity = kNoSymbol, set_color = kNoSymbol, qP = kNoSymbol,
+             qH = kNoSymbol, qU = kNoSymbol, qL = kNoSymbol, qE = kNoSymbol;
     explicit Symbols(const SymbolTable& st) {
         auto get = [&](const char* n, SymbolId& out) {
             if (auto id = st.find(n)) out = *id;
         };
-        get("F", F), get("f", f), get("G", G), get("+", plus), get("-", minus), get("&", amp), get("^", caret);
+        get("F", F), get("f", f), get("G", G), get("+", plus), get("-", minus), get("&", amp),
+            get("^", caret);
         get("\\", back), get("/", slash), get("|", pipe), get("$", dollar), get("[", open), get("]", close);
         get("!", bang), get(";", semi), get("@O", sphere), get("@R", set_head), get("SetHead", set_head2);
         get("@M", move_to), get("@Tp", tropism), get("@Ts", elasticity), get("SetColor", set_color);
@@ -98,7 +101,8 @@ glm::vec3 palette_color(int index) {
     return palette[((index % n) + n) % n];
 }
 
-void interpret(const Program& program, const ModuleString& s, const TurtleOptions& options, TurtleSink& sink) {
+void interpret(const Program& program, const ModuleString& s, const TurtleOptions& options,
+               TurtleSink& sink) {
     const Symbols y(program.symbols);
     TurtleState t;
     t.step = options.step;
@@ -118,10 +122,13 @@ void interpret(const Program& program, const ModuleString& s, const TurtleOption
         return glm::dvec3(a[k], a[k + 1], a[k + 2]);
     };
     auto check = [&](std::size_t i) {
-        auto finite = [](const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+        auto finite = [](const glm::dvec3& v) {
+            return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+        };
         if (!finite(t.position) || !finite(t.heading) || !finite(t.left) || !finite(t.up))
-            throw RuntimeError(Span{}, fmt::format("the turtle left finite space at module {} ('{}') of the string", i + 1,
-                                                   program.symbols[s.sym[i]].name));
+            throw RuntimeError(Span{},
+                               fmt::format("the turtle left finite space at module {} ('{}') of the string",
+                                           i + 1, program.symbols[s.sym[i]].name));
     };
     auto tropism = [&]() {
         // ABOP p. 58: rotate H toward T by e |H x T| about H x T
@@ -208,9 +215,10 @@ void interpret(const Program& program, const ModuleString& s, const TurtleOption
             t.axis = -1;
         } else if (sym == y.close) {
             if (stack.empty())
-                throw RuntimeError(Span{}, fmt::format("']' at module {} of the string closes no '[' (the turtle's "
-                                                       "stack is empty)",
-                                                       i + 1));
+                throw RuntimeError(Span{},
+                                   fmt::format("']' at module {} of the string closes no '[' (the turtle's "
+                                               "stack is empty)",
+                                               i + 1));
             t = stack.back();
             stack.pop_back();
             parent_axis = parent_stack.back();

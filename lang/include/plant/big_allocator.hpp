@@ -23,10 +23,12 @@ namespace plant {
 // for later, which then need no fresh, kernel-cleared pages for that part. Thread-safe.
 namespace big_pages {
 constexpr std::size_t kHuge = std::size_t{2} << 20;
-inline std::size_t rounded(std::size_t bytes) { return (bytes + kHuge - 1) / kHuge * kHuge; }
-void* map(std::size_t bytes);            // bytes: a multiple of kHuge; nullptr when out of memory
-void unmap(void* p, std::size_t bytes);  // a block from map(), whole
-void trim();                             // gives every kept page back to the system
+inline std::size_t rounded(std::size_t bytes) {
+    return (bytes + kHuge - 1) / kHuge * kHuge;
+}
+void* map(std::size_t bytes);           // bytes: a multiple of kHuge; nullptr when out of memory
+void unmap(void* p, std::size_t bytes); // a block from map(), whole
+void trim();                            // gives every kept page back to the system
 std::size_t kept_bytes();
 } // namespace big_pages
 
@@ -39,7 +41,8 @@ template <typename T> struct BigAllocator {
 
     T* allocate(std::size_t n) {
         const std::size_t bytes = n * sizeof(T);
-        void* p = bytes >= kMapped ? big_pages::map(big_pages::rounded(bytes)) : std::malloc(bytes ? bytes : 1);
+        void* p =
+            bytes >= kMapped ? big_pages::map(big_pages::rounded(bytes)) : std::malloc(bytes ? bytes : 1);
         if (!p) throw std::bad_alloc();
         return static_cast<T*>(p);
     }

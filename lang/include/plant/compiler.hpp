@@ -16,17 +16,17 @@ struct CompileOptions {
     std::vector<std::pair<std::string, std::string>> defines; // -D name=value
     std::vector<std::string> include_dirs;                    // -I dir, then PLANT_PATH, then stdlib
     std::map<std::string, std::string> file_texts;            // imported files' text, instead of reading them
-    EnvironmentFactory environments;                          // the runtime's kinds; none: `env` cannot be used
+    EnvironmentFactory environments; // the runtime's kinds; none: `env` cannot be used
 };
 
 // Reads, parses and compiles `path` and everything it imports. Returns null when there were
 // errors (which are in `diags`). Warnings do not stop compilation.
-std::unique_ptr<Program> compile_file(SourceManager& sources, const std::string& path, const CompileOptions& options,
-                                      Diagnostics& diags);
+std::unique_ptr<Program> compile_file(SourceManager& sources, const std::string& path,
+                                      const CompileOptions& options, Diagnostics& diags);
 
 // The same for a file already loaded into `sources`.
-std::unique_ptr<Program> compile_source(SourceManager& sources, std::uint32_t file_id, const CompileOptions& options,
-                                        Diagnostics& diags);
+std::unique_ptr<Program> compile_source(SourceManager& sources, std::uint32_t file_id,
+                                        const CompileOptions& options, Diagnostics& diags);
 
 // Reads a whole file. Returns false when it cannot be read.
 bool read_file(const std::string& path, std::string& out);

@@ -24,11 +24,10 @@ struct RulePlan;  // rewriter.hpp
 // heading, up or left vector into every query module (?P ?H ?U ?L). Called before a step whose
 // productions read query modules.
 class QueryPass {
-public:
+  public:
     virtual ~QueryPass() = default;
     virtual void fill_queries(const Derivation& derivation, ModuleString& string) = 0;
 };
-
 
 struct StepStats {
     int step = 0;
@@ -54,7 +53,7 @@ struct DeriveOptions {
 };
 
 class Derivation {
-public:
+  public:
     Derivation(const Program& program, DeriveOptions options);
     Derivation(const Derivation&) = default;
     Derivation& operator=(const Derivation&) = delete; // holds a reference to its program
@@ -92,10 +91,10 @@ public:
     // The string as the turtle sees it: interpretation rules applied (max_depth passes).
     ModuleString interpreted(const ModuleString& s) const;
 
-private:
+  private:
     void run_hook(HookKind kind);
-    void rewrite(const ModuleString& in, ModuleString& out, const RulePlan& plan,
-                 std::uint64_t phase, int step_for_env) const;
+    void rewrite(const ModuleString& in, ModuleString& out, const RulePlan& plan, std::uint64_t phase,
+                 int step_for_env) const;
     template <typename Setup>
     bool rewrite_direct(Rewriter& rw, const ModuleString& in, ModuleString& out, int threads,
                         const Setup& setup) const;
@@ -124,7 +123,8 @@ private:
     mutable std::vector<std::shared_ptr<const RulePlan>> plans_;
     mutable std::vector<const RulePlan*> step_plans_; // per group + 1 (index 0: no group), from plans_
     mutable std::vector<std::uint32_t> brackets_;     // the bracket table, kept from step to step
-    mutable std::vector<std::uint16_t> kernel_scratch_; // the symbol kernel's right keys (Rewriter::run_symbols)
+    mutable std::vector<std::uint16_t>
+        kernel_scratch_; // the symbol kernel's right keys (Rewriter::run_symbols)
     // The string a step replaced, when small, kept for the next step to write its output into:
     // small strings would otherwise pay a round of allocations a step. Copies start without one.
     struct Spare {

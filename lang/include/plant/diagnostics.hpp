@@ -21,7 +21,7 @@ struct Diagnostic {
 };
 
 class Diagnostics {
-public:
+  public:
     explicit Diagnostics(std::size_t cap = 50) : cap_(cap) {}
     void error(Span span, std::string message) { add({Severity::Error, span, std::move(message), {}}); }
     void warning(Span span, std::string message) { add({Severity::Warning, span, std::move(message), {}}); }
@@ -29,9 +29,12 @@ public:
     bool has_errors() const { return errors_ > 0; }
     std::size_t error_count() const { return errors_; }
     const std::vector<Diagnostic>& all() const { return items_; }
-    void clear() { items_.clear(); errors_ = 0; }
+    void clear() {
+        items_.clear();
+        errors_ = 0;
+    }
 
-private:
+  private:
     std::size_t cap_;
     std::size_t errors_ = 0;
     std::vector<Diagnostic> items_;

@@ -21,7 +21,7 @@ struct EnvArg {
     std::string key;
     ValueType type = ValueType::Number; // String for a quoted file name, in `text`
     double v[3] = {0, 0, 0};
-    std::string text;                   // a string argument; a file path resolved against the grammar
+    std::string text; // a string argument; a file path resolved against the grammar
     Span span;
 };
 
@@ -38,7 +38,7 @@ struct EnvMethod {
 };
 
 class Environment {
-public:
+  public:
     virtual ~Environment() = default;
     virtual const std::vector<EnvMethod>& methods() const = 0;
     // Back to the state it was declared with: a derivation starting again (the REPL's :set, a
@@ -51,7 +51,8 @@ public:
     // Triangles (world space, consecutive corners, wound outward) that show the environment in
     // meshes and previews: the wall a climber clings to, say. `lo` and `hi` bound the plant, for
     // giving an unbounded shape (a plane) a size.
-    virtual void geometry(std::vector<glm::dvec3>& triangles, const glm::dvec3& lo, const glm::dvec3& hi) const {
+    virtual void geometry(std::vector<glm::dvec3>& triangles, const glm::dvec3& lo,
+                          const glm::dvec3& hi) const {
         (void)triangles, (void)lo, (void)hi;
     }
     // Answers a query. `args` holds the arguments' numbers (three for a vec3), `result` receives
@@ -63,14 +64,16 @@ public:
     // the point (and, for a second number, the module's identity), in their order. `axis` is the
     // index of the axis the turtle was drawing at the module (-1 when none); environments that
     // know axes (proximity) use it to tell which stem is asking.
-    virtual void communicate(const glm::dvec3& position, ModuleId id, int axis, double* slots, std::size_t n) const {
+    virtual void communicate(const glm::dvec3& position, ModuleId id, int axis, double* slots,
+                             std::size_t n) const {
         (void)axis;
         std::size_t slot = 0;
         const auto& ms = methods();
         for (std::size_t m = 0; m < ms.size() && slot < n; ++m) {
             const auto& a = ms[m].args;
             bool point = !a.empty() && a[0] == ValueType::Vec3;
-            if (!ms[m].communicates || !point || a.size() > 2 || (a.size() == 2 && a[1] == ValueType::Vec3)) continue;
+            if (!ms[m].communicates || !point || a.size() > 2 || (a.size() == 2 && a[1] == ValueType::Vec3))
+                continue;
             double args[4] = {position.x, position.y, position.z, static_cast<double>(id)};
             double result[3] = {0, 0, 0};
             call(m, args, result);
@@ -81,8 +84,7 @@ public:
 
 // Makes an environment of `kind`. Returns null and explains why in `error` when the kind is
 // unknown or an argument is wrong.
-using EnvironmentFactory = std::function<std::unique_ptr<Environment>(const std::string& kind,
-                                                                      const std::vector<EnvArg>& args,
-                                                                      std::string& error)>;
+using EnvironmentFactory = std::function<std::unique_ptr<Environment>(
+    const std::string& kind, const std::vector<EnvArg>& args, std::string& error)>;
 
 } // namespace plant

@@ -76,6 +76,7 @@ void bracket_table(const ModuleString& s, SymbolId open, SymbolId close, std::ve
 // Removes every module for which `cuts(i)` holds together with the rest of its branch, up to the
 // ']' that closes it (kept) or the string's end: what '%' does, and what a climber does to a
 // part that broke off.
-void cut_branches(ModuleString& s, SymbolId open, SymbolId close, const std::function<bool(std::size_t)>& cuts);
+void cut_branches(ModuleString& s, SymbolId open, SymbolId close,
+                  const std::function<bool(std::size_t)>& cuts);
 
 } // namespace plant

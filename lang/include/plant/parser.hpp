@@ -7,7 +7,8 @@
 
 namespace plant {
 
-std::unique_ptr<ast::File> parse_file(const SourceManager& sources, std::uint32_t file_id, Diagnostics& diags);
+std::unique_ptr<ast::File> parse_file(const SourceManager& sources, std::uint32_t file_id,
+                                      Diagnostics& diags);
 
 // Parses one expression (the REPL and -D values use it). Returns null on error.
 ast::ExprPtr parse_expression(const SourceManager& sources, std::uint32_t file_id, Diagnostics& diags);

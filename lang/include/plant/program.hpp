@@ -18,24 +18,26 @@
 namespace plant {
 
 enum class ValueType : std::uint8_t { Number, Bool, Vec3, String, Void };
-inline int value_width(ValueType t) { return t == ValueType::Vec3 ? 3 : (t == ValueType::Void ? 0 : 1); }
+inline int value_width(ValueType t) {
+    return t == ValueType::Vec3 ? 3 : (t == ValueType::Void ? 0 : 1);
+}
 const char* value_type_name(ValueType t);
 
 struct SymbolInfo {
     std::string name;
-    bool declared = false;  // by `module`, or a built-in turtle or query symbol
-    bool turtle = false;    // has a meaning for the turtle (LANGUAGE.md section 10)
-    bool query = false;     // ?P ?H ?U ?L ?E
-    int arity = -1;         // declared parameter count; -1 when any count is accepted
-    int max_arity = -1;     // for built-ins: the most parameters accepted
+    bool declared = false; // by `module`, or a built-in turtle or query symbol
+    bool turtle = false;   // has a meaning for the turtle (LANGUAGE.md section 10)
+    bool query = false;    // ?P ?H ?U ?L ?E
+    int arity = -1;        // declared parameter count; -1 when any count is accepted
+    int max_arity = -1;    // for built-ins: the most parameters accepted
     std::vector<ValueType> param_types;
     std::vector<std::string> param_names;
-    std::string bound_to;   // climber environment for physics-bound segments
+    std::string bound_to; // climber environment for physics-bound segments
     Span decl_span;
 };
 
 class SymbolTable {
-public:
+  public:
     // Thrown by intern when every symbol id is taken (kNoSymbol - 1 names).
     struct Full {};
     SymbolTable();
@@ -48,7 +50,7 @@ public:
 
     SymbolId open_bracket = 0, close_bracket = 0, cut = 0;
 
-private:
+  private:
     std::vector<SymbolInfo> infos_;
     std::unordered_map<std::string, SymbolId> index_;
 };
@@ -62,24 +64,43 @@ enum class Op : std::uint8_t {
     StoreLocal, // pop n into frame[a ..)
     LoadGlobal, // push globals[a .. a+n)
     StoreGlobal,
-    Pop,        // drop n
-    Add, Sub, Mul, Div, Mod, Neg, Not,
-    Lt, Le, Gt, Ge, Eq, Ne,
-    VAdd, VSub, VMulS, VSMul, VDivS, VNeg, VEq, VNe, // vec3 arithmetic (S: scalar operand)
+    Pop, // drop n
+    Add,
+    Sub,
+    Mul,
+    Div,
+    Mod,
+    Neg,
+    Not,
+    Lt,
+    Le,
+    Gt,
+    Ge,
+    Eq,
+    Ne,
+    VAdd,
+    VSub,
+    VMulS,
+    VSMul,
+    VDivS,
+    VNeg,
+    VEq,
+    VNe,        // vec3 arithmetic (S: scalar operand)
     Member,     // pop vec3, push component a
     Jump,       // pc = a
     JumpIfZero, // pop; if 0 pc = a
-    JumpIfZeroKeep, JumpIfNonZeroKeep, // for && and ||: inspect top, jump keeping it, else pop
-    Builtin,    // call builtin a with its known argument types (b: variant)
-    Call,       // call user function a
-    Return,     // end a function with the value on top (or nothing)
-    Emit,       // pop the parameters of module a (n doubles) and append it to the output
-    ProduceEnd, // produce: the body has applied and ends
-    NProduceMark, // marks that something was produced
-    Use,        // select rule group a (-1: none)
-    Stop,       // stop the derivation after the current hook
-    Print,      // pop n values described by print_formats[a] and print them
-    ForCheck,   // loop guard: counts turns in frame[a], stops a runaway loop
+    JumpIfZeroKeep,
+    JumpIfNonZeroKeep, // for && and ||: inspect top, jump keeping it, else pop
+    Builtin,           // call builtin a with its known argument types (b: variant)
+    Call,              // call user function a
+    Return,            // end a function with the value on top (or nothing)
+    Emit,              // pop the parameters of module a (n doubles) and append it to the output
+    ProduceEnd,        // produce: the body has applied and ends
+    NProduceMark,      // marks that something was produced
+    Use,               // select rule group a (-1: none)
+    Stop,              // stop the derivation after the current hook
+    Print,             // pop n values described by print_formats[a] and print them
+    ForCheck,          // loop guard: counts turns in frame[a], stops a runaway loop
     Halt,
     // superinstructions made by fuse() in straight-line code
     LoadMulConst, // push frame[a] * consts[b]
@@ -90,9 +111,9 @@ enum class Op : std::uint8_t {
 
 struct Instr {
     Op op;
-    std::uint8_t n = 0;   // widths, argument counts
-    std::uint16_t b = 0;  // secondary operand
-    std::int32_t a = 0;   // primary operand
+    std::uint8_t n = 0;  // widths, argument counts
+    std::uint16_t b = 0; // secondary operand
+    std::int32_t a = 0;  // primary operand
 };
 
 struct Code {
@@ -106,9 +127,9 @@ struct Code {
 // One argument of a predecessor or context module: bind it to frame slots or require a value.
 struct PatternArg {
     bool bind = true;
-    std::uint16_t slot = 0;  // frame slot of the first double when binding
-    std::uint8_t width = 1;  // 1 or 3
-    double value = 0;        // required value when !bind
+    std::uint16_t slot = 0; // frame slot of the first double when binding
+    std::uint8_t width = 1; // 1 or 3
+    double value = 0;       // required value when !bind
 };
 
 struct PatternModule {
@@ -129,7 +150,7 @@ struct SuccessorTemplate {
     std::vector<double> params;           // constants; holes are overwritten
     std::vector<std::uint32_t> holes;     // parameter index of each computed number
     std::vector<Span> hole_spans;
-    int keep = -1;                        // module that keeps the predecessor's identity
+    int keep = -1; // module that keeps the predecessor's identity
     Code values;
     // When every computed number is a bound name, optionally times or plus a constant (the
     // common `A(l * r1, w)`), the numbers are computed without the stack machine.
@@ -209,9 +230,9 @@ struct CurveDef {
 // `surface name = polygon(p0, p1, ...)` or `= load("file.obj")`, evaluated at compile time.
 struct SurfaceDef {
     std::string name;
-    std::string kind;                 // polygon | load
+    std::string kind;                          // polygon | load
     std::vector<std::array<double, 3>> points; // polygon corners
-    std::string path;                 // load: resolved against the grammar's directory
+    std::string path;                          // load: resolved against the grammar's directory
     Span span;
 };
 
@@ -225,15 +246,15 @@ struct Program {
     std::vector<Function> functions;
     std::vector<std::string> print_formats;
 
-    Code axiom;                   // emits the axiom's modules
+    Code axiom; // emits the axiom's modules
     Code setting_derive, setting_angle, setting_step, setting_width, setting_seed;
     double default_angle = 90, default_step = 1, default_width = 1;
     std::vector<std::uint8_t> ignored; // per symbol: skipped when matching context
     bool uses_cut = false;             // some successor or the axiom produces '%'
     bool uses_id = false;              // some code calls id()
 
-    RuleSet rules;                // the unnamed, always-active group
-    std::vector<RuleSet> groups;  // named groups, selected by `use`
+    RuleSet rules;               // the unnamed, always-active group
+    std::vector<RuleSet> groups; // named groups, selected by `use`
     RuleSet decompose;
     RuleSet interpret;
     std::array<Code, 4> hooks;

@@ -14,7 +14,8 @@ inline std::uint64_t mix64(std::uint64_t z) {
     return z ^ (z >> 31);
 }
 
-inline std::uint64_t random_bits(std::uint64_t seed, std::uint64_t phase, std::uint64_t position, std::uint64_t draw) {
+inline std::uint64_t random_bits(std::uint64_t seed, std::uint64_t phase, std::uint64_t position,
+                                 std::uint64_t draw) {
     std::uint64_t h = mix64(seed + 0x9e3779b97f4a7c15ULL);
     h = mix64(h ^ (phase * 0xd1b54a32d192ed03ULL));
     h = mix64(h ^ (position * 0xabc98388fb8fac03ULL));
@@ -22,6 +23,8 @@ inline std::uint64_t random_bits(std::uint64_t seed, std::uint64_t phase, std::u
 }
 
 // Uniform in [0, 1) with 53 random bits.
-inline double random_unit(std::uint64_t bits) { return static_cast<double>(bits >> 11) * 0x1.0p-53; }
+inline double random_unit(std::uint64_t bits) {
+    return static_cast<double>(bits >> 11) * 0x1.0p-53;
+}
 
 } // namespace plant

@@ -23,7 +23,7 @@ struct LineCol {
 };
 
 class SourceFile {
-public:
+  public:
     SourceFile(std::string name, std::string text);
     const std::string& name() const { return name_; }
     const std::string& text() const { return text_; }
@@ -31,7 +31,7 @@ public:
     std::string_view line_text(std::uint32_t line) const; // without the newline
     std::uint32_t offset_of(std::uint32_t line, std::uint32_t col) const;
 
-private:
+  private:
     std::string name_;
     std::string text_;
     std::vector<std::uint32_t> line_starts_;
@@ -39,13 +39,13 @@ private:
 
 // Owns every file read during one compilation (the main grammar and its imports).
 class SourceManager {
-public:
+  public:
     SourceManager();
     std::uint32_t add(std::string name, std::string text);
     const SourceFile& file(std::uint32_t id) const { return *files_.at(id); }
     std::size_t size() const { return files_.size(); }
 
-private:
+  private:
     std::vector<std::unique_ptr<SourceFile>> files_;
 };
 

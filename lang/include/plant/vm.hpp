@@ -38,8 +38,8 @@ struct EvalEnv {
     const SymbolId* keep_syms = nullptr; // predecessor modules whose identities may be kept
     const ModuleId* keep_ids = nullptr;
     std::uint32_t keep_count = 0;
-    std::uint32_t keep_used = 0; // bit mask
-    ModuleId new_count = 0;      // new modules emitted by this chunk so far
+    std::uint32_t keep_used = 0;  // bit mask
+    ModuleId new_count = 0;       // new modules emitted by this chunk so far
     ModuleId id_base = kNewIdBit; // a new module's identity is id_base + new_count
     bool produced = false;
 

@@ -35,8 +35,8 @@
 #include <glm/glm.hpp>
 
 #include <map>
-#include <optional>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <unordered_map>
@@ -45,26 +45,26 @@
 namespace plant {
 
 class Climber : public Environment, public BoundPoses {
-public:
+  public:
     struct Attractor {
         glm::dvec3 point;
         double radius, strength;
     };
     struct Config {
-        int substeps = 4;           // physics steps of dt per derivation step
-        glm::dvec3 light{0, 1, 0};  // toward the light
-        double phototropism = 0;    // eta, Eq. 7
-        double adaption = 0.5;      // tau, Eq. 6
+        int substeps = 4;          // physics steps of dt per derivation step
+        glm::dvec3 light{0, 1, 0}; // toward the light
+        double phototropism = 0;   // eta, Eq. 7
+        double adaption = 0.5;     // tau, Eq. 6
         double adaption_range = 0.3;
         double response = 10;       // growth responses act over substeps * dt * response seconds
         double anchor = 0;          // phi of Eq. 5 for new particles near a surface (0: no anchors)
         double anchor_range = 0.05; // how near (beyond the particle's radius)
         double anchor_release = 0.3;
-        double light_cell = 0.1;    // occupancy grid for occlusion
-        double opacity = 0.15;      // occlusion 1 - exp(-opacity * particles between p and the light)
+        double light_cell = 0.1; // occupancy grid for occlusion
+        double opacity = 0.15;   // occlusion 1 - exp(-opacity * particles between p and the light)
         std::vector<Attractor> attractors;
         double attractor_reach = 0.1; // a painted sample a particle comes this near is used up
-        bool air = false;           // SPH air fills [air_min, air_max] (section 5.3)
+        bool air = false;             // SPH air fills [air_min, air_max] (section 5.3)
         physics::FluidSettings fluid;
     };
 
@@ -81,9 +81,12 @@ public:
     }
     void reset() override;
     bool evolves() const override { return true; }
-    void geometry(std::vector<glm::dvec3>& triangles, const glm::dvec3& lo, const glm::dvec3& hi) const override;
+    void geometry(std::vector<glm::dvec3>& triangles, const glm::dvec3& lo,
+                  const glm::dvec3& hi) const override;
     // A loaded mesh's triangles for obstacle k (a sampled grid), to show it.
-    void show_mesh(std::size_t k, std::vector<glm::dvec3> triangles) { meshes_.emplace_back(k, std::move(triangles)); }
+    void show_mesh(std::size_t k, std::vector<glm::dvec3> triangles) {
+        meshes_.emplace_back(k, std::move(triangles));
+    }
 
     // Environment
     const std::vector<EnvMethod>& methods() const override;
@@ -94,8 +97,8 @@ public:
     // The step's sync, driven by the query pass: begin, observe every bound module the turtle
     // drew (in string order), advance.
     void begin_sync();
-    void observe(ModuleId id, ModuleId parent, const glm::dvec3& from, const glm::dvec3& to, const glm::dmat3& frame,
-                 double radius, double length);
+    void observe(ModuleId id, ModuleId parent, const glm::dvec3& from, const glm::dvec3& to,
+                 const glm::dmat3& frame, double radius, double length);
     void advance();
     // Modules whose particles broke off or were cut in the last advance.
     const std::set<ModuleId>& detached() const { return detached_; }
@@ -104,7 +107,7 @@ public:
     const physics::World& world() const { return world_; }
     physics::Handle particle(ModuleId id) const;
 
-private:
+  private:
     double occlusion(const glm::dvec3& p) const;
     // The obstacle nearest to p if one is nearer than `within`, and its distance.
     const physics::Obstacle* nearest_obstacle(const glm::dvec3& p, double within, double& distance) const;

@@ -30,7 +30,7 @@ namespace plant {
 
 // An environment that sees the plant: the turtle pass calls update() before each step.
 class SkeletonEnvironment : public Environment {
-public:
+  public:
     virtual void update(const Skeleton& skeleton) = 0;
 };
 

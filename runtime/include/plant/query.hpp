@@ -10,7 +10,7 @@ namespace plant {
 // Modules are matched by identity, so query modules that interpretation rules leave alone are
 // found in the original string.
 class TurtleQueryPass : public QueryPass {
-public:
+  public:
     void fill_queries(const Derivation& derivation, ModuleString& string) override;
 };
 

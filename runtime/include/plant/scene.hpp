@@ -44,7 +44,7 @@ struct Scene {
     std::vector<MeshPart> prototypes; // organ shapes (leaves, flowers, spheres), in their own frame
     std::vector<std::string> prototype_names;
     std::vector<Instance> instances;
-    std::vector<Material> materials;  // at least one
+    std::vector<Material> materials;              // at least one
     glm::vec3 bounds_min{0.0f}, bounds_max{0.0f}; // of everything, instances included
     void update_bounds();
 };

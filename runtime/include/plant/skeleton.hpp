@@ -16,8 +16,8 @@ struct SkeletonPoint {
     glm::dvec3 position, heading, left, up;
     double radius = 0.5;
     glm::vec3 color{0.45f, 0.32f, 0.2f};
-    ModuleId id = 0;           // module that drew the segment ending here (0 for an axis start)
-    std::string module;        // its name
+    ModuleId id = 0;    // module that drew the segment ending here (0 for an axis start)
+    std::string module; // its name
 };
 
 // One generalized cylinder: consecutive F's of one branch level, lateral branches between them
@@ -40,20 +40,22 @@ struct Skeleton {
 };
 
 class SkeletonBuilder : public TurtleSink {
-public:
-    SkeletonBuilder(const Program& program, const ModuleString& string) : program_(program), string_(string) {}
+  public:
+    SkeletonBuilder(const Program& program, const ModuleString& string)
+        : program_(program), string_(string) {}
     void axis_begin(int axis, int parent, const TurtleState& t) override;
     void segment(const TurtleSegment& s) override;
     void organ(const TurtleOrgan& o) override;
     Skeleton take() { return std::move(skeleton_); }
 
-private:
+  private:
     const Program& program_;
     const ModuleString& string_;
     Skeleton skeleton_;
 };
 
 // Interpretation rules, then the turtle, then the skeleton.
-Skeleton build_skeleton(const Program& program, const ModuleString& interpreted, const TurtleOptions& options);
+Skeleton build_skeleton(const Program& program, const ModuleString& interpreted,
+                        const TurtleOptions& options);
 
 } // namespace plant

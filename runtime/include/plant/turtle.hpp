@@ -25,9 +25,9 @@ struct TurtleState {
     int color_index = 0;               // ;(c)
     glm::vec3 color{0.45f, 0.32f, 0.2f};
     glm::dvec3 tropism{0.0, -1.0, 0.0}; // @Tp
-    double elasticity = 0.0;           // @Ts; 0: no tropism
-    int axis = -1;                     // axis being drawn, -1 when the next F starts a new one
-    ModuleId bound_parent = 0;         // the last module bound to a climber on this path (0: none)
+    double elasticity = 0.0;            // @Ts; 0: no tropism
+    int axis = -1;                      // axis being drawn, -1 when the next F starts a new one
+    ModuleId bound_parent = 0;          // the last module bound to a climber on this path (0: none)
 };
 
 // A drawn segment: from the state before an F to the state after it.
@@ -50,7 +50,7 @@ struct TurtleOrgan {
 // Receives what the turtle does. Every method has a no-op default (PlantGL's split of turtle,
 // state and sink).
 class TurtleSink {
-public:
+  public:
     virtual ~TurtleSink() = default;
     // A new axis starts at `from` (a lateral branch starts inside its parent).
     virtual void axis_begin(int /*axis*/, int /*parent*/, const TurtleState&) {}
@@ -64,16 +64,16 @@ public:
 // bound ivy;`): the turtle draws such a module's segment from where it stands to the particle's
 // position and takes the particle's frame. A module without a particle yet is drawn like F(len).
 class BoundPoses {
-public:
+  public:
     virtual ~BoundPoses() = default;
     // The particle of module `id`: its position and its frame (+y heading, -x left, +z up).
     virtual bool pose(ModuleId id, glm::dvec3& position, glm::dmat3& frame) const = 0;
 };
 
 struct TurtleOptions {
-    double angle = 90.0; // the grammar's `angle`
-    double step = 1.0;   // the grammar's `step`
-    double width = 0.1;  // the grammar's `width`
+    double angle = 90.0;                  // the grammar's `angle`
+    double step = 1.0;                    // the grammar's `step`
+    double width = 0.1;                   // the grammar's `width`
     std::vector<const BoundPoses*> poses; // the program's climbers: poses of bound modules
 };
 class Derivation;

@@ -19,8 +19,12 @@ constexpr double kPi = std::numbers::pi;
 
 // Müller et al. 2003: the constants in front of the kernels. Eq. 21's spiky gradient and Eq.
 // 22's viscosity Laplacian share 45 / (pi h^6).
-double Fluid::poly6_coefficient(double h) { return 315.0 / (64.0 * kPi * std::pow(h, 9)); }
-double Fluid::gradient_coefficient(double h) { return 45.0 / (kPi * std::pow(h, 6)); }
+double Fluid::poly6_coefficient(double h) {
+    return 315.0 / (64.0 * kPi * std::pow(h, 9));
+}
+double Fluid::gradient_coefficient(double h) {
+    return 45.0 / (kPi * std::pow(h, 6));
+}
 
 // Müller et al. 2003, Eq. 20: W_poly6 for densities
 double Fluid::poly6(double r2, double h) {
@@ -72,7 +76,8 @@ void Fluid::build_grid() {
     // the cell-sorted arrays, about 125 candidates for the 33 neighbours at rest
     const double cell = s_.support / 2;
     lo_ = s_.domain_lo - glm::dvec3(s_.support);
-    n_ = glm::max(glm::ivec3(glm::floor((s_.domain_hi - s_.domain_lo + 2 * s_.support) / cell)) + 1, glm::ivec3(1));
+    n_ = glm::max(glm::ivec3(glm::floor((s_.domain_hi - s_.domain_lo + 2 * s_.support) / cell)) + 1,
+                  glm::ivec3(1));
     const std::size_t cells = static_cast<std::size_t>(n_.x) * n_.y * n_.z;
     cell_start_.assign(cells + 1, 0);
     std::vector<std::uint32_t> cell_of(x_.size());
@@ -112,7 +117,8 @@ template <class F> void Fluid::for_neighbours(const glm::dvec3& p, double radius
     for (int z = std::max(c.z - reach, 0); z <= std::min(c.z + reach, n_.z - 1); ++z)
         for (int y = std::max(c.y - reach, 0); y <= std::min(c.y + reach, n_.y - 1); ++y) {
             const std::size_t row = (static_cast<std::size_t>(z) * n_.y + y) * n_.x;
-            for (std::uint32_t e = cell_start_[row + x0]; e < cell_start_[row + x1 + 1]; ++e) f(e, sorted_x_[e]);
+            for (std::uint32_t e = cell_start_[row + x0]; e < cell_start_[row + x1 + 1]; ++e)
+                f(e, sorted_x_[e]);
         }
 }
 
@@ -124,8 +130,10 @@ template <class F> void Fluid::for_mirrors(const glm::dvec3& p, F&& f) const {
     int near = 0;
     for (int k = 0; k < 3; ++k) {
         if (s_.wind[k] != 0) continue;
-        if (p[k] - s_.domain_lo[k] < s_.support) wall[k] = s_.domain_lo[k], near |= 1 << k;
-        else if (s_.domain_hi[k] - p[k] < s_.support) wall[k] = s_.domain_hi[k], near |= 1 << k;
+        if (p[k] - s_.domain_lo[k] < s_.support)
+            wall[k] = s_.domain_lo[k], near |= 1 << k;
+        else if (s_.domain_hi[k] - p[k] < s_.support)
+            wall[k] = s_.domain_hi[k], near |= 1 << k;
     }
     for (int set = near; set > 0; set = (set - 1) & near) {
         glm::dvec3 q = p;
@@ -149,7 +157,8 @@ void Fluid::gather_boundary(const World& plant) {
         D[0][0] = 1.0 / (r.x + h), D[1][1] = 1.0 / (r.y + h), D[2][2] = 1.0 / (r.z + h);
         const double volume = 4.0 / 3.0 * kPi * r.x * r.y * r.z;
         const double reach = std::max({r.x, r.y, r.z}) + h;
-        boundary_.push_back({i, plant.position(hd), plant.velocity(hd), R * D * glm::transpose(R), volume, reach});
+        boundary_.push_back(
+            {i, plant.position(hd), plant.velocity(hd), R * D * glm::transpose(R), volume, reach});
     }
 }
 
@@ -158,8 +167,10 @@ void Fluid::compute_densities(const World* plant) {
     poly6_c_ = poly6_coefficient(hh);
     grad_c_ = gradient_coefficient(hh);
     build_grid();
-    if (plant) gather_boundary(*plant);
-    else boundary_.clear();
+    if (plant)
+        gather_boundary(*plant);
+    else
+        boundary_.clear();
     const double h = s_.support, m = mass_, h2 = h * h;
     // Neighbour lists (within h, not itself), kNeighbours slots per particle; a particle with
     // more (air squeezed hard) searches again where its list is needed. One pass on one thread

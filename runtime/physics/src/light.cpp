@@ -5,7 +5,9 @@
 namespace plant::physics {
 
 namespace {
-bool finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool finite(const glm::dvec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 } // namespace
 
 void LightGrid::clear() {
@@ -51,11 +53,12 @@ double LightGrid::count_toward(const glm::dvec3& p, const glm::dvec3& dir) const
     for (int k = 0; k < 4 * (n_.x + n_.y + n_.z); ++k) {
         q += dir * (cell * 0.5);
         const glm::dvec3 rel = q - lo_;
-        if (rel.x < 0 || rel.y < 0 || rel.z < 0 || rel.x >= extent.x || rel.y >= extent.y || rel.z >= extent.z) {
+        if (rel.x < 0 || rel.y < 0 || rel.z < 0 || rel.x >= extent.x || rel.y >= extent.y ||
+            rel.z >= extent.z) {
             // outside the grid: nothing more in the way once moving away from it
-            const bool leaving = (rel.x < 0 && dir.x <= 0) || (rel.y < 0 && dir.y <= 0) || (rel.z < 0 && dir.z <= 0) ||
-                                 (rel.x >= extent.x && dir.x >= 0) || (rel.y >= extent.y && dir.y >= 0) ||
-                                 (rel.z >= extent.z && dir.z >= 0);
+            const bool leaving = (rel.x < 0 && dir.x <= 0) || (rel.y < 0 && dir.y <= 0) ||
+                                 (rel.z < 0 && dir.z <= 0) || (rel.x >= extent.x && dir.x >= 0) ||
+                                 (rel.y >= extent.y && dir.y >= 0) || (rel.z >= extent.z && dir.z >= 0);
             if (leaving) break;
             continue;
         }

@@ -34,7 +34,7 @@ void run_part(void (*job)(void*, std::size_t), void* context, std::size_t k, std
 // crew is made once and never destroyed: its threads sleep through the process's exit, and no
 // static destructor can find it gone.
 class Crew {
-public:
+  public:
     // false when the crew is busy with another call (from another thread, or from inside a part)
     bool run(std::size_t parts, void (*job)(void*, std::size_t), void* context) {
         bool expected = false;
@@ -74,13 +74,14 @@ public:
         return true;
     }
 
-private:
+  private:
     void serve(std::size_t number) {
         std::uint64_t seen = 0;
         for (;;) {
             // a step hands out parts a dozen times in quick succession: look for the next round
             // for a little while before sleeping, since waking a sleeping thread takes longer
-            for (int spin = 0; spin < (1 << 14) && round_.load(std::memory_order_acquire) == seen; ++spin) cpu_relax();
+            for (int spin = 0; spin < (1 << 14) && round_.load(std::memory_order_acquire) == seen; ++spin)
+                cpu_relax();
             void (*job)(void*, std::size_t) = nullptr;
             void* context = nullptr;
             std::size_t parts = 0;

@@ -32,25 +32,30 @@ glm::dvec3 surface_adaption(const glm::dvec3& forward, const glm::dvec3& to_surf
     return glm::normalize(glm::angleAxis(angle, axis / len) * f);
 }
 
-glm::dvec3 phototropism(const glm::dvec3& forward, const glm::dvec3& to_light, double occlusion, double eta, double dt) {
+glm::dvec3 phototropism(const glm::dvec3& forward, const glm::dvec3& to_light, double occlusion, double eta,
+                        double dt) {
     glm::dvec3 f = glm::normalize(forward), l = glm::normalize(to_light);
     glm::dvec3 axis = glm::cross(f, l); // toward the light (PLANTS.md pitfall)
     double len = glm::length(axis);
     if (len < 1e-12) return f;
     // Eq. 7, and never past the light direction itself
-    double angle = std::min((1 - std::clamp(occlusion, 0.0, 1.0)) * eta * dt, std::acos(std::clamp(glm::dot(f, l), -1.0, 1.0)));
+    double angle = std::min((1 - std::clamp(occlusion, 0.0, 1.0)) * eta * dt,
+                            std::acos(std::clamp(glm::dot(f, l), -1.0, 1.0)));
     return glm::normalize(glm::angleAxis(angle, axis / len) * f);
 }
 
 double Obstacle::distance(const glm::dvec3& p) const {
     switch (kind) {
-    case Sphere: return glm::length(p - a) - b.x;
+    case Sphere:
+        return glm::length(p - a) - b.x;
     case Box: {
         glm::dvec3 c = (a + b) * 0.5, h = (b - a) * 0.5, q = glm::abs(p - c) - h;
         return glm::length(glm::max(q, glm::dvec3(0.0))) + std::min(std::max(q.x, std::max(q.y, q.z)), 0.0);
     }
-    case Plane: return glm::dot(p - a, glm::normalize(b));
-    case Grid: return grid ? grid->sample(p - a) : 1e300;
+    case Plane:
+        return glm::dot(p - a, glm::normalize(b));
+    case Grid:
+        return grid ? grid->sample(p - a) : 1e300;
     }
     return 1e300;
 }
@@ -123,13 +128,17 @@ void large_turn(double w2, double& cw, double& sw) {
 // Müller et al. 2016, Eq. 10-12: turn R toward the columns of A about omega. Also gives R as a
 // matrix: the last one computed when the iterations stop on convergence. With `have_matrix`,
 // `matrix` holds q's already (a warm start from the last pass keeps it).
-glm::dquat rotation_of(const glm::dmat3& A, glm::dquat q, int iterations, glm::dmat3& matrix, bool have_matrix = false) {
+glm::dquat rotation_of(const glm::dmat3& A, glm::dquat q, int iterations, glm::dmat3& matrix,
+                       bool have_matrix = false) {
     bool current = have_matrix; // whether `matrix` is q's
     for (int k = 0; k < iterations; ++k) {
         if (!current) matrix = glm::mat3_cast(q);
         current = true;
-        glm::dvec3 omega = glm::cross(matrix[0], A[0]) + glm::cross(matrix[1], A[1]) + glm::cross(matrix[2], A[2]);
-        double denom = std::fabs(glm::dot(matrix[0], A[0]) + glm::dot(matrix[1], A[1]) + glm::dot(matrix[2], A[2])) + 1e-9;
+        glm::dvec3 omega =
+            glm::cross(matrix[0], A[0]) + glm::cross(matrix[1], A[1]) + glm::cross(matrix[2], A[2]);
+        double denom =
+            std::fabs(glm::dot(matrix[0], A[0]) + glm::dot(matrix[1], A[1]) + glm::dot(matrix[2], A[2])) +
+            1e-9;
         omega *= 1.0 / denom;
         const double w2 = glm::dot(omega, omega);
         if (!(w2 >= 1e-18)) break; // |omega| below 1e-9: converged, or nothing to match (zero A), or NaN
@@ -152,7 +161,9 @@ glm::dquat rotation_of(const glm::dmat3& A, glm::dquat q, int iterations, glm::d
 using v2 = double __attribute__((vector_size(16)));
 using m2 = long long __attribute__((vector_size(16)));
 
-inline v2 both(double a) { return v2{a, a}; }
+inline v2 both(double a) {
+    return v2{a, a};
+}
 
 struct Quat2 {
     v2 w, x, y, z;
@@ -187,8 +198,8 @@ glm::dquat extract_rotation(const glm::dmat3& A, glm::dquat q, int iterations) {
     return rotation_of(A, q, iterations, matrix);
 }
 
-Handle World::add_root(const glm::dvec3& position_in, const glm::dquat& orientation_in, const glm::dvec3& radii_in,
-                       bool fixed) {
+Handle World::add_root(const glm::dvec3& position_in, const glm::dquat& orientation_in,
+                       const glm::dvec3& radii_in, bool fixed) {
     // copies first: the arguments may refer into the arrays that grow below
     const glm::dvec3 position = position_in, radii = radii_in;
     const glm::dquat orientation = orientation_in;
@@ -289,9 +300,12 @@ glm::dmat3 World::rest_moment(std::uint32_t j) const {
     return 0.2 * matching_mass(j) * D * glm::transpose(glm::mat3_cast(rest_q_[j]));
 }
 
-glm::dmat3 World::ellipsoid_moment(std::uint32_t j) const { return glm::mat3_cast(q_[j]) * rest_moment(j); }
+glm::dmat3 World::ellipsoid_moment(std::uint32_t j) const {
+    return glm::mat3_cast(q_[j]) * rest_moment(j);
+}
 
-void World::group_moments(const Groups& g, std::vector<glm::dmat3>& each, std::vector<glm::dmat3>& sums) const {
+void World::group_moments(const Groups& g, std::vector<glm::dmat3>& each,
+                          std::vector<glm::dmat3>& sums) const {
     const std::size_t n = x_.size();
     each.resize(n);
     sums.resize(n);
@@ -300,7 +314,8 @@ void World::group_moments(const Groups& g, std::vector<glm::dmat3>& each, std::v
     const bool cached = !groups_stale_ && scratch_.rest_moment.size() == n;
     auto one = [&](std::size_t j) {
         if (alive_[j])
-            each[j] = cached ? glm::mat3_cast(q_[j]) * scratch_.rest_moment[j] : ellipsoid_moment(static_cast<std::uint32_t>(j));
+            each[j] = cached ? glm::mat3_cast(q_[j]) * scratch_.rest_moment[j]
+                             : ellipsoid_moment(static_cast<std::uint32_t>(j));
     };
     parallel_ranges(n, settings_.threads, 2048, [&](std::size_t b, std::size_t e) {
         std::size_t j = b;
@@ -333,8 +348,8 @@ void World::group_moments(const Groups& g, std::vector<glm::dmat3>& each, std::v
     });
 }
 
-void World::group_frame(std::uint32_t i, glm::dquat warm, const glm::dmat3& moment, int iterations, const Groups& g,
-                        Frame& out, bool warm_matrix) const {
+void World::group_frame(std::uint32_t i, glm::dquat warm, const glm::dmat3& moment, int iterations,
+                        const Groups& g, Frame& out, bool warm_matrix) const {
     // Eq. 14 with Eq. 15's ellipsoid moments (summed over the group already), positions
     // relative to the centers to keep the sums well conditioned
     const Groups::Member* from = g.member.data() + g.start[i];
@@ -423,11 +438,12 @@ void World::build_groups(Groups& g) const {
     g.source_start[n] = static_cast<std::uint32_t>(g.source.size());
 }
 
-void World::frame_pair(const std::uint32_t (&group)[2], const std::vector<glm::dmat3>& moments, const Groups& g,
-                       std::vector<Frame>& frames) const {
+void World::frame_pair(const std::uint32_t (&group)[2], const std::vector<glm::dmat3>& moments,
+                       const Groups& g, std::vector<Frame>& frames) const {
     // group_frame with one rotation iteration from the last pass's frame, for two groups with
     // the same number of members at once (equal counts: no lane needs padding)
-    const Groups::Member* from[2] = {g.member.data() + g.start[group[0]], g.member.data() + g.start[group[1]]};
+    const Groups::Member* from[2] = {g.member.data() + g.start[group[0]],
+                                     g.member.data() + g.start[group[1]]};
     const std::uint32_t count = g.start[group[0] + 1] - g.start[group[0]];
     const glm::dvec3* x = x_.data();
     v2 cx = both(0), cy = both(0), cz = both(0);
@@ -452,7 +468,8 @@ void World::frame_pair(const std::uint32_t (&group)[2], const std::vector<glm::d
     }
     // rotation_of, one iteration, warm-started from the frames' rotations and their matrices
     Frame* f[2] = {&frames[group[0]], &frames[group[1]]};
-    Quat2 q{v2{f[0]->R.w, f[1]->R.w}, v2{f[0]->R.x, f[1]->R.x}, v2{f[0]->R.y, f[1]->R.y}, v2{f[0]->R.z, f[1]->R.z}};
+    Quat2 q{v2{f[0]->R.w, f[1]->R.w}, v2{f[0]->R.x, f[1]->R.x}, v2{f[0]->R.y, f[1]->R.y},
+            v2{f[0]->R.z, f[1]->R.z}};
     Mat2 M;
     for (int c = 0; c < 3; ++c)
         for (int r = 0; r < 3; ++r) M.m[c][r] = v2{f[0]->M[c][r], f[1]->M[c][r]};
@@ -644,7 +661,8 @@ void World::step() {
                 // blends by s would take it: a normalized linear blend on the short arc. The
                 // steps are small, where it and slerp agree to second order, and it needs no
                 // trigonometry.
-                double rest = 1.0; // (1 - s)^passes, by multiplying: pow() costs more than the rest of the blend
+                double rest =
+                    1.0; // (1 - s)^passes, by multiplying: pow() costs more than the rest of the blend
                 for (int k = 0; k < passes; ++k) rest *= 1.0 - st;
                 const double so = 1.0 - rest;
                 glm::dquat target = glm::normalize(frames[i].R * rest_q_[i]);
@@ -694,7 +712,8 @@ void World::step() {
     }
     pulls_.clear();
     times_.collision = collision_ms;
-    times_.dynamics = std::chrono::duration<double, std::milli>(clock::now() - t_start).count() - collision_ms;
+    times_.dynamics =
+        std::chrono::duration<double, std::milli>(clock::now() - t_start).count() - collision_ms;
 }
 
 namespace {
@@ -765,8 +784,10 @@ void World::grow() {
             if (random_unit(g.seed, i, 3 * static_cast<std::uint64_t>(b)) >= g.branch_probability) continue;
             double angle = random_unit(g.seed, i, 3 * static_cast<std::uint64_t>(b) + 1) * g.branch_variance *
                            std::numbers::pi / 2;
-            double around = random_unit(g.seed, i, 3 * static_cast<std::uint64_t>(b) + 2) * 2 * std::numbers::pi;
-            glm::dvec3 side = glm::normalize(glm::cross(f, std::fabs(f.y) < 0.9 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0)));
+            double around =
+                random_unit(g.seed, i, 3 * static_cast<std::uint64_t>(b) + 2) * 2 * std::numbers::pi;
+            glm::dvec3 side = glm::normalize(
+                glm::cross(f, std::fabs(f.y) < 0.9 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0)));
             glm::dvec3 axis = glm::angleAxis(around, f) * side;
             glm::dvec3 lf = glm::angleAxis(angle, axis) * f;
             add_grown(parent, x_[i] + lf * g.segment_length, heading_to(lf), radii_[i] * g.falloff);
@@ -809,7 +830,7 @@ void World::separate_particles() {
     // a lookup touches one cache line.
     std::size_t size = 16;
     while (size < 4 * n) size *= 2; // a quarter full at most: short probes
-    auto& table = scratch_.table; // begin == end: an empty slot
+    auto& table = scratch_.table;   // begin == end: an empty slot
     table.assign(size, Cell{});
     auto& slot_of = scratch_.slot_of;
     slot_of.assign(n, ~0u);
@@ -858,7 +879,8 @@ void World::separate_particles() {
             glm::dvec3 pushed(0.0);
             for (const std::uint64_t k : keys) {
                 std::size_t slot = k & (size - 1);
-                while (table[slot].end != table[slot].begin && table[slot].key != k) slot = (slot + 1) & (size - 1);
+                while (table[slot].end != table[slot].begin && table[slot].key != k)
+                    slot = (slot + 1) & (size - 1);
                 const Cell& run = table[slot];
                 for (std::uint32_t at = run.begin; at < run.end; ++at) {
                     const std::uint32_t j = members[at];

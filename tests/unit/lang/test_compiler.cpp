@@ -26,7 +26,8 @@ TEST_CASE("names are resolved to slots: params, consts, locals and functions", "
 TEST_CASE("unknown names suggest the nearest known one", "[compiler]") {
     auto c = compile("param length = 1; axiom: F(lenght);");
     CHECK(!c->program);
-    CHECK(messages(*c, Severity::Error) == std::vector<std::string>{"unknown name 'lenght'; did you mean 'length'?"});
+    CHECK(messages(*c, Severity::Error) ==
+          std::vector<std::string>{"unknown name 'lenght'; did you mean 'length'?"});
 }
 
 TEST_CASE("declared modules fix their arity", "[compiler]") {
@@ -61,8 +62,9 @@ TEST_CASE("an undeclared letter run without meaning warns and names the nearest 
     REQUIRE(c->program);
     auto w = messages(*c, Severity::Warning);
     REQUIRE(w.size() == 1);
-    CHECK(w[0] == "'Bd' is not a declared module and is read as 2 separate letters, none of which has a rule or a "
-                  "turtle meaning; did you mean 'Bud'?");
+    CHECK(w[0] ==
+          "'Bd' is not a declared module and is read as 2 separate letters, none of which has a rule or a "
+          "turtle meaning; did you mean 'Bud'?");
     // letters with meaning (F has a turtle meaning) are fine
     auto ok = compile("axiom: FF+X; rules { X -> FX; }");
     CHECK(messages(*ok, Severity::Warning).empty());
@@ -108,23 +110,27 @@ TEST_CASE("types: vectors, members and mismatches", "[compiler]") {
     CHECK(messages(*c, Severity::Error)[0] == "operator '+' cannot be applied to vec3 and number");
 }
 
-TEST_CASE("a surface in an importing file replaces the library's, but twice in one file is an error", "[compiler]") {
+TEST_CASE("a surface in an importing file replaces the library's, but twice in one file is an error",
+          "[compiler]") {
     CompileOptions opts;
-    opts.file_texts["/virtual/lib.plant"] = "surface leaf = polygon(vec3(0, 0, 0), vec3(1, 0, 0), vec3(0, 1, 0));";
+    opts.file_texts["/virtual/lib.plant"] =
+        "surface leaf = polygon(vec3(0, 0, 0), vec3(1, 0, 0), vec3(0, 1, 0));";
     SourceManager sources;
     Diagnostics diags;
-    std::uint32_t id = sources.add("/virtual/main.plant",
-                                   "import \"lib.plant\";\n"
-                                   "surface leaf = polygon(vec3(0, 0, 0), vec3(2, 0, 0), vec3(2, 2, 0), vec3(0, 2, 0));\n"
-                                   "axiom: ~leaf(1);");
+    std::uint32_t id =
+        sources.add("/virtual/main.plant",
+                    "import \"lib.plant\";\n"
+                    "surface leaf = polygon(vec3(0, 0, 0), vec3(2, 0, 0), vec3(2, 2, 0), vec3(0, 2, 0));\n"
+                    "axiom: ~leaf(1);");
     auto program = compile_source(sources, id, opts, diags);
     INFO(render_all(diags, sources));
     REQUIRE(program);
     REQUIRE(program->surfaces.size() == 1);
     CHECK(program->surfaces[0].points.size() == 4);
 
-    auto twice = test::compile("surface leaf = polygon(vec3(0, 0, 0), vec3(1, 0, 0), vec3(0, 1, 0));\n"
-                               "surface leaf = polygon(vec3(0, 0, 0), vec3(1, 0, 0), vec3(0, 1, 0));\naxiom: F;");
+    auto twice =
+        test::compile("surface leaf = polygon(vec3(0, 0, 0), vec3(1, 0, 0), vec3(0, 1, 0));\n"
+                      "surface leaf = polygon(vec3(0, 0, 0), vec3(1, 0, 0), vec3(0, 1, 0));\naxiom: F;");
     CHECK(!twice->program);
     CHECK(twice->rendered().find("surface 'leaf'") != std::string::npos);
 }
@@ -141,5 +147,6 @@ TEST_CASE("a program with more module names than symbol ids is refused, not wrap
     auto c = compile(source(70000));
     CHECK(!c->program);
     CHECK(messages(*c, Severity::Error) ==
-          std::vector<std::string>{"the program names more than 65534 different modules, the most plant can tell apart"});
+          std::vector<std::string>{
+              "the program names more than 65534 different modules, the most plant can tell apart"});
 }

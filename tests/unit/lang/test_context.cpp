@@ -10,10 +10,13 @@ TEST_CASE("ABOP p. 32: BC < S > G[H]M applies in ABC[DE][SG[HI[JK]L]MNO]", "[con
     // context skips nothing here, matches the branch [H... and the ']' skips the rest of it.
     DeriveOptions o;
     o.steps = 1;
-    CHECK(derive("axiom: ABC[DE][SG[HI[JK]L]MNO]; rules { B C < S > G[H]M -> X; }", o) == "ABC[DE][XG[HI[JK]L]MNO]");
+    CHECK(derive("axiom: ABC[DE][SG[HI[JK]L]MNO]; rules { B C < S > G[H]M -> X; }", o) ==
+          "ABC[DE][XG[HI[JK]L]MNO]");
     // any module in place of the pattern's modules breaks the match
-    CHECK(derive("axiom: ABC[DE][SG[HI[JK]L]NNO]; rules { B C < S > G[H]M -> X; }", o) == "ABC[DE][SG[HI[JK]L]NNO]");
-    CHECK(derive("axiom: ABD[DE][SG[HI[JK]L]MNO]; rules { B C < S > G[H]M -> X; }", o) == "ABD[DE][SG[HI[JK]L]MNO]");
+    CHECK(derive("axiom: ABC[DE][SG[HI[JK]L]NNO]; rules { B C < S > G[H]M -> X; }", o) ==
+          "ABC[DE][SG[HI[JK]L]NNO]");
+    CHECK(derive("axiom: ABD[DE][SG[HI[JK]L]MNO]; rules { B C < S > G[H]M -> X; }", o) ==
+          "ABD[DE][SG[HI[JK]L]MNO]");
 }
 
 TEST_CASE("the right context skips lateral branches the pattern does not name", "[context]") {

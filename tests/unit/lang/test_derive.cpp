@@ -110,7 +110,8 @@ TEST_CASE("the module limit stops an explosion with an error naming the step", "
         d.run();
         FAIL("expected an error");
     } catch (const RuntimeError& e) {
-        CHECK(e.message == "step 6: the string grew past the limit of 100000 modules (raise it with --max-modules)");
+        CHECK(e.message ==
+              "step 6: the string grew past the limit of 100000 modules (raise it with --max-modules)");
     }
 }
 
@@ -215,7 +216,7 @@ TEST_CASE("without identities: every rewriting route, on one and two threads", "
         // backward new context
         "axiom: A B B B B; derive 4; rules { A >> B -> A; B -> B B; }",
         // a table-driven context-sensitive system
-    // (the first, second and last grow past 20,000 modules, where two threads split the work)
+        // (the first, second and last grow past 20,000 modules, where two threads split the work)
         "ignore: + - F; axiom: F b F b F b; derive 36; "
         "rules { a < a > a -> a; a < a > b -> b [ + F b F b ]; a < b > a -> b; a < b > b -> b; "
         "        b < a > a -> a; b < a > b -> b F b; b < b > a -> a; b < b > b -> a; + -> -; - -> +; }",
@@ -244,7 +245,8 @@ TEST_CASE("the symbol kernel writes what the general route writes", "[derive][id
         "rules { a < a > a -> b; a < a > b -> a [ + F b F b ]; a < b > a -> a; a < b > b -> a; "
         "        b < a > a -> a; b < a > b -> b F b; b < b > a -> b; b < b > b -> a; + -> -; - -> +; }",
         // unbalanced brackets: a ']' without its '[' and a '[' without its ']'
-        "axiom: b a ] a b [ a b a [ b; derive 8; rules { a < a -> b; b < a > b -> a a; a > b -> b [ a ]; b > a -> a; }",
+        "axiom: b a ] a b [ a b a [ b; derive 8; rules { a < a -> b; b < a > b -> a a; a > b -> b [ a ]; b > "
+        "a -> a; }",
         // a left context only, a right context only, ignored symbols that are rewritten
         "ignore: x; axiom: a x b x a; derive 12; rules { a < b -> b x a; b > a -> a; x -> y; y -> x x; }",
     };
@@ -276,7 +278,8 @@ TEST_CASE("the symbol kernel writes the same for any split of the string", "[der
         "ignore: + - F; axiom: F b F b F b; derive 14; "
         "rules { a < a > a -> a; a < a > b -> b [ + F b F b ]; a < b > a -> b; a < b > b -> b; "
         "        b < a > a -> a; b < a > b -> b F b; b < b > a -> a; b < b > b -> a; + -> -; - -> +; }",
-        "axiom: b a ] a b [ a b a [ b; derive 5; rules { a < a -> b; b < a > b -> a a; a > b -> b [ a ]; b > a -> a; }",
+        "axiom: b a ] a b [ a b a [ b; derive 5; rules { a < a -> b; b < a > b -> a a; a > b -> b [ a ]; b > "
+        "a -> a; }",
     };
     for (const char* g : grammars) {
         INFO(g);

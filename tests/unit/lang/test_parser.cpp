@@ -78,7 +78,8 @@ TEST_CASE("top-level items land in the syntax tree", "[parser]") {
 }
 
 TEST_CASE("context parts of a production are sorted by their operators", "[parser]") {
-    auto p = parse("axiom: A; rules { B C < A > E [ F ] >> D : x > 1 -> G : 2; X << Y -> Z; * < P > * -> Q; }");
+    auto p =
+        parse("axiom: A; rules { B C < A > E [ F ] >> D : x > 1 -> G : 2; X << Y -> Z; * < P > * -> Q; }");
     REQUIRE(p->errors().empty());
     const auto& prods = p->file->rule_blocks[0].productions;
     REQUIRE(prods.size() == 3);
@@ -100,8 +101,8 @@ TEST_CASE("turtle symbols, @-names, queries and the color symbol with arguments 
     REQUIRE(p->errors().empty());
     std::vector<std::string> names;
     for (const auto& m : p->file->axioms[0].successor) names.push_back(m.name);
-    CHECK(names == std::vector<std::string>{"F", "+", "-", "&", "^", "\\", "/", "|", "$", "!", ";", "~leaf", "%",
-                                            "@O", "?P", "[", "G", "]", "f", "/", "/"});
+    CHECK(names == std::vector<std::string>{"F",     "+", "-",  "&",  "^", "\\", "/", "|", "$", "!", ";",
+                                            "~leaf", "%", "@O", "?P", "[", "G",  "]", "f", "/", "/"});
 }
 
 TEST_CASE("precedence and associativity of expressions", "[parser]") {
@@ -132,8 +133,8 @@ TEST_CASE("parse errors name what was expected, where the construct began and wh
           "2:1: unterminated comment: expected '*/' to close '/*' at 1:11, found end of file");
     CHECK(first_error("import \"lib.plant;\n") ==
           "1:19: unterminated string: expected '\"' to close '\"' at 1:8, found end of line");
-    CHECK(first_error("banana;\n") ==
-          "1:1: expected a top-level item (param, const, var, module, fn, axiom, rules, derive, ...), found 'banana'");
+    CHECK(first_error("banana;\n") == "1:1: expected a top-level item (param, const, var, module, fn, axiom, "
+                                      "rules, derive, ...), found 'banana'");
 }
 
 TEST_CASE("the parser recovers at the next item and reports later errors too", "[parser]") {
@@ -144,7 +145,8 @@ TEST_CASE("the parser recovers at the next item and reports later errors too", "
 }
 
 TEST_CASE("deep nesting is an error, not a stack overflow", "[parser]") {
-    std::string deep = "param x = " + std::string(10000, '(') + "1" + std::string(10000, ')') + ";\naxiom: F;";
+    std::string deep =
+        "param x = " + std::string(10000, '(') + "1" + std::string(10000, ')') + ";\naxiom: F;";
     CHECK(first_error(deep) == "1:211: nesting deeper than 200 levels, found '('");
     std::string brackets = "axiom: " + std::string(10000, '[') + std::string(10000, ']') + ";";
     auto p = parse(brackets);

@@ -38,7 +38,8 @@ TEST_CASE("the same diagnostic is kept once and the count is capped", "[diagnost
     CHECK(ds.error_count() == 11);
 }
 
-TEST_CASE("a span over several characters gets a caret with tildes, and binary bytes are masked", "[diagnostics]") {
+TEST_CASE("a span over several characters gets a caret with tildes, and binary bytes are masked",
+          "[diagnostics]") {
     SourceManager sm;
     auto id = sm.add("g.plant", std::string("ab\x01\x02 xyz\n"));
     Diagnostics ds;

@@ -29,7 +29,8 @@ const char* kBushy = R"(
 
 TEST_CASE("10,000 draws of a 0.3/0.7 rule land within 3 sigma", "[stochastic]") {
     // 10,000 A's, each rewritten once to X (weight 0.3) or Y (weight 0.7)
-    auto c = test::compile("axiom: A; derive 1; decompose max_depth 14 { A -> A A; } rules { A -> X : 0.3; A -> Y : 0.7; }");
+    auto c = test::compile(
+        "axiom: A; derive 1; decompose max_depth 14 { A -> A A; } rules { A -> X : 0.3; A -> Y : 0.7; }");
     REQUIRE(c->program);
     // the decomposition doubles A 14 times: 16,384 draws
     DeriveOptions o;

@@ -38,7 +38,8 @@ TEST_CASE("fluid: Müller kernels integrate to one over their support", "[fluid]
     double sum = 0;
     for (double x = -h; x <= h; x += step)
         for (double y = -h; y <= h; y += step)
-            for (double z = -h; z <= h; z += step) sum += Fluid::poly6(x * x + y * y + z * z, h) * step * step * step;
+            for (double z = -h; z <= h; z += step)
+                sum += Fluid::poly6(x * x + y * y + z * z, h) * step * step * step;
     CHECK(sum == Approx(1.0).epsilon(0.01));
     CHECK(Fluid::poly6(h * h, h) == 0);
     CHECK(Fluid::spiky_gradient(h, h) == 0);
@@ -51,7 +52,8 @@ TEST_CASE("fluid: interior density stays within 1 percent of rest in a closed bo
         int n = 0;
         for (std::size_t i = 0; i < f.size(); ++i) {
             const glm::dvec3& p = f.positions()[i];
-            if (glm::any(glm::lessThan(p, glm::dvec3(0.2))) || glm::any(glm::greaterThan(p, glm::dvec3(0.4)))) continue;
+            if (glm::any(glm::lessThan(p, glm::dvec3(0.2))) || glm::any(glm::greaterThan(p, glm::dvec3(0.4))))
+                continue;
             worst = std::max(worst, std::abs(f.densities()[i] / 1.3 - 1));
             mean += f.densities()[i] / 1.3;
             ++n;
@@ -126,7 +128,8 @@ TEST_CASE("fluid: the same state on one and two threads", "[fluid]") {
     CHECK(run(1) == run(2));
 }
 
-TEST_CASE("fluid: an emitter starts a wind stream that carries on downstream and bends a branch in it", "[fluid]") {
+TEST_CASE("fluid: an emitter starts a wind stream that carries on downstream and bends a branch in it",
+          "[fluid]") {
     // still air in a long box; an emitter near the left end blows along +x; a stem stands in
     // the stream 0.4 m downstream of it
     auto run = [](const glm::dvec3& velocity, double& tip_x, double& stream_vx, double& aside_vx) {
@@ -149,7 +152,8 @@ TEST_CASE("fluid: an emitter starts a wind stream that carries on downstream and
         for (std::size_t i = 0; i < f.size(); ++i) {
             const glm::dvec3& p = f.positions()[i];
             if (p.x < 0.35 || p.x > 0.5) continue;
-            if (glm::distance(glm::dvec2(p.y, p.z), glm::dvec2(0.25, 0.2)) < 0.1) sum += f.velocities()[i].x, ++n;
+            if (glm::distance(glm::dvec2(p.y, p.z), glm::dvec2(0.25, 0.2)) < 0.1)
+                sum += f.velocities()[i].x, ++n;
             if (p.y > 0.5) aside += f.velocities()[i].x, ++m;
         }
         REQUIRE(n > 0);
@@ -160,12 +164,13 @@ TEST_CASE("fluid: an emitter starts a wind stream that carries on downstream and
     double tip_off, vx_off, aside_off, tip_on, vx_on, aside_on;
     run(glm::dvec3(0.0), tip_off, vx_off, aside_off);
     run(glm::dvec3(3, 0, 0), tip_on, vx_on, aside_on);
-    INFO("off: tip " << tip_off << " stream " << vx_off << "; on: tip " << tip_on << " stream " << vx_on << " aside "
-                     << aside_on);
+    INFO("off: tip " << tip_off << " stream " << vx_off << "; on: tip " << tip_on << " stream " << vx_on
+                     << " aside " << aside_on);
     // switched off, the air only settles (a few cm/s) and the stem barely moves
     CHECK(std::fabs(vx_off) < 0.1 * vx_on);
     CHECK(std::fabs(tip_off - 0.6) < 0.001);
-    CHECK(vx_on > 0.3);            // the stream reaches 0.2 m past the emitter's edge
-    CHECK(aside_on < 0.5 * vx_on); // and is a stream: slower away from its axis (the closed box returns it there)
+    CHECK(vx_on > 0.3); // the stream reaches 0.2 m past the emitter's edge
+    CHECK(aside_on <
+          0.5 * vx_on); // and is a stream: slower away from its axis (the closed box returns it there)
     CHECK(tip_on - 0.6 > 10 * std::fabs(tip_off - 0.6) + 0.003); // the stem in it bends downstream
 }

@@ -36,7 +36,8 @@ struct Cantilever {
         world.settings().fixed_stiffness = stiffness;
         glm::dvec3 r(0.06, 0.02, 0.02);
         p.push_back(world.add_root({0, 0, 0}, glm::dquat(1, 0, 0, 0), r));
-        for (int k = 1; k < 10; ++k) p.push_back(world.add_particle(p.back(), {0.1 * k, 0, 0}, glm::dquat(1, 0, 0, 0), r));
+        for (int k = 1; k < 10; ++k)
+            p.push_back(world.add_particle(p.back(), {0.1 * k, 0, 0}, glm::dquat(1, 0, 0, 0), r));
     }
     double tip_sag() const { return world.rest_position(p.back()).y - world.position(p.back()).y; }
     void run(double seconds) {
@@ -60,7 +61,8 @@ TEST_CASE("rotation extraction gives a proper rotation, also on degenerate input
     CHECK(angle_between(q, truth) < 1e-6);
     // zero, rank one and a reflection: still proper rotations, no NaN
     CHECK(proper_rotation(extract_rotation(glm::dmat3(0.0), truth)));
-    CHECK(proper_rotation(extract_rotation(glm::dmat3(glm::dvec3(1, 0, 0), glm::dvec3(2, 0, 0), glm::dvec3(0.5, 0, 0)), truth)));
+    CHECK(proper_rotation(extract_rotation(
+        glm::dmat3(glm::dvec3(1, 0, 0), glm::dvec3(2, 0, 0), glm::dvec3(0.5, 0, 0)), truth)));
     glm::dmat3 reflect(1.0);
     reflect[0][0] = -1;
     CHECK(proper_rotation(extract_rotation(reflect, glm::dquat(1, 0, 0, 0))));
@@ -139,8 +141,9 @@ TEST_CASE("surface adaption turns an apex leaning into a wall parallel to it", "
     glm::dvec3 f = glm::normalize(glm::dvec3(1, 1, 0));
     for (int k = 0; k < 400; ++k) f = surface_adaption(f, to_wall, 1.0, 0.025);
     CHECK(std::fabs(glm::dot(f, to_wall)) < 0.05); // parallel to the wall
-    CHECK(f.y > 0.99);                              // still growing upward
-    CHECK(glm::length(surface_adaption(glm::dvec3(0, 1, 0), to_wall, 1.0, 0.025) - glm::dvec3(0, 1, 0)) < 1e-12);
+    CHECK(f.y > 0.99);                             // still growing upward
+    CHECK(glm::length(surface_adaption(glm::dvec3(0, 1, 0), to_wall, 1.0, 0.025) - glm::dvec3(0, 1, 0)) <
+          1e-12);
 }
 
 TEST_CASE("anchors pull in by (1 - phi) each step and let go past their distance", "[physics]") {
@@ -178,7 +181,8 @@ TEST_CASE("no particle ends inside an obstacle", "[physics]") {
     // a loose branch dropped from 1 m onto the ground and the ball
     Handle a = w.add_root({0, 1, 0}, glm::dquat(1, 0, 0, 0), {0.03, 0.03, 0.03}, false);
     std::vector<Handle> p{a};
-    for (int k = 1; k < 6; ++k) p.push_back(w.add_particle(p.back(), {0.1 * k, 1, 0}, glm::dquat(1, 0, 0, 0), {0.03, 0.03, 0.03}));
+    for (int k = 1; k < 6; ++k)
+        p.push_back(w.add_particle(p.back(), {0.1 * k, 1, 0}, glm::dquat(1, 0, 0, 0), {0.03, 0.03, 0.03}));
     for (int step = 0; step < 200; ++step) {
         w.step();
         for (Handle h : p) {
@@ -212,7 +216,8 @@ World grown(Growth g, double seconds, glm::dvec3 start_forward = {0, 1, 0}) {
     s.collisions = false;
     s.growth = g;
     World w(s);
-    w.add_root({0, 0, 0}, glm::rotation(glm::dvec3(0, 1, 0), glm::normalize(start_forward)), {0.02, 0.05, 0.02});
+    w.add_root({0, 0, 0}, glm::rotation(glm::dvec3(0, 1, 0), glm::normalize(start_forward)),
+               {0.02, 0.05, 0.02});
     int steps = static_cast<int>(seconds / s.dt);
     for (int k = 0; k < steps; ++k) {
         w.step();
@@ -274,12 +279,14 @@ TEST_CASE("an apex growing toward a wall turns parallel to it and never enters i
     wall.a = glm::dvec3(0.3, 0, 0);
     wall.b = glm::dvec3(-1, 0, 0);
     w.add_obstacle(wall);
-    w.add_root({0, 0, 0}, glm::rotation(glm::dvec3(0, 1, 0), glm::normalize(glm::dvec3(1, 1, 0))), {0.02, 0.05, 0.02});
+    w.add_root({0, 0, 0}, glm::rotation(glm::dvec3(0, 1, 0), glm::normalize(glm::dvec3(1, 1, 0))),
+               {0.02, 0.05, 0.02});
     Handle apex{0, 0};
     for (int k = 0; k < 400 && w.size() < 60; ++k) {
         w.step();
         w.grow();
-        for (std::uint32_t i = 0; i < w.size(); ++i) REQUIRE(wall.distance(w.position(Handle{i, 0})) >= 0.02 - 1e-9);
+        for (std::uint32_t i = 0; i < w.size(); ++i)
+            REQUIRE(wall.distance(w.position(Handle{i, 0})) >= 0.02 - 1e-9);
     }
     apex = Handle{static_cast<std::uint32_t>(w.size() - 1), 0};
     CHECK(std::fabs(glm::dot(w.forward(apex), glm::dvec3(1, 0, 0))) < 0.2); // parallel to the wall
@@ -336,7 +343,8 @@ TEST_CASE("two warm-started rotation iterations a pass settle where a full solve
     CHECK(std::fabs(fast.tip_sag() - exact.tip_sag()) < 0.02 * exact.tip_sag());
 }
 
-TEST_CASE("plant-plant collision: crossing branches of two plants end apart, and overlap without it", "[physics]") {
+TEST_CASE("plant-plant collision: crossing branches of two plants end apart, and overlap without it",
+          "[physics]") {
     auto closest = [](bool collisions) {
         Settings s;
         s.gravity = glm::dvec3(0.0);
@@ -349,18 +357,20 @@ TEST_CASE("plant-plant collision: crossing branches of two plants end apart, and
         a.push_back(w.add_root({0, 0, 0}, along_x, r));
         for (int k = 1; k <= 10; ++k) a.push_back(w.add_particle(a.back(), {0.05 * k, 0, 0}, along_x, r));
         b.push_back(w.add_root({0.25, -0.25, 0.01}, glm::dquat(1, 0, 0, 0), r));
-        for (int k = 1; k <= 10; ++k) b.push_back(w.add_particle(b.back(), {0.25, -0.25 + 0.05 * k, 0.01}, glm::dquat(1, 0, 0, 0), r));
+        for (int k = 1; k <= 10; ++k)
+            b.push_back(w.add_particle(b.back(), {0.25, -0.25 + 0.05 * k, 0.01}, glm::dquat(1, 0, 0, 0), r));
         for (int step = 0; step < 20; ++step) w.step();
         double gap = 1e9; // distance between surfaces, negative when they overlap
         for (Handle p : a)
             for (Handle q : b) gap = std::min(gap, glm::distance(w.position(p), w.position(q)) - 0.04);
         return gap;
     };
-    CHECK(closest(false) < -0.02);  // the branches run through each other
-    CHECK(closest(true) > -0.004);  // they end (nearly) apart: within a tenth of the contact distance
+    CHECK(closest(false) < -0.02); // the branches run through each other
+    CHECK(closest(true) > -0.004); // they end (nearly) apart: within a tenth of the contact distance
 }
 
-TEST_CASE("growth: a new particle's rest state continues its parent's, also when the parent sags (Eq. 9-10)", "[physics]") {
+TEST_CASE("growth: a new particle's rest state continues its parent's, also when the parent sags (Eq. 9-10)",
+          "[physics]") {
     Settings s;
     s.collisions = false;
     s.fixed_stiffness = 0.2; // soft: the stem sags well away from its rest shape while it grows
@@ -386,7 +396,8 @@ TEST_CASE("growth: a new particle's rest state continues its parent's, also when
     CHECK(worst < 1e-9);
 }
 
-TEST_CASE("growth: phototropism turns an apex toward the light less in the plant's own shade (Eq. 7)", "[physics]") {
+TEST_CASE("growth: phototropism turns an apex toward the light less in the plant's own shade (Eq. 7)",
+          "[physics]") {
     // an apex growing along +x, the light above; in the second world a dense layer of the
     // plant's particles hangs between the apex and the light
     auto rise = [](bool shaded) {
@@ -404,7 +415,8 @@ TEST_CASE("growth: phototropism turns an apex toward the light less in the plant
         Handle apex = w.add_root({0, 0, 0}, along_x, {0.02, 0.05, 0.02});
         if (shaded)
             for (int a = -5; a <= 20; ++a)
-                for (int b = -5; b <= 5; ++b) w.add_root({0.05 * a, 0.3, 0.05 * b}, along_x, {0.02, 0.05, 0.02});
+                for (int b = -5; b <= 5; ++b)
+                    w.add_root({0.05 * a, 0.3, 0.05 * b}, along_x, {0.02, 0.05, 0.02});
         const std::uint32_t first = apex.index;
         for (int k = 0; k < 20; ++k) {
             w.step();
@@ -425,6 +437,6 @@ TEST_CASE("growth: phototropism turns an apex toward the light less in the plant
     };
     const double open = rise(false), shaded = rise(true);
     INFO("forward.y of the tip: in the open " << open << ", in the shade " << shaded);
-    CHECK(open > 0.1);           // turned toward the light
-    CHECK(shaded < 0.5 * open);  // much less under the layer
+    CHECK(open > 0.1);          // turned toward the light
+    CHECK(shaded < 0.5 * open); // much less under the layer
 }

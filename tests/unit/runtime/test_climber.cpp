@@ -51,29 +51,33 @@ std::size_t count(const std::string& s, const std::string& what) {
 
 // A horizontal cantilever of four bound segments, 0.1 long, growing along +x from the origin.
 std::string cantilever(const std::string& climber_args, const std::string& extra = "") {
-    return "env ivy = climber(" + climber_args + ");\n"
-           "module Seg(len, r) bound ivy;\n" + extra +
+    return "env ivy = climber(" + climber_args +
+           ");\n"
+           "module Seg(len, r) bound ivy;\n" +
+           extra +
            "derive 6;\n"
            "axiom: -(90) Seg(0.1, 0.01) Seg(0.1, 0.01) Seg(0.1, 0.01) Seg(0.1, 0.01) ?P(0, 0, 0);\n";
 }
 
 } // namespace
 
-TEST_CASE("climber: bound segments sag under gravity and the turtle draws them where the particles are", "[climber]") {
+TEST_CASE("climber: bound segments sag under gravity and the turtle draws them where the particles are",
+          "[climber]") {
     Grown soft = grow(cantilever("stiffness: 0.3, substeps: 10"));
     Grown still = grow(cantilever("stiffness: 0.3, substeps: 10, gravity: vec3(0, 0, 0)"));
     REQUIRE(soft.skeleton.axes.size() == 1);
     const auto& tip = soft.skeleton.axes[0].points.back().position;
     const auto& straight = still.skeleton.axes[0].points.back().position;
-    CHECK(tip.y < -0.02);                           // it sagged
-    CHECK(straight.y == Approx(0.0).margin(1e-9));  // without gravity it keeps its shape
+    CHECK(tip.y < -0.02);                          // it sagged
+    CHECK(straight.y == Approx(0.0).margin(1e-9)); // without gravity it keeps its shape
     CHECK(straight.x == Approx(0.4).margin(1e-9));
     // the query module after the tip reads the physical position
     CHECK(soft.string.find("?P(" + fmt::format("{}", tip.x)) != std::string::npos);
     CHECK(soft.particles == 5); // a fixed root and one particle per segment
 }
 
-TEST_CASE("climber: a pulled tip past the break threshold leaves the string, and so does a cut branch", "[climber]") {
+TEST_CASE("climber: a pulled tip past the break threshold leaves the string, and so does a cut branch",
+          "[climber]") {
     // ids in the axiom: -(90) is 1, the segments 2 to 5
     Grown pulled = grow(cantilever("stiffness: 1, substeps: 4, break_threshold: 0.3",
                                    "on before_step { if step() == 2 { ivy.pull(5, vec3(1, 1, 0)); } }\n"));
@@ -83,7 +87,8 @@ TEST_CASE("climber: a pulled tip past the break threshold leaves the string, and
     Grown whole = grow(cantilever("stiffness: 1, substeps: 4, break_threshold: 0.3"));
     CHECK(count(whole.string, "Seg(") == 4);
 
-    Grown cut = grow(cantilever("stiffness: 1, substeps: 4", "on before_step { if step() == 3 { ivy.cut(4); } }\n"));
+    Grown cut =
+        grow(cantilever("stiffness: 1, substeps: 4", "on before_step { if step() == 3 { ivy.cut(4); } }\n"));
     CHECK(cut.string == "-(90)Seg(0.1,0.01)Seg(0.1,0.01)");
     CHECK(cut.particles == 5); // the world keeps its slots; the cut ones are dead
 }
@@ -105,12 +110,13 @@ rules {
     REQUIRE(pts.size() > 25);
     double lowest_z = 1e9;
     for (const auto& p : pts) lowest_z = std::min(lowest_z, p.position.z);
-    CHECK(lowest_z >= 0.0);                        // never inside the wall (z < 0)
-    CHECK(pts.back().position.y > 0.8);            // it climbed
-    CHECK(std::abs(pts.back().heading.z) < 0.15);  // along the face, not away from it
+    CHECK(lowest_z >= 0.0);                       // never inside the wall (z < 0)
+    CHECK(pts.back().position.y > 0.8);           // it climbed
+    CHECK(std::abs(pts.back().heading.z) < 0.15); // along the face, not away from it
 }
 
-TEST_CASE("climber: grow_dir turns a free shoot toward the light, and not when there is none to follow", "[climber]") {
+TEST_CASE("climber: grow_dir turns a free shoot toward the light, and not when there is none to follow",
+          "[climber]") {
     auto shoot = [](double eta) {
         return grow(fmt::format(R"(
 env ivy = climber(gravity: vec3(0, 0, 0), light: vec3(1, 1, 0), phototropism: {});
@@ -129,11 +135,13 @@ rules {{
     CHECK(blind.skeleton.axes[0].points.back().heading.x == Approx(0.0).margin(1e-9));
 }
 
-TEST_CASE("climber: a grammar grows the same plant for a seed, on any thread count and when derived again", "[climber]") {
+TEST_CASE("climber: a grammar grows the same plant for a seed, on any thread count and when derived again",
+          "[climber]") {
     // the library with a wall scene, through the stdlib search path
-    const std::string text = "import climber with { N = 3, BP = 0.3, steps = 20, shoot_length = 20 };\n"
-                             "env ivy = climber(box_min: vec3(-1, 0, -0.2), box_max: vec3(1, 3, 0), adaption: 0.8, "
-                             "anchor: 0.5, phototropism: 0.3);\nseed 5;\n";
+    const std::string text =
+        "import climber with { N = 3, BP = 0.3, steps = 20, shoot_length = 20 };\n"
+        "env ivy = climber(box_min: vec3(-1, 0, -0.2), box_max: vec3(1, 3, 0), adaption: 0.8, "
+        "anchor: 0.5, phototropism: 0.3);\nseed 5;\n";
     Grown a = grow(text, 1), b = grow(text, 2);
     CHECK(a.string == b.string);
     CHECK(count(a.string, "Seg(") > 60);
@@ -174,7 +182,8 @@ axiom: Seg(0.1, 0.02) Seg(0.1, 0.02) Seg(0.1, 0.02) Seg(0.1, 0.02) Seg(0.1, 0.02
     CHECK(bent.x > 0.005);                      // coupled, it bends the stem downwind
 }
 
-TEST_CASE("climber: a mesh obstacle (a distance grid of a loaded cube) is climbed and never entered", "[climber]") {
+TEST_CASE("climber: a mesh obstacle (a distance grid of a loaded cube) is climbed and never entered",
+          "[climber]") {
     // the unit cube [0, 1]^3 from tests/data/cube.obj, scaled by nothing: a plant starts in front
     // of its +z face and leans into it
     const std::string cube = std::string(PLANT_TEST_DATA) + "/cube.obj";
@@ -196,8 +205,8 @@ rules {{
         const bool inside = x.x > 0.01 && x.x < 0.99 && x.y > 0.01 && x.y < 0.99 && x.z > 0.01 && x.z < 0.99;
         CHECK(!inside);
     }
-    CHECK(pts.back().position.y > 0.7);      // it went up the face
-    CHECK(pts.back().position.z < 1.1);      // staying on it
+    CHECK(pts.back().position.y > 0.7); // it went up the face
+    CHECK(pts.back().position.z < 1.1); // staying on it
 }
 
 TEST_CASE("distance grid: trilinear samples of a box's distance", "[climber]") {
@@ -213,11 +222,12 @@ TEST_CASE("distance grid: trilinear samples of a box's distance", "[climber]") {
     for (int z = 0; z < 9; ++z)
         for (int y = 0; y < 9; ++y)
             for (int x = 0; x < 9; ++x)
-                g.d[(static_cast<std::size_t>(z) * 9 + y) * 9 + x] = box.distance(g.lo + glm::dvec3(x, y, z) * 0.25);
-    CHECK(g.sample(glm::dvec3(0.75, 0, 0)) == Approx(0.25));     // a grid point
-    CHECK(g.sample(glm::dvec3(0.625, 0, 0)) == Approx(0.125));   // between two, along a linear stretch
-    CHECK(g.sample(glm::dvec3(0, 0, 0)) == Approx(-0.5));        // the centre
-    CHECK(g.sample(glm::dvec3(3, 0, 0)) == Approx(2.5));         // outside the grid: 2 beyond it plus 0.5
+                g.d[(static_cast<std::size_t>(z) * 9 + y) * 9 + x] =
+                    box.distance(g.lo + glm::dvec3(x, y, z) * 0.25);
+    CHECK(g.sample(glm::dvec3(0.75, 0, 0)) == Approx(0.25));   // a grid point
+    CHECK(g.sample(glm::dvec3(0.625, 0, 0)) == Approx(0.125)); // between two, along a linear stretch
+    CHECK(g.sample(glm::dvec3(0, 0, 0)) == Approx(-0.5));      // the centre
+    CHECK(g.sample(glm::dvec3(3, 0, 0)) == Approx(2.5));       // outside the grid: 2 beyond it plus 0.5
 }
 
 TEST_CASE("climber: a box moved by a hook pushes the plant along, which never ends inside it", "[climber]") {
@@ -249,7 +259,8 @@ TEST_CASE("climber: a hook seeds a new branch at a segment, and it grows from th
     // stdlib/climber.plant with one unbranched plant; #12 is its second segment
     auto plant = [](const std::string& hook) {
         return grow("import climber with { N = 1, BP = 0, steps = 12, leaf_size = 0 };\n"
-                    "env ivy = climber(box_min: vec3(-1, 0, -0.2), box_max: vec3(1, 3, 0), adaption: 0.8, anchor: 0.5);\n" +
+                    "env ivy = climber(box_min: vec3(-1, 0, -0.2), box_max: vec3(1, 3, 0), adaption: 0.8, "
+                    "anchor: 0.5);\n" +
                     hook);
     };
     Grown plain = plant(""), seeded = plant("on before_step { if step() == 4 { ivy.seed(12); } }\n");

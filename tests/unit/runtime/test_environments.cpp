@@ -41,19 +41,20 @@ double ask(const Environment& e, std::size_t method, std::vector<double> args) {
 
 TEST_CASE("ellipsoid: containment, scaled containment, level", "[environments]") {
     auto e = make("ellipsoid", {vec_arg("center", 0, 4, 0), vec_arg("radii", 3, 2, 3)});
-    CHECK(ask(*e, 0, {0, 5.9, 0}) == 1);          // inside: 1.9 / 2 < 1
-    CHECK(ask(*e, 0, {0, 6.1, 0}) == 0);          // outside the top
+    CHECK(ask(*e, 0, {0, 5.9, 0}) == 1); // inside: 1.9 / 2 < 1
+    CHECK(ask(*e, 0, {0, 6.1, 0}) == 0); // outside the top
     CHECK(ask(*e, 0, {2.9, 4, 0}) == 1);
-    CHECK(ask(*e, 1, {2.5, 4, 0, 0.8}) == 0);     // 2.5 / 3 = 0.83 > 0.8: outside the shrunk one
+    CHECK(ask(*e, 1, {2.5, 4, 0, 0.8}) == 0); // 2.5 / 3 = 0.83 > 0.8: outside the shrunk one
     CHECK(ask(*e, 1, {2.3, 4, 0, 0.8}) == 1);
-    CHECK(ask(*e, 2, {3, 4, 0}) == Approx(1.0));  // on the surface
+    CHECK(ask(*e, 2, {3, 4, 0}) == Approx(1.0)); // on the surface
     CHECK(ask(*e, 2, {1.5, 5, 0}) == Approx(std::sqrt(0.25 + 0.25)));
     CHECK(ask(*e, 3, {0, 7, 0}) == Approx(1.0));  // 1 above the top (y = 6)
     CHECK(ask(*e, 3, {0, 5, 0}) == Approx(-1.0)); // 1 below it, inside
     CHECK(ask(*e, 3, {0, 4, 0}) == Approx(-2.0)); // the center
 }
 
-TEST_CASE("proximity: distance to other stems, the asking stem and its branching point excluded", "[environments]") {
+TEST_CASE("proximity: distance to other stems, the asking stem and its branching point excluded",
+          "[environments]") {
     auto c = test::compile("module S(x); axiom: S(1) F F [ +(90) S(2) F F ] F;");
     REQUIRE(c->program);
     Derivation d(*c->program, {});
@@ -98,9 +99,9 @@ TEST_CASE("proximity: clearance of a stem from older stems only", "[environments
 }
 
 TEST_CASE("obstacles: signed distances to spheres, boxes and planes", "[environments]") {
-    auto e = make("obstacles", {vec_arg("sphere", 0, 0, 0), num_arg("sphere_radius", 1), vec_arg("box_min", 4, 0, 0),
-                                vec_arg("box_max", 6, 2, 2), vec_arg("plane_point", 0, -3, 0),
-                                vec_arg("plane_normal", 0, 1, 0)});
+    auto e = make("obstacles", {vec_arg("sphere", 0, 0, 0), num_arg("sphere_radius", 1),
+                                vec_arg("box_min", 4, 0, 0), vec_arg("box_max", 6, 2, 2),
+                                vec_arg("plane_point", 0, -3, 0), vec_arg("plane_normal", 0, 1, 0)});
     CHECK(ask(*e, 0, {0, 2, 0}) == Approx(1.0));      // 1 above the sphere
     CHECK(ask(*e, 0, {0, 0.5, 0}) == Approx(-0.5));   // inside the sphere
     CHECK(ask(*e, 0, {5, 1, 1}) == Approx(-1.0));     // at the box's center, 1 from each face
@@ -124,9 +125,9 @@ TEST_CASE("envelope: Cescatti's crown, asymmetric sides and shape coefficients",
     // 2 (+z), 3 (-x), 2 (-z); C1 = C2 = 2 (ellipse-like above and below)
     auto e = make("envelope", {vec_arg("top", 0, 10, 0), vec_arg("bottom", 0, 2, 0), vec_arg("px", 4, 6, 0),
                                vec_arg("pz", 0, 6, 2), vec_arg("nx", -3, 6, 0), vec_arg("nz", 0, 6, -2)});
-    CHECK(ask(*e, 1, {4, 6, 0}) == Approx(1.0));                 // on the peripheral line at +x
-    CHECK(ask(*e, 1, {-3, 6, 0}) == Approx(1.0));                // at -x, a different radius
-    CHECK(ask(*e, 1, {0, 10, 0}) == Approx(1.0));                // the top
+    CHECK(ask(*e, 1, {4, 6, 0}) == Approx(1.0));                    // on the peripheral line at +x
+    CHECK(ask(*e, 1, {-3, 6, 0}) == Approx(1.0));                   // at -x, a different radius
+    CHECK(ask(*e, 1, {0, 10, 0}) == Approx(1.0));                   // the top
     CHECK(ask(*e, 1, {2, 8, 0}) == Approx(std::sqrt(0.25 + 0.25))); // (2/4)^2 + (2/4)^2 above the line
     CHECK(ask(*e, 1, {0, 4, 1}) == Approx(std::sqrt(0.25 + 0.25))); // (1/2)^2 + (2/4)^2 below it
     CHECK(ask(*e, 0, {3.9, 6, 0}) == 1);
@@ -146,10 +147,11 @@ TEST_CASE("light: exposure falls behind occupied cells toward the light", "[envi
     Derivation d(*c->program, {});
     d.run();
     Skeleton sk = build_skeleton(*c->program, d.string(), TurtleOptions{});
-    auto env = make("light", {vec_arg("direction", 0, 1, 0), num_arg("resolution", 10), num_arg("opacity", 0.5)});
+    auto env =
+        make("light", {vec_arg("direction", 0, 1, 0), num_arg("resolution", 10), num_arg("opacity", 0.5)});
     dynamic_cast<SkeletonEnvironment&>(*env).update(sk);
-    CHECK(ask(*env, 0, {0, 10.5, 0}) == Approx(1.0));     // above the plant: full light
-    CHECK(ask(*env, 1, {1.5, 3, 0}) >= 1);                // under the +x... layer at y = 5
+    CHECK(ask(*env, 0, {0, 10.5, 0}) == Approx(1.0)); // above the plant: full light
+    CHECK(ask(*env, 1, {1.5, 3, 0}) >= 1);            // under the +x... layer at y = 5
     CHECK(ask(*env, 0, {1.5, 3, 0}) < 1.0);
     CHECK(ask(*env, 0, {1.5, 3, 0}) == Approx(std::pow(0.5, ask(*env, 1, {1.5, 3, 0}))));
 }
@@ -160,8 +162,8 @@ TEST_CASE("obstacles: signed distance to a loaded mesh", "[environments]") {
     mesh.type = ValueType::String;
     mesh.text = std::string(PLANT_TEST_DATA) + "/cube.obj";
     auto e = make("obstacles", {mesh});
-    CHECK(ask(*e, 0, {0.5, 0.5, 2}) == Approx(1.0));    // 1 above the top face
-    CHECK(ask(*e, 0, {0.5, 0.5, 0.5}) == Approx(-0.5)); // the center, 0.5 from every face
+    CHECK(ask(*e, 0, {0.5, 0.5, 2}) == Approx(1.0));          // 1 above the top face
+    CHECK(ask(*e, 0, {0.5, 0.5, 0.5}) == Approx(-0.5));       // the center, 0.5 from every face
     CHECK(ask(*e, 0, {2, 2, 0.5}) == Approx(std::sqrt(2.0))); // nearest to the edge x = y = 1
     CHECK(ask(*e, 1, {0.2, 0.3, 0.4}) == 1);
     std::string error;

@@ -17,8 +17,7 @@ Scene scene_of(const std::string& grammar) {
     REQUIRE(c->program);
     Derivation d(*c->program, {});
     d.run();
-    Skeleton sk = build_skeleton(*c->program, d.interpreted(d.string()),
-                                 turtle_options(d));
+    Skeleton sk = build_skeleton(*c->program, d.interpreted(d.string()), turtle_options(d));
     return build_scene(*c->program, sk, MeshOptions{});
 }
 
@@ -48,12 +47,12 @@ TEST_CASE("the PNG preview frames the plant: drawn, centred, not clipped", "[exp
     Image img = render_scene(s, 200, 200);
     REQUIRE(img.rgb.size() == 200u * 200u * 3u);
     Box b = drawn(img);
-    CHECK(b.count > 500);                   // not blank
-    CHECK(b.x0 > 0);                        // not clipped on any side
+    CHECK(b.count > 500); // not blank
+    CHECK(b.x0 > 0);      // not clipped on any side
     CHECK(b.y0 > 0);
     CHECK(b.x1 < 199);
     CHECK(b.y1 < 199);
-    CHECK(b.y1 - b.y0 > 150);               // framed on the bounding box: the plant fills the height
+    CHECK(b.y1 - b.y0 > 150); // framed on the bounding box: the plant fills the height
     CHECK(std::abs((b.x0 + b.x1) / 2 - 100) < 40);
 }
 
@@ -71,7 +70,8 @@ TEST_CASE("writers leave no partial file when they fail", "[export]") {
 }
 
 TEST_CASE("the skeleton JSON lists axes with points and organs with matrices", "[export]") {
-    auto c = test::compile("surface s = polygon(vec3(0,0,0), vec3(1,0,0), vec3(0,1,0)); axiom: F [ + F ~s(1) ] F;");
+    auto c = test::compile(
+        "surface s = polygon(vec3(0,0,0), vec3(1,0,0), vec3(0,1,0)); axiom: F [ + F ~s(1) ] F;");
     REQUIRE(c->program);
     Derivation d(*c->program, {});
     d.run();

@@ -23,8 +23,7 @@ Skeleton skeleton_of(const std::string& grammar, int steps) {
     o.steps = steps;
     Derivation d(*c->program, o);
     d.run();
-    return build_skeleton(*c->program, d.interpreted(d.string()),
-                          turtle_options(d));
+    return build_skeleton(*c->program, d.interpreted(d.string()), turtle_options(d));
 }
 
 MeshPart tube_of(const TubePath& path, const MeshOptions& o) {
@@ -58,7 +57,8 @@ int boundary_loops(const MeshPart& part, bool& manifold) {
     }
     manifold = true;
     for (std::size_t t = 0; t + 2 < part.indices.size(); t += 3) {
-        auto f = mesh.add_face(handle[part.indices[t]], handle[part.indices[t + 1]], handle[part.indices[t + 2]]);
+        auto f =
+            mesh.add_face(handle[part.indices[t]], handle[part.indices[t + 1]], handle[part.indices[t + 2]]);
         if (!f.is_valid()) manifold = false; // OpenMesh refuses faces that would make it non-manifold
     }
     for (auto v : mesh.vertices())
@@ -115,7 +115,8 @@ TEST_CASE("ring centers are the turtle's points and ring vertices lie at the rad
             // end rings are perpendicular to the axis: every vertex at the radius
             double r = axis.points[k].radius * (k + 1 == axis.points.size() ? o.tip_taper : 1.0);
             for (std::size_t j = 0; j < 8; ++j)
-                CHECK(glm::length(glm::dvec3(m.positions[k * stride + j]) - axis.points[k].position) == Approx(r).epsilon(1e-5));
+                CHECK(glm::length(glm::dvec3(m.positions[k * stride + j]) - axis.points[k].position) ==
+                      Approx(r).epsilon(1e-5));
         } else {
             // joint rings are widened along the bend (a miter): no vertex comes closer than the radius
             for (std::size_t j = 0; j < 8; ++j)
@@ -125,7 +126,8 @@ TEST_CASE("ring centers are the turtle's points and ring vertices lie at the rad
     }
 }
 
-TEST_CASE("every tube is a manifold with two boundary loops, unit normals and no degenerate triangles", "[mesh]") {
+TEST_CASE("every tube is a manifold with two boundary loops, unit normals and no degenerate triangles",
+          "[mesh]") {
     for (const char* g : kGrammars) {
         INFO(g);
         Skeleton sk = skeleton_of(g, 4);
@@ -172,12 +174,14 @@ TEST_CASE("a sympodial axis goes on into its straightest child when the turn is 
     std::size_t points = 0;
     for (const TubePath& t : tubes) {
         points += t.size();
-        for (std::size_t k = 1; k < t.size(); ++k) CHECK(glm::length(t[k]->position - t[k - 1]->position) > 1e-9);
+        for (std::size_t k = 1; k < t.size(); ++k)
+            CHECK(glm::length(t[k]->position - t[k - 1]->position) > 1e-9);
         for (std::size_t k = 1; k + 1 < t.size(); ++k) {
             // every joint in a tube is gentle: a 5 degree turn
             glm::dvec3 d0 = glm::normalize(t[k]->position - t[k - 1]->position);
             glm::dvec3 d1 = glm::normalize(t[k + 1]->position - t[k]->position);
-            CHECK(glm::degrees(std::acos(std::clamp(glm::dot(d0, d1), -1.0, 1.0))) == Approx(5.0).margin(1e-6));
+            CHECK(glm::degrees(std::acos(std::clamp(glm::dot(d0, d1), -1.0, 1.0))) ==
+                  Approx(5.0).margin(1e-6));
         }
     }
     // each axis contributes its two points, minus the shared joint where it continues a parent
@@ -207,8 +211,8 @@ TEST_CASE("the scene shares organ prototypes between placements and bounds inclu
     Skeleton sk = build_skeleton(*c->program, d.string(), TurtleOptions{});
     Scene s = build_scene(*c->program, sk, MeshOptions{});
     CHECK(s.instances.size() == 4);
-    CHECK(s.prototypes.size() == 3); // leaf in two colors, one sphere
-    CHECK(s.prototypes[0].triangle_count() == 4); // a quad, front and back
+    CHECK(s.prototypes.size() == 3);                     // leaf in two colors, one sphere
+    CHECK(s.prototypes[0].triangle_count() == 4);        // a quad, front and back
     CHECK(s.bounds_max.y >= 3.0f + 2.0f * 1.0f - 1e-4f); // the top leaf (length 2, scale 2) reaches y = 3 + 4
     CHECK(s.tubes.triangle_count() > 0);
 }
@@ -218,19 +222,22 @@ TEST_CASE("sphere faces are wound outward, like their normals", "[mesh]") {
     REQUIRE(c->program);
     Derivation d(*c->program, {});
     d.run();
-    Scene s = build_scene(*c->program, build_skeleton(*c->program, d.string(), TurtleOptions{}), MeshOptions{});
+    Scene s =
+        build_scene(*c->program, build_skeleton(*c->program, d.string(), TurtleOptions{}), MeshOptions{});
     REQUIRE(s.prototypes.size() == 1);
     const MeshPart& m = s.prototypes[0];
     REQUIRE(m.triangle_count() > 0);
     for (std::size_t t = 0; t < m.indices.size(); t += 3) {
-        glm::vec3 a = m.positions[m.indices[t]], b = m.positions[m.indices[t + 1]], c2 = m.positions[m.indices[t + 2]];
+        glm::vec3 a = m.positions[m.indices[t]], b = m.positions[m.indices[t + 1]],
+                  c2 = m.positions[m.indices[t + 2]];
         glm::vec3 face = glm::cross(b - a, c2 - a);
         CHECK(glm::dot(face, a + b + c2) > 0); // the face normal points away from the center
     }
 }
 
 TEST_CASE("a surface loaded from a file is meshed once and placed by transform", "[mesh]") {
-    auto c = test::compile(std::string("surface leaf = load(\"") + PLANT_TEST_DATA + "/leaf.obj\"); axiom: F ~leaf(2) F ~leaf(1);");
+    auto c = test::compile(std::string("surface leaf = load(\"") + PLANT_TEST_DATA +
+                           "/leaf.obj\"); axiom: F ~leaf(2) F ~leaf(1);");
     REQUIRE(c->program);
     Derivation d(*c->program, {});
     d.run();
@@ -239,7 +246,8 @@ TEST_CASE("a surface loaded from a file is meshed once and placed by transform",
     REQUIRE(s.prototypes.size() == 1);
     CHECK(s.prototypes[0].triangle_count() == 2);
     CHECK(s.instances.size() == 2);
-    CHECK(s.bounds_max.y == Approx(1.0f + 2 * 1.2f)); // the first leaf, at y = 1 and scaled by 2, reaches highest
+    CHECK(s.bounds_max.y ==
+          Approx(1.0f + 2 * 1.2f)); // the first leaf, at y = 1 and scaled by 2, reaches highest
     auto bad = test::compile("surface leaf = load(\"/nonexistent/leaf.obj\"); axiom: ~leaf(1);");
     REQUIRE(bad->program);
     Derivation d2(*bad->program, {});

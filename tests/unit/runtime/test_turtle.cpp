@@ -104,7 +104,8 @@ TEST_CASE("popping an empty stack is a runtime error naming the module", "[turtl
 TEST_CASE("@M moves, SetHead sets the heading, @O places a sphere", "[turtle]") {
     near(draw("@M(1, 2, 3) F").ends[0], {1, 3, 3});
     near(draw("SetHead(1, 0, 0, 0, 1, 0) F").ends[0], {1, 0, 0});
-    Drawn drawn = skeleton_of("axiom: !(4) F @O(2) ~leaf(3); surface leaf = polygon(vec3(0,0,0), vec3(1,0,0), vec3(0,1,0));");
+    Drawn drawn = skeleton_of(
+        "axiom: !(4) F @O(2) ~leaf(3); surface leaf = polygon(vec3(0,0,0), vec3(1,0,0), vec3(0,1,0));");
     const Skeleton& sk = drawn.skeleton;
     REQUIRE(sk.axes.size() == 1);
     CHECK(sk.axes[0].points.back().radius == Approx(2.0)); // !(4): width 4, radius 2

@@ -31,9 +31,9 @@ enum Origin { FromRoot = 0, FromTip = 1, FromSecond = 2, FromRandom = 3, FromExt
 
 struct StemInfo {
     int type = 0, state = 0, origin = 0;
-    int axis = -1;         // in the skeleton
-    int own_segments = 0;  // F modules of the stem itself
-    int blooms = 0;        // Bloom modules anywhere in its branch
+    int axis = -1;        // in the skeleton
+    int own_segments = 0; // F modules of the stem itself
+    int blooms = 0;       // Bloom modules anywhere in its branch
 };
 
 struct Rose {
@@ -44,8 +44,8 @@ struct Rose {
     std::map<std::string, int> counts; // modules by name in the final string
 };
 
-Rose grow(const std::string& path, std::uint64_t seed, std::vector<std::pair<std::string, std::string>> defines = {},
-          int threads = 1) {
+Rose grow(const std::string& path, std::uint64_t seed,
+          std::vector<std::pair<std::string, std::string>> defines = {}, int threads = 1) {
     SourceManager sources;
     Diagnostics diags;
     CompileOptions co;
@@ -70,7 +70,8 @@ Rose grow(const std::string& path, std::uint64_t seed, std::vector<std::pair<std
 
     std::map<ModuleId, int> axis_of_first;
     for (std::size_t a = 0; a < rose.skeleton.axes.size(); ++a)
-        if (rose.skeleton.axes[a].points.size() > 1) axis_of_first[rose.skeleton.axes[a].points[1].id] = static_cast<int>(a);
+        if (rose.skeleton.axes[a].points.size() > 1)
+            axis_of_first[rose.skeleton.axes[a].points[1].id] = static_cast<int>(a);
 
     const ModuleString& s = d.string();
     auto name = [&](std::size_t i) -> const std::string& { return program->symbols[s.sym[i]].name; };
@@ -84,9 +85,12 @@ Rose grow(const std::string& path, std::uint64_t seed, std::vector<std::pair<std
         int depth = 0;
         for (std::size_t j = i + 1; j < s.size() && depth >= 0; ++j) {
             const std::string& n = name(j);
-            if (n == "[") ++depth;
-            else if (n == "]") --depth;
-            else if (n == "Bloom") ++st.blooms;
+            if (n == "[")
+                ++depth;
+            else if (n == "]")
+                --depth;
+            else if (n == "Bloom")
+                ++st.blooms;
             else if (n == "F" && depth == 0) {
                 if (st.own_segments++ == 0) {
                     auto it = axis_of_first.find(s.ids[j]);
@@ -108,7 +112,9 @@ std::vector<glm::dvec3> points(const Rose& r, const StemInfo& s) {
 }
 
 // |p / radii| for an ellipsoid centred on the bud union: 1 on the surface
-double level(const glm::dvec3& p, double r, double h) { return glm::length(p / glm::dvec3(r, h, r)); }
+double level(const glm::dvec3& p, double r, double h) {
+    return glm::length(p / glm::dvec3(r, h, r));
+}
 
 std::vector<std::string> rose_grammars() {
     std::vector<std::string> files;
@@ -170,7 +176,8 @@ void check_rose(const Rose& r, const std::string& what) {
         if (st.type == Trunk) {
             ++trunks;
             // trunks end just past the trunk ellipsoid, or past the crown when that is smaller
-            bool past_trunk = level(last, r_trunk, h_trunk) >= 1, past_crown = level(last, r_crown, h_crown) >= 1;
+            bool past_trunk = level(last, r_trunk, h_trunk) >= 1,
+                 past_crown = level(last, r_crown, h_crown) >= 1;
             CHECK((past_trunk || past_crown));
             if (segments > 1) {
                 CHECK(level(before, r_trunk, h_trunk) < 1);
@@ -267,7 +274,8 @@ void check_rose(const Rose& r, const std::string& what) {
         for (const auto& c : kids) {
             if (c.k >= skip_from) continue;
             const glm::dvec3 d = dir[c.k], rr = ref[c.k];
-            az.emplace_back(c.k, std::atan2(glm::dot(c.g, glm::cross(d, rr)), glm::dot(c.g, rr)) * 180 / std::numbers::pi);
+            az.emplace_back(c.k, std::atan2(glm::dot(c.g, glm::cross(d, rr)), glm::dot(c.g, rr)) * 180 /
+                                     std::numbers::pi);
         }
         std::sort(az.begin(), az.end());
         for (std::size_t i = 1; i < az.size(); ++i) {
@@ -358,5 +366,5 @@ TEST_CASE("rose: stage 1 is the winter-pruned shape, dormant buds where terminal
     for (const auto& st : winter.stems) woody_winter += st.type <= Inter;
     CHECK(woody_winter == woody_summer); // flowering adds to the frame, never changes it
     CHECK(terminal > 0);
-    CHECK(terminal <= dormant);          // some buds are picked by density control
+    CHECK(terminal <= dormant); // some buds are picked by density control
 }

@@ -29,23 +29,23 @@ struct Emitter {
 };
 
 struct FluidSettings {
-    double spacing = 0.05;        // initial distance between particles (m)
-    double support = 0.1;         // h: kernel support radius (2 spacings)
-    double rest_density = 1.3;    // rho_0: air, kg/m^3 (the paper: 1.3 - 1.4)
-    double stiffness = 20.0;      // k of p = k rho (a gas)
-    double viscosity = 0.02;      // mu
-    double dt = 0.0025;           // a fluid step; the plant's 25 ms step runs several
+    double spacing = 0.05;     // initial distance between particles (m)
+    double support = 0.1;      // h: kernel support radius (2 spacings)
+    double rest_density = 1.3; // rho_0: air, kg/m^3 (the paper: 1.3 - 1.4)
+    double stiffness = 20.0;   // k of p = k rho (a gas)
+    double viscosity = 0.02;   // mu
+    double dt = 0.0025;        // a fluid step; the plant's 25 ms step runs several
     glm::dvec3 domain_lo{-1, 0, -1}, domain_hi{1, 2, 1};
-    glm::dvec3 wind{0.0};         // the wind's velocity: particles leaving the domain re-enter upwind
-    double drive = 5.0;           // 1/s: how fast a wind brings the air to its velocity
+    glm::dvec3 wind{0.0}; // the wind's velocity: particles leaving the domain re-enter upwind
+    double drive = 5.0;   // 1/s: how fast a wind brings the air to its velocity
     std::vector<Emitter> emitters;
-    double emitter_drive = 40.0;  // 1/s: how fast an emitter brings the air at its centre to its velocity
-    double coupling = 1.0;        // scales the forces between air and plant
+    double emitter_drive = 40.0; // 1/s: how fast an emitter brings the air at its centre to its velocity
+    double coupling = 1.0;       // scales the forces between air and plant
     int threads = 1;
 };
 
 class Fluid {
-public:
+  public:
     explicit Fluid(FluidSettings s = {}) : s_(s) {}
 
     // Fills the box [lo, hi] with particles at the centres of cubic cells of the spacing and sets the
@@ -80,7 +80,7 @@ public:
     static double poly6_coefficient(double h);
     static double gradient_coefficient(double h);
 
-private:
+  private:
     void build_grid();
     // f(index, position) for every particle in the cells a ball of `radius` around p touches
     template <class F> void for_neighbours(const glm::dvec3& p, double radius, F&& f) const;

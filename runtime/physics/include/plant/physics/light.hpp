@@ -11,7 +11,7 @@
 namespace plant::physics {
 
 class LightGrid {
-public:
+  public:
     // Counts `points` in cells of `cell` (doubled until the grid has at most 4 million cells);
     // points that are not finite are left out.
     void build(const std::vector<glm::dvec3>& points, double cell);
@@ -21,7 +21,7 @@ public:
     // Eq. 7's O: 1 - exp(-opacity * count_toward(p, to_light)), in [0, 1).
     double occlusion(const glm::dvec3& p, const glm::dvec3& to_light, double opacity) const;
 
-private:
+  private:
     glm::dvec3 lo_{0.0};
     double cell_ = 0.1;
     glm::ivec3 n_{0};

@@ -24,19 +24,19 @@ struct Handle {
 
 // Growth and branching (section 4.2, 4.3; Table 2's parameters).
 struct Growth {
-    double segment_length = 0.1;    // a new particle every this much of growth
-    double speed = 0.05;            // apical growth, m/s
+    double segment_length = 0.1; // a new particle every this much of growth
+    double speed = 0.05;         // apical growth, m/s
     std::size_t max_particles = 25000;
-    double branch_probability = 0;  // BP: chance that a new particle carries a lateral bud
-    double branch_variance = 0.5;   // V in [0, 1]: a lateral turns up to V * 90 degrees away
-    int max_lateral = 1;            // B: lateral buds per particle
-    double falloff = 0.8;           // thickness of a lateral relative to its parent
+    double branch_probability = 0; // BP: chance that a new particle carries a lateral bud
+    double branch_variance = 0.5;  // V in [0, 1]: a lateral turns up to V * 90 degrees away
+    int max_lateral = 1;           // B: lateral buds per particle
+    double falloff = 0.8;          // thickness of a lateral relative to its parent
     glm::dvec3 to_light{0, 1, 0};
-    double phototropism = 0;        // eta (Eq. 7)
-    double adaption = 0;            // tau (Eq. 6)
-    double adaption_range = 0.3;    // obstacles nearer than this steer the apex
-    double opacity = 0.15;          // Eq. 7's O = 1 - exp(-opacity * particles between the apex and the light)
-    double light_cell = 0.1;        // the cells those particles are counted in
+    double phototropism = 0;     // eta (Eq. 7)
+    double adaption = 0;         // tau (Eq. 6)
+    double adaption_range = 0.3; // obstacles nearer than this steer the apex
+    double opacity = 0.15;       // Eq. 7's O = 1 - exp(-opacity * particles between the apex and the light)
+    double light_cell = 0.1;     // the cells those particles are counted in
     std::uint64_t seed = 1;
 };
 
@@ -48,8 +48,8 @@ struct Settings {
     double stiffening_time = 10; // t_m: a particle reaches full stiffness at this age (s = t_l / t_m)
     double fixed_stiffness = -1; // >= 0: every particle has this stiffness instead (tests, tools)
     Growth growth;
-    int iterations = 4;          // shape-matching passes per step
-    int threads = 1;             // threads for the shape-matching passes (results do not depend on it)
+    int iterations = 4; // shape-matching passes per step
+    int threads = 1;    // threads for the shape-matching passes (results do not depend on it)
     // Rotation-extraction iterations per group and pass. Each pass warm-starts from the last
     // one's rotation, so the iterations add up over a step's passes, as Müller et al. 2016
     // suggest for simulations; a cold solve (goals(), group_rotation()) runs up to 20.
@@ -66,7 +66,8 @@ glm::dvec3 surface_adaption(const glm::dvec3& forward, const glm::dvec3& to_surf
 // Phototropism, Eq. 7: toward the light by (1 - O) eta dt, O the occlusion in [0, 1]. The axis is
 // forward x to_light, so the apex turns toward the light (the printed v_l x v_f turns it away:
 // PLANTS.md lists that pitfall).
-glm::dvec3 phototropism(const glm::dvec3& forward, const glm::dvec3& to_light, double occlusion, double eta, double dt);
+glm::dvec3 phototropism(const glm::dvec3& forward, const glm::dvec3& to_light, double occlusion, double eta,
+                        double dt);
 
 // Obstacles for particles: signed distance fields.
 // A signed distance sampled on a regular grid (a triangle mesh's, say): trilinear inside the
@@ -81,11 +82,11 @@ struct DistanceGrid {
 
 struct Obstacle {
     enum Kind { Sphere, Box, Plane, Grid } kind = Plane;
-    glm::dvec3 a{0.0}, b{0.0, 1.0, 0.0}; // sphere: center, (radius in b.x); box: min, max; plane: point, normal;
-                                         // grid: a is its offset from where it was sampled
+    glm::dvec3 a{0.0}, b{0.0, 1.0, 0.0}; // sphere: center, (radius in b.x); box: min, max; plane: point,
+                                         // normal; grid: a is its offset from where it was sampled
     std::shared_ptr<const DistanceGrid> grid{}; // Grid: the sampled distance (shared, never changed)
-    double friction = 0.5;   // fraction of the tangential velocity removed on contact
-    double elasticity = 0.0; // fraction of the normal velocity kept, reversed, on contact
+    double friction = 0.5;                      // fraction of the tangential velocity removed on contact
+    double elasticity = 0.0;                    // fraction of the normal velocity kept, reversed, on contact
     double distance(const glm::dvec3& p) const;
     glm::dvec3 normal(const glm::dvec3& p) const; // gradient of the distance
 };
@@ -97,7 +98,7 @@ struct Obstacle {
 glm::dquat extract_rotation(const glm::dmat3& A, glm::dquat q, int iterations = 20);
 
 class World {
-public:
+  public:
     explicit World(Settings s = {}) : settings_(s) {}
 
     // A root: fixed where it is, with effectively infinite mass in its groups (or, with
@@ -116,7 +117,8 @@ public:
     // A particle placed next to a parent that may have moved or bent since it was made: its rest
     // state is taken relative to the parent's rest state as its current state is to the parent's
     // current state, so growth becomes part of the shape the plant returns to (Eq. 9-10).
-    Handle add_grown(Handle parent, const glm::dvec3& position, const glm::dquat& orientation, const glm::dvec3& radii);
+    Handle add_grown(Handle parent, const glm::dvec3& position, const glm::dquat& orientation,
+                     const glm::dvec3& radii);
     // Removes h and everything attached below it (cutting a branch).
     void remove(Handle h);
     // Whether h still hangs from a fixed root (false once its branch broke off or was cut).
@@ -198,7 +200,7 @@ public:
     // A hash of the whole state, for determinism tests.
     std::uint64_t state_hash() const;
 
-private:
+  private:
     // The shape-matching group of particle i: its parent, itself, its children.
     template <class F> void for_group(std::uint32_t i, F&& f) const {
         if (parent_[i] != kNone) f(parent_[i]);
@@ -207,7 +209,9 @@ private:
     }
     static constexpr std::uint32_t kNone = ~0u; // no parent
     // The particle's own rotation from rest: a warm start for its group's rotation.
-    glm::dquat rotation_from_rest(std::uint32_t i) const { return glm::normalize(q_[i] * glm::inverse(rest_q_[i])); }
+    glm::dquat rotation_from_rest(std::uint32_t i) const {
+        return glm::normalize(q_[i] * glm::inverse(rest_q_[i]));
+    }
     // A group's mass center now and its rotation (Eq. 14-15), also as a matrix for the goals.
     struct Frame {
         glm::dvec3 c{0.0};
@@ -230,15 +234,15 @@ private:
     struct Groups {
         struct Member {
             std::uint32_t particle;
-            double share;   // m_j / M_i, for the mass center
-            glm::dvec3 mr;  // m_j (x̄_j - c̄_i), for Eq. 14's sum
+            double share;  // m_j / M_i, for the mass center
+            glm::dvec3 mr; // m_j (x̄_j - c̄_i), for Eq. 14's sum
         };
         struct Source {
             std::uint32_t group;
             double weight;     // Eq. 4's weight over the sum of j's weights
             glm::dvec3 offset; // x̄_j - c̄_i
         };
-        std::vector<std::uint32_t> start;  // group i: member[start[i] .. start[i + 1])
+        std::vector<std::uint32_t> start; // group i: member[start[i] .. start[i + 1])
         std::vector<Member> member;
         std::vector<std::uint32_t> source_start; // particle j: source[source_start[j] .. source_start[j + 1])
         std::vector<Source> source;
@@ -246,16 +250,17 @@ private:
     };
     void build_groups(Groups& g) const;
     // Eq. 15's ellipsoid moments of every particle (`each`) and their sums over each group.
-    void group_moments(const Groups& groups, std::vector<glm::dmat3>& each, std::vector<glm::dmat3>& sums) const;
+    void group_moments(const Groups& groups, std::vector<glm::dmat3>& each,
+                       std::vector<glm::dmat3>& sums) const;
     // Group i's frame, given the sum of its members' ellipsoid moments, with at most
     // `iterations` rotation-extraction iterations warm-started from `warm`; with `warm_matrix`,
     // out.M is warm's rotation matrix already.
-    void group_frame(std::uint32_t i, glm::dquat warm, const glm::dmat3& moment, int iterations, const Groups& groups,
-                     Frame& out, bool warm_matrix = false) const;
+    void group_frame(std::uint32_t i, glm::dquat warm, const glm::dmat3& moment, int iterations,
+                     const Groups& groups, Frame& out, bool warm_matrix = false) const;
     // group_frame for two groups with the same number of members, each warm-started from its
     // frame with one iteration: the same results, computed two lanes at a time.
-    void frame_pair(const std::uint32_t (&group)[2], const std::vector<glm::dmat3>& moments, const Groups& groups,
-                    std::vector<Frame>& frames) const;
+    void frame_pair(const std::uint32_t (&group)[2], const std::vector<glm::dmat3>& moments,
+                    const Groups& groups, std::vector<Frame>& frames) const;
     // One shape-matching pass: every group's frame (Eq. 14-15, warm-started from `frames`),
     // with at most `iterations` rotation-extraction iterations per group; `moments` holds each
     // group's moment sum (group_moments).
@@ -298,11 +303,11 @@ private:
         std::vector<Frame> frames;
         std::vector<glm::dmat3> moments, group_moment; // per particle, and summed per group
         std::vector<glm::dvec3> old;
-        std::vector<Cell> table;                  // the collision pass's cells
+        std::vector<Cell> table;                     // the collision pass's cells
         std::vector<std::uint32_t> slot_of, members; // particles grouped by table slot
-        std::vector<glm::i64vec3> cell_of;          // each particle's collision cell
-        std::vector<double> thin;                                   // each particle's thinnest radius
-        std::vector<glm::dmat3> rest_moment;                        // 0.2 m D R̄ᵀ, while the groups are current
+        std::vector<glm::i64vec3> cell_of;           // each particle's collision cell
+        std::vector<double> thin;                    // each particle's thinnest radius
+        std::vector<glm::dmat3> rest_moment;         // 0.2 m D R̄ᵀ, while the groups are current
         std::vector<glm::dvec3> push;
         std::vector<double> stiffness; // each particle's s, during a step
         Groups groups;
