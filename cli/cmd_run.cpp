@@ -98,14 +98,16 @@ void setup_run(CLI::App& app, int& exit_code) {
         app.add_subcommand("run", "Grow a grammar and write meshes, images, skeletons or strings");
     add_grammar_options(*cmd, c->g, true);
     cmd->add_option("-o,--output", c->outputs,
-                    "Output file, chosen by extension: .glb .gltf .obj .ply .off .png .svg .txt .skel.json "
-                    ".mesh.txt (counts and bounds); "
-                    "repeat for several (default: out/NAME.glb and out/NAME.png)")
+                    "Output file, its format chosen by extension (listed below); repeat for several "
+                    "(default: out/NAME.glb and out/NAME.png)")
         ->type_name("FILE");
     cmd->add_option("--sides", c->sides, "Vertices around each ring of a branch")->check(CLI::Range(3, 64));
     cmd->add_option("--size", c->size, "Size of PNG previews")->type_name("WxH");
     cmd->add_flag("--no-obstacles", c->no_obstacles,
                   "Leave the environments' obstacles (a climber's walls, say) out of meshes and images");
+    std::string formats = "Output formats:\n";
+    for (const auto& f : output_formats()) formats += fmt::format("  {:<11} {}\n", f.extension, f.doc);
+    cmd->footer(formats);
     cmd->callback([c, &exit_code] { exit_code = run_main(*c); });
 }
 

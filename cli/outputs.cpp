@@ -32,31 +32,73 @@ std::string mesh_summary(const Scene& s) {
         s.bounds_min.z, s.bounds_max.x, s.bounds_max.y, s.bounds_max.z);
 }
 
+void write_scene_gltf(const OutputSources& from, const std::string& path) {
+    write_gltf(from.scene, path);
+}
+void write_scene_mesh(const OutputSources& from, const std::string& path) {
+    write_mesh_file(from.scene, path); // OBJ, PLY or OFF by the path's extension
+}
+void write_scene_png(const OutputSources& from, const std::string& path) {
+    write_png(from.scene, path, from.options.width, from.options.height);
+}
+void write_skeleton_svg(const OutputSources& from, const std::string& path) {
+    write_svg(from.skeleton, path);
+}
+void write_skeleton_file(const OutputSources& from, const std::string& path) {
+    write_skeleton_json(from.skeleton, path);
+}
+void write_string_text(const OutputSources& from, const std::string& path) {
+    write_file_atomically(path, format_string(from.program, from.derivation.string()) + "\n");
+}
+void write_mesh_summary(const OutputSources& from, const std::string& path) {
+    write_file_atomically(path, mesh_summary(from.scene));
+}
+
+// Adding a format: one row here and its writer above (docs: README.md lists the extensions).
+constexpr OutputFormat kFormats[] = {
+    {".glb", OutputNeeds::Scene, write_scene_gltf,
+     "glTF 2.0, binary; each organ is one mesh shared by every node that places it"},
+    {".gltf", OutputNeeds::Scene, write_scene_gltf, "glTF 2.0 as JSON, the buffer embedded as a data URI"},
+    {".obj", OutputNeeds::Scene, write_scene_mesh, "Wavefront OBJ, everything in one triangle mesh"},
+    {".ply", OutputNeeds::Scene, write_scene_mesh, "PLY, everything in one triangle mesh"},
+    {".off", OutputNeeds::Scene, write_scene_mesh, "OFF, everything in one triangle mesh"},
+    {".png", OutputNeeds::Scene, write_scene_png, "a shaded preview from a 3/4 view, --size pixels"},
+    {".svg", OutputNeeds::Skeleton, write_skeleton_svg, "a line drawing of the XY plane, for 2D grammars"},
+    {".txt", OutputNeeds::String, write_string_text, "the derived string, as plant derive prints it"},
+    {".skel.json", OutputNeeds::Skeleton, write_skeleton_file,
+     "the skeleton, what the turtle drew before meshing (docs/skeleton.md)"},
+    {".mesh.txt", OutputNeeds::Scene, write_mesh_summary,
+     "counts and bounds of the meshed scene, for golden files"},
+};
+
 } // namespace
 
-std::optional<Format> format_of(const std::string& given) {
+std::span<const OutputFormat> output_formats() {
+    return kFormats;
+}
+
+const OutputFormat* format_of(const std::string& given) {
     std::string path = given;
     std::transform(path.begin(), path.end(), path.begin(),
                    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    auto ends = [&](const char* ext) {
-        std::string e = ext;
-        return path.size() > e.size() && path.compare(path.size() - e.size(), e.size(), e) == 0;
-    };
-    if (ends(".skel.json")) return Format::Skeleton;
-    if (ends(".mesh.txt")) return Format::MeshSummary;
-    if (ends(".glb")) return Format::Glb;
-    if (ends(".gltf")) return Format::Gltf;
-    if (ends(".obj")) return Format::Obj;
-    if (ends(".ply")) return Format::Ply;
-    if (ends(".off")) return Format::Off;
-    if (ends(".png")) return Format::Png;
-    if (ends(".svg")) return Format::Svg;
-    if (ends(".txt")) return Format::Txt;
-    return std::nullopt;
+    const OutputFormat* best = nullptr;
+    for (const auto& f : kFormats) {
+        const std::string_view e = f.extension;
+        if (path.size() > e.size() && path.compare(path.size() - e.size(), e.size(), e) == 0 &&
+            (!best || e.size() > std::string_view(best->extension).size()))
+            best = &f;
+    }
+    return best;
 }
 
-const char* known_extensions() {
-    return ".glb .gltf .obj .ply .off .png .svg .txt .skel.json or .mesh.txt";
+std::string known_extensions() {
+    std::string out;
+    for (std::size_t k = 0; k < std::size(kFormats); ++k)
+        out += (k == 0                         ? ""
+                : k + 1 == std::size(kFormats) ? " or "
+                                               : " ") +
+               std::string(kFormats[k].extension);
+    return out;
 }
 
 // The environments' obstacles as one more prototype, placed once where it is: flat-shaded
@@ -94,17 +136,17 @@ static void add_environments(const Program& program, Scene& scene) {
 
 OutputSummary write_outputs(const Program& program, const Derivation& d,
                             const std::vector<std::string>& paths, const OutputOptions& options) {
-    std::vector<Format> formats;
+    std::vector<const OutputFormat*> formats;
     for (const auto& p : paths) {
-        auto f = format_of(p);
+        const OutputFormat* f = format_of(p);
         if (!f)
             throw ExportError(fmt::format("cannot tell the format of '{}': use {}", p, known_extensions()));
-        formats.push_back(*f);
+        formats.push_back(f);
     }
     bool need_skeleton = false, need_scene = false;
-    for (Format f : formats) {
-        need_skeleton = need_skeleton || f != Format::Txt;
-        need_scene = need_scene || (f != Format::Txt && f != Format::Svg && f != Format::Skeleton);
+    for (const OutputFormat* f : formats) {
+        need_skeleton = need_skeleton || f->needs != OutputNeeds::String;
+        need_scene = need_scene || f->needs == OutputNeeds::Scene;
     }
     Skeleton skeleton;
     Scene scene;
@@ -136,32 +178,7 @@ OutputSummary write_outputs(const Program& program, const Derivation& d,
                            name.substr(name.find('.') == std::string::npos ? name.size() : name.find('.'))))
                     .string();
             temps.push_back(path);
-            switch (formats[k]) {
-            case Format::Glb:
-            case Format::Gltf:
-                write_gltf(scene, path);
-                break;
-            case Format::Obj:
-            case Format::Ply:
-            case Format::Off:
-                write_mesh_file(scene, path);
-                break;
-            case Format::Png:
-                write_png(scene, path, options.width, options.height);
-                break;
-            case Format::Svg:
-                write_svg(skeleton, path);
-                break;
-            case Format::Skeleton:
-                write_skeleton_json(skeleton, path);
-                break;
-            case Format::Txt:
-                write_file_atomically(path, format_string(program, d.string()) + "\n");
-                break;
-            case Format::MeshSummary:
-                write_file_atomically(path, mesh_summary(scene));
-                break;
-            }
+            formats[k]->write(OutputSources{program, d, skeleton, scene, options}, path);
         }
         for (std::size_t k = 0; k < temps.size(); ++k) {
             std::error_code ec;

@@ -1,25 +1,54 @@
-// Writing a derivation's results to files by extension; shared by `plant run` and the REPL.
+// Writing a derivation's results to files by extension; shared by `plant run`, the REPL's
+// :export and `plant help formats`. Every output format is one row of `output_formats()`.
 #pragma once
 
 #include "plant/derive.hpp"
+#include "plant/scene.hpp"
+#include "plant/skeleton.hpp"
 
-#include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
 namespace plant::cli {
-
-enum class Format { Glb, Gltf, Obj, Ply, Off, Png, Svg, Txt, Skeleton, MeshSummary };
-
-// The format named by a file's extension, if any.
-std::optional<Format> format_of(const std::string& path);
-const char* known_extensions();
 
 struct OutputOptions {
     int sides = 8;
     int width = 800, height = 800;
     bool obstacles = true; // the environments' geometry (walls, boxes) goes into meshes and images
 };
+
+// What a format is made from; each stage needs the ones before it.
+enum class OutputNeeds {
+    String,   // the derived module string only
+    Skeleton, // what the turtle drew (interprets the string)
+    Scene,    // the meshed plant (meshes the skeleton)
+};
+
+// Everything a writer may read; the skeleton and scene are empty unless some requested format
+// needs them.
+struct OutputSources {
+    const Program& program;
+    const Derivation& derivation;
+    const Skeleton& skeleton;
+    const Scene& scene;
+    const OutputOptions& options;
+};
+
+struct OutputFormat {
+    const char* extension; // with its dot; matched case-insensitively, the longest match wins
+    OutputNeeds needs;
+    void (*write)(const OutputSources& from, const std::string& path);
+    const char* doc; // one line for `plant run --help` and `plant help formats`
+};
+
+// The formats, in the order they are listed to users.
+std::span<const OutputFormat> output_formats();
+
+// The format named by a file's extension, or null.
+const OutputFormat* format_of(const std::string& path);
+// The extensions for messages: ".glb .gltf ... or .mesh.txt".
+std::string known_extensions();
 
 // Interprets, meshes (when some output needs it) and writes every path. Throws RuntimeError or
 // ExportError. Returns the number of triangles and organs meshed, for a summary.
