@@ -607,18 +607,13 @@ ValueType Compiler::compile_call(Ctx& c, const ast::Expr& e) {
             width += value_width(types[i]);
         }
         if (!ok) continue;
-        if ((b.id == BuiltinId::Uniform || b.id == BuiltinId::Normal || b.id == BuiltinId::Chance ||
-             b.id == BuiltinId::Id) &&
-            c.kind == CtxKind::Global) {
+        if (b.per_module() && c.kind == CtxKind::Global) {
             diags_->error(e.span,
                           fmt::format("'{}' depends on the module being rewritten and cannot be used where "
                                       "the value must be known before the derivation starts",
                                       name));
         }
-        if ((b.id == BuiltinId::Uniform || b.id == BuiltinId::Normal || b.id == BuiltinId::Chance ||
-             b.id == BuiltinId::Id) &&
-            c.function >= 0)
-            fn_random_[static_cast<std::size_t>(c.function)] = true;
+        if (b.per_module() && c.function >= 0) fn_random_[static_cast<std::size_t>(c.function)] = true;
         if (b.id == BuiltinId::Id) P_.uses_id = true;
         emit(c, Op::Builtin, static_cast<std::int32_t>(b.id), width, e.span,
              static_cast<std::uint16_t>(value_width(b.result)));
