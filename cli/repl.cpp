@@ -8,11 +8,11 @@
 #include "plant/export.hpp"
 #include "plant/query.hpp"
 #include "plant/vm.hpp"
+#include "repl_text.hpp"
 
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <charconv>
 #include <filesystem>
 #include <sstream>
 #include <thread>
@@ -21,65 +21,6 @@
 namespace plant::cli {
 
 namespace fs = std::filesystem;
-
-namespace {
-
-// A whole number written with digits only, as the REPL's counts and seeds are.
-std::optional<std::uint64_t> whole_number(const std::string& text) {
-    std::uint64_t v = 0;
-    auto r = std::from_chars(text.data(), text.data() + text.size(), v);
-    if (text.empty() || r.ec != std::errc() || r.ptr != text.data() + text.size()) return std::nullopt;
-    return v;
-}
-
-std::string modules(std::size_t n) {
-    return fmt::format("{} module{}", n, n == 1 ? "" : "s");
-}
-
-std::string trim(const std::string& s) {
-    std::size_t b = s.find_first_not_of(" \t\r\n"), e = s.find_last_not_of(" \t\r\n");
-    return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
-}
-
-struct CommandInfo {
-    const char* name;
-    const char* usage;
-    const char* help;
-};
-
-const CommandInfo kCommands[] = {
-    {"load", ":load FILE", "read a grammar file; the session starts again at step 0"},
-    {"reload", ":reload",
-     "read the file again, keep :set values and typed rules, replay the same number of steps"},
-    {"step", ":step [N]", "derive N more steps (default 1)"},
-    {"back", ":back [N]",
-     "undo the last N steps (default 1), with the edits (:do) made in them and the :use choices made after "
-     "the step it goes back to"},
-    {"reset", ":reset", "go back to the axiom (step 0)"},
-    {"show", ":show [A..B] [--ids]", "print the string, or modules A to B; long strings are shortened"},
-    {"find", ":find PATTERN",
-     "list the modules a name or predecessor pattern matches (A, A(x) : x > 2, B < A(x)), with positions and "
-     "identities"},
-    {"set", ":set NAME VALUE", "change a param (VALUE is an expression) and replay"},
-    {"params", ":params", "list the params and vars with their current values"},
-    {"seed", ":seed S", "change the random seed and replay"},
-    {"rules", ":rules", "list the productions, typed ones included"},
-    {"use", ":use GROUP", "select a rule group for the next steps (:use none to clear)"},
-    {"do", ":do STATEMENTS",
-     "run statements as an on before_step hook would before the next step: a climber's edits "
-     "(ivy.cut(ID), ivy.pull(ID, vec3(X, Y, Z)), ivy.wind(vec3(X, Y, Z)), ivy.seed(ID), "
-     "ivy.move(K, vec3(X, Y, Z))), or assigning vars; such a call typed alone needs no :do. "
-     "Kept with the step for replays; :back undoes it"},
-    {"edits", ":edits", "list the edits (:do) and the steps they run before"},
-    {"stats", ":stats", "modules per symbol, branch depth, steps and the time of the last step"},
-    {"time", ":time", "the time of the last step"},
-    {"export", ":export FILE...", "write files as plant run does (.glb .png .obj .svg .txt .skel.json ...)"},
-    {"render", ":render [FILE.png]", "write a PNG preview (default out/repl.png)"},
-    {"help", ":help [COMMAND]", "list the commands, or explain one"},
-    {"quit", ":quit", "end the session"},
-};
-
-} // namespace
 
 Session::Session(std::ostream& out, std::ostream& err, bool color) : out_(out), err_(err), color_(color) {}
 
@@ -503,149 +444,24 @@ void Session::export_files(const std::vector<std::string>& paths) {
     }
 }
 
-void Session::help(const std::string& topic) {
-    std::string name = topic.empty() || topic[0] != ':' ? topic : topic.substr(1);
-    for (const auto& c : kCommands) {
-        if (name.empty()) {
-            out_ << fmt::format("  {:<22} {}\n", c.usage, c.help);
-        } else if (name == c.name) {
-            out_ << c.usage << "\n  " << c.help << "\n";
-            return;
-        }
+// :back [N] and :reset; back_to (above) does their work
+void Session::back_command(const std::string& name, const std::string& rest) {
+    auto count = [&](int fallback) { return count_arg(name, rest, fallback); };
+    if (auto n = count(1); n && need_derivation()) {
+        int k = std::min<int>(*n, static_cast<int>(history_.size()) - 1);
+        if (k == 0)
+            out_ << "nothing to undo\n";
+        else if (k < *n)
+            out_ << fmt::format("only {} step{} to undo\n", k, k == 1 ? "" : "s");
+        back_to(static_cast<int>(history_.size()) - 1 - k);
+        out_ << fmt::format("step {}: {}\n", current().steps_done(), modules(current().string().size()));
     }
-    if (!name.empty()) {
-        error() << fmt::format("no command ':{}'; :help lists them\n", name);
-        return;
-    }
-    out_ << "Anything else is a production (A(x) -> B(x + 1);), an axiom (axiom: A(1);) or an expression "
-            "to evaluate (2 * pi).\n";
 }
 
-bool Session::command(const std::string& name, const std::string& rest) {
-    auto count = [&](int fallback) -> std::optional<int> {
-        if (rest.empty()) return fallback;
-        if (auto v = whole_number(rest); v && *v <= 1000000) return static_cast<int>(*v);
-        error() << fmt::format("':{}' expects a whole number from 0 to 1000000, found '{}'\n", name, rest);
-        return std::nullopt;
-    };
-    if (name == "quit" || name == "q" || name == "exit") return false;
-    if (name == "help" || name == "h" || name == "?") {
-        help(rest);
-    } else if (name == "load") {
-        if (rest.empty())
-            error() << "':load' expects a file name\n";
-        else
-            load(rest);
-    } else if (name == "reload") {
-        if (file_.empty()) {
-            error() << "nothing to reload: :load a file first\n";
-        } else {
-            int steps = history_.empty() ? 0 : current().steps_done();
-            std::string saved = file_text_;
-            if (!read_file(file_, file_text_)) {
-                error() << fmt::format("plant: cannot read '{}'\n", file_);
-            } else if (rebuild(steps)) {
-                out_ << fmt::format("reloaded; step {}: {}\n", current().steps_done(),
-                                    modules(current().string().size()));
-            } else {
-                file_text_ = saved;
-            }
-        }
-    } else if (name == "step" || name == "s") {
-        if (auto n = count(1)) step(*n);
-    } else if (name == "back" || name == "b") {
-        if (auto n = count(1); n && need_derivation()) {
-            int k = std::min<int>(*n, static_cast<int>(history_.size()) - 1);
-            if (k == 0)
-                out_ << "nothing to undo\n";
-            else if (k < *n)
-                out_ << fmt::format("only {} step{} to undo\n", k, k == 1 ? "" : "s");
-            back_to(static_cast<int>(history_.size()) - 1 - k);
-            out_ << fmt::format("step {}: {}\n", current().steps_done(), modules(current().string().size()));
-        }
-    } else if (name == "reset") {
-        // back_to derives again only when it has to; :reset always starts afresh
-        if (need_derivation() && (back_to(0) || rebuild(0)))
-            out_ << fmt::format("step 0: {}\n", modules(current().string().size()));
-    } else if (name == "show") {
-        show(rest);
-    } else if (name == "find") {
-        find(rest);
-    } else if (name == "set") {
-        std::istringstream in(rest);
-        std::string pname;
-        in >> pname;
-        std::string value;
-        std::getline(in, value);
-        value = trim(value);
-        if (pname.empty() || value.empty()) {
-            error() << "':set' expects NAME VALUE, as in :set r1 0.8\n";
-        } else if (program_ &&
-                   std::none_of(program_->globals.begin(), program_->globals.end(), [&](const Global& g) {
-                       return g.kind == GlobalKind::Param && g.name == pname;
-                   })) {
-            error() << fmt::format("no param '{}'; :params lists them\n", pname);
-        } else {
-            auto saved = params_;
-            params_[pname] = value;
-            int steps = history_.empty() ? 0 : current().steps_done();
-            if (rebuild(steps))
-                out_ << fmt::format("{} = {}; step {}: {}\n", pname, value, current().steps_done(),
-                                    modules(current().string().size()));
-            else
-                params_ = saved;
-        }
-    } else if (name == "params") {
-        params();
-    } else if (name == "seed") {
-        if (auto v = whole_number(rest)) {
-            auto saved = seed_;
-            seed_ = *v;
-            int steps = history_.empty() ? 0 : current().steps_done();
-            if (history_.empty() || rebuild(steps))
-                out_ << fmt::format("seed {}\n", *seed_);
-            else
-                seed_ = saved;
-        } else {
-            error() << fmt::format("':seed' expects a whole number, found '{}'\n", rest);
-        }
-    } else if (name == "rules") {
-        rules();
-    } else if (name == "use") {
-        if (need_derivation()) {
-            int g = rest == "none" ? -1 : program_->group_index(rest);
-            if (g < 0 && rest != "none")
-                error() << fmt::format("no rule group '{}'\n", rest);
-            else {
-                current().use_group(g);
-                // remembered with its step, for replays; later choices at the same step win
-                std::erase_if(uses_, [&](const auto& u) { return u.first >= current().steps_done(); });
-                uses_.emplace_back(current().steps_done(), rest == "none" ? std::string() : rest);
-                out_ << fmt::format("using {}\n", rest);
-            }
-        }
-    } else if (name == "do") {
-        edit(rest);
-    } else if (name == "edits") {
-        list_edits();
-    } else if (name == "stats") {
-        stats();
-    } else if (name == "time") {
-        out_ << fmt::format("last step: {:.3f} ms\n", last_step_ms_);
-    } else if (name == "export") {
-        std::istringstream in(rest);
-        std::vector<std::string> paths;
-        for (std::string p; in >> p;) paths.push_back(p);
-        if (paths.empty())
-            error() << "':export' expects one or more file names\n";
-        else
-            export_files(paths);
-    } else if (name == "render") {
-        export_files({rest.empty() ? std::string("out/repl.png") : rest});
-    } else {
-        error() << fmt::format("unknown command ':{}'; :help lists the commands\n", name);
-    }
-    return true;
+void Session::reset_command() {
+    // back_to derives again only when it has to; :reset always starts afresh
+    if (need_derivation() && (back_to(0) || rebuild(0)))
+        out_ << fmt::format("step 0: {}\n", modules(current().string().size()));
 }
 
 std::ostream& Session::error() {
@@ -694,23 +510,6 @@ bool Session::execute(const std::string& raw) {
     if (line.back() == ';') line.pop_back(); // `2 * r1;` is an expression too
     evaluate(line);
     return true;
-}
-
-std::vector<std::string> Session::completions() const {
-    std::vector<std::string> out;
-    for (const auto& c : kCommands) out.push_back(std::string(":") + c.name);
-    if (program_) {
-        for (const auto& g : program_->globals) out.push_back(g.name);
-        for (const auto& s : program_->symbols.all())
-            if (s.arity >= 0 && !s.name.empty()) out.push_back(s.name);
-        for (const auto& g : program_->groups) out.push_back(g.name);
-        for (const auto& e : program_->environment_names) out.push_back(e);
-        for (const auto& c : program_->curves) out.push_back(c.name);
-        for (const auto& f : program_->functions) out.push_back(f.name);
-    }
-    std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
-    return out;
 }
 
 } // namespace plant::cli

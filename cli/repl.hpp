@@ -12,10 +12,35 @@
 #include <optional>
 #include <ostream>
 #include <set>
+#include <span>
 #include <string>
 #include <vector>
 
 namespace plant::cli {
+
+class Session;
+
+// What Tab offers after a command's name.
+enum class ReplCompletion {
+    Nothing,  // a number, a range, or no argument at all
+    Files,    // file names (left to the line editor)
+    Commands, // command names (:help)
+    Params,   // the grammar's params (:set)
+    Groups,   // rule groups and `none` (:use)
+    Modules,  // module names (:find)
+    Names,    // every name the grammar defines (:do, expressions)
+};
+
+// One REPL command: the one table :help, Tab completion and dispatch read (Session::commands()).
+// Adding a command is one row plus what it does.
+struct ReplCommand {
+    const char* name;
+    const char* aliases; // other names it answers to, separated by spaces
+    void (*run)(Session& session, const std::string& typed, const std::string& rest); // typed: as written
+    const char* usage;
+    const char* help;
+    ReplCompletion completes;
+};
 
 class Session {
   public:
@@ -23,8 +48,15 @@ class Session {
     // Runs one input line: a :command, `axiom: ...`, a production, or an expression.
     // Returns false when the session should end (:quit).
     bool execute(const std::string& line);
-    // Names for tab completion: commands, params, modules, rule groups.
-    std::vector<std::string> completions() const;
+    // Names for tab completion of a word preceded on its line by `before`: after a command's
+    // name, what that command takes; otherwise commands, params, modules, rule groups, ...
+    std::vector<std::string> completions(const std::string& before) const;
+    // What the word after `before` is: Files means the line editor completes file names.
+    ReplCompletion completion_kind(const std::string& before) const;
+    // The commands, in the order :help lists them.
+    static std::span<const ReplCommand> commands();
+    // The lines :help (and `plant help repl`) prints.
+    static std::string command_list();
     void set_interrupt(const std::atomic<bool>* flag) { interrupt_ = flag; }
     int load(const std::string& path); // :load; 0, or the exit code of the failure (65, 66, 70)
     // Whether some line since the last call reported an error (scripts exit 1 when one did).
@@ -37,6 +69,17 @@ class Session {
   private:
     bool command(const std::string& name, const std::string& rest);
     void help(const std::string& topic);
+    // The bodies of the commands that are more than a call (repl_commands.cpp, and for :back and
+    // :reset, repl.cpp beside back_to).
+    std::optional<int> count_arg(const std::string& typed, const std::string& rest, int fallback);
+    void reload();
+    void back_command(const std::string& name, const std::string& rest);
+    void reset_command();
+    void set_param(const std::string& rest);
+    void set_seed(const std::string& rest);
+    void use(const std::string& rest);
+    void export_command(const std::string& rest);
+    const ReplCommand* find_command(const std::string& name) const;
     // Recompiles the session's grammar and replays `steps` steps. Keeps the previous state and
     // reports the error when the new grammar does not compile or derive.
     bool rebuild(int steps, const std::string* extra_fn = nullptr);
@@ -81,6 +124,7 @@ class Session {
     std::vector<std::pair<int, std::string>> edits_;
     std::set<std::string> shown_; // warnings already shown
     bool failed_ = false;
+    bool quit_ = false; // :quit was typed
     bool last_error_runtime_ = false;
     std::ostream& error(); // err_, marking the line as failed
 

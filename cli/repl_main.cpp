@@ -6,6 +6,7 @@
 #include <editline/readline.h>
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
@@ -25,21 +26,27 @@ extern "C" void on_sigint(int) {
 
 std::vector<std::string> g_matches;
 
+std::string g_before; // the line before the word being completed
+
 char* completion_generator(const char* text, int state) {
     static std::size_t next = 0;
     if (state == 0) {
         next = 0;
         g_matches.clear();
         std::string prefix = text;
-        for (const auto& c : g_session->completions())
+        for (const auto& c : g_session->completions(g_before))
             if (c.rfind(prefix, 0) == 0) g_matches.push_back(c);
     }
     if (next >= g_matches.size()) return nullptr;
     return strdup(g_matches[next++].c_str());
 }
 
-char** complete(const char* text, int, int) {
-    rl_attempted_completion_over = 1; // no file name completion
+char** complete(const char* text, int start, int) {
+    g_before.assign(rl_line_buffer, static_cast<std::size_t>(std::max(start, 0)));
+    // file names only where a command takes them (:load, :export)
+    const bool files = g_session->completion_kind(g_before) == ReplCompletion::Files;
+    rl_attempted_completion_over = files ? 0 : 1;
+    if (files) return nullptr;
     return rl_completion_matches(text, completion_generator);
 }
 

@@ -1,0 +1,252 @@
+// The REPL's commands: one table that :help, Tab completion and dispatch read, and the bodies of
+// the commands that are more than a call into the session (repl.cpp holds the session itself).
+#include "repl.hpp"
+#include "repl_text.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <sstream>
+
+namespace plant::cli {
+
+std::span<const ReplCommand> Session::commands() {
+    using C = ReplCompletion;
+    using S = Session;
+    using A = const std::string&;
+    // Adding a command: one row here, and what it does (a call into the session).
+    static const ReplCommand table[] = {
+        {"load", "",
+         [](S& s, A, A rest) {
+             if (rest.empty())
+                 s.error() << "':load' expects a file name\n";
+             else
+                 s.load(rest);
+         },
+         ":load FILE", "read a grammar file; the session starts again at step 0", C::Files},
+        {"reload", "", [](S& s, A, A) { s.reload(); }, ":reload",
+         "read the file again, keep :set values and typed rules, replay the same number of steps",
+         C::Nothing},
+        {"step", "s",
+         [](S& s, A typed, A rest) {
+             if (auto n = s.count_arg(typed, rest, 1)) s.step(*n);
+         },
+         ":step [N]", "derive N more steps (default 1)", C::Nothing},
+        {"back", "b", [](S& s, A typed, A rest) { s.back_command(typed, rest); }, ":back [N]",
+         "undo the last N steps (default 1), with the edits (:do) made in them and the :use choices made "
+         "after "
+         "the step it goes back to",
+         C::Nothing},
+        {"reset", "", [](S& s, A, A) { s.reset_command(); }, ":reset", "go back to the axiom (step 0)",
+         C::Nothing},
+        {"show", "", [](S& s, A, A rest) { s.show(rest); }, ":show [A..B] [--ids]",
+         "print the string, or modules A to B; long strings are shortened", C::Nothing},
+        {"find", "", [](S& s, A, A rest) { s.find(rest); }, ":find PATTERN",
+         "list the modules a name or predecessor pattern matches (A, A(x) : x > 2, B < A(x)), with positions "
+         "and "
+         "identities",
+         C::Modules},
+        {"set", "", [](S& s, A, A rest) { s.set_param(rest); }, ":set NAME VALUE",
+         "change a param (VALUE is an expression) and replay", C::Params},
+        {"params", "", [](S& s, A, A) { s.params(); }, ":params",
+         "list the params and vars with their current values", C::Nothing},
+        {"seed", "", [](S& s, A, A rest) { s.set_seed(rest); }, ":seed S",
+         "change the random seed and replay", C::Nothing},
+        {"rules", "", [](S& s, A, A) { s.rules(); }, ":rules", "list the productions, typed ones included",
+         C::Nothing},
+        {"use", "", [](S& s, A, A rest) { s.use(rest); }, ":use GROUP",
+         "select a rule group for the next steps (:use none to clear)", C::Groups},
+        {"do", "", [](S& s, A, A rest) { s.edit(rest); }, ":do STATEMENTS",
+         "run statements as an on before_step hook would before the next step: a climber's edits "
+         "(ivy.cut(ID), ivy.pull(ID, vec3(X, Y, Z)), ivy.wind(vec3(X, Y, Z)), ivy.seed(ID), "
+         "ivy.move(K, vec3(X, Y, Z))), or assigning vars; such a call typed alone needs no :do. "
+         "Kept with the step for replays; :back undoes it",
+         C::Names},
+        {"edits", "", [](S& s, A, A) { s.list_edits(); }, ":edits",
+         "list the edits (:do) and the steps they run before", C::Nothing},
+        {"stats", "", [](S& s, A, A) { s.stats(); }, ":stats",
+         "modules per symbol, branch depth, steps and the time of the last step", C::Nothing},
+        {"time", "", [](S& s, A, A) { s.out_ << fmt::format("last step: {:.3f} ms\n", s.last_step_ms_); },
+         ":time", "the time of the last step", C::Nothing},
+        {"export", "", [](S& s, A, A rest) { s.export_command(rest); }, ":export FILE...",
+         "write files as plant run does (.glb .png .obj .svg .txt .skel.json ...)", C::Files},
+        {"render", "",
+         [](S& s, A, A rest) { s.export_files({rest.empty() ? std::string("out/repl.png") : rest}); },
+         ":render [FILE.png]", "write a PNG preview (default out/repl.png)", C::Files},
+        {"help", "h ?", [](S& s, A, A rest) { s.help(rest); }, ":help [COMMAND]",
+         "list the commands, or explain one", C::Commands},
+        {"quit", "q exit", [](S& s, A, A) { s.quit_ = true; }, ":quit", "end the session", C::Nothing},
+    };
+    return table;
+}
+
+std::string Session::command_list() {
+    std::string out;
+    for (const auto& c : commands()) out += fmt::format("  {:<22} {}\n", c.usage, c.help);
+    return out;
+}
+
+const ReplCommand* Session::find_command(const std::string& name) const {
+    for (const auto& c : commands()) {
+        if (name == c.name) return &c;
+        std::istringstream aliases(c.aliases);
+        for (std::string alias; aliases >> alias;)
+            if (name == alias) return &c;
+    }
+    return nullptr;
+}
+
+bool Session::command(const std::string& name, const std::string& rest) {
+    const ReplCommand* c = find_command(name);
+    if (!c) {
+        error() << fmt::format("unknown command ':{}'; :help lists the commands\n", name);
+        return true;
+    }
+    c->run(*this, name, rest);
+    return !quit_;
+}
+
+void Session::help(const std::string& topic) {
+    std::string name = topic.empty() || topic[0] != ':' ? topic : topic.substr(1);
+    if (name.empty()) {
+        out_ << command_list();
+        out_ << "Anything else is a production (A(x) -> B(x + 1);), an axiom (axiom: A(1);) or an expression "
+                "to evaluate (2 * pi).\n";
+        return;
+    }
+    for (const auto& c : commands()) {
+        if (name == c.name) {
+            out_ << c.usage << "\n  " << c.help << "\n";
+            return;
+        }
+    }
+    error() << fmt::format("no command ':{}'; :help lists them\n", name);
+}
+
+std::optional<int> Session::count_arg(const std::string& typed, const std::string& rest, int fallback) {
+    if (rest.empty()) return fallback;
+    if (auto v = whole_number(rest); v && *v <= 1000000) return static_cast<int>(*v);
+    error() << fmt::format("':{}' expects a whole number from 0 to 1000000, found '{}'\n", typed, rest);
+    return std::nullopt;
+}
+
+void Session::reload() {
+    if (file_.empty()) {
+        error() << "nothing to reload: :load a file first\n";
+    } else {
+        int steps = history_.empty() ? 0 : current().steps_done();
+        std::string saved = file_text_;
+        if (!read_file(file_, file_text_)) {
+            error() << fmt::format("plant: cannot read '{}'\n", file_);
+        } else if (rebuild(steps)) {
+            out_ << fmt::format("reloaded; step {}: {}\n", current().steps_done(),
+                                modules(current().string().size()));
+        } else {
+            file_text_ = saved;
+        }
+    }
+}
+
+void Session::set_param(const std::string& rest) {
+    std::istringstream in(rest);
+    std::string pname;
+    in >> pname;
+    std::string value;
+    std::getline(in, value);
+    value = trim(value);
+    if (pname.empty() || value.empty()) {
+        error() << "':set' expects NAME VALUE, as in :set r1 0.8\n";
+    } else if (program_ &&
+               std::none_of(program_->globals.begin(), program_->globals.end(), [&](const Global& g) {
+                   return g.kind == GlobalKind::Param && g.name == pname;
+               })) {
+        error() << fmt::format("no param '{}'; :params lists them\n", pname);
+    } else {
+        auto saved = params_;
+        params_[pname] = value;
+        int steps = history_.empty() ? 0 : current().steps_done();
+        if (rebuild(steps))
+            out_ << fmt::format("{} = {}; step {}: {}\n", pname, value, current().steps_done(),
+                                modules(current().string().size()));
+        else
+            params_ = saved;
+    }
+}
+
+void Session::set_seed(const std::string& rest) {
+    if (auto v = whole_number(rest)) {
+        auto saved = seed_;
+        seed_ = *v;
+        int steps = history_.empty() ? 0 : current().steps_done();
+        if (history_.empty() || rebuild(steps))
+            out_ << fmt::format("seed {}\n", *seed_);
+        else
+            seed_ = saved;
+    } else {
+        error() << fmt::format("':seed' expects a whole number, found '{}'\n", rest);
+    }
+}
+
+void Session::use(const std::string& rest) {
+    if (need_derivation()) {
+        int g = rest == "none" ? -1 : program_->group_index(rest);
+        if (g < 0 && rest != "none")
+            error() << fmt::format("no rule group '{}'\n", rest);
+        else {
+            current().use_group(g);
+            // remembered with its step, for replays; later choices at the same step win
+            std::erase_if(uses_, [&](const auto& u) { return u.first >= current().steps_done(); });
+            uses_.emplace_back(current().steps_done(), rest == "none" ? std::string() : rest);
+            out_ << fmt::format("using {}\n", rest);
+        }
+    }
+}
+
+void Session::export_command(const std::string& rest) {
+    std::istringstream in(rest);
+    std::vector<std::string> paths;
+    for (std::string p; in >> p;) paths.push_back(p);
+    if (paths.empty())
+        error() << "':export' expects one or more file names\n";
+    else
+        export_files(paths);
+}
+
+ReplCompletion Session::completion_kind(const std::string& before) const {
+    // the line's first word (a command's name, say), or a word in a production or expression
+    std::string line = trim(before);
+    if (line.empty() || line[0] != ':') return ReplCompletion::Names;
+    std::size_t sp = line.find_first_of(" \t");
+    const ReplCommand* c = find_command(line.substr(1, sp == std::string::npos ? std::string::npos : sp - 1));
+    return c ? c->completes : ReplCompletion::Nothing;
+}
+
+std::vector<std::string> Session::completions(const std::string& before) const {
+    const ReplCompletion kind = completion_kind(before);
+    std::vector<std::string> out;
+    if (kind == ReplCompletion::Names)
+        for (const auto& c : commands()) out.push_back(std::string(":") + c.name);
+    if (kind == ReplCompletion::Commands)
+        for (const auto& c : commands()) out.push_back(c.name);
+    if (kind == ReplCompletion::Groups) out.push_back("none");
+    if (program_) {
+        const bool all = kind == ReplCompletion::Names;
+        for (const auto& g : program_->globals)
+            if (all || (kind == ReplCompletion::Params && g.kind == GlobalKind::Param)) out.push_back(g.name);
+        if (all || kind == ReplCompletion::Modules)
+            for (const auto& s : program_->symbols.all())
+                if (s.arity >= 0 && !s.name.empty()) out.push_back(s.name);
+        if (all || kind == ReplCompletion::Groups)
+            for (const auto& g : program_->groups) out.push_back(g.name);
+        if (all) {
+            for (const auto& e : program_->environment_names) out.push_back(e);
+            for (const auto& c : program_->curves) out.push_back(c.name);
+            for (const auto& f : program_->functions) out.push_back(f.name);
+        }
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+}
+
+} // namespace plant::cli
