@@ -36,6 +36,29 @@ for cmd in run derive check test; do
   contains "$cmd --help shows usage" "$tmp/stdout" "Usage"
 done
 check "no command" 64 "$plant"
+# plant help: the commands and topics, each topic printed from its table
+check "help" 0 "$plant" help
+contains "help lists commands" "$tmp/stdout" "derive"
+contains "help lists topics" "$tmp/stdout" "builtins"
+check "help --help" 0 "$plant" help --help
+contains "help --help shows usage" "$tmp/stdout" "Usage"
+check "help builtins" 0 "$plant" help builtins
+contains "help builtins has docs" "$tmp/stdout" "uniform(number, number) -> number"
+contains "help builtins marks random draws" "$tmp/stdout" "draws random numbers"
+check "help builtins --names" 0 "$plant" help builtins --names
+contains "builtin names" "$tmp/stdout" "smoothstep"
+check "help env" 0 "$plant" help env
+contains "help env lists kinds" "$tmp/stdout" "climber"
+check "help env KIND" 0 "$plant" help env climber
+contains "help env KIND lists methods" "$tmp/stdout" "pull(number, vec3) -> number"
+check "help env unknown kind" 64 "$plant" help env tree
+check "help formats" 0 "$plant" help formats
+contains "help formats" "$tmp/stdout" ".skel.json"
+check "help repl" 0 "$plant" help repl
+contains "help repl" "$tmp/stdout" ":step [N]"
+check "help of a command" 0 "$plant" help run
+contains "help of a command shows usage" "$tmp/stdout" "Usage: plant run"
+check "help unknown topic" 64 "$plant" help frobnicate
 check "unknown command" 64 "$plant" grow
 check "unknown option" 64 "$plant" derive "$tmp/ok.plant" --frobnicate
 check "bad -n" 64 "$plant" derive "$tmp/ok.plant" -n minus

@@ -1,0 +1,216 @@
+// plant help [TOPIC [NAME]]: the commands, and the tables the language and the tools are made
+// of (built-ins, environment kinds and their methods, output formats, REPL commands), printed
+// from those tables themselves so that the help cannot drift from what the program does.
+#include "commands.hpp"
+#include "outputs.hpp"
+#include "repl.hpp"
+
+#include "plant/builtins.hpp"
+#include "plant/environments.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <iostream>
+
+namespace plant::cli {
+
+namespace {
+
+struct HelpArgs {
+    std::vector<std::string> words; // the topic and what follows it
+    bool names = false;             // only the names, one per line (for scripts and the docs test)
+};
+
+std::string signature(const char* name, std::span<const ValueType> args, ValueType result) {
+    std::string s = std::string(name) + "(";
+    for (std::size_t k = 0; k < args.size(); ++k)
+        s += (k ? ", " : "") + std::string(value_type_name(args[k]));
+    return s + ") -> " + value_type_name(result);
+}
+
+// Rows of `left  right`, the right column aligned.
+void print_columns(const std::vector<std::pair<std::string, std::string>>& rows) {
+    std::size_t width = 0;
+    for (const auto& r : rows) width = std::max(width, r.first.size());
+    for (const auto& [left, right] : rows) std::cout << fmt::format("  {:<{}}  {}\n", left, width, right);
+}
+
+int help_builtins(const HelpArgs& a) {
+    std::vector<std::pair<std::string, std::string>> rows;
+    std::vector<std::string> names;
+    for (const auto& b : builtin_table()) {
+        if (std::find(names.begin(), names.end(), b.name) == names.end()) names.emplace_back(b.name);
+        std::string doc = b.doc;
+        if (b.draws_random()) doc += " (draws random numbers)";
+        if (b.reads == BuiltinReads::Identity) doc += " (reads the module's identity)";
+        rows.emplace_back(signature(b.name, std::span(b.args, b.nargs), b.result), doc);
+    }
+    if (a.names) {
+        for (const auto& n : names) std::cout << n << "\n";
+        return kOk;
+    }
+    std::cout << "Built-in functions (a bool is accepted where a number is expected):\n";
+    print_columns(rows);
+    return kOk;
+}
+
+// The environment kinds the runtime makes, each with arguments it accepts, so that its methods can
+// be listed from a live object. TODO(lead): when the environments expose each kind's method table
+// without constructing one, read that instead of `example` (runtime/src/environments.cpp).
+struct EnvKind {
+    const char* kind;
+    const char* summary;
+    std::vector<EnvArg> (*example)();
+};
+
+EnvArg vec_arg(const char* key, double x, double y, double z) {
+    EnvArg a;
+    a.key = key;
+    a.type = ValueType::Vec3;
+    a.v[0] = x, a.v[1] = y, a.v[2] = z;
+    return a;
+}
+
+std::vector<EnvArg> no_args() {
+    return {};
+}
+
+std::vector<EnvArg> envelope_args() {
+    return {vec_arg("top", 0, 2, 0), vec_arg("bottom", 0, 0, 0), vec_arg("px", 1, 1, 0),
+            vec_arg("pz", 0, 1, 1),  vec_arg("nx", -1, 1, 0),    vec_arg("nz", 0, 1, -1)};
+}
+
+const EnvKind kEnvKinds[] = {
+    {"ellipsoid", "an ellipsoid given by center and radii: inside tests and levels", no_args},
+    {"envelope", "Cescatti's asymmetric crown envelope", envelope_args},
+    {"proximity", "distances between the plant's stems, for density control", no_args},
+    {"light", "self-shading: light reaching a point through the plant's occupied cells", no_args},
+    {"obstacles", "spheres, boxes, planes and meshes: signed distance and inside tests", no_args},
+    {"climber", "a particle world the plant's bound modules live in (docs/physics.md)", no_args},
+};
+
+int help_env_kind(const EnvKind& k, const HelpArgs& a) {
+    std::string error;
+    auto env = runtime_environments()(k.kind, k.example(), error);
+    if (!env) {
+        std::cerr << fmt::format("plant: internal error: cannot list the methods of '{}': {}\n", k.kind,
+                                 error);
+        return kRuntime;
+    }
+    std::vector<std::pair<std::string, std::string>> rows;
+    for (const auto& m : env->methods()) {
+        if (a.names) {
+            std::cout << m.name << "\n";
+            continue;
+        }
+        rows.emplace_back(signature(m.name.c_str(), m.args, m.result),
+                          std::string(m.doc) + (m.hook_only ? " (in hooks only)" : ""));
+    }
+    if (a.names) return kOk;
+    std::cout << fmt::format("{}: {}. Methods (called as NAME.method(...)):\n", k.kind, k.summary);
+    print_columns(rows);
+    return kOk;
+}
+
+int help_env(const HelpArgs& a) {
+    if (a.words.size() > 1) {
+        for (const auto& k : kEnvKinds)
+            if (a.words[1] == k.kind) return help_env_kind(k, a);
+        std::string kinds;
+        for (const auto& k : kEnvKinds) kinds += (kinds.empty() ? "" : ", ") + std::string(k.kind);
+        std::cerr << fmt::format("plant: no environment kind '{}'; the kinds are {}\n", a.words[1], kinds);
+        return kUsage;
+    }
+    std::vector<std::pair<std::string, std::string>> rows;
+    for (const auto& k : kEnvKinds) {
+        if (a.names) std::cout << k.kind << "\n";
+        rows.emplace_back(k.kind, k.summary);
+    }
+    if (a.names) return kOk;
+    std::cout << "Environment kinds (env NAME = KIND(key: value, ...); 'plant help env KIND' lists its "
+                 "methods):\n";
+    print_columns(rows);
+    return kOk;
+}
+
+int help_formats(const HelpArgs& a) {
+    std::vector<std::pair<std::string, std::string>> rows;
+    for (const auto& f : output_formats()) {
+        if (a.names) std::cout << f.extension << "\n";
+        rows.emplace_back(f.extension, f.doc);
+    }
+    if (a.names) return kOk;
+    std::cout << "Output formats of 'plant run -o FILE' and the REPL's :export, chosen by extension:\n";
+    print_columns(rows);
+    return kOk;
+}
+
+int help_repl(const HelpArgs& a) {
+    if (a.names) {
+        for (const auto& c : Session::commands()) std::cout << ":" << c.name << "\n";
+        return kOk;
+    }
+    std::cout << "Commands of 'plant repl':\n" << Session::command_list();
+    return kOk;
+}
+
+// Adding a topic: one row here and its printer above.
+struct HelpTopic {
+    const char* name;
+    const char* summary;
+    int (*print)(const HelpArgs& args);
+};
+
+const HelpTopic kTopics[] = {
+    {"builtins", "the built-in functions, their argument types and what they do", help_builtins},
+    {"env", "environment kinds; 'plant help env KIND' lists a kind's methods", help_env},
+    {"formats", "the output formats 'plant run' writes, by extension", help_formats},
+    {"repl", "the commands of 'plant repl'", help_repl},
+};
+
+int help_main(CLI::App& app, const HelpArgs& a) {
+    if (a.words.empty()) {
+        std::vector<std::pair<std::string, std::string>> commands, topics;
+        for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
+            commands.emplace_back(sub->get_name(), sub->get_description());
+        for (const auto& t : kTopics) topics.emplace_back(t.name, t.summary);
+        if (a.names) {
+            for (const auto& c : commands) std::cout << c.first << "\n";
+            for (const auto& t : topics) std::cout << t.first << "\n";
+            return kOk;
+        }
+        std::cout << "Commands ('plant COMMAND --help' or 'plant help COMMAND' shows a command's options):\n";
+        print_columns(commands);
+        std::cout << "Topics ('plant help TOPIC'; --names lists only the names):\n";
+        print_columns(topics);
+        return kOk;
+    }
+    for (const auto& t : kTopics)
+        if (a.words[0] == t.name) return t.print(a);
+    for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
+        if (sub->get_name() != a.words[0]) continue;
+        std::cout << sub->help("plant");
+        return kOk;
+    }
+    std::string names;
+    for (const auto& t : kTopics) names += (names.empty() ? "" : ", ") + std::string(t.name);
+    std::cerr << fmt::format("plant: no help topic or command '{}'; the topics are {}\n", a.words[0], names);
+    return kUsage;
+}
+
+} // namespace
+
+void setup_help(CLI::App& app, int& exit_code) {
+    auto a = std::make_shared<HelpArgs>();
+    CLI::App* cmd = app.add_subcommand("help", "List the commands and topics, or explain one");
+    cmd->add_option("TOPIC", a->words, "A command or a topic, and for env a kind: plant help env climber")
+        ->type_name("");
+    cmd->add_flag("--names", a->names, "Print only the names the topic lists, one per line");
+    std::string topics = "Topics:\n";
+    for (const auto& t : kTopics) topics += fmt::format("  {:<10} {}\n", t.name, t.summary);
+    cmd->footer(topics);
+    cmd->callback([&app, a, &exit_code] { exit_code = help_main(app, *a); });
+}
+
+} // namespace plant::cli
