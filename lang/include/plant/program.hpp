@@ -29,7 +29,6 @@ struct SymbolInfo {
     bool turtle = false;   // has a meaning for the turtle (LANGUAGE.md section 10)
     bool query = false;    // ?P ?H ?U ?L ?E
     int arity = -1;        // declared parameter count; -1 when any count is accepted
-    int max_arity = -1;    // for built-ins: the most parameters accepted
     std::vector<ValueType> param_types;
     std::vector<std::string> param_names;
     std::string bound_to; // climber environment for physics-bound segments
@@ -207,13 +206,20 @@ struct Function {
     Code code;
 };
 
-enum class HookKind { Start = 0, BeforeStep = 1, AfterStep = 2, End = 3 };
+using HookKind = ast::HookKind;
 
-// Declarations parsed now and given meaning by the runtime issues (surfaces, curves,
-// environments, instances); kept with their syntax so later passes can compile them.
-struct Deferred {
-    std::vector<const ast::ShapeDecl*> curves, surfaces, envs;
-    std::vector<const ast::InstanceDecl*> instances;
+// Where a rule block was written, for listings such as the REPL's :rules (the text itself stays
+// in the SourceManager).
+struct RuleBlockSource {
+    ast::RuleKind kind = ast::RuleKind::Rules;
+    std::string group;
+    std::vector<Span> productions;
+};
+
+// A file the program was read from: its source id and its rule blocks, in file order.
+struct ProgramFile {
+    std::uint32_t source = 0;
+    std::vector<RuleBlockSource> rule_blocks;
 };
 
 // `curve name = linear(...)` or `bezier(...)`: a function of t in [0, 1], as cpfg's function
@@ -257,16 +263,15 @@ struct Program {
     std::vector<RuleSet> groups; // named groups, selected by `use`
     RuleSet decompose;
     RuleSet interpret;
-    std::array<Code, 4> hooks;
-    std::array<bool, 4> has_hook{};
-    std::array<std::uint16_t, 4> hook_frame{};
+    std::array<Code, ast::kHooks.size()> hooks;
+    std::array<bool, ast::kHooks.size()> has_hook{};
+    std::array<std::uint16_t, ast::kHooks.size()> hook_frame{};
 
-    Deferred deferred;
     std::vector<SurfaceDef> surfaces;
     std::vector<CurveDef> curves;
     std::vector<std::shared_ptr<Environment>> environments; // `env` declarations, in file order
     std::vector<std::string> environment_names;
-    std::vector<std::unique_ptr<ast::File>> files; // the syntax trees the program was built from
+    std::vector<ProgramFile> files; // in the order they were read: the main file first
 
     int group_index(std::string_view name) const;
 };
