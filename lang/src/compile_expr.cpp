@@ -19,71 +19,10 @@ constexpr int kMaxStack = 1000;
 void Compiler::emit(Ctx& c, Op op, std::int32_t a, int n, Span span, std::uint16_t b) {
     c.code->instrs.push_back(Instr{op, static_cast<std::uint8_t>(n), b, a});
     c.code->spans.push_back(span);
-    // stack effect, conservative along both branches of a jump
-    switch (op) {
-    case Op::Const:
-    case Op::LoadMulConst:
-    case Op::LoadAddConst:
-        c.depth += 1;
-        break;
-    case Op::Const3:
-        c.depth += 3;
-        break;
-    case Op::LoadLocal:
-    case Op::LoadGlobal:
-        c.depth += n;
-        break;
-    case Op::StoreLocal:
-    case Op::StoreGlobal:
-    case Op::Pop:
-    case Op::Emit:
-    case Op::Print:
-        c.depth -= n;
-        break;
-    case Op::Add:
-    case Op::Sub:
-    case Op::Mul:
-    case Op::Div:
-    case Op::Mod:
-    case Op::Lt:
-    case Op::Le:
-    case Op::Gt:
-    case Op::Ge:
-    case Op::Eq:
-    case Op::Ne:
-    case Op::JumpIfZero:
-    case Op::JumpIfZeroKeep:
-    case Op::JumpIfNonZeroKeep:
-    case Op::VMulS:
-    case Op::VSMul:
-    case Op::VDivS:
-        c.depth -= 1;
-        break;
-    case Op::VAdd:
-    case Op::VSub:
-        c.depth -= 3;
-        break;
-    case Op::VEq:
-    case Op::VNe:
-        c.depth -= 5;
-        break;
-    case Op::Member:
-        c.depth -= 2;
-        break;
-    case Op::Builtin:
-        c.depth += b - n;
-        break; // b: width of the result
-    case Op::EnvCall:
-        c.depth += 3 - n;
-        break; // at most a vec3
-    case Op::Call: {
-        const Function& fn = P_.functions[static_cast<std::size_t>(a)];
-        c.depth += std::max(1, value_width(fn.result)) - fn.param_width;
-        break;
-    }
-    default:
-        break;
-    }
+    // the depth of the operand stack from the opcode table, conservative along both branches
+    // of a jump (a call's n and b are the widths of its result and of its arguments)
+    const StackEffect effect = stack_effect(c.code->instrs.back());
+    c.depth += effect.pushes - effect.pops;
     if (c.depth > kMaxStack && !c.stack_error) {
         c.stack_error = true;
         diags_->error(span, "this expression is too large: it needs more than 1000 values at once");
@@ -248,36 +187,8 @@ ValueType Compiler::compile_expr(Ctx& c, const ast::Expr& e) {
         diags_->error(e.span, "a string is allowed only as an argument of print(...) or load(...)");
         emit_const(c, 0, e.span);
         return ValueType::Number;
-    case K::Name: {
-        if (const LocalVar* l = find_local(c, e.text)) {
-            emit(c, Op::LoadLocal, l->slot, value_width(l->type), e.span);
-            return l->type;
-        }
-        if (auto it = consts_.find(e.text); it != consts_.end()) {
-            const ConstVal& v = it->second;
-            for (int k = 0; k < value_width(v.type); ++k) emit_const(c, v.v[k], e.span);
-            return v.type;
-        }
-        if (auto it = P_.global_index.find(e.text); it != P_.global_index.end()) {
-            const Global& g = P_.globals[it->second];
-            emit(c, Op::LoadGlobal, static_cast<std::int32_t>(g.slot), value_width(g.type), e.span);
-            return g.type;
-        }
-        if (e.text == "pi") {
-            emit_const(c, std::numbers::pi, e.span);
-            return ValueType::Number;
-        }
-        if (env_names_.count(e.text)) {
-            diags_->error(
-                e.span,
-                fmt::format("environment '{}' can only be queried with a method, as in '{}.contains(p)'",
-                            e.text, e.text));
-        } else {
-            unknown_name(c, e.text, e.span, "name");
-        }
-        emit_const(c, 0, e.span);
-        return ValueType::Number;
-    }
+    case K::Name:
+        return compile_name(c, e);
     case K::Unary: {
         if (e.unary == ast::UnaryOp::Neg &&
             e.args[0]->kind == K::Number) { // a negative literal is a constant
@@ -335,30 +246,66 @@ ValueType Compiler::compile_expr(Ctx& c, const ast::Expr& e) {
         emit(c, Op::Member, comp, 0, e.span);
         return ValueType::Number;
     }
-    case K::Method: {
-        const ast::Expr& obj = *e.args[0];
-        std::size_t env = P_.environment_names.size();
-        if (obj.kind == K::Name)
-            for (std::size_t k = 0; k < P_.environment_names.size(); ++k)
-                if (P_.environment_names[k] == obj.text && P_.environments[k]) env = k;
-        if (env < P_.environments.size()) return compile_env_call(c, e, env);
-        if (obj.kind == K::Name && env_names_.count(obj.text)) {
-            diags_->error(
-                e.span,
-                opts_.environments
-                    ? fmt::format("environment '{}' is not available: its declaration has an error", obj.text)
-                    : fmt::format("environment '{}' (kind '{}') cannot be queried here: no runtime "
-                                  "provides environments to this compilation",
-                                  obj.text, env_names_[obj.text]));
-        } else {
-            diags_->error(
-                e.span, fmt::format("'.{}(...)' is a method call, and only environment objects have methods",
-                                    e.text));
-        }
-        emit_const(c, 0, e.span);
+    case K::Method:
+        return compile_method(c, e);
+    }
+    return ValueType::Number;
+}
+
+// A name in an expression: a local, a const (its value), a param or var, or pi.
+ValueType Compiler::compile_name(Ctx& c, const ast::Expr& e) {
+    if (const LocalVar* l = find_local(c, e.text)) {
+        emit(c, Op::LoadLocal, l->slot, value_width(l->type), e.span);
+        return l->type;
+    }
+    if (auto it = consts_.find(e.text); it != consts_.end()) {
+        const ConstVal& v = it->second;
+        for (int k = 0; k < value_width(v.type); ++k) emit_const(c, v.v[k], e.span);
+        return v.type;
+    }
+    if (auto it = P_.global_index.find(e.text); it != P_.global_index.end()) {
+        const Global& g = P_.globals[it->second];
+        emit(c, Op::LoadGlobal, static_cast<std::int32_t>(g.slot), value_width(g.type), e.span);
+        return g.type;
+    }
+    if (e.text == "pi") {
+        emit_const(c, std::numbers::pi, e.span);
         return ValueType::Number;
     }
+    if (env_names_.count(e.text)) {
+        diags_->error(
+            e.span, fmt::format("environment '{}' can only be queried with a method, as in '{}.contains(p)'",
+                                e.text, e.text));
+    } else {
+        unknown_name(c, e.text, e.span, "name");
     }
+    emit_const(c, 0, e.span);
+    return ValueType::Number;
+}
+
+// `object.method(args)`: only environments have methods.
+ValueType Compiler::compile_method(Ctx& c, const ast::Expr& e) {
+    using K = ast::ExprKind;
+    const ast::Expr& obj = *e.args[0];
+    std::size_t env = P_.environment_names.size();
+    if (obj.kind == K::Name)
+        for (std::size_t k = 0; k < P_.environment_names.size(); ++k)
+            if (P_.environment_names[k] == obj.text && P_.environments[k]) env = k;
+    if (env < P_.environments.size()) return compile_env_call(c, e, env);
+    if (obj.kind == K::Name && env_names_.count(obj.text)) {
+        diags_->error(
+            e.span,
+            opts_.environments
+                ? fmt::format("environment '{}' is not available: its declaration has an error", obj.text)
+                : fmt::format("environment '{}' (kind '{}') cannot be queried here: no runtime "
+                              "provides environments to this compilation",
+                              obj.text, env_names_[obj.text]));
+    } else {
+        diags_->error(
+            e.span,
+            fmt::format("'.{}(...)' is a method call, and only environment objects have methods", e.text));
+    }
+    emit_const(c, 0, e.span);
     return ValueType::Number;
 }
 
@@ -471,7 +418,8 @@ ValueType Compiler::compile_call(Ctx& c, const ast::Expr& e) {
                                           value_type_name(fn.param_types[i]), value_type_name(t)));
         }
         if (e.args.size() == fn.param_types.size())
-            emit(c, Op::Call, static_cast<std::int32_t>(it->second), 0, e.span);
+            emit(c, Op::Call, static_cast<std::int32_t>(it->second), std::max(1, value_width(fn.result)),
+                 e.span, fn.param_width);
         // a recursive call inside the function's own body: its type is not known yet, and the
         // operators around it take it from their other operand
         if (!fn_result_known_[it->second]) return ValueType::Void;

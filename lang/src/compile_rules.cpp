@@ -291,11 +291,8 @@ void Compiler::build_template(Production& p) {
                 static_cast<std::int64_t>(t.values.instrs.size()) - static_cast<std::int64_t>(seg_begin);
             for (std::size_t k = seg_begin; k < pc; ++k) {
                 Instr J = body.instrs[k];
-                if (J.op == Op::Jump || J.op == Op::JumpIfZero || J.op == Op::JumpIfZeroKeep ||
-                    J.op == Op::JumpIfNonZeroKeep)
-                    J.a = static_cast<std::int32_t>(J.a + shift);
-                if (J.op == Op::Emit || J.op == Op::ProduceEnd || J.op == Op::Return || J.op == Op::Halt)
-                    return;
+                if (is_jump(J.op)) J.a = static_cast<std::int32_t>(J.a + shift);
+                if (J.op == Op::Emit || op_info(J.op).flow == OpFlow::End) return;
                 t.values.instrs.push_back(J);
                 t.values.spans.push_back(body.spans[k]);
             }

@@ -42,37 +42,9 @@ void Compiler::compile_stmt(Ctx& c, const ast::Stmt& s) {
         }
         break;
     }
-    case K::For: {
-        // for i in a..b { } runs i = a, a+1, ... while i < b
-        std::size_t mark = c.locals.size();
-        ValueType ta = compile_expr(c, *s.expr);
-        std::uint16_t var = add_local(c, s.name, ValueType::Number);
-        emit(c, Op::StoreLocal, var, 1, s.span);
-        ValueType tb = compile_expr(c, *s.expr2);
-        if (!numeric(ta) || !numeric(tb))
-            diags_->error(s.span, "the bounds of a 'for' range must be numbers");
-        std::uint16_t end = add_local(c, " end", ValueType::Number);
-        emit(c, Op::StoreLocal, end, 1, s.span);
-        std::uint16_t guard = add_local(c, " guard", ValueType::Number);
-        emit_const(c, 0, s.span);
-        emit(c, Op::StoreLocal, guard, 1, s.span);
-        std::size_t top = here(c);
-        emit(c, Op::LoadLocal, var, 1, s.span);
-        emit(c, Op::LoadLocal, end, 1, s.span);
-        emit(c, Op::Lt, 0, 0, s.span);
-        std::size_t j_exit = here(c);
-        emit(c, Op::JumpIfZero, 0, 0, s.span);
-        emit(c, Op::ForCheck, guard, 0, s.span);
-        compile_block(c, s.body);
-        emit(c, Op::LoadLocal, var, 1, s.span);
-        emit_const(c, 1, s.span);
-        emit(c, Op::Add, 0, 0, s.span);
-        emit(c, Op::StoreLocal, var, 1, s.span);
-        emit(c, Op::Jump, static_cast<std::int32_t>(top), 0, s.span);
-        patch(c, j_exit);
-        c.locals.resize(mark);
+    case K::For:
+        compile_for(c, s);
         break;
-    }
     case K::Produce:
     case K::NProduce:
         if (c.kind != CtxKind::Production) {
@@ -83,25 +55,9 @@ void Compiler::compile_stmt(Ctx& c, const ast::Stmt& s) {
         compile_successor(c, s.successor);
         emit(c, s.kind == K::Produce ? Op::ProduceEnd : Op::NProduceMark, 0, 0, s.span);
         break;
-    case K::Use: {
-        if (c.kind != CtxKind::Hook) {
-            diags_->error(s.span, fmt::format("'use' is allowed only in hooks (on {}, on {}, ...)",
-                                              ast::kHooks[0].spelling, ast::kHooks[1].spelling));
-            break;
-        }
-        int g = s.name == "none" ? -1 : P_.group_index(s.name);
-        if (g == -1 && s.name != "none") {
-            std::vector<std::string> names;
-            for (const auto& rs : P_.groups) names.push_back(rs.name);
-            std::string near = nearest_name(s.name, names);
-            diags_->error(s.span, near.empty() ? fmt::format("unknown rule group '{}'", s.name)
-                                               : fmt::format("unknown rule group '{}'; did you mean '{}'?",
-                                                             s.name, near));
-        }
-        used_groups_.insert(s.name);
-        emit(c, Op::Use, g, 0, s.span);
+    case K::Use:
+        compile_use(c, s);
         break;
-    }
     case K::Stop:
         if (c.kind != CtxKind::Hook) {
             diags_->error(s.span, "'stop' is allowed only in hooks");
@@ -109,25 +65,9 @@ void Compiler::compile_stmt(Ctx& c, const ast::Stmt& s) {
         }
         emit(c, Op::Stop, 0, 0, s.span);
         break;
-    case K::Return: {
-        if (c.kind != CtxKind::Function) {
-            diags_->error(s.span, "'return' is allowed only in functions");
-            break;
-        }
-        ValueType t = s.expr ? compile_expr(c, *s.expr) : ValueType::Number;
-        if (!s.expr) emit_const(c, 0, s.span);
-        if (t == ValueType::Void) { // `return f(...)` inside f: the width is set when f is done
-            c.void_returns.push_back(here(c));
-            emit(c, Op::Return, 0, 0, s.span);
-            break;
-        }
-        if (c.fn_result_known && value_width(t) != value_width(*c.fn_result))
-            diags_->error(s.span, "all 'return' statements of a function must give the same type");
-        *c.fn_result = t;
-        c.fn_result_known = true;
-        emit(c, Op::Return, 0, value_width(t), s.span);
+    case K::Return:
+        compile_return(c, s);
         break;
-    }
     case K::Expr: {
         const ast::Expr& e = *s.expr;
         if (e.kind == ast::ExprKind::Call && e.text == "print") {
@@ -146,6 +86,74 @@ void Compiler::compile_stmt(Ctx& c, const ast::Stmt& s) {
         break;
     }
     }
+}
+
+void Compiler::compile_for(Ctx& c, const ast::Stmt& s) {
+    // for i in a..b { } runs i = a, a+1, ... while i < b
+    std::size_t mark = c.locals.size();
+    ValueType ta = compile_expr(c, *s.expr);
+    std::uint16_t var = add_local(c, s.name, ValueType::Number);
+    emit(c, Op::StoreLocal, var, 1, s.span);
+    ValueType tb = compile_expr(c, *s.expr2);
+    if (!numeric(ta) || !numeric(tb)) diags_->error(s.span, "the bounds of a 'for' range must be numbers");
+    std::uint16_t end = add_local(c, " end", ValueType::Number);
+    emit(c, Op::StoreLocal, end, 1, s.span);
+    std::uint16_t guard = add_local(c, " guard", ValueType::Number);
+    emit_const(c, 0, s.span);
+    emit(c, Op::StoreLocal, guard, 1, s.span);
+    std::size_t top = here(c);
+    emit(c, Op::LoadLocal, var, 1, s.span);
+    emit(c, Op::LoadLocal, end, 1, s.span);
+    emit(c, Op::Lt, 0, 0, s.span);
+    std::size_t j_exit = here(c);
+    emit(c, Op::JumpIfZero, 0, 0, s.span);
+    emit(c, Op::ForCheck, guard, 0, s.span);
+    compile_block(c, s.body);
+    emit(c, Op::LoadLocal, var, 1, s.span);
+    emit_const(c, 1, s.span);
+    emit(c, Op::Add, 0, 0, s.span);
+    emit(c, Op::StoreLocal, var, 1, s.span);
+    emit(c, Op::Jump, static_cast<std::int32_t>(top), 0, s.span);
+    patch(c, j_exit);
+    c.locals.resize(mark);
+}
+
+void Compiler::compile_use(Ctx& c, const ast::Stmt& s) {
+    if (c.kind != CtxKind::Hook) {
+        diags_->error(s.span, fmt::format("'use' is allowed only in hooks (on {}, on {}, ...)",
+                                          ast::kHooks[0].spelling, ast::kHooks[1].spelling));
+        return;
+    }
+    int g = s.name == "none" ? -1 : P_.group_index(s.name);
+    if (g == -1 && s.name != "none") {
+        std::vector<std::string> names;
+        for (const auto& rs : P_.groups) names.push_back(rs.name);
+        std::string near = nearest_name(s.name, names);
+        diags_->error(s.span, near.empty()
+                                  ? fmt::format("unknown rule group '{}'", s.name)
+                                  : fmt::format("unknown rule group '{}'; did you mean '{}'?", s.name, near));
+    }
+    used_groups_.insert(s.name);
+    emit(c, Op::Use, g, 0, s.span);
+}
+
+void Compiler::compile_return(Ctx& c, const ast::Stmt& s) {
+    if (c.kind != CtxKind::Function) {
+        diags_->error(s.span, "'return' is allowed only in functions");
+        return;
+    }
+    ValueType t = s.expr ? compile_expr(c, *s.expr) : ValueType::Number;
+    if (!s.expr) emit_const(c, 0, s.span);
+    if (t == ValueType::Void) { // `return f(...)` inside f: the width is set when f is done
+        c.void_returns.push_back(here(c));
+        emit(c, Op::Return, 0, 0, s.span);
+        return;
+    }
+    if (c.fn_result_known && value_width(t) != value_width(*c.fn_result))
+        diags_->error(s.span, "all 'return' statements of a function must give the same type");
+    *c.fn_result = t;
+    c.fn_result_known = true;
+    emit(c, Op::Return, 0, value_width(t), s.span);
 }
 
 void Compiler::compile_print(Ctx& c, const ast::Expr& e) {

@@ -75,6 +75,8 @@ class Compiler {
     // expressions (compile_expr.cpp), statements (compile_stmt.cpp), rules (compile_rules.cpp),
     // functions (compile_declarations.cpp)
     ValueType compile_expr(Ctx& c, const ast::Expr& e);
+    ValueType compile_name(Ctx& c, const ast::Expr& e);
+    ValueType compile_method(Ctx& c, const ast::Expr& e);
     ValueType compile_binary(Ctx& c, const ast::Expr& e);
     ValueType compile_call(Ctx& c, const ast::Expr& e);
     std::optional<ConstVal> eval_const(const ast::Expr& e, const char* what);
@@ -82,6 +84,9 @@ class Compiler {
     void compile_block(Ctx& c, const std::vector<ast::Stmt>& body);
     void compile_stmt(Ctx& c, const ast::Stmt& s);
     void compile_assign(Ctx& c, const ast::Stmt& s);
+    void compile_for(Ctx& c, const ast::Stmt& s);
+    void compile_use(Ctx& c, const ast::Stmt& s);
+    void compile_return(Ctx& c, const ast::Stmt& s);
     void compile_print(Ctx& c, const ast::Expr& e);
     void compile_successor(Ctx& c, const ast::ModuleList& list);
     std::vector<PatternModule> compile_pattern(Ctx& c, const ast::ModuleList& list, PatternRole role);

@@ -56,57 +56,41 @@ class SymbolTable {
 
 // ---- compiled expressions and statements: a small stack machine over doubles -----------------
 
+// The opcodes, their stack effects and docs: one table, opcodes.hpp.
 enum class Op : std::uint8_t {
-    Const,      // push consts[a]
-    Const3,     // push consts[a..a+3)
-    LoadLocal,  // push frame[a .. a+n)
-    StoreLocal, // pop n into frame[a ..)
-    LoadGlobal, // push globals[a .. a+n)
-    StoreGlobal,
-    Pop, // drop n
-    Add,
-    Sub,
-    Mul,
-    Div,
-    Mod,
-    Neg,
-    Not,
-    Lt,
-    Le,
-    Gt,
-    Ge,
-    Eq,
-    Ne,
-    VAdd,
-    VSub,
-    VMulS,
-    VSMul,
-    VDivS,
-    VNeg,
-    VEq,
-    VNe,        // vec3 arithmetic (S: scalar operand)
-    Member,     // pop vec3, push component a
-    Jump,       // pc = a
-    JumpIfZero, // pop; if 0 pc = a
-    JumpIfZeroKeep,
-    JumpIfNonZeroKeep, // for && and ||: inspect top, jump keeping it, else pop
-    Builtin,           // call builtin a with its known argument types (b: variant)
-    Call,              // call user function a
-    Return,            // end a function with the value on top (or nothing)
-    Emit,              // pop the parameters of module a (n doubles) and append it to the output
-    ProduceEnd,        // produce: the body has applied and ends
-    NProduceMark,      // marks that something was produced
-    Use,               // select rule group a (-1: none)
-    Stop,              // stop the derivation after the current hook
-    Print,             // pop n values described by print_formats[a] and print them
-    ForCheck,          // loop guard: counts turns in frame[a], stops a runaway loop
-    Halt,
-    // superinstructions made by fuse() in straight-line code
-    LoadMulConst, // push frame[a] * consts[b]
-    LoadAddConst, // push frame[a] + consts[b]
-    Curve,        // replace t on top of the stack by curves[a](t)
-    EnvCall,      // environments[a]->call(b, n argument numbers), pushes the result
+#define OPCODE(name, pops, pushes, flow, doc) name,
+#include "plant/opcodes.hpp"
+#undef OPCODE
 };
+
+// Where control goes after an instruction.
+enum class OpFlow : std::uint8_t {
+    Next,       // the next instruction
+    Jump,       // instruction a
+    Branch,     // the next instruction or a
+    BranchKeep, // the next instruction (having popped the top) or a (keeping it)
+    End,        // nowhere: the code ends
+};
+
+struct OpInfo {
+    const char* name;
+    OpFlow flow;
+    const char* doc;
+};
+
+inline constexpr OpInfo kOps[] = {
+#define OPCODE(name, pops, pushes, flow, doc) {#name, OpFlow::flow, doc},
+#include "plant/opcodes.hpp"
+#undef OPCODE
+};
+
+inline constexpr const OpInfo& op_info(Op op) {
+    return kOps[static_cast<std::size_t>(op)];
+}
+inline constexpr bool is_jump(Op op) {
+    const OpFlow f = op_info(op).flow;
+    return f == OpFlow::Jump || f == OpFlow::Branch || f == OpFlow::BranchKeep;
+}
 
 struct Instr {
     Op op;
@@ -114,6 +98,23 @@ struct Instr {
     std::uint16_t b = 0; // secondary operand
     std::int32_t a = 0;  // primary operand
 };
+
+// How many numbers an instruction pops, then pushes (opcodes.hpp).
+struct StackEffect {
+    int pops = 0, pushes = 0;
+};
+
+inline StackEffect stack_effect(const Instr& I) {
+    const int n = I.n, b = I.b;
+    switch (I.op) {
+#define OPCODE(name, pops, pushes, flow, doc)                                                                \
+    case Op::name:                                                                                           \
+        return {pops, pushes};
+#include "plant/opcodes.hpp"
+#undef OPCODE
+    }
+    return {};
+}
 
 struct Code {
     std::vector<Instr> instrs;
