@@ -1,3 +1,5 @@
+// The stack machine: one switch over the opcodes of opcodes.hpp, the built-ins, curves, the
+// superinstruction pass (fuse) and the stack check of compiled code (check_stack).
 #include "plant/vm.hpp"
 
 #include "plant/builtins.hpp"

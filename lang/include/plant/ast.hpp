@@ -61,7 +61,7 @@ inline constexpr std::array<Spelled<AssignOp>, 5> kAssignOps = {{
 // `on NAME { ... }`: the hooks, in the order they run in a derivation.
 enum class HookKind : std::uint8_t { Start, BeforeStep, AfterStep, End };
 inline constexpr std::array<Spelled<HookKind>, 4> kHooks = {{
-    {HookKind::Start, "start", "once, before the first step"},
+    {HookKind::Start, "start", "once, after the axiom is built"},
     {HookKind::BeforeStep, "before_step", "before each step"},
     {HookKind::AfterStep, "after_step", "after each step"},
     {HookKind::End, "end", "once, after the last step"},

@@ -26,7 +26,7 @@ const char* value_type_name(ValueType t);
 struct SymbolInfo {
     std::string name;
     bool declared = false; // by `module`, or a built-in turtle or query symbol
-    bool turtle = false;   // has a meaning for the turtle (LANGUAGE.md section 10)
+    bool turtle = false;   // has a meaning for the turtle (docs/language.md, the turtle)
     bool query = false;    // ?P ?H ?U ?L ?E
     int arity = -1;        // declared parameter count; -1 when any count is accepted
     std::vector<ValueType> param_types;
