@@ -312,14 +312,14 @@ void Session::rules() {
     };
     // the grammar's files first (imports come before the session's own text), typed rules last
     for (auto it = program_->files.rbegin(); it != program_->files.rend(); ++it) {
-        const ast::File& f = **it;
+        const ProgramFile& f = *it;
         const bool typed = sources_->file(f.source).name() == "<session>";
         for (const auto& rb : f.rule_blocks) {
             const char* kind = rb.kind == ast::RuleKind::Rules       ? "rules"
                                : rb.kind == ast::RuleKind::Decompose ? "decompose"
                                                                      : "interpret";
             out_ << kind << (rb.group.empty() ? "" : " " + rb.group) << (typed ? " (typed)" : "") << ":\n";
-            for (const auto& p : rb.productions) out_ << "  " << text_of(p.span) << "\n";
+            for (Span p : rb.productions) out_ << "  " << text_of(p) << "\n";
         }
     }
 }

@@ -1,5 +1,6 @@
-// The compiler's private state, shared by compiler.cpp (expressions, statements, patterns)
-// and compiler_program.cpp (imports, declarations, rule sets, checks).
+// The compiler's private state, shared by its stages: compiler.cpp (the driver),
+// compile_imports.cpp, compile_declarations.cpp, compile_shapes.cpp, compile_expr.cpp,
+// compile_stmt.cpp, compile_rules.cpp and check.cpp.
 #pragma once
 
 #include "plant/ast.hpp"
@@ -58,6 +59,10 @@ struct LoadedFile {
     std::map<std::string, std::pair<const ast::Expr*, Span>> overrides; // from `import ... with { }`
 };
 
+inline bool numeric(ValueType t) {
+    return t == ValueType::Number || t == ValueType::Bool;
+}
+
 std::size_t edit_distance(std::string_view a, std::string_view b);
 std::string nearest_name(std::string_view name, const std::vector<std::string>& candidates);
 
@@ -67,8 +72,11 @@ class Compiler {
         : sm_(sm), opts_(opts), diags_(&diags) {}
     std::unique_ptr<Program> compile(std::uint32_t main_file);
 
-    // expressions (compiler.cpp)
+    // expressions (compile_expr.cpp), statements (compile_stmt.cpp), rules (compile_rules.cpp),
+    // functions (compile_declarations.cpp)
     ValueType compile_expr(Ctx& c, const ast::Expr& e);
+    ValueType compile_name(Ctx& c, const ast::Expr& e);
+    ValueType compile_method(Ctx& c, const ast::Expr& e);
     ValueType compile_binary(Ctx& c, const ast::Expr& e);
     ValueType compile_call(Ctx& c, const ast::Expr& e);
     std::optional<ConstVal> eval_const(const ast::Expr& e, const char* what);
@@ -76,38 +84,50 @@ class Compiler {
     void compile_block(Ctx& c, const std::vector<ast::Stmt>& body);
     void compile_stmt(Ctx& c, const ast::Stmt& s);
     void compile_assign(Ctx& c, const ast::Stmt& s);
+    void compile_for(Ctx& c, const ast::Stmt& s);
+    void compile_use(Ctx& c, const ast::Stmt& s);
+    void compile_return(Ctx& c, const ast::Stmt& s);
     void compile_print(Ctx& c, const ast::Expr& e);
-    void compile_successor(Ctx& c, const ast::ModuleList& list, Span span);
+    void compile_successor(Ctx& c, const ast::ModuleList& list);
     std::vector<PatternModule> compile_pattern(Ctx& c, const ast::ModuleList& list, PatternRole role);
     std::vector<std::pair<std::string, Span>> split_run(const ast::ModuleRef& m);
-    SymbolId module_symbol(const std::string& name, Span span);
+    SymbolId module_symbol(const std::string& name);
     void declare_function(const ast::FnDecl& fd);
     void ensure_function_compiled(std::uint32_t index);
     ValueType compile_function_body(std::uint32_t index, Code& code, std::uint16_t& frame_size);
     ValueType param_type(const ast::ParamName& p);
 
   private:
-    // program structure (compiler_program.cpp)
+    // the stages, in the order data flows
     void load(std::uint32_t file_id, std::map<std::string, std::pair<const ast::Expr*, Span>> overrides,
               std::vector<std::string>& stack);
     std::string resolve_import(const ast::Import& im, std::uint32_t from_file,
                                std::vector<std::string>& searched);
+    void declare();
     void declare_modules(const ast::File& f);
     void declare_values(const LoadedFile& lf);
     void compile_rules(const ast::File& f);
-    void compile_production(const ast::Production& p, RuleSet& set, bool is_decompose);
+    void compile_production(const ast::Production& p, RuleSet& set);
     void compile_hooks(const ast::File& f);
+    void compile_hook_bodies();
     void compile_settings(const ast::File& f);
+    void finish();
+    void finish_rule_set(RuleSet& set);
+
+    // whole-program checks (check.cpp)
+    void check_defines_used();
+    void check_bound_modules();
+    void check_group_directions();
+    void check_shadowed(const ast::Production& p, const Production& cp, const RuleSet& set);
     void check_never_applying();
     void check_raw_runs();
-    void finish_rule_set(RuleSet& set);
     void build_template(Production& p);
     void compile_surface(const ast::ShapeDecl& s);
     void compile_curve(const ast::ShapeDecl& s);
     void compile_environment(const ast::ShapeDecl& s);
     ValueType compile_env_call(Ctx& c, const ast::Expr& e, std::size_t env);
 
-    // helpers (compiler.cpp)
+    // helpers (compile_expr.cpp; where and duplicate in compiler.cpp)
     void emit(Ctx& c, Op op, std::int32_t a, int n, Span span, std::uint16_t b = 0);
     void emit_const(Ctx& c, double v, Span span);
     std::size_t here(Ctx& c) const;
@@ -128,7 +148,9 @@ class Compiler {
     Program& P_ = *program_;
     std::uint32_t current_file_ = 0;
 
-    std::vector<LoadedFile> order_;
+    std::vector<std::unique_ptr<ast::File>> files_; // the syntax trees, in the order they were read
+    std::vector<LoadedFile> order_;                 // files after the files they import
+    std::vector<const ast::ShapeDecl*> curve_decls_, surface_decls_, env_decls_; // in load order
     std::set<std::string> loaded_paths_;
     std::unordered_map<std::string, ConstVal> consts_;
     std::unordered_map<std::string, Span> value_spans_;
@@ -148,8 +170,8 @@ class Compiler {
     std::unordered_map<std::string, Span> shape_spans_;
     std::set<SymbolId> ignore_syms_, consider_syms_;
     bool has_ignore_ = false, has_consider_ = false, has_axiom_ = false;
-    std::vector<std::tuple<std::string, Span, bool>> group_decls_;
-    std::array<std::vector<const ast::Hook*>, 4> hook_bodies_;
+    std::vector<std::pair<std::string, Span>> group_decls_;
+    std::array<std::vector<const ast::Hook*>, ast::kHooks.size()> hook_bodies_;
 };
 
 } // namespace plant

@@ -374,8 +374,7 @@ void Derivation::run_hook(HookKind kind) {
     try {
         plant::run(prog_.hooks[k], frame.data(), env);
     } catch (RuntimeError& e) {
-        static const char* names[] = {"on start", "on before_step", "on after_step", "on end"};
-        e.message = fmt::format("step {}, {}: {}", step_, names[k], e.message);
+        e.message = fmt::format("step {}, on {}: {}", step_, ast::spelling(kind), e.message);
         throw;
     }
     if (!effects.printed.empty() && opt_.on_print) opt_.on_print(effects.printed);

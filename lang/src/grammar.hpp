@@ -1,5 +1,5 @@
-// The .plant grammar as PEGTL rules (LANGUAGE.md sections 2-7). Only rule types live here;
-// the parse-tree selector and the lowering to the AST are in parser.cpp, the error messages in
+// The .plant grammar as PEGTL rules (docs/language.md, from lexical rules to hooks). Only rule types live
+// here; the parse-tree selector and the lowering to the AST are in parser.cpp, the error messages in
 // grammar_errors.hpp. Each rule carries the grammar line it implements as a comment.
 //
 // Commit points: after a keyword that opens an item, after '->', after '(' '{' and '/*', a
@@ -74,7 +74,7 @@ struct open_brace : pad<one<'{'>> {};
 struct close_brace : pad<one<'}'>> {};
 struct name : pad<identifier> {};
 
-// ---- expressions (LANGUAGE.md section 5) -------------------------------------------------
+// ---- expressions (docs/language.md, values and expressions) -------------------------------
 
 struct expr;
 // number <- [0-9]+ ('.' [0-9]+)? exponent? | '.' [0-9]+ exponent?
@@ -128,7 +128,7 @@ struct expr : seq<ternary> {};
 struct ternary_then : seq<expr> {};
 struct ternary_else : seq<expr> {};
 
-// ---- modules, successors and patterns (sections 2, 4) --------------------------------------
+// ---- modules, successors and patterns (docs/language.md, productions) -----------------------
 
 // A module name: an @-name, a ?-query name, a ~surface name, a turtle symbol or a letter run.
 struct at_name : seq<one<'@'>, identifier> {};
@@ -162,7 +162,7 @@ struct production_tail : sor<arrow_form, block> {};
 struct production : seq<pattern, star<ctx_part>, opt<condition>, must<production_tail>> {};
 struct rules_body : if_must<open_brace, star<production>, close_brace> {};
 
-// ---- statements (section 4, body form; section 7, hooks) ----------------------------------
+// ---- statements (docs/language.md, productions: body form; hooks and groups) --------------
 
 struct statement;
 struct block : if_must<open_brace, star<statement>, close_brace> {};
@@ -184,7 +184,7 @@ struct expr_stmt : seq<expr, must<semi>> {};
 struct statement : sor<let_stmt, if_stmt, for_stmt, produce_stmt, nproduce_stmt, use_stmt, stop_stmt,
                        return_stmt, assign_stmt, expr_stmt> {};
 
-// ---- top-level items (section 3) -----------------------------------------------------------
+// ---- top-level items (docs/language.md, top-level items) ------------------------------------
 
 struct param_item : if_must<kw_param, name, equals, expr, semi> {};
 struct const_item : if_must<kw_const, name, equals, expr, semi> {};

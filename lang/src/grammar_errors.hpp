@@ -1,6 +1,7 @@
 // Error messages for the .plant grammar and the control class that raises them. A message may
 // contain {at}: it is replaced by the line:column where the innermost open construct (a
-// production, a '(' or '{', an item) began, so messages name both ends of a problem.
+// production, a '(' or '{', an item) began, so messages name both ends of a problem; {hooks}
+// is replaced by the hook names of ast::kHooks.
 #pragma once
 
 #include "grammar.hpp"
@@ -52,7 +53,7 @@ PLANT_ERR(key_args, "expected '(' and the arguments");
 PLANT_ERR(key_arg, "expected an argument");
 PLANT_ERR(instance_body, "expected '{' to start the instance body");
 PLANT_ERR(rules_body, "expected '{' to start the rules");
-PLANT_ERR(hook_name, "expected a hook name: start, before_step, after_step or end");
+PLANT_ERR(hook_name, "expected a hook name: {hooks}"); // the names from ast::kHooks
 PLANT_ERR(import_target, "expected a library name or a quoted path after 'import'");
 PLANT_ERR(override_block, "expected '{' and parameter overrides after 'with'");
 PLANT_ERR(override_item, "expected 'name = value'");

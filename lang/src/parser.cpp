@@ -52,6 +52,18 @@ class Lowering {
         while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.pop_back();
         return s;
     }
+    // The entry of `table` that the node spells (an operator or keyword, without the spaces and
+    // comments after it); the grammar admits only spellings that are in the table.
+    template <typename E, std::size_t N>
+    static E spelled(const std::array<ast::Spelled<E>, N>& table, const Node& n) {
+        std::string_view text = n.string_view();
+        std::size_t len = 0;
+        while (len < text.size() && !std::isspace(static_cast<unsigned char>(text[len])) &&
+               text.compare(len, 1, "#") != 0 && text.compare(len, 2, "/*") != 0)
+            ++len;
+        auto value = ast::lookup(table, text.substr(0, len));
+        return value ? *value : table[0].value;
+    }
 
     ast::ExprPtr expr(const Node& n) {
         auto e = std::make_unique<ast::Expr>();
@@ -77,7 +89,7 @@ class Lowering {
             for (const auto& a : n.children.at(1)->children) e->args.push_back(expr(*a));
         } else if (n.is_type<g::unary_expr>()) {
             e->kind = ast::ExprKind::Unary;
-            e->text = n.children.at(0)->string();
+            e->unary = spelled(ast::kUnaryOps, *n.children.at(0));
             e->args.push_back(expr(*n.children.at(1)));
         } else if (n.is_type<g::paren_expr>()) {
             // the value is the inner expression; its span takes in the parentheses, so that a
@@ -123,7 +135,7 @@ class Lowering {
             for (std::size_t i = 1; i + 1 < n.children.size(); i += 2) {
                 auto be = std::make_unique<ast::Expr>();
                 be->kind = ast::ExprKind::Binary;
-                be->text = n.children[i]->string();
+                be->binary = spelled(ast::kBinaryOps, *n.children[i]);
                 auto rhs = expr(*n.children[i + 1]);
                 be->span = {file_, cur->span.begin, rhs->span.end};
                 be->args.push_back(std::move(cur));
@@ -200,7 +212,7 @@ class Lowering {
         } else if (n.is_type<g::assign_stmt>()) {
             s.kind = ast::StmtKind::Assign;
             s.name = n.children.at(0)->string();
-            s.op = trimmed(*n.children.at(1));
+            s.op = spelled(ast::kAssignOps, *n.children.at(1));
             s.expr = expr(*n.children.at(2));
         } else if (n.is_type<g::if_stmt>()) {
             s.kind = ast::StmtKind::If;
@@ -428,7 +440,7 @@ class Lowering {
         } else if (n.is_type<g::setting_item>()) {
             ast::Setting s;
             s.span = span(n);
-            s.key = trimmed(*n.children.at(0));
+            s.key = spelled(ast::kSettings, *n.children.at(0));
             s.value = expr(*n.children.at(1));
             f.settings.push_back(std::move(s));
         } else if (n.is_type<g::axiom_item>()) {
@@ -451,12 +463,13 @@ class Lowering {
         } else if (n.is_type<g::hook_item>()) {
             ast::Hook h;
             h.span = span(*n.children.at(0));
-            h.when = n.children.at(0)->children.at(0)->string();
+            const std::string when = n.children.at(0)->children.at(0)->string();
             h.body = block(*n.children.at(1));
-            if (h.when != "start" && h.when != "before_step" && h.when != "after_step" && h.when != "end")
-                diags_.error(
-                    h.span,
-                    fmt::format("unknown hook '{}': expected start, before_step, after_step or end", h.when));
+            if (auto kind = ast::lookup(ast::kHooks, when))
+                h.when = *kind;
+            else
+                diags_.error(h.span,
+                             fmt::format("unknown hook '{}': expected {}", when, ast::hook_list("", " or ")));
             f.hooks.push_back(std::move(h));
         } else if (n.is_type<g::import_item>()) {
             ast::Import im;
@@ -502,6 +515,7 @@ std::string describe_found(const std::string& text, std::size_t byte) {
 // what was found at the error is named.
 void report(const g::GrammarError& e, const SourceFile& src, std::uint32_t file_id, Diagnostics& diags) {
     std::string msg = e.message;
+    if (auto p = msg.find("{hooks}"); p != std::string::npos) msg.replace(p, 7, ast::hook_list("", " or "));
     if (auto p = msg.find("{at}"); p != std::string::npos) {
         std::string at = "?";
         if (e.at != std::string::npos) {
@@ -589,6 +603,16 @@ ast::ExprPtr parse_expression(const SourceManager& sources, std::uint32_t file_i
         report(e, src, file_id, diags);
         return nullptr;
     }
+}
+
+std::string ast::hook_list(std::string_view prefix, std::string_view last_separator) {
+    std::string out;
+    for (std::size_t k = 0; k < kHooks.size(); ++k) {
+        if (k > 0) out += k + 1 == kHooks.size() ? last_separator : ", ";
+        out += prefix;
+        out += kHooks[k].spelling;
+    }
+    return out;
 }
 
 } // namespace plant

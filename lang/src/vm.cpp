@@ -1,3 +1,5 @@
+// The stack machine: one switch over the opcodes of opcodes.hpp, the built-ins, curves, the
+// superinstruction pass (fuse) and the stack check of compiled code (check_stack).
 #include "plant/vm.hpp"
 
 #include "plant/builtins.hpp"
@@ -7,6 +9,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <numbers>
 
@@ -504,9 +507,7 @@ double CurveDef::operator()(double t) const {
 
 void fuse(Code& code) {
     for (const Instr& I : code.instrs)
-        if (I.op == Op::Jump || I.op == Op::JumpIfZero || I.op == Op::JumpIfZeroKeep ||
-            I.op == Op::JumpIfNonZeroKeep)
-            return;
+        if (is_jump(I.op)) return;
     if (code.consts.size() > 65535) return;
     std::vector<Instr> out;
     std::vector<Span> spans;
@@ -532,6 +533,79 @@ double eval_number(const Code& code, double* frame, EvalEnv& env) {
     double r[3] = {0, 0, 0};
     run(code, frame, env, r);
     return r[0];
+}
+
+StackCheck check_stack(const Code& code) {
+    // the range of depths each instruction can start at, widened until nothing changes; an
+    // upper bound past the VM's stack stops the walk (a loop that keeps pushing)
+    const std::size_t size = code.instrs.size();
+    std::vector<int> lo(size + 1, INT_MAX), hi(size + 1, -1);
+    std::vector<std::size_t> work;
+    StackCheck out;
+    auto fail_at = [&](std::size_t pc, std::string why) {
+        out.ok = false;
+        out.pc = pc;
+        out.error = std::move(why);
+    };
+    auto reach = [&](std::size_t from, std::int64_t target, int l, int h) {
+        if (target < 0 || static_cast<std::size_t>(target) > size) {
+            fail_at(from, fmt::format("jumps to {}, outside the code", target));
+            return;
+        }
+        auto t = static_cast<std::size_t>(target);
+        if (l >= lo[t] && h <= hi[t]) return;
+        lo[t] = std::min(lo[t], l);
+        hi[t] = std::max(hi[t], h);
+        work.push_back(t);
+    };
+    if (size == 0) return out;
+    reach(0, 0, 0, 0);
+    while (!work.empty() && out.ok) {
+        const std::size_t pc = work.back();
+        work.pop_back();
+        out.max_depth = std::max(out.max_depth, hi[pc]);
+        if (pc == size) continue; // fell off the end
+        const Instr& I = code.instrs[pc];
+        const StackEffect e = stack_effect(I);
+        if (lo[pc] < e.pops) {
+            fail_at(pc, fmt::format("{} pops {} with {} on the stack", op_info(I.op).name, e.pops, lo[pc]));
+            break;
+        }
+        const int l = lo[pc] - e.pops + e.pushes, h = hi[pc] - e.pops + e.pushes;
+        if (h > static_cast<int>(kStackSize)) {
+            fail_at(pc, fmt::format("the stack can grow past {} numbers", kStackSize));
+            break;
+        }
+        out.max_depth = std::max(out.max_depth, h);
+        switch (op_info(I.op).flow) {
+        case OpFlow::Next:
+            reach(pc, static_cast<std::int64_t>(pc) + 1, l, h);
+            break;
+        case OpFlow::Jump:
+            reach(pc, I.a, l, h);
+            break;
+        case OpFlow::Branch:
+            reach(pc, static_cast<std::int64_t>(pc) + 1, l, h);
+            reach(pc, I.a, l, h);
+            break;
+        case OpFlow::BranchKeep: // the jump keeps what the fall-through pops
+            reach(pc, static_cast<std::int64_t>(pc) + 1, l, h);
+            reach(pc, I.a, lo[pc], hi[pc]);
+            break;
+        case OpFlow::End:
+            break;
+        }
+    }
+    return out;
+}
+
+std::string disassemble(const Code& code) {
+    std::string out;
+    for (std::size_t pc = 0; pc < code.instrs.size(); ++pc) {
+        const Instr& I = code.instrs[pc];
+        out += fmt::format("{:4} {:<18} a={} n={} b={}\n", pc, op_info(I.op).name, I.a, I.n, I.b);
+    }
+    return out;
 }
 
 } // namespace plant

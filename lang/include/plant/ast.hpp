@@ -4,11 +4,111 @@
 
 #include "plant/source.hpp"
 
+#include <array>
+#include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace plant::ast {
+
+// ---- the language's small vocabularies: each an enum and one table {enum, spelling, doc} ------
+// The parser reads spellings through these tables, the compiler switches on the enums, and
+// messages and listings print the spellings from them.
+
+template <typename E> struct Spelled {
+    E value;
+    const char* spelling;
+    const char* doc;
+};
+
+// Binary operators, in the order of the grammar's precedence levels (grammar.hpp).
+enum class BinaryOp : std::uint8_t { Mul, Div, Mod, Add, Sub, Lt, Le, Gt, Ge, Eq, Ne, And, Or };
+inline constexpr std::array<Spelled<BinaryOp>, 13> kBinaryOps = {{
+    {BinaryOp::Mul, "*", "product; a vec3 times a number scales it"},
+    {BinaryOp::Div, "/", "quotient; division by zero is a runtime error"},
+    {BinaryOp::Mod, "%", "remainder (fmod)"},
+    {BinaryOp::Add, "+", "sum; of two vec3s too"},
+    {BinaryOp::Sub, "-", "difference; of two vec3s too"},
+    {BinaryOp::Lt, "<", "less than"},
+    {BinaryOp::Le, "<=", "less than or equal"},
+    {BinaryOp::Gt, ">", "greater than"},
+    {BinaryOp::Ge, ">=", "greater than or equal"},
+    {BinaryOp::Eq, "==", "equal; of two vec3s too"},
+    {BinaryOp::Ne, "!=", "not equal; of two vec3s too"},
+    {BinaryOp::And, "&&", "both non-zero; the right side runs only when the left is"},
+    {BinaryOp::Or, "||", "either non-zero; the right side runs only when the left is zero"},
+}};
+
+enum class UnaryOp : std::uint8_t { Neg, Not };
+inline constexpr std::array<Spelled<UnaryOp>, 2> kUnaryOps = {{
+    {UnaryOp::Neg, "-", "negation; of a vec3 too"},
+    {UnaryOp::Not, "!", "1 for zero, else 0"},
+}};
+
+// `name = value` and the compound assignments of statements.
+enum class AssignOp : std::uint8_t { Set, Add, Sub, Mul, Div };
+inline constexpr std::array<Spelled<AssignOp>, 5> kAssignOps = {{
+    {AssignOp::Set, "=", "assign"},
+    {AssignOp::Add, "+=", "add to"},
+    {AssignOp::Sub, "-=", "subtract from"},
+    {AssignOp::Mul, "*=", "multiply by"},
+    {AssignOp::Div, "/=", "divide by"},
+}};
+
+// `on NAME { ... }`: the hooks, in the order they run in a derivation.
+enum class HookKind : std::uint8_t { Start, BeforeStep, AfterStep, End };
+inline constexpr std::array<Spelled<HookKind>, 4> kHooks = {{
+    {HookKind::Start, "start", "once, after the axiom is built"},
+    {HookKind::BeforeStep, "before_step", "before each step"},
+    {HookKind::AfterStep, "after_step", "after each step"},
+    {HookKind::End, "end", "once, after the last step"},
+}};
+
+// The top-level settings `derive N;`, `angle A;` and so on.
+enum class SettingKey : std::uint8_t { Derive, Angle, Step, Width, Seed };
+inline constexpr std::array<Spelled<SettingKey>, 5> kSettings = {{
+    {SettingKey::Derive, "derive", "the number of steps"},
+    {SettingKey::Angle, "angle", "the turtle's default turning angle, in degrees"},
+    {SettingKey::Step, "step", "the turtle's default step length"},
+    {SettingKey::Width, "width", "the turtle's initial line width"},
+    {SettingKey::Seed, "seed", "the seed of the random numbers"},
+}};
+
+// The spelling of an enum value; the tables are in enum order.
+template <typename E, std::size_t N>
+constexpr const char* spelling_in(const std::array<Spelled<E>, N>& table, E value) {
+    return table[static_cast<std::size_t>(value)].spelling;
+}
+inline const char* spelling(BinaryOp op) {
+    return spelling_in(kBinaryOps, op);
+}
+inline const char* spelling(UnaryOp op) {
+    return spelling_in(kUnaryOps, op);
+}
+inline const char* spelling(AssignOp op) {
+    return spelling_in(kAssignOps, op);
+}
+inline const char* spelling(HookKind kind) {
+    return spelling_in(kHooks, kind);
+}
+inline const char* spelling(SettingKey key) {
+    return spelling_in(kSettings, key);
+}
+
+// The value spelled `text`, if any.
+template <typename E, std::size_t N>
+std::optional<E> lookup(const std::array<Spelled<E>, N>& table, std::string_view text) {
+    for (const auto& entry : table)
+        if (text == entry.spelling) return entry.value;
+    return std::nullopt;
+}
+
+// The hook names as a list: "start, before_step, after_step or end" with prefix "" and last
+// separator " or ", "on start, on before_step, ..." with prefix "on " and last separator ", ".
+std::string hook_list(std::string_view prefix, std::string_view last_separator);
 
 struct Expr;
 using ExprPtr = std::unique_ptr<Expr>;
@@ -18,8 +118,8 @@ enum class ExprKind {
     Bool,    // number != 0
     String,  // text
     Name,    // text
-    Unary,   // text = op, args[0]
-    Binary,  // text = op, args[0], args[1]
+    Unary,   // unary, args[0]
+    Binary,  // binary, args[0], args[1]
     Ternary, // args[0] ? args[1] : args[2]
     Call,    // text = function name, args
     Member,  // args[0].text  (.x .y .z)
@@ -31,6 +131,8 @@ struct Expr {
     Span span;
     double number = 0;
     std::string text;
+    BinaryOp binary = BinaryOp::Add; // Binary
+    UnaryOp unary = UnaryOp::Neg;    // Unary
     std::vector<ExprPtr> args;
 };
 
@@ -52,10 +154,10 @@ enum class StmtKind { Let, Assign, If, For, Produce, NProduce, Use, Stop, Return
 struct Stmt {
     StmtKind kind = StmtKind::Expr;
     Span span;
-    std::string name; // Let/Assign/For variable, Use group
-    std::string op;   // Assign: "=", "+=", ...
-    ExprPtr expr;     // value, condition, range start
-    ExprPtr expr2;    // range end
+    std::string name;            // Let/Assign/For variable, Use group
+    AssignOp op = AssignOp::Set; // Assign
+    ExprPtr expr;                // value, condition, range start
+    ExprPtr expr2;               // range end
     std::vector<Stmt> body;
     std::vector<Stmt> else_body;
     ModuleList successor;
@@ -128,7 +230,7 @@ struct ShapeDecl {
 
 struct Setting {
     Span span;
-    std::string key; // derive angle step width seed
+    SettingKey key = SettingKey::Derive;
     ExprPtr value;
 };
 
@@ -140,7 +242,7 @@ struct SymbolSet {
 
 struct Hook {
     Span span;
-    std::string when; // start before_step after_step end
+    HookKind when = HookKind::Start;
     std::vector<Stmt> body;
 };
 

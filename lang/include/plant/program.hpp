@@ -26,10 +26,9 @@ const char* value_type_name(ValueType t);
 struct SymbolInfo {
     std::string name;
     bool declared = false; // by `module`, or a built-in turtle or query symbol
-    bool turtle = false;   // has a meaning for the turtle (LANGUAGE.md section 10)
+    bool turtle = false;   // has a meaning for the turtle (docs/language.md, the turtle)
     bool query = false;    // ?P ?H ?U ?L ?E
     int arity = -1;        // declared parameter count; -1 when any count is accepted
-    int max_arity = -1;    // for built-ins: the most parameters accepted
     std::vector<ValueType> param_types;
     std::vector<std::string> param_names;
     std::string bound_to; // climber environment for physics-bound segments
@@ -57,57 +56,41 @@ class SymbolTable {
 
 // ---- compiled expressions and statements: a small stack machine over doubles -----------------
 
+// The opcodes, their stack effects and docs: one table, opcodes.hpp.
 enum class Op : std::uint8_t {
-    Const,      // push consts[a]
-    Const3,     // push consts[a..a+3)
-    LoadLocal,  // push frame[a .. a+n)
-    StoreLocal, // pop n into frame[a ..)
-    LoadGlobal, // push globals[a .. a+n)
-    StoreGlobal,
-    Pop, // drop n
-    Add,
-    Sub,
-    Mul,
-    Div,
-    Mod,
-    Neg,
-    Not,
-    Lt,
-    Le,
-    Gt,
-    Ge,
-    Eq,
-    Ne,
-    VAdd,
-    VSub,
-    VMulS,
-    VSMul,
-    VDivS,
-    VNeg,
-    VEq,
-    VNe,        // vec3 arithmetic (S: scalar operand)
-    Member,     // pop vec3, push component a
-    Jump,       // pc = a
-    JumpIfZero, // pop; if 0 pc = a
-    JumpIfZeroKeep,
-    JumpIfNonZeroKeep, // for && and ||: inspect top, jump keeping it, else pop
-    Builtin,           // call builtin a with its known argument types (b: variant)
-    Call,              // call user function a
-    Return,            // end a function with the value on top (or nothing)
-    Emit,              // pop the parameters of module a (n doubles) and append it to the output
-    ProduceEnd,        // produce: the body has applied and ends
-    NProduceMark,      // marks that something was produced
-    Use,               // select rule group a (-1: none)
-    Stop,              // stop the derivation after the current hook
-    Print,             // pop n values described by print_formats[a] and print them
-    ForCheck,          // loop guard: counts turns in frame[a], stops a runaway loop
-    Halt,
-    // superinstructions made by fuse() in straight-line code
-    LoadMulConst, // push frame[a] * consts[b]
-    LoadAddConst, // push frame[a] + consts[b]
-    Curve,        // replace t on top of the stack by curves[a](t)
-    EnvCall,      // environments[a]->call(b, n argument numbers), pushes the result
+#define OPCODE(name, pops, pushes, flow, doc) name,
+#include "plant/opcodes.hpp"
+#undef OPCODE
 };
+
+// Where control goes after an instruction.
+enum class OpFlow : std::uint8_t {
+    Next,       // the next instruction
+    Jump,       // instruction a
+    Branch,     // the next instruction or a
+    BranchKeep, // the next instruction (having popped the top) or a (keeping it)
+    End,        // nowhere: the code ends
+};
+
+struct OpInfo {
+    const char* name;
+    OpFlow flow;
+    const char* doc;
+};
+
+inline constexpr OpInfo kOps[] = {
+#define OPCODE(name, pops, pushes, flow, doc) {#name, OpFlow::flow, doc},
+#include "plant/opcodes.hpp"
+#undef OPCODE
+};
+
+inline constexpr const OpInfo& op_info(Op op) {
+    return kOps[static_cast<std::size_t>(op)];
+}
+inline constexpr bool is_jump(Op op) {
+    const OpFlow f = op_info(op).flow;
+    return f == OpFlow::Jump || f == OpFlow::Branch || f == OpFlow::BranchKeep;
+}
 
 struct Instr {
     Op op;
@@ -115,6 +98,23 @@ struct Instr {
     std::uint16_t b = 0; // secondary operand
     std::int32_t a = 0;  // primary operand
 };
+
+// How many numbers an instruction pops, then pushes (opcodes.hpp).
+struct StackEffect {
+    int pops = 0, pushes = 0;
+};
+
+inline StackEffect stack_effect(const Instr& I) {
+    const int n = I.n, b = I.b;
+    switch (I.op) {
+#define OPCODE(name, pops, pushes, flow, doc)                                                                \
+    case Op::name:                                                                                           \
+        return {pops, pushes};
+#include "plant/opcodes.hpp"
+#undef OPCODE
+    }
+    return {};
+}
 
 struct Code {
     std::vector<Instr> instrs;
@@ -207,13 +207,20 @@ struct Function {
     Code code;
 };
 
-enum class HookKind { Start = 0, BeforeStep = 1, AfterStep = 2, End = 3 };
+using HookKind = ast::HookKind;
 
-// Declarations parsed now and given meaning by the runtime issues (surfaces, curves,
-// environments, instances); kept with their syntax so later passes can compile them.
-struct Deferred {
-    std::vector<const ast::ShapeDecl*> curves, surfaces, envs;
-    std::vector<const ast::InstanceDecl*> instances;
+// Where a rule block was written, for listings such as the REPL's :rules (the text itself stays
+// in the SourceManager).
+struct RuleBlockSource {
+    ast::RuleKind kind = ast::RuleKind::Rules;
+    std::string group;
+    std::vector<Span> productions;
+};
+
+// A file the program was read from: its source id and its rule blocks, in file order.
+struct ProgramFile {
+    std::uint32_t source = 0;
+    std::vector<RuleBlockSource> rule_blocks;
 };
 
 // `curve name = linear(...)` or `bezier(...)`: a function of t in [0, 1], as cpfg's function
@@ -257,16 +264,15 @@ struct Program {
     std::vector<RuleSet> groups; // named groups, selected by `use`
     RuleSet decompose;
     RuleSet interpret;
-    std::array<Code, 4> hooks;
-    std::array<bool, 4> has_hook{};
-    std::array<std::uint16_t, 4> hook_frame{};
+    std::array<Code, ast::kHooks.size()> hooks;
+    std::array<bool, ast::kHooks.size()> has_hook{};
+    std::array<std::uint16_t, ast::kHooks.size()> hook_frame{};
 
-    Deferred deferred;
     std::vector<SurfaceDef> surfaces;
     std::vector<CurveDef> curves;
     std::vector<std::shared_ptr<Environment>> environments; // `env` declarations, in file order
     std::vector<std::string> environment_names;
-    std::vector<std::unique_ptr<ast::File>> files; // the syntax trees the program was built from
+    std::vector<ProgramFile> files; // in the order they were read: the main file first
 
     int group_index(std::string_view name) const;
 };

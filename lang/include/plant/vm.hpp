@@ -65,4 +65,19 @@ void fuse(Code& code);
 // Convenience for code that yields one number.
 double eval_number(const Code& code, double* frame, EvalEnv& env);
 
+// The operand stack along every path through `code`, from the opcode table's stack effects
+// (opcodes.hpp): the most numbers it can hold at once, or the first instruction that could pop
+// more than is there or jump out of the code. A check for tests and debugging; run() trusts the
+// compiler.
+struct StackCheck {
+    bool ok = true;
+    int max_depth = 0;
+    std::size_t pc = 0; // the offending instruction when !ok
+    std::string error;
+};
+StackCheck check_stack(const Code& code);
+
+// One line per instruction: index, opcode name, operands a, n, b.
+std::string disassemble(const Code& code);
+
 } // namespace plant

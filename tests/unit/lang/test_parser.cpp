@@ -111,15 +111,15 @@ TEST_CASE("precedence and associativity of expressions", "[parser]") {
     const ast::Expr& e = *p->file->values[0].value;
     REQUIRE(e.kind == ast::ExprKind::Ternary);
     const ast::Expr& orx = *e.args[0];
-    CHECK(orx.text == "||");
-    CHECK(orx.args[0]->text == "&&");
+    CHECK(ast::spelling(orx.binary) == std::string("||"));
+    CHECK(ast::spelling(orx.args[0]->binary) == std::string("&&"));
     const ast::Expr& eq = *orx.args[0]->args[0];
-    CHECK(eq.text == "==");
-    CHECK(eq.args[0]->text == "<");
+    CHECK(ast::spelling(eq.binary) == std::string("=="));
+    CHECK(ast::spelling(eq.args[0]->binary) == std::string("<"));
     const ast::Expr& sub = *eq.args[0]->args[0];
-    CHECK(sub.text == "-");
-    CHECK(sub.args[0]->text == "-"); // (1 - 2) - ...
-    CHECK(sub.args[1]->text == "*");
+    CHECK(ast::spelling(sub.binary) == std::string("-"));
+    CHECK(ast::spelling(sub.args[0]->binary) == std::string("-")); // (1 - 2) - ...
+    CHECK(ast::spelling(sub.args[1]->binary) == std::string("*"));
 }
 
 TEST_CASE("parse errors name what was expected, where the construct began and what was found", "[parser]") {

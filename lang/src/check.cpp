@@ -1,0 +1,150 @@
+// The whole-program checks, in one place: -D values that name no param, modules bound to
+// something that is not a climber, rule groups that read new context both ways, productions
+// shadowed by an earlier one or with a condition that is always false, and, after everything
+// is compiled, letter runs read as separate letters that mean nothing, productions that can
+// never apply and rule groups never selected.
+#include "compiler_internal.hpp"
+
+#include <fmt/format.h>
+
+#include <set>
+
+namespace plant {
+
+// -D name=value must name a param of the grammar.
+void Compiler::check_defines_used() {
+    for (const auto& [name, d] : defines_) {
+        if (!defines_used_.count(name)) {
+            std::vector<std::string> params;
+            for (const auto& g : P_.globals)
+                if (g.kind == GlobalKind::Param) params.push_back(g.name);
+            std::string near = nearest_name(name, params);
+            diags_->error(
+                Span{}, near.empty() ? fmt::format("-D {}: the grammar has no param '{}'", name, name)
+                                     : fmt::format("-D {}: the grammar has no param '{}'; did you mean '{}'?",
+                                                   name, name, near));
+        }
+    }
+}
+
+// `module Seg(len, r) bound ivy;` needs ivy to be a climber
+void Compiler::check_bound_modules() {
+    for (const auto& info : P_.symbols.all()) {
+        if (info.bound_to.empty()) continue;
+        auto it = env_names_.find(info.bound_to);
+        if (it == env_names_.end())
+            diags_->error(info.decl_span,
+                          fmt::format("module '{}' is bound to '{}', which is not an environment; "
+                                      "declare it first, as in env {} = climber(...);",
+                                      info.name, info.bound_to, info.bound_to));
+        else if (it->second != "climber")
+            diags_->error(info.decl_span,
+                          fmt::format("module '{}' is bound to '{}', which is not a climber (it is "
+                                      "'{}'); only a climber can hold segments",
+                                      info.name, info.bound_to, it->second));
+    }
+}
+
+// A named group runs together with the unnamed one: together they may read only one direction
+// of new context.
+void Compiler::check_group_directions() {
+    for (const auto& g : P_.groups) {
+        bool left = g.uses_left_new || P_.rules.uses_left_new,
+             right = g.uses_right_new || P_.rules.uses_right_new;
+        if (left && right)
+            diags_->error(g.span,
+                          fmt::format("rule group '{}' and the unnamed rules together read both the forward "
+                                      "(<<) and the backward (>>) new context; use one direction",
+                                      g.name));
+    }
+}
+
+// A production about to join `set`: an earlier production that always applies to the same
+// predecessor shadows it, and so does a condition that is always false.
+void Compiler::check_shadowed(const ast::Production& p, const Production& cp, const RuleSet& set) {
+    for (const auto& q : set.productions) {
+        bool same = q.strict.size() == cp.strict.size();
+        for (std::size_t k = 0; same && k < q.strict.size(); ++k) {
+            same = q.strict[k].sym == cp.strict[k].sym && q.strict[k].width == cp.strict[k].width;
+            for (const auto& a : q.strict[k].args) same = same && a.bind;
+        }
+        bool always = same && q.condition.empty() && q.weight.empty() && !q.body_form && !q.has_context() &&
+                      !q.has_new_context();
+        if (always && cp.weight.empty()) {
+            Diagnostic d{
+                Severity::Warning,
+                p.span,
+                fmt::format("this production can never apply: the production at {} always applies first "
+                            "to '{}'",
+                            where(q.span), P_.symbols[cp.strict[0].sym].name),
+                {}};
+            diags_->add(std::move(d));
+            break;
+        }
+    }
+    if (p.condition) {
+        if (auto v = fold_number(*p.condition); v && *v == 0)
+            diags_->warning(p.condition->span,
+                            "this production can never apply: its condition is always false");
+    }
+}
+
+void Compiler::check_raw_runs() {
+    std::vector<bool> has_rule(P_.symbols.size(), false);
+    auto mark = [&](const RuleSet& rs) {
+        for (const auto& p : rs.productions)
+            for (const auto& m : p.strict) has_rule[m.sym] = true;
+    };
+    mark(P_.rules);
+    for (const auto& g : P_.groups) mark(g);
+    mark(P_.decompose);
+    mark(P_.interpret);
+    std::vector<std::string> declared;
+    for (const auto& s : P_.symbols.all())
+        if (s.declared && s.arity >= 0) declared.push_back(s.name);
+    std::set<std::pair<std::uint32_t, std::uint32_t>> reported;
+    for (const auto& run : raw_runs_) {
+        bool meaningful = false;
+        for (const auto& l : run.letters) {
+            auto id = P_.symbols.find(l);
+            if (id && (has_rule[*id] || P_.symbols[*id].turtle || P_.symbols[*id].declared))
+                meaningful = true;
+        }
+        if (meaningful || !reported.insert({run.span.file, run.span.begin}).second) continue;
+        std::string near = nearest_name(run.text, declared);
+        diags_->warning(
+            run.span,
+            near.empty()
+                ? fmt::format("'{}' is not a declared module and is read as {} separate letters, none of "
+                              "which has a rule or a turtle meaning; declare it with 'module {}(...);'",
+                              run.text, run.letters.size(), run.text)
+                : fmt::format("'{}' is not a declared module and is read as {} separate letters, none of "
+                              "which has a rule or a turtle meaning; did you mean '{}'?",
+                              run.text, run.letters.size(), near));
+    }
+}
+
+void Compiler::check_never_applying() {
+    auto check = [&](const RuleSet& rs) {
+        for (const auto& p : rs.productions) {
+            SymbolId s = p.strict[0].sym;
+            if (!produced_.count(s)) {
+                diags_->warning(p.span,
+                                fmt::format("this production can never apply: neither the axiom nor any "
+                                            "successor produces '{}'",
+                                            P_.symbols[s].name));
+            }
+        }
+    };
+    check(P_.rules);
+    for (const auto& g : P_.groups) check(g);
+    check(P_.decompose);
+    check(P_.interpret);
+    for (const auto& [name, span] : group_decls_) {
+        if (!used_groups_.count(name))
+            diags_->warning(
+                span, fmt::format("rule group '{}' is never selected: no hook says 'use {};'", name, name));
+    }
+}
+
+} // namespace plant

@@ -1,0 +1,336 @@
+// Rules: rule blocks into rule sets, productions (patterns that bind names, conditions, weights,
+// bodies), successors and letter runs split into modules, and the successor templates that let
+// the engine apply an arrow-form production without running its code module by module.
+#include "compiler_internal.hpp"
+#include "plant/vm.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace plant {
+
+void Compiler::compile_rules(const ast::File& f) {
+    for (const auto& rb : f.rule_blocks) {
+        RuleSet* set = nullptr;
+        if (rb.kind == ast::RuleKind::Rules) {
+            set = rb.group.empty() ? &P_.rules : &P_.groups[P_.group_index(rb.group)];
+        } else {
+            set = rb.kind == ast::RuleKind::Decompose ? &P_.decompose : &P_.interpret;
+            if (rb.max_depth) {
+                if (auto v = eval_const(*rb.max_depth, "max_depth")) {
+                    if (v->v[0] < 1 || v->v[0] > 1000 || v->v[0] != std::floor(v->v[0]))
+                        diags_->error(rb.max_depth->span, "max_depth must be a whole number from 1 to 1000");
+                    else
+                        set->max_depth = static_cast<int>(v->v[0]);
+                }
+            }
+        }
+        for (const auto& p : rb.productions) compile_production(p, *set);
+    }
+}
+
+void Compiler::compile_production(const ast::Production& p, RuleSet& set) {
+    Production cp;
+    cp.span = p.span;
+    Ctx c;
+    c.kind = CtxKind::Production;
+    cp.strict = compile_pattern(c, p.strict, PatternRole::Strict);
+    cp.left = compile_pattern(c, p.left, PatternRole::Left);
+    cp.left_new = compile_pattern(c, p.left_new, PatternRole::LeftNew);
+    cp.right = compile_pattern(c, p.right, PatternRole::Right);
+    cp.right_new = compile_pattern(c, p.right_new, PatternRole::RightNew);
+    if (cp.strict.empty()) {
+        diags_->error(p.span, "a production needs a predecessor");
+        return;
+    }
+    if (cp.strict.size() > 32) diags_->error(p.span, "a predecessor can have at most 32 modules");
+    if (p.condition) {
+        c.code = &cp.condition;
+        ValueType t = compile_expr(c, *p.condition);
+        if (t != ValueType::Number && t != ValueType::Bool)
+            diags_->error(p.condition->span, fmt::format("a condition must be a bool or number, found a {}",
+                                                         value_type_name(t)));
+        emit(c, Op::Halt, 0, 1, p.condition->span);
+    }
+    if (p.weight) {
+        c.code = &cp.weight;
+        ValueType t = compile_expr(c, *p.weight);
+        if (t != ValueType::Number && t != ValueType::Bool)
+            diags_->error(p.weight->span,
+                          fmt::format("a weight must be a number, found a {}", value_type_name(t)));
+        emit(c, Op::Halt, 0, 1, p.weight->span);
+    }
+    c.code = &cp.body;
+    cp.body_form = p.body_form;
+    if (p.body_form) {
+        compile_block(c, p.body);
+        emit(c, Op::Halt, 0, 0, p.span);
+    } else {
+        compile_successor(c, p.successor);
+        emit(c, Op::ProduceEnd, 0, 0, p.arrow_span);
+    }
+    cp.frame_size = c.next_slot;
+    if (!p.body_form) build_template(cp);
+    if (!cp.left.empty() || !cp.right.empty()) set.needs_brackets = true;
+    if (!cp.left_new.empty()) set.uses_left_new = true;
+    if (!cp.right_new.empty()) set.uses_right_new = true;
+    if (set.uses_left_new && set.uses_right_new)
+        diags_->error(p.span,
+                      "one rule set cannot read both the forward (<<) and the backward (>>) new context");
+    check_shadowed(p, cp, set);
+    set.productions.push_back(std::move(cp));
+}
+
+void Compiler::finish_rule_set(RuleSet& set) {
+    set.index(P_.symbols.size());
+}
+
+// Splits a letter run by longest match over declared module names, else one letter a module.
+std::vector<std::pair<std::string, Span>> Compiler::split_run(const ast::ModuleRef& m) {
+    std::vector<std::pair<std::string, Span>> out;
+    const std::string& s = m.name;
+    if (!m.raw) {
+        out.emplace_back(s, m.name_span);
+        return out;
+    }
+    if (auto id = P_.symbols.find(s); id && P_.symbols[*id].declared) {
+        out.emplace_back(s, m.name_span);
+        return out;
+    }
+    std::size_t i = 0;
+    while (i < s.size()) {
+        std::size_t best = 1;
+        for (std::size_t len = std::min(s.size() - i, max_declared_len_); len > 1; --len) {
+            if (auto id = P_.symbols.find(std::string_view(s).substr(i, len));
+                id && P_.symbols[*id].declared) {
+                best = len;
+                break;
+            }
+        }
+        Span sp{m.name_span.file, static_cast<std::uint32_t>(m.name_span.begin + i),
+                static_cast<std::uint32_t>(m.name_span.begin + i + best)};
+        out.emplace_back(s.substr(i, best), sp);
+        i += best;
+    }
+    if (out.size() > 1) {
+        RawRun run{s, m.name_span, {}};
+        for (const auto& part : out) run.letters.push_back(part.first);
+        raw_runs_.push_back(std::move(run));
+    }
+    return out;
+}
+
+SymbolId Compiler::module_symbol(const std::string& name) {
+    return P_.symbols.intern(name);
+}
+
+void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list) {
+    for (const auto& m : list) {
+        if (m.name == "*") {
+            diags_->error(m.span, "'*' (any context) is allowed only in a context pattern");
+            continue;
+        }
+        auto parts = split_run(m);
+        for (std::size_t k = 0; k < parts.size(); ++k) {
+            SymbolId sym = module_symbol(parts[k].first);
+            produced_.insert(sym);
+            const bool last = k + 1 == parts.size();
+            const SymbolInfo& info = P_.symbols[sym];
+            int width = 0;
+            std::size_t nargs = last ? m.args.size() : 0;
+            if (info.arity >= 0 && (last ? m.has_args || info.arity > 0 : info.arity > 0) &&
+                static_cast<int>(nargs) != info.arity) {
+                diags_->error(last ? m.span : Span{parts[k].second},
+                              fmt::format("module '{}' takes {} parameter{}, given {} (declared at {})",
+                                          info.name, info.arity, info.arity == 1 ? "" : "s", nargs,
+                                          where(info.decl_span)));
+            }
+            if (sym == P_.symbols.open_bracket || sym == P_.symbols.close_bracket) {
+                if (nargs) diags_->error(m.span, "brackets take no parameters");
+                emit(c, Op::Emit, static_cast<std::int32_t>(sym), 0, m.span);
+                continue;
+            }
+            std::vector<Span> arg_spans;
+            const bool communication = info.query && info.name == "?E";
+            for (std::size_t i = 0; i < nargs; ++i) {
+                // ?E(env, slots...): the first argument names an environment, which is kept as its index
+                if (communication && i == 0) {
+                    const ast::Expr& a = *m.args[0];
+                    std::size_t env = P_.environment_names.size();
+                    if (a.kind == ast::ExprKind::Name)
+                        for (std::size_t e = 0; e < P_.environment_names.size(); ++e)
+                            if (P_.environment_names[e] == a.text) env = e;
+                    if (env == P_.environment_names.size()) {
+                        diags_->error(a.span,
+                                      "the first argument of ?E names an environment, as in ?E(sun, 0)");
+                        emit_const(c, -1, a.span);
+                    } else {
+                        emit_const(c, static_cast<double>(env), a.span);
+                    }
+                    arg_spans.push_back(a.span);
+                    width += 1;
+                    continue;
+                }
+                ValueType t = compile_expr(c, *m.args[i]);
+                for (int w = 0; w < std::max(1, value_width(t)); ++w) arg_spans.push_back(m.args[i]->span);
+                if (t == ValueType::String) t = ValueType::Number;
+                if (info.arity >= 0 && i < info.param_types.size() &&
+                    value_width(t) != value_width(info.param_types[i])) {
+                    diags_->error(m.args[i]->span,
+                                  fmt::format("parameter '{}' of '{}' is a {}, found a {}",
+                                              info.param_names[i], info.name,
+                                              value_type_name(info.param_types[i]), value_type_name(t)));
+                }
+                width += value_width(t);
+            }
+            if (width > 255) {
+                diags_->error(m.span, "a module can carry at most 255 numbers");
+                width = 0;
+            }
+            std::uint16_t spans_index = 0;
+            if (!arg_spans.empty() && c.code->arg_spans.size() < 65535) {
+                c.code->arg_spans.push_back(std::move(arg_spans));
+                spans_index = static_cast<std::uint16_t>(c.code->arg_spans.size());
+            }
+            emit(c, Op::Emit, static_cast<std::int32_t>(sym), width, last ? m.span : parts[k].second,
+                 spans_index);
+        }
+    }
+}
+
+// Compiles one pattern list (strict predecessor or context) and binds its names in `c`.
+std::vector<PatternModule> Compiler::compile_pattern(Ctx& c, const ast::ModuleList& list, PatternRole role) {
+    std::vector<PatternModule> out;
+    for (const auto& m : list) {
+        auto parts = split_run(m);
+        for (std::size_t k = 0; k < parts.size(); ++k) {
+            PatternModule pm;
+            pm.sym = module_symbol(parts[k].first);
+            pm.span = parts[k].second;
+            const SymbolInfo& info = P_.symbols[pm.sym];
+            const bool last = k + 1 == parts.size();
+            bool bracket = pm.sym == P_.symbols.open_bracket || pm.sym == P_.symbols.close_bracket;
+            if (bracket && role != PatternRole::Right) {
+                diags_->error(m.span, role == PatternRole::Strict
+                                          ? "a predecessor cannot contain '[' or ']'"
+                                          : "brackets are allowed only in a right context");
+            }
+            std::size_t nargs = last ? m.args.size() : 0;
+            if (info.arity >= 0 && static_cast<int>(nargs) != info.arity) {
+                diags_->error(
+                    last ? m.span : pm.span,
+                    fmt::format("module '{}' takes {} parameter{}, the pattern gives {} (declared at {})",
+                                info.name, info.arity, info.arity == 1 ? "" : "s", nargs,
+                                where(info.decl_span)));
+            }
+            for (std::size_t i = 0; i < nargs; ++i) {
+                const ast::Expr& a = *m.args[i];
+                PatternArg pa;
+                ValueType t = ValueType::Number;
+                if (info.arity >= 0 && i < info.param_types.size()) t = info.param_types[i];
+                if (info.query && nargs == 1) t = ValueType::Vec3;
+                pa.width = static_cast<std::uint8_t>(value_width(t));
+                if (a.kind == ast::ExprKind::Name && !consts_.count(a.text)) {
+                    if (a.text == "_") {
+                        pa.bind = false;
+                        pa.value = std::nan("");
+                    } else {
+                        for (const auto& l : c.locals) {
+                            if (l.name == a.text) {
+                                diags_->error(a.span,
+                                              fmt::format("'{}' is bound twice in this production", a.text));
+                                break;
+                            }
+                        }
+                        pa.slot = add_local(c, a.text, t);
+                        c.locals.back().bound = true;
+                    }
+                } else if (auto v = fold_number(a)) {
+                    pa.bind = false;
+                    pa.value = *v;
+                    if (t == ValueType::Vec3)
+                        diags_->error(a.span, "a vec3 parameter cannot be matched against a number");
+                } else {
+                    diags_->error(a.span, "a pattern argument must be a name to bind or a constant value");
+                }
+                pm.width += pa.width;
+                pm.args.push_back(pa);
+            }
+            out.push_back(std::move(pm));
+        }
+    }
+    return out;
+}
+
+// Splits an arrow-form body (argument code, Emit, argument code, Emit, ..., ProduceEnd) into a
+// template: a module whose arguments are all constants is copied as it is; the argument code of
+// the others is moved, in order, into `values`. Draws of random numbers happen in the same
+// order as in the body, so both paths derive the same string.
+void Compiler::build_template(Production& p) {
+    SuccessorTemplate t;
+    if (p.strict.size() != 1) return;
+    const Code& body = p.body;
+    t.values.consts = body.consts;
+    std::size_t seg_begin = 0;
+    for (std::size_t pc = 0; pc < body.instrs.size(); ++pc) {
+        const Instr& I = body.instrs[pc];
+        if (I.op == Op::ProduceEnd) break;
+        if (I.op != Op::Emit) continue;
+        const auto sym = static_cast<SymbolId>(I.a);
+        if (t.keep < 0 && sym == p.strict[0].sym) t.keep = static_cast<int>(t.syms.size());
+        t.syms.push_back(sym);
+        const auto first = static_cast<std::uint32_t>(t.params.size());
+        bool constant = true;
+        for (std::size_t k = seg_begin; k < pc; ++k) constant = constant && body.instrs[k].op == Op::Const;
+        if (constant) {
+            for (std::size_t k = seg_begin; k < pc; ++k) t.params.push_back(body.consts[body.instrs[k].a]);
+        } else {
+            const auto shift =
+                static_cast<std::int64_t>(t.values.instrs.size()) - static_cast<std::int64_t>(seg_begin);
+            for (std::size_t k = seg_begin; k < pc; ++k) {
+                Instr J = body.instrs[k];
+                if (is_jump(J.op)) J.a = static_cast<std::int32_t>(J.a + shift);
+                if (J.op == Op::Emit || op_info(J.op).flow == OpFlow::End) return;
+                t.values.instrs.push_back(J);
+                t.values.spans.push_back(body.spans[k]);
+            }
+            for (int k = 0; k < I.n; ++k) {
+                t.holes.push_back(first + static_cast<std::uint32_t>(k));
+                t.hole_spans.push_back(I.b > 0 ? body.arg_spans[I.b - 1][static_cast<std::size_t>(k)]
+                                               : body.spans[pc]);
+                t.params.push_back(0);
+            }
+        }
+        t.param_end.push_back(static_cast<std::uint32_t>(t.params.size()));
+        seg_begin = pc + 1;
+    }
+    if (t.holes.size() > 255) return;
+    if (!t.holes.empty()) {
+        t.values.instrs.push_back(Instr{Op::Halt, static_cast<std::uint8_t>(t.holes.size()), 0, 0});
+        t.values.spans.push_back(p.span);
+        fuse(t.values);
+        // the affine fast path: one instruction per computed number, each a slot with a factor
+        std::vector<SuccessorTemplate::Affine> affine;
+        for (std::size_t k = 0; k + 1 < t.values.instrs.size(); ++k) {
+            const Instr& I = t.values.instrs[k];
+            auto slot = static_cast<std::uint16_t>(I.a);
+            using A = SuccessorTemplate::Affine;
+            if (I.op == Op::LoadLocal && I.n == 1)
+                affine.push_back({A::Copy, slot, 0.0});
+            else if (I.op == Op::LoadMulConst)
+                affine.push_back({A::Mul, slot, t.values.consts[I.b]});
+            else if (I.op == Op::LoadAddConst)
+                affine.push_back({A::Add, slot, t.values.consts[I.b]});
+            else
+                break;
+        }
+        if (affine.size() == t.holes.size() && affine.size() + 1 == t.values.instrs.size())
+            t.affine = std::move(affine);
+    }
+    t.valid = true;
+    p.tmpl = std::move(t);
+}
+
+} // namespace plant

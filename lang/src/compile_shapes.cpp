@@ -1,0 +1,195 @@
+// Shapes and environments: `curve` and `surface` declarations evaluated at compile time, `env`
+// declarations made by the runtime's factory, and the method calls that query them.
+#include "compiler_internal.hpp"
+
+#include <fmt/format.h>
+
+#include <filesystem>
+
+namespace plant {
+
+namespace fs = std::filesystem;
+
+void Compiler::compile_curve(const ast::ShapeDecl& s) {
+    CurveDef def;
+    def.name = s.name;
+    def.span = s.span;
+    for (const auto& other : P_.curves) {
+        if (other.name == s.name) {
+            duplicate("curve", s.name, s.span, other.span);
+            return;
+        }
+    }
+    if (s.kind != "linear" && s.kind != "bezier") {
+        diags_->error(s.kind_span,
+                      fmt::format("unknown curve kind '{}': expected linear(...) or bezier(...)", s.kind));
+        return;
+    }
+    def.bezier = s.kind == "bezier";
+    bool points = false;
+    for (std::size_t i = 0; i < s.args.size(); ++i) {
+        auto v = eval_const(*s.args[i], "a curve's control value");
+        if (!v) return;
+        bool vec = v->type == ValueType::Vec3;
+        if (i == 0) points = vec;
+        if (vec != points) {
+            diags_->error(s.args[i]->span, "a curve's control values are all numbers or all vec3 points");
+            return;
+        }
+        def.xs.push_back(vec ? v->v[0] : 0.0);
+        def.ys.push_back(vec ? v->v[1] : v->v[0]);
+    }
+    if (def.ys.size() < 2) {
+        diags_->error(s.span, fmt::format("curve '{}' needs at least two control values", s.name));
+        return;
+    }
+    if (!points)
+        for (std::size_t i = 0; i < def.xs.size(); ++i) def.xs[i] = double(i) / double(def.xs.size() - 1);
+    for (std::size_t i = 1; i < def.xs.size(); ++i) {
+        if (def.xs[i] < def.xs[i - 1]) {
+            diags_->error(s.args[i]->span,
+                          "the x of a curve's points must not decrease (x is t, from 0 to 1)");
+            return;
+        }
+    }
+    P_.curves.push_back(std::move(def));
+}
+
+void Compiler::compile_surface(const ast::ShapeDecl& s) {
+    SurfaceDef def;
+    def.name = s.name;
+    def.kind = s.kind;
+    def.span = s.span;
+    // a surface in an importing file replaces the library's (libraries are compiled first), so a
+    // user swaps a default leaf for load("my_leaf.obj"); twice in one file is an error
+    std::size_t replace = P_.surfaces.size();
+    for (std::size_t i = 0; i < P_.surfaces.size(); ++i) {
+        if (P_.surfaces[i].name != s.name) continue;
+        if (P_.surfaces[i].span.file == s.span.file) {
+            duplicate("surface", s.name, s.span, P_.surfaces[i].span);
+            return;
+        }
+        replace = i;
+    }
+    if (s.kind == "polygon") {
+        for (const auto& a : s.args) {
+            auto v = eval_const(*a, "a polygon corner");
+            if (!v) return;
+            if (v->type != ValueType::Vec3) {
+                diags_->error(a->span, "a polygon corner must be a vec3, as in vec3(0, 1, 0)");
+                return;
+            }
+            def.points.push_back({v->v[0], v->v[1], v->v[2]});
+        }
+        if (def.points.size() < 3) {
+            diags_->error(s.span, fmt::format("polygon '{}' needs at least 3 corners, found {}", s.name,
+                                              def.points.size()));
+            return;
+        }
+    } else if (s.kind == "load") {
+        if (s.args.size() != 1 || s.args[0]->kind != ast::ExprKind::String) {
+            diags_->error(s.span, "load(...) takes one quoted file name, as in load(\"leaf.obj\")");
+            return;
+        }
+        fs::path p(s.args[0]->text);
+        if (p.is_relative()) p = fs::path(sm_.file(s.span.file).name()).parent_path() / p;
+        def.path = p.lexically_normal().string();
+    } else {
+        diags_->error(
+            s.kind_span,
+            fmt::format("unknown surface kind '{}': expected polygon(...) or load(\"file\")", s.kind));
+        return;
+    }
+    if (replace < P_.surfaces.size())
+        P_.surfaces[replace] = std::move(def);
+    else
+        P_.surfaces.push_back(std::move(def));
+}
+
+void Compiler::compile_environment(const ast::ShapeDecl& s) {
+    for (const ast::ShapeDecl* other : env_decls_) {
+        if (other == &s) break;
+        if (other->name == s.name) {
+            duplicate("environment", s.name, s.span, other->span);
+            return;
+        }
+    }
+    P_.environment_names.push_back(s.name);
+    P_.environments.emplace_back();  // null until made
+    if (!opts_.environments) return; // no runtime: using it is reported where it is used
+    std::vector<EnvArg> args;
+    for (std::size_t i = 0; i < s.args.size(); ++i) {
+        if (s.args[i]->kind == ast::ExprKind::String) { // a file, relative to the grammar
+            EnvArg a;
+            a.key = s.keys[i];
+            a.type = ValueType::String;
+            fs::path path(s.args[i]->text);
+            if (path.is_relative()) path = fs::path(sm_.file(s.span.file).name()).parent_path() / path;
+            a.text = path.lexically_normal().string();
+            a.span = s.args[i]->span;
+            args.push_back(a);
+            continue;
+        }
+        auto v = eval_const(*s.args[i], "an environment's argument");
+        if (!v) return;
+        EnvArg a;
+        a.key = s.keys[i];
+        a.type = v->type;
+        std::copy(v->v, v->v + 3, a.v);
+        a.span = s.args[i]->span;
+        args.push_back(a);
+    }
+    std::string error;
+    auto env = opts_.environments(s.kind, args, error);
+    if (!env) {
+        diags_->error(s.kind_span,
+                      error.empty() ? fmt::format("unknown environment kind '{}'", s.kind) : error);
+        return;
+    }
+    P_.environments.back() = std::shared_ptr<Environment>(std::move(env));
+}
+
+ValueType Compiler::compile_env_call(Ctx& c, const ast::Expr& e, std::size_t env) {
+    const Environment& object = *P_.environments[env];
+    const std::string& env_name = P_.environment_names[env];
+    const auto& methods = object.methods();
+    std::size_t m = 0;
+    while (m < methods.size() && methods[m].name != e.text) ++m;
+    if (m == methods.size()) {
+        std::vector<std::string> names;
+        for (const auto& mm : methods) names.push_back(mm.name);
+        std::string near = nearest_name(e.text, names);
+        diags_->error(e.span, near.empty()
+                                  ? fmt::format("environment '{}' has no method '{}'", env_name, e.text)
+                                  : fmt::format("environment '{}' has no method '{}'; did you mean '{}'?",
+                                                env_name, e.text, near));
+        emit_const(c, 0, e.span);
+        return ValueType::Number;
+    }
+    const EnvMethod& method = methods[m];
+    if (method.hook_only && c.kind != CtxKind::Hook)
+        diags_->error(e.span, fmt::format("'{}.{}' changes the environment and can be called only in hooks "
+                                          "({})",
+                                          env_name, e.text, ast::hook_list("on ", ", ")));
+    const std::size_t given = e.args.size() - 1;
+    if (given != method.args.size()) {
+        diags_->error(e.span, fmt::format("'{}.{}' takes {} argument{}, given {}", env_name, e.text,
+                                          method.args.size(), method.args.size() == 1 ? "" : "s", given));
+        emit_const(c, 0, e.span);
+        return ValueType::Number;
+    }
+    int width = 0;
+    for (std::size_t i = 0; i < given; ++i) {
+        ValueType t = compile_expr(c, *e.args[i + 1]);
+        bool fits = method.args[i] == ValueType::Vec3 ? t == ValueType::Vec3 : numeric(t);
+        if (!fits)
+            diags_->error(e.args[i + 1]->span,
+                          fmt::format("argument {} of '{}.{}' must be a {}, found a {}", i + 1, env_name,
+                                      e.text, value_type_name(method.args[i]), value_type_name(t)));
+        width += value_width(t);
+    }
+    emit(c, Op::EnvCall, static_cast<std::int32_t>(env), width, e.span, static_cast<std::uint16_t>(m));
+    return method.result;
+}
+
+} // namespace plant

@@ -1,0 +1,61 @@
+// The compiled program's own lookups: the symbol table (turtle and query symbols are interned
+// first, so their ids are fixed), the rule index by first symbol, rule groups by name.
+#include "plant/program.hpp"
+
+#include <cctype>
+
+namespace plant {
+
+SymbolTable::SymbolTable() {
+    // Turtle symbols of LANGUAGE.md section 10 and the query modules of section 8.
+    static const char* turtle[] = {"F", "f",  "G",  "+",       "-",  "&",   "^",   "\\",
+                                   "/", "|",  "$",  "[",       "]",  "!",   ";",   "~",
+                                   "%", "@O", "@R", "SetHead", "@M", "@Tp", "@Ts", "SetColor"};
+    for (const char* t : turtle) {
+        SymbolId id = intern(t);
+        infos_[id].turtle = true;
+        // multi-letter turtle names are declared so letter runs do not split them
+        infos_[id].declared =
+            std::string_view(t).size() > 1 && std::isalpha(static_cast<unsigned char>(t[0]));
+    }
+    for (const char* q : {"?P", "?H", "?U", "?L", "?E"}) {
+        SymbolId id = intern(q);
+        infos_[id].query = true;
+        infos_[id].declared = true;
+    }
+    open_bracket = *find("[");
+    close_bracket = *find("]");
+    cut = *find("%");
+}
+
+SymbolId SymbolTable::intern(std::string_view name) {
+    auto it = index_.find(std::string(name));
+    if (it != index_.end()) return it->second;
+    if (infos_.size() >= kNoSymbol) throw Full{};
+    auto id = static_cast<SymbolId>(infos_.size());
+    SymbolInfo info;
+    info.name = std::string(name);
+    infos_.push_back(std::move(info));
+    index_.emplace(std::string(name), id);
+    return id;
+}
+
+std::optional<SymbolId> SymbolTable::find(std::string_view name) const {
+    auto it = index_.find(std::string(name));
+    if (it == index_.end()) return std::nullopt;
+    return it->second;
+}
+
+void RuleSet::index(std::size_t symbols) {
+    by_symbol.assign(symbols, {});
+    for (std::uint32_t i = 0; i < productions.size(); ++i)
+        by_symbol[productions[i].strict[0].sym].push_back(i);
+}
+
+int Program::group_index(std::string_view name) const {
+    for (std::size_t i = 0; i < groups.size(); ++i)
+        if (groups[i].name == name) return static_cast<int>(i);
+    return -1;
+}
+
+} // namespace plant
