@@ -29,9 +29,9 @@ double next_unit(EvalEnv& env) {
     return random_unit(random_bits(env.seed, env.phase, env.position, env.draw++));
 }
 
-// Applies builtin `id` to the arguments at `a` (already popped); writes the result to `r`.
-// Returns the width of the result.
-int apply_builtin(BuiltinId id, const double* a, double* r, EvalEnv& env) {
+// Functions of numbers alone. Each apply_* returns the width of its result, 0 when `id` is not one
+// of its own.
+int apply_math(BuiltinId id, const double* a, double* r) {
     switch (id) {
     case BuiltinId::Sin:
         r[0] = std::sin(a[0]);
@@ -93,9 +93,6 @@ int apply_builtin(BuiltinId id, const double* a, double* r, EvalEnv& env) {
     case BuiltinId::Mix:
         r[0] = a[0] + (a[1] - a[0]) * a[2];
         return 1;
-    case BuiltinId::MixV:
-        for (int k = 0; k < 3; ++k) r[k] = a[k] + (a[3 + k] - a[k]) * a[6];
-        return 3;
     case BuiltinId::Smoothstep: {
         double t =
             a[1] == a[0] ? (a[2] < a[0] ? 0.0 : 1.0) : std::clamp((a[2] - a[0]) / (a[1] - a[0]), 0.0, 1.0);
@@ -111,6 +108,17 @@ int apply_builtin(BuiltinId id, const double* a, double* r, EvalEnv& env) {
     case BuiltinId::Pi:
         r[0] = kPi;
         return 1;
+    default:
+        return 0;
+    }
+}
+
+// Functions that take or give vec3s.
+int apply_vector(BuiltinId id, const double* a, double* r) {
+    switch (id) {
+    case BuiltinId::MixV:
+        for (int k = 0; k < 3; ++k) r[k] = a[k] + (a[3 + k] - a[k]) * a[6];
+        return 3;
     case BuiltinId::Vec3:
         r[0] = a[0];
         r[1] = a[1];
@@ -145,6 +153,14 @@ int apply_builtin(BuiltinId id, const double* a, double* r, EvalEnv& env) {
         r[0] = std::sqrt(dx * dx + dy * dy + dz * dz);
         return 1;
     }
+    default:
+        return 0;
+    }
+}
+
+// Functions of the module being rewritten: its random stream, the step, its identity.
+int apply_per_module(BuiltinId id, const double* a, double* r, EvalEnv& env) {
+    switch (id) {
     case BuiltinId::Uniform:
         r[0] = a[0] + (a[1] - a[0]) * next_unit(env);
         return 1;
@@ -166,8 +182,17 @@ int apply_builtin(BuiltinId id, const double* a, double* r, EvalEnv& env) {
     case BuiltinId::Lod:
         r[0] = a[2] == 0 ? a[0] : std::round(a[0] * (1 - a[1] / a[2]));
         return 1;
+    default:
+        return 0;
     }
-    return 0;
+}
+
+// Applies builtin `id` to the arguments at `a` (already popped); writes the result to `r`.
+// Returns the width of the result.
+int apply_builtin(BuiltinId id, const double* a, double* r, EvalEnv& env) {
+    if (int w = apply_math(id, a, r)) return w;
+    if (int w = apply_vector(id, a, r)) return w;
+    return apply_per_module(id, a, r, env);
 }
 
 std::string format_number(double v) {

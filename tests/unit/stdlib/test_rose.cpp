@@ -141,14 +141,12 @@ double wrap_degrees(double a) {
     return a;
 }
 
-// Every rule of PLANTS.md that can be read off one grown rose.
-void check_rose(const Rose& r, const std::string& what) {
-    INFO(what);
+// The stems' own rules (docs/rose.md, checks): how each kind of stem ends, how many trunks.
+void check_stems(const Rose& r) {
     const double h_trunk = r.params.at("h_trunk"), r_trunk = r.params.at("r_trunk");
     const double h_crown = r.params.at("h_crown"), r_crown = r.params.at("r_crown");
     const int N_D = static_cast<int>(r.params.at("N_D")), N_T = static_cast<int>(r.params.at("N_T"));
     const int N_B = static_cast<int>(r.params.at("N_B"));
-    const double delta = r.params.at("delta_min");
     const bool flowering = r.params.at("stage") >= 2;
 
     // the derivation finished: nothing is left waiting to grow or branch
@@ -199,9 +197,12 @@ void check_rose(const Rose& r, const std::string& what) {
         CHECK((flowering || (st.type != Term && st.type != BloomStem)));
     }
     CHECK(trunks <= static_cast<int>(r.params.at("N_S")));
+}
 
-    // Eq. 3: no two stems (trunks, intermediate, terminal) have nodes closer than delta_min,
-    // except where one branches from the other (a stem's first point lies on its parent)
+// Eq. 3: no two stems (trunks, intermediate, terminal) have nodes closer than delta_min, except
+// where one branches from the other (a stem's first point lies on its parent).
+void check_spacing(const Rose& r) {
+    const double delta = r.params.at("delta_min");
     std::vector<std::vector<glm::dvec3>> nodes;
     std::vector<glm::dvec3> base;
     for (const auto& st : r.stems)
@@ -219,7 +220,10 @@ void check_rose(const Rose& r, const std::string& what) {
                     if (glm::distance(y, base[a]) >= 1e-9) closest = std::min(closest, glm::distance(x, y));
             }
     CHECK(closest >= delta - 1e-9);
+}
 
+void check_phyllotaxis(const Rose& r) {
+    const bool flowering = r.params.at("stage") >= 2;
     // 3/8 phyllotaxis: the children along a stem (lateral stems and leaves; not the tip's child,
     // nor the branching children of the last two nodes of a trunk or intermediate stem) are 135
     // degrees apart per node around the stem, measured in a frame carried along the stem by
@@ -287,6 +291,14 @@ void check_rose(const Rose& r, const std::string& what) {
         }
     }
     if (flowering) CHECK(measured > 0);
+}
+
+// Every rule of docs/rose.md that can be read off one grown rose.
+void check_rose(const Rose& r, const std::string& what) {
+    INFO(what);
+    check_stems(r);
+    check_spacing(r);
+    check_phyllotaxis(r);
 }
 
 } // namespace
