@@ -1,5 +1,5 @@
 #include "helpers.hpp"
-#include "rewriter.hpp"
+#include "rewrite/rewriter.hpp"
 
 #include <catch2/catch.hpp>
 
