@@ -7,6 +7,17 @@
 
 namespace plant {
 
+namespace {
+
+// Resizes one of the output's arrays. Kept out of line: inlined, vector's growth path copied
+// five times into run_symbols more than doubles the loop's code, and the first step (the one a
+// fresh process runs with cold caches) pays for it.
+template <typename Vector> [[gnu::noinline]] void resize(Vector& v, std::size_t size) {
+    v.resize(size);
+}
+
+} // namespace
+
 // run_range for strings without parameters or identities under a plan with a symbol kernel
 // (parameterless context-sensitive systems such as ABOP's Fig. 1.31). A module's successor
 // comes from its symbol's block: itself, its direct template, or the context table's entry
@@ -66,12 +77,12 @@ template <bool Whole> void Rewriter::run_symbols(Worker& w, std::size_t b, std::
     std::size_t depth = 0; // the left keys at the open '['s are on the stack
     std::uint64_t fresh = 0;
     std::size_t i = b, next_check = b + 65536;
-    out.sym.resize(std::max(out.sym.capacity(), m)); // the room reserved is written in place
+    resize(out.sym, std::max(out.sym.capacity(), m)); // the room reserved is written in place
     while (i < e) {
         // the modules that fit: each writes at most Mmax, and a copy writes kPad
         std::size_t room = out.sym.size() >= m + kPad ? (out.sym.size() - m - kPad) / Mmax : 0;
         if (room == 0) {
-            out.sym.resize(std::max(m + Mmax + kPad, 2 * out.sym.size()));
+            resize(out.sym, std::max(m + Mmax + kPad, 2 * out.sym.size()));
             continue;
         }
         if (i >= next_check) {
@@ -79,7 +90,7 @@ template <bool Whole> void Rewriter::run_symbols(Worker& w, std::size_t b, std::
             if (env.interrupt && env.interrupt->load())
                 throw RuntimeError{RuntimeErrorKind::Interrupted, Span{}, "interrupted"};
             if (m > env.max_output) {
-                out.sym.resize(m);
+                resize(out.sym, m);
                 limit_error();
             }
         }
@@ -111,12 +122,12 @@ template <bool Whole> void Rewriter::run_symbols(Worker& w, std::size_t b, std::
         }
     }
     if (m > env.max_output) {
-        out.sym.resize(m);
+        resize(out.sym, m);
         limit_error();
     }
-    out.sym.resize(m);
+    resize(out.sym, m);
     const std::size_t m0 = out.poff.size();
-    out.poff.resize(m + 1);
+    resize(out.poff, m + 1);
     std::fill(out.poff.begin() + static_cast<std::ptrdiff_t>(m0), out.poff.end(),
               static_cast<std::uint32_t>(p_end));
     env.new_count += static_cast<ModuleId>(fresh);
