@@ -166,7 +166,7 @@ bool Session::step(int n) {
             next->step();
         } catch (const RuntimeError& e) {
             error() << render(Diagnostic{Severity::Error, e.span, e.message, {}}, *sources_, color_);
-            if (e.message.find("interrupted") != std::string::npos)
+            if (e.kind == RuntimeErrorKind::Interrupted)
                 error() << fmt::format("interrupted; still at step {}\n", current().steps_done());
             return false;
         }

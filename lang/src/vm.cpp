@@ -21,8 +21,9 @@ constexpr int kMaxCallDepth = 256;
 constexpr std::size_t kStackSize = 1024;
 constexpr double kPi = std::numbers::pi;
 
-[[noreturn]] void fail(const Code& code, std::size_t pc, std::string msg) {
-    throw RuntimeError{pc < code.spans.size() ? code.spans[pc] : Span{}, std::move(msg)};
+[[noreturn]] void fail(const Code& code, std::size_t pc, std::string msg,
+                       RuntimeErrorKind kind = RuntimeErrorKind::General) {
+    throw RuntimeError{kind, pc < code.spans.size() ? code.spans[pc] : Span{}, std::move(msg)};
 }
 
 double next_unit(EvalEnv& env) {
@@ -264,12 +265,12 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
             break;
         case Op::Div:
             --sp;
-            if (st[sp] == 0) fail(code, pc, "division by zero");
+            if (st[sp] == 0) fail(code, pc, "division by zero", RuntimeErrorKind::Arithmetic);
             st[sp - 1] /= st[sp];
             break;
         case Op::Mod:
             --sp;
-            if (st[sp] == 0) fail(code, pc, "remainder of a division by zero");
+            if (st[sp] == 0) fail(code, pc, "remainder of a division by zero", RuntimeErrorKind::Arithmetic);
             st[sp - 1] = std::fmod(st[sp - 1], st[sp]);
             break;
         case Op::Neg:
@@ -323,7 +324,7 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
         }
         case Op::VDivS: {
             double s = st[--sp];
-            if (s == 0) fail(code, pc, "division by zero");
+            if (s == 0) fail(code, pc, "division by zero", RuntimeErrorKind::Arithmetic);
             for (int k = 0; k < 3; ++k) st[sp - 3 + k] /= s;
             break;
         }
@@ -400,8 +401,8 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
                         fmt::format("parameter {} of '{}' is {}", k + 1, env.prog->symbols[I.a].name,
                                     std::isnan(p[k]) ? "NaN" : "infinite");
                     if (I.b > 0 && static_cast<std::size_t>(k) < code.arg_spans[I.b - 1].size())
-                        throw RuntimeError{code.arg_spans[I.b - 1][k], msg};
-                    fail(code, pc, msg);
+                        throw RuntimeError{RuntimeErrorKind::Arithmetic, code.arg_spans[I.b - 1][k], msg};
+                    fail(code, pc, msg, RuntimeErrorKind::Arithmetic);
                 }
             }
             auto sym = static_cast<SymbolId>(I.a);
@@ -419,7 +420,7 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
             env.out->push(sym, p, I.n, id);
             env.produced = true;
             if (env.out->size() > env.max_output || env.out->params.size() > env.max_params)
-                fail(code, pc, "the string outgrew the module limit");
+                fail(code, pc, "the string outgrew the module limit", RuntimeErrorKind::ModuleLimit);
             break;
         }
         case Op::ProduceEnd:

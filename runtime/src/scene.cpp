@@ -108,7 +108,8 @@ MeshPart loaded_prototype(const SurfaceDef& s) {
     omerr().disable(); // failures are reported as our own diagnostics
     OpenMesh::IO::Options opt;
     if (!OpenMesh::IO::read_mesh(mesh, s.path, opt))
-        throw RuntimeError(s.span, fmt::format("cannot load surface '{}' from '{}'", s.name, s.path));
+        throw RuntimeError(RuntimeErrorKind::Geometry, s.span,
+                           fmt::format("cannot load surface '{}' from '{}'", s.name, s.path));
     mesh.triangulate();
     mesh.update_normals();
     MeshPart m;
@@ -123,7 +124,8 @@ MeshPart loaded_prototype(const SurfaceDef& s) {
     for (auto f : mesh.faces())
         for (auto v : mesh.fv_range(f)) m.indices.push_back(static_cast<std::uint32_t>(v.idx()));
     if (m.indices.empty())
-        throw RuntimeError(s.span, fmt::format("surface '{}' loaded from '{}' has no faces", s.name, s.path));
+        throw RuntimeError(RuntimeErrorKind::Geometry, s.span,
+                           fmt::format("surface '{}' loaded from '{}' has no faces", s.name, s.path));
     m.primitives.push_back(Primitive{0, static_cast<std::uint32_t>(m.indices.size()), 0});
     return m;
 }
@@ -178,7 +180,7 @@ Scene build_scene(const Program& program, const Skeleton& skeleton, const MeshOp
                     for (const auto& s : program.surfaces)
                         if (s.name == organ.shape) def = &s;
                     if (!def)
-                        throw RuntimeError(Span{},
+                        throw RuntimeError(RuntimeErrorKind::Geometry, Span{},
                                            fmt::format("'~{}' places a surface that is not declared: add "
                                                        "'surface {} = polygon(...);'",
                                                        organ.shape, organ.shape));
@@ -200,7 +202,7 @@ Scene build_scene(const Program& program, const Skeleton& skeleton, const MeshOp
     for (float v : {scene.bounds_min.x, scene.bounds_min.y, scene.bounds_min.z, scene.bounds_max.x,
                     scene.bounds_max.y, scene.bounds_max.z})
         if (!std::isfinite(v))
-            throw RuntimeError(Span{},
+            throw RuntimeError(RuntimeErrorKind::Geometry, Span{},
                                "the plant reaches coordinates beyond the range of single-precision numbers "
                                "(about 3e38) and cannot be meshed");
     return scene;

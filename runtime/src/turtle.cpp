@@ -126,7 +126,7 @@ void interpret(const Program& program, const ModuleString& s, const TurtleOption
             return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
         };
         if (!finite(t.position) || !finite(t.heading) || !finite(t.left) || !finite(t.up))
-            throw RuntimeError(Span{},
+            throw RuntimeError(RuntimeErrorKind::Turtle, Span{},
                                fmt::format("the turtle left finite space at module {} ('{}') of the string",
                                            i + 1, program.symbols[s.sym[i]].name));
     };
@@ -215,7 +215,7 @@ void interpret(const Program& program, const ModuleString& s, const TurtleOption
             t.axis = -1;
         } else if (sym == y.close) {
             if (stack.empty())
-                throw RuntimeError(Span{},
+                throw RuntimeError(RuntimeErrorKind::Turtle, Span{},
                                    fmt::format("']' at module {} of the string closes no '[' (the turtle's "
                                                "stack is empty)",
                                                i + 1));

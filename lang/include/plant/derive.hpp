@@ -1,6 +1,6 @@
-// The derivation engine: hooks, parallel rewriting with tree-aware context, stochastic choice,
-// decomposition and cut (LANGUAGE.md sections 4, 6, 7). The result depends only on the program,
-// its parameters and the seed: never on the thread count.
+// The derivation: hooks, parallel rewriting with tree-aware context, stochastic choice,
+// decomposition and cut (docs/language.md: productions, module identity, hooks and groups).
+// The result depends only on the program, its parameters and the seed: never on the thread count.
 #pragma once
 
 #include "plant/diagnostics.hpp"
@@ -16,9 +16,25 @@
 
 namespace plant {
 
-class Rewriter;   // derive.cpp
 class Derivation; // below
-struct RulePlan;  // rewriter.hpp
+struct Engine;    // the rewriting engine's state (lang/src/rewrite/engine.hpp)
+
+namespace detail {
+// Owns a derivation's engine state. A copy gets what a copied derivation keeps (see Engine's copy
+// constructor): the rule plans, shared; the identity counter; no buffers and no spare string.
+class EngineHandle {
+  public:
+    EngineHandle();
+    EngineHandle(const EngineHandle& other);
+    EngineHandle& operator=(const EngineHandle&) = delete;
+    ~EngineHandle();
+    Engine* operator->() const { return engine_.get(); }
+    Engine& operator*() const { return *engine_; }
+
+  private:
+    std::unique_ptr<Engine> engine_;
+};
+} // namespace detail
 
 // Implemented by the runtime: interprets the string with the turtle and writes the position,
 // heading, up or left vector into every query module (?P ?H ?U ?L). Called before a step whose
@@ -46,7 +62,7 @@ struct DeriveOptions {
     std::function<void(const StepStats&)> on_step;
     std::function<void(const std::string&)> on_print; // output of print(...) in hooks
     const std::atomic<bool>* interrupt = nullptr;     // set asynchronously to abandon a step
-    // Whether the string keeps module identities (LANGUAGE.md section 6). Without them a
+    // Whether the string keeps module identities (docs/language.md, module identity). Without them a
     // derivation writes 8 bytes less per module; they are kept anyway when the program can
     // observe them (it calls id(), or has query modules or environments).
     bool identities = true;
@@ -83,7 +99,7 @@ class Derivation {
     int active_group() const { return group_; }
     void use_group(int group) { group_ = group; } // -1: none (the REPL's :use)
     void set_seed(std::uint64_t seed) { seed_ = seed; }
-    ModuleId next_id() const { return next_id_; }
+    ModuleId next_id() const;
     const Program& program() const { return prog_; }
     // Whether the string keeps module identities (see DeriveOptions::identities).
     bool keeps_identities() const { return current_.keep_ids; }
@@ -92,20 +108,9 @@ class Derivation {
     ModuleString interpreted(const ModuleString& s) const;
 
   private:
+    friend struct Engine; // reads the program, options, settings and string it rewrites
+
     void run_hook(HookKind kind);
-    void rewrite(const ModuleString& in, ModuleString& out, const RulePlan& plan, std::uint64_t phase,
-                 int step_for_env) const;
-    template <typename Setup>
-    bool rewrite_direct(Rewriter& rw, const ModuleString& in, ModuleString& out, int threads,
-                        const Setup& setup) const;
-    void decompose(ModuleString& s, int step_for_env);
-    void apply_cut(ModuleString& s) const;
-    void check_limits(const ModuleString& s) const;
-    void check_limits(std::size_t modules, std::size_t params) const;
-    // The plan for rewriting with `sets`, built the first time and kept (copies share them).
-    const RulePlan& plan_for(const std::vector<const RuleSet*>& sets) const;
-    // The plan for a step with the active group: plan_for(group's rules, then the unnamed ones).
-    const RulePlan& step_plan() const;
 
     const Program& prog_;
     DeriveOptions opt_;
@@ -118,30 +123,14 @@ class Derivation {
     bool started_ = false;
     std::uint64_t seed_ = 0;
     double angle_ = 90, step_length_ = 1, width_ = 1;
-    mutable ModuleId next_id_ = 1;
-    mutable double growth_ = 2.0, param_growth_ = 2.0; // last step's growth, for reserving memory
-    mutable std::vector<std::shared_ptr<const RulePlan>> plans_;
-    mutable std::vector<const RulePlan*> step_plans_; // per group + 1 (index 0: no group), from plans_
-    mutable std::vector<std::uint32_t> brackets_;     // the bracket table, kept from step to step
-    mutable std::vector<std::uint16_t>
-        kernel_scratch_; // the symbol kernel's right keys (Rewriter::run_symbols)
-    // The string a step replaced, when small, kept for the next step to write its output into:
-    // small strings would otherwise pay a round of allocations a step. Copies start without one.
-    struct Spare {
-        static constexpr std::size_t kMaxBytes = std::size_t{1} << 20;
-        ModuleString s;
-        Spare() = default;
-        Spare(const Spare&) {}
-        Spare& operator=(const Spare&) { return *this; }
-    };
-    Spare spare_;
+    detail::EngineHandle engine_; // the rule plans, the identity counter, buffers kept between steps
 };
 
 // The positions where the first production of `rules` matches in the derivation's current string
 // (its pattern, context and condition): what `:find PATTERN` lists in the REPL.
 std::vector<std::size_t> find_matches(const Derivation& d, const Program& program, const RuleSet& rules);
 
-// Formats a string in ABOP notation (LANGUAGE.md section 11).
+// Formats a string in ABOP notation (docs/language.md, printing strings).
 // With `max_chars`, stops after the module that passes that length (the REPL's :show).
 std::string format_string(const Program& program, const ModuleString& s, bool with_ids = false,
                           std::size_t max_chars = ~std::size_t{0});

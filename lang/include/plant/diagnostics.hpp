@@ -44,12 +44,35 @@ class Diagnostics {
 std::string render(const Diagnostic& d, const SourceManager& sources, bool color = false);
 std::string render_all(const Diagnostics& ds, const SourceManager& sources, bool color = false);
 
+// What kind of runtime error it is: callers decide by the kind, never by the message's text.
+enum class RuntimeErrorKind {
+    General,     // a mistake the program makes at run time (deep recursion, a long loop, a bad weight)
+    Arithmetic,  // division by zero, or NaN or infinity reaching a module parameter
+    ModuleLimit, // the string outgrew --max-modules or --max-bytes
+    Interrupted, // the derivation was asked to stop (Ctrl-C in the REPL)
+    Setting,     // a setting (derive, seed) out of its range
+    Turtle,      // the turtle cannot interpret the string (unbalanced ']', leaving finite space)
+    Geometry,    // the plant cannot be meshed (a surface that cannot be loaded, out-of-range points)
+};
+
 // Thrown by the runtime for errors that end a derivation (runtime errors exit 70).
 struct RuntimeError : std::exception {
     RuntimeError(Span s, std::string m) : span(s), message(std::move(m)) {}
+    RuntimeError(RuntimeErrorKind k, Span s, std::string m) : kind(k), span(s), message(std::move(m)) {}
     const char* what() const noexcept override { return message.c_str(); }
+
+    // Names the step the error happened in, unless one is named already: sets `step` and puts
+    // "step N: " before the message.
+    void at_step(int n) {
+        if (step >= 0) return;
+        step = n;
+        message = "step " + std::to_string(n) + ": " + message;
+    }
+
+    RuntimeErrorKind kind = RuntimeErrorKind::General;
     Span span;
-    std::string message;
+    std::string message; // as shown to the user, with the step's prefix once `step` is set
+    int step = -1;       // the derivation step it happened in; -1: none named
 };
 
 } // namespace plant

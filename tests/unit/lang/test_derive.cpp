@@ -1,5 +1,5 @@
 #include "helpers.hpp"
-#include "rewriter.hpp"
+#include "rewrite/rewriter.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -112,6 +112,8 @@ TEST_CASE("the module limit stops an explosion with an error naming the step", "
     } catch (const RuntimeError& e) {
         CHECK(e.message ==
               "step 6: the string grew past the limit of 100000 modules (raise it with --max-modules)");
+        CHECK(e.kind == RuntimeErrorKind::ModuleLimit);
+        CHECK(e.step == 6);
     }
 }
 
@@ -126,9 +128,33 @@ TEST_CASE("NaN and infinity never reach a module parameter", "[derive][limits]")
         FAIL("expected an error");
     } catch (const RuntimeError& e) {
         CHECK(e.message == "step 1: division by zero");
+        CHECK(e.kind == RuntimeErrorKind::Arithmetic);
+        CHECK(e.step == 1);
         const std::string& text = c2->sources.file(e.span.file).text();
         CHECK(text.substr(e.span.begin, e.span.end - e.span.begin) == "x / (x - 1)");
     }
+}
+
+TEST_CASE("runtime errors say their kind and step beside the message", "[derive][limits]") {
+    auto c = test::compile("axiom: A; derive 3; rules { A -> A A; }");
+    std::atomic<bool> stop{true};
+    DeriveOptions o;
+    o.interrupt = &stop;
+    Derivation d(*c->program, o);
+    try {
+        d.run();
+        FAIL("expected an error");
+    } catch (const RuntimeError& e) {
+        CHECK(e.kind == RuntimeErrorKind::Interrupted);
+        CHECK(e.step == -1);
+        CHECK(e.message == "interrupted");
+    }
+    RuntimeError e{Span{}, "division by zero"};
+    CHECK(e.kind == RuntimeErrorKind::General);
+    e.at_step(4);
+    e.at_step(5); // a step named once stays
+    CHECK(e.step == 4);
+    CHECK(e.message == "step 4: division by zero");
 }
 
 TEST_CASE("recursion in functions is bounded", "[derive][limits]") {

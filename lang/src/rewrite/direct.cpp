@@ -1,0 +1,113 @@
+// The direct path: when every module is copied or rewritten by a direct template, the size of
+// any stretch's output is known before it is written (count_direct), so the derivation allocates
+// the output once and each thread writes its stretch in place (write_direct).
+#include "rewriter.hpp"
+
+namespace plant {
+
+Rewriter::Counts Rewriter::count_direct(std::size_t b, std::size_t e) const {
+    Counts c;
+    for (std::size_t i = b; i < e; ++i) {
+        const SymbolId s = in.sym[i];
+        if (!plan.has_prod[s]) {
+            ++c.modules;
+            c.params += in.arity(i);
+            continue;
+        }
+        const Production* pr = plan.direct[s];
+        if (!pr || in.arity(i) != pr->strict[0].width) {
+            c.ok = false;
+            return c;
+        }
+        c.modules += pr->tmpl.syms.size();
+        c.params += pr->tmpl.params.size();
+        c.new_ids += pr->tmpl.syms.size() - (pr->tmpl.keep >= 0 ? 1 : 0);
+    }
+    return c;
+}
+
+// Writes the output of modules [b, e) at module m_at and parameter p_at of `out`, whose
+// arrays are already sized; new identities are numbered from id_at.
+// Identities are written only when `out` keeps them (Ids, a template argument so that the
+// loop has no test for it).
+void Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at,
+                            std::size_t p_at, ModuleId id_at) {
+    if (out.keep_ids)
+        write_direct<true>(w, b, e, out, m_at, p_at, id_at);
+    else
+        write_direct<false>(w, b, e, out, m_at, p_at, id_at);
+}
+template <bool Ids>
+void Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at,
+                            std::size_t p_at, ModuleId id_at) {
+    w.frame.assign(plan.frame_size, 0.0);
+    SymbolId* S = out.sym.data() + m_at;
+    ModuleId* ID = Ids ? out.ids.data() + m_at : nullptr;
+    std::uint32_t* PO = out.poff.data() + m_at + 1; // poff[m_at] is the previous stretch's end
+    double* PA = out.params.data() + p_at;
+    std::size_t p = p_at;
+    double values[256];
+    std::size_t i = b;
+    std::size_t next_check = b + 65536;
+    while (i < e) {
+        if (i >= next_check) { // a long step can be interrupted (Ctrl-C in the REPL)
+            next_check = i + 65536;
+            if (w.env.interrupt && w.env.interrupt->load())
+                throw RuntimeError{RuntimeErrorKind::Interrupted, Span{}, "interrupted"};
+        }
+        if (!plan.has_prod[in.sym[i]]) { // a run of modules without productions: copy it
+            std::size_t j = i + 1;
+            while (j < e && !plan.has_prod[in.sym[j]]) ++j;
+            const std::size_t n = j - i;
+            const std::uint32_t pb = in.poff[i], pe = in.poff[j];
+            const auto shift = static_cast<std::uint32_t>(p - pb); // wraps around on purpose
+            if (n <= 8 && pe - pb <= 8) {
+                // the usual run between two rewritten modules is a few turtle symbols: plain
+                // loops beat three library calls
+                for (std::size_t k = 0; k < n; ++k) {
+                    S[k] = in.sym[i + k];
+                    if constexpr (Ids) ID[k] = in.ids[i + k];
+                    PO[k] = in.poff[i + 1 + k] + shift;
+                }
+                for (std::uint32_t k = 0; k < pe - pb; ++k) PA[k] = in.params[pb + k];
+            } else {
+                std::memcpy(S, in.sym.data() + i, n * sizeof(SymbolId));
+                if constexpr (Ids) std::memcpy(ID, in.ids.data() + i, n * sizeof(ModuleId));
+                if (pe > pb) std::memcpy(PA, in.params.data() + pb, (pe - pb) * sizeof(double));
+                for (std::size_t k = 0; k < n; ++k) PO[k] = in.poff[i + 1 + k] + shift;
+            }
+            S += n;
+            if constexpr (Ids) ID += n;
+            PO += n;
+            PA += pe - pb;
+            p += pe - pb;
+            i = j;
+            continue;
+        }
+        const Production& pr = *plan.direct[in.sym[i]];
+        const SuccessorTemplate& t = pr.tmpl;
+        if (!t.holes.empty()) {
+            const double* a = in.args(i);
+            for (const auto& pa : pr.strict[0].args) {
+                for (int k = 0; k < pa.width; ++k) w.frame[pa.slot + k] = a[k];
+                a += pa.width;
+            }
+            w.env.position = i;
+            w.env.draw = 0;
+            w.env.id = in.id(i);
+            w.env.out = nullptr;
+            compute_holes(w, t, values);
+            check_holes(t, values);
+        }
+        const std::size_t m = t.syms.size();
+        put_template<Ids>(t, values, p, Ids ? in.ids[i] : 0, id_at, S, PO, PA, ID);
+        if constexpr (Ids) ID += m;
+        S += m;
+        PO += m;
+        PA += t.params.size();
+        p += t.params.size();
+        ++i;
+    }
+}
+
+} // namespace plant

@@ -1,0 +1,349 @@
+// The passes a step runs over the string. Parallel rewriting splits the old string into
+// stretches, one per thread. When every module is copied or rewritten by a fixed successor, each
+// thread's output is counted first and written in place into one string (rewrite_direct);
+// otherwise each thread writes its own buffer and the buffers are joined by prefix sums
+// (rewrite_parallel). Random draws are keyed by the module's position in the old string and new
+// identities are numbered in string order, so the result is the same for any number of threads.
+#include "engine.hpp"
+
+#include "plant/random.hpp"
+#include "rewriter.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <thread>
+
+namespace plant {
+
+namespace detail {
+
+EngineHandle::EngineHandle() : engine_(std::make_unique<Engine>()) {}
+EngineHandle::EngineHandle(const EngineHandle& other) : engine_(std::make_unique<Engine>(*other.engine_)) {}
+EngineHandle::~EngineHandle() = default;
+
+} // namespace detail
+
+namespace {
+
+// Whether some module of `s` is the first module of a predecessor in `rs`: a pass over the
+// symbols is much cheaper than a rewrite that copies the whole string unchanged.
+bool any_candidate(const ModuleString& s, const RuleSet& rs) {
+    for (SymbolId x : s.sym)
+        if (x < rs.by_symbol.size() && !rs.by_symbol[x].empty()) return true;
+    return false;
+}
+
+} // namespace
+
+void Engine::check_limits(const Derivation& d, const ModuleString& s) const {
+    check_limits(d, s.size(), s.params.size());
+}
+
+void Engine::check_limits(const Derivation& d, std::size_t modules, std::size_t params) const {
+    auto limit = [&](std::string message) {
+        RuntimeError e{RuntimeErrorKind::ModuleLimit, Span{}, std::move(message)};
+        e.at_step(d.step_);
+        return e;
+    };
+    if (modules > d.opt_.max_modules)
+        throw limit(fmt::format("the string grew past the limit of {} modules (raise it with --max-modules)",
+                                d.opt_.max_modules));
+    std::size_t estimate =
+        modules * (sizeof(SymbolId) + sizeof(std::uint32_t) + (d.current_.keep_ids ? sizeof(ModuleId) : 0)) +
+        params * sizeof(double);
+    if (estimate > d.opt_.max_bytes)
+        throw limit(fmt::format("the string needs about {:.1f} GiB, more than the limit of {:.1f} GiB",
+                                estimate / double(1 << 30), d.opt_.max_bytes / double(1 << 30)));
+}
+
+const RulePlan& Engine::plan_for(const Program& prog, const std::vector<const RuleSet*>& sets) {
+    for (const auto& p : plans)
+        if (p->sets == sets) return *p;
+    plans.push_back(std::make_shared<const RulePlan>(prog, sets));
+    return *plans.back();
+}
+
+const RulePlan& Engine::step_plan(const Derivation& d) {
+    const Program& prog = d.prog_;
+    const int g = d.group_ >= 0 && d.group_ < static_cast<int>(prog.groups.size()) ? d.group_ : -1;
+    if (step_plans.size() != prog.groups.size() + 1) step_plans.assign(prog.groups.size() + 1, nullptr);
+    const RulePlan*& slot = step_plans[static_cast<std::size_t>(g + 1)];
+    if (!slot) {
+        std::vector<const RuleSet*> sets;
+        if (g >= 0) sets.push_back(&prog.groups[static_cast<std::size_t>(g)]);
+        sets.push_back(&prog.rules);
+        slot = &plan_for(prog, sets);
+    }
+    return *slot;
+}
+
+void Engine::rewrite(const Derivation& d, const ModuleString& in, ModuleString& out, const RulePlan& plan,
+                     std::uint64_t phase, int step_for_env) {
+    const std::size_t n = in.size();
+    int threads = std::max(1, d.opt_.threads);
+    if (plan.sequential() || n < 20000) threads = 1;
+    Rewriter rw(plan, in, &brackets, &kernel_scratch, threads == 1);
+    auto setup = [&](Worker& w) {
+        w.env.prog = &d.prog_;
+        w.env.globals = const_cast<double*>(d.globals_.data()); // read-only during rewriting
+        w.env.seed = d.seed_;
+        w.env.phase = phase;
+        w.env.step = step_for_env;
+        w.env.max_output = d.opt_.max_modules;
+        w.env.max_params = d.opt_.max_bytes / sizeof(double);
+        w.env.interrupt = d.opt_.interrupt;
+        w.out.keep_ids = in.keep_ids;
+    };
+    out.clear();
+    out.keep_ids = in.keep_ids;
+    // The direct path needs every module's successor to be a direct template: a plan with
+    // symbols rewritten otherwise would find one in nearly every string, after counting up to it.
+    if (!plan.sequential() && plan.all_direct && rewrite_direct(d, rw, in, out, threads, setup)) {
+        // done
+    } else if (threads == 1) {
+        Worker w(std::move(out)); // writes into the arrays `out` has
+        setup(w);
+        rewrite_one_thread(d, rw, in, w, plan);
+        out = std::move(w.out);
+    } else {
+        rewrite_parallel(d, rw, in, out, threads, setup);
+    }
+    if (n > 0) {
+        growth = std::max(0.5, std::min(16.0, double(out.size()) / double(n)));
+        param_growth =
+            in.params.empty()
+                ? growth
+                : std::max(0.5, std::min(16.0, double(out.params.size()) / double(in.params.size())));
+    }
+    check_limits(d, out);
+}
+
+// The whole string on one thread, which numbers new modules in string order as it writes them.
+void Engine::rewrite_one_thread(const Derivation& d, Rewriter& rw, const ModuleString& in, Worker& w,
+                                const RulePlan& plan) {
+    const std::size_t n = in.size();
+    w.env.id_base = next_id;
+    // A small string reserves twice what it expects: its arrays come back as the spare two
+    // steps on (see Derivation::step), and then still fit, instead of being reallocated.
+    auto room = [](std::size_t want) { return want < 65536 ? 2 * want : want; };
+    w.out.sym.reserve(room(static_cast<std::size_t>(n * growth * 1.02) + 16));
+    if (w.out.keep_ids) w.out.ids.reserve(w.out.sym.capacity());
+    w.out.poff.reserve(w.out.sym.capacity() + 1);
+    w.out.params.reserve(room(static_cast<std::size_t>(in.params.size() * param_growth * 1.02) + 16));
+    try {
+        if (plan.right_new) {
+            // right to left: new modules are marked, then numbered in string order
+            w.env.id_base = kNewIdBit;
+            rw.run_backward(w);
+            w.out = rw.assemble_backward(w.out);
+            ModuleId next = next_id;
+            for (auto& id : w.out.ids)
+                if (id & kNewIdBit) id = next++;
+        } else {
+            rw.run_range(w, 0, n);
+        }
+    } catch (const RuntimeError& e) {
+        if (e.kind == RuntimeErrorKind::ModuleLimit) check_limits(d, w.out);
+        throw;
+    }
+    next_id += w.env.new_count;
+}
+
+// Worker 0 writes into buffers sized for the whole output and numbers its new modules directly;
+// the others' parts are appended to it afterwards, so only (T-1)/T of the string is copied a
+// second time.
+template <typename Setup>
+void Engine::rewrite_parallel(const Derivation& d, Rewriter& rw, const ModuleString& in, ModuleString& out,
+                              int threads, const Setup& setup) {
+    const std::size_t n = in.size();
+    std::vector<Worker> workers(static_cast<std::size_t>(threads));
+    {
+        std::vector<std::jthread> pool;
+        for (int t = 0; t < threads; ++t) {
+            pool.emplace_back([&, t] {
+                Worker& w = workers[static_cast<std::size_t>(t)];
+                setup(w);
+                std::size_t b = n * static_cast<std::size_t>(t) / static_cast<std::size_t>(threads);
+                std::size_t e = n * static_cast<std::size_t>(t + 1) / static_cast<std::size_t>(threads);
+                std::size_t modules = (t == 0 ? n : e - b),
+                            params = in.params.size() * (e - b) / std::max<std::size_t>(n, 1);
+                if (t == 0) {
+                    params = in.params.size();
+                    w.env.id_base = next_id;
+                }
+                w.out.sym.reserve(static_cast<std::size_t>(modules * growth * 1.02) + 16);
+                if (w.out.keep_ids) w.out.ids.reserve(w.out.sym.capacity());
+                w.out.poff.reserve(w.out.sym.capacity() + 1);
+                w.out.params.reserve(static_cast<std::size_t>(params * param_growth * 1.02) + 16);
+                try {
+                    rw.run_range(w, b, e);
+                } catch (const RuntimeError& err) {
+                    w.error = err;
+                }
+            });
+        }
+    }
+    std::size_t total = 0, total_params = 0;
+    for (auto& w : workers) {
+        if (w.error) {
+            if (w.error->kind == RuntimeErrorKind::ModuleLimit) check_limits(d, w.out);
+            throw *w.error;
+        }
+        total += w.out.size();
+        total_params += w.out.params.size();
+    }
+    if (total > d.opt_.max_modules) {
+        check_limits(d, total, total_params);
+    }
+    std::vector<std::size_t> mod_at(workers.size()), par_at(workers.size());
+    std::vector<ModuleId> id_at(workers.size());
+    std::size_t m = 0, p = 0;
+    ModuleId ids = next_id;
+    for (std::size_t t = 0; t < workers.size(); ++t) {
+        mod_at[t] = m;
+        par_at[t] = p;
+        id_at[t] = ids;
+        m += workers[t].out.size();
+        p += workers[t].out.params.size();
+        ids += workers[t].env.new_count;
+    }
+    out.swap(workers[0].out);
+    out.sym.resize(total);
+    if (out.keep_ids) out.ids.resize(total);
+    out.poff.resize(total + 1);
+    out.params.resize(total_params);
+    {
+        std::vector<std::jthread> pool;
+        for (std::size_t t = 1; t < workers.size(); ++t) {
+            pool.emplace_back([&, t] {
+                ModuleString& src = workers[t].out;
+                std::copy(src.sym.begin(), src.sym.end(),
+                          out.sym.begin() + static_cast<std::ptrdiff_t>(mod_at[t]));
+                std::copy(src.params.begin(), src.params.end(),
+                          out.params.begin() + static_cast<std::ptrdiff_t>(par_at[t]));
+                for (std::size_t i = 0; i < src.size(); ++i) {
+                    out.poff[mod_at[t] + i] = static_cast<std::uint32_t>(par_at[t] + src.poff[i]);
+                    if (!out.keep_ids) continue;
+                    ModuleId id = src.ids[i];
+                    out.ids[mod_at[t] + i] = (id & kNewIdBit) ? id_at[t] + (id & ~kNewIdBit) : id;
+                }
+                ModuleString().swap(src);
+            });
+        }
+    }
+    out.poff[total] = static_cast<std::uint32_t>(total_params);
+    next_id = ids;
+}
+
+// Tries the direct path (see Rewriter::count_direct): count the output of each thread's stretch,
+// allocate the output once, write the stretches in place. Returns false, having written
+// nothing, when some module needs the general path.
+template <typename Setup>
+bool Engine::rewrite_direct(const Derivation& d, Rewriter& rw, const ModuleString& in, ModuleString& out,
+                            int threads, const Setup& setup) {
+    const std::size_t n = in.size();
+    const auto T = static_cast<std::size_t>(threads);
+    std::vector<Rewriter::Counts> counts(T);
+    auto bounds = [&](std::size_t t) { return std::pair{n * t / T, n * (t + 1) / T}; };
+    auto parallel = [&](auto&& body) {
+        if (T == 1) {
+            body(std::size_t{0});
+            return;
+        }
+        std::vector<std::jthread> pool;
+        for (std::size_t t = 0; t < T; ++t) pool.emplace_back([&body, t] { body(t); });
+    };
+    parallel([&](std::size_t t) {
+        auto [b, e] = bounds(t);
+        counts[t] = rw.count_direct(b, e);
+    });
+    std::size_t modules = 0, params = 0;
+    for (const auto& c : counts) {
+        if (!c.ok) return false;
+        modules += c.modules;
+        params += c.params;
+    }
+    check_limits(d, modules, params); // before allocating anything
+    out.sym.resize(modules);
+    if (out.keep_ids) out.ids.resize(modules);
+    out.poff.resize(modules + 1);
+    out.params.resize(params);
+    out.poff[0] = 0;
+    std::vector<Worker> workers(T);
+    std::vector<std::size_t> m_at(T), p_at(T);
+    std::vector<ModuleId> id_at(T);
+    ModuleId ids = next_id;
+    for (std::size_t t = 0, m = 0, p = 0; t < T; ++t) {
+        m_at[t] = m;
+        p_at[t] = p;
+        id_at[t] = ids;
+        m += counts[t].modules;
+        p += counts[t].params;
+        ids += counts[t].new_ids;
+    }
+    parallel([&](std::size_t t) {
+        Worker& w = workers[t];
+        setup(w);
+        auto [b, e] = bounds(t);
+        try {
+            rw.write_direct(w, b, e, out, m_at[t], p_at[t], id_at[t]);
+        } catch (const RuntimeError& err) {
+            w.error = err;
+        }
+    });
+    for (auto& w : workers)
+        if (w.error) throw *w.error;
+    next_id = ids;
+    return true;
+}
+
+void Engine::decompose(const Derivation& d, ModuleString& s, int step_for_env) {
+    const Program& prog = d.prog_;
+    if (prog.decompose.empty()) return;
+    std::vector<const RuleSet*> sets{&prog.decompose};
+    for (int pass = 0; pass < prog.decompose.max_depth; ++pass) {
+        if (!any_candidate(s, prog.decompose)) break;
+        ModuleString next;
+        ModuleId before = next_id;
+        rewrite(d, s, next, plan_for(prog, sets), stream::decompose(step_for_env, pass), step_for_env);
+        bool changed =
+            next_id != before || next.size() != s.size() || next.sym != s.sym || next.params != s.params;
+        s.swap(next);
+        if (!changed) break;
+    }
+}
+
+void Engine::apply_cut(const Program& prog, ModuleString& s) {
+    if (!prog.uses_cut) return;
+    const SymbolId cut = prog.symbols.cut, open = prog.symbols.open_bracket,
+                   close = prog.symbols.close_bracket;
+    bool any = false;
+    for (SymbolId x : s.sym)
+        if (x == cut) {
+            any = true;
+            break;
+        }
+    if (!any) return;
+    cut_branches(s, open, close, [&](std::size_t i) { return s.sym[i] == cut; });
+}
+
+ModuleString Engine::interpreted(const Derivation& d, const ModuleString& s) {
+    const Program& prog = d.prog_;
+    ModuleString cur = s;
+    if (prog.interpret.empty()) return cur;
+    std::vector<const RuleSet*> sets{&prog.interpret};
+    ModuleId saved = next_id;
+    for (int pass = 0; pass < prog.interpret.max_depth; ++pass) {
+        if (!any_candidate(cur, prog.interpret)) break;
+        ModuleString next;
+        rewrite(d, cur, next, plan_for(prog, sets), stream::interpret(d.step_, pass), d.step_);
+        bool changed = next.sym != cur.sym || next.params != cur.params;
+        cur.swap(next);
+        if (!changed) break;
+    }
+    next_id = saved; // interpretation never creates modules that live on
+    return cur;
+}
+
+} // namespace plant

@@ -1,0 +1,70 @@
+// The rewriting engine as a derivation drives it: its state (the rule plans, the identity
+// counter, the buffers kept from step to step) and the passes a step runs over the string
+// (the rewrite on one or several threads, decomposition, cut, interpretation). Private to the
+// language library; the Derivation holds one through detail::EngineHandle.
+#pragma once
+
+#include "plan.hpp"
+#include "plant/derive.hpp"
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace plant {
+
+class Rewriter;
+struct Worker;
+
+struct Engine {
+    Engine() = default;
+    // What a copied derivation keeps: the rule plans (shared, they never change), the identity
+    // counter and the growth estimates. The buffers are scratch, rebuilt by every rewrite, and
+    // the spare string is not copied: copies start without one.
+    Engine(const Engine& o)
+        : next_id(o.next_id), growth(o.growth), param_growth(o.param_growth), plans(o.plans),
+          step_plans(o.step_plans) {}
+    Engine& operator=(const Engine&) = delete;
+
+    // Rewrites `in` into `out` under `plan`, its random draws from stream `phase`; environments
+    // see `step_for_env` as the step.
+    void rewrite(const Derivation& d, const ModuleString& in, ModuleString& out, const RulePlan& plan,
+                 std::uint64_t phase, int step_for_env);
+    // The decomposition rules, applied until nothing changes (at most their max_depth passes).
+    void decompose(const Derivation& d, ModuleString& s, int step_for_env);
+    // Removes the branches cut by '%'.
+    static void apply_cut(const Program& prog, ModuleString& s);
+    // The string as the turtle sees it (Derivation::interpreted).
+    ModuleString interpreted(const Derivation& d, const ModuleString& s);
+    // Throws the error that names the limit the string passes (--max-modules, --max-bytes).
+    void check_limits(const Derivation& d, const ModuleString& s) const;
+    void check_limits(const Derivation& d, std::size_t modules, std::size_t params) const;
+
+    // The plan for rewriting with `sets`, built the first time and kept (copies share them).
+    const RulePlan& plan_for(const Program& prog, const std::vector<const RuleSet*>& sets);
+    // The plan for a step with the active group: plan_for(group's rules, then the unnamed ones).
+    const RulePlan& step_plan(const Derivation& d);
+
+    ModuleId next_id = 1;                    // the identity the next new module gets
+    double growth = 2.0, param_growth = 2.0; // last step's growth, for reserving memory
+    std::vector<std::shared_ptr<const RulePlan>> plans;
+    std::vector<const RulePlan*> step_plans;   // per group + 1 (index 0: no group), from plans
+    std::vector<std::uint32_t> brackets;       // the bracket table, kept from step to step
+    std::vector<std::uint16_t> kernel_scratch; // the symbol kernel's right keys (Rewriter::run_symbols)
+    // The string a step replaced, when small, kept for the next step to write its output into:
+    // small strings would otherwise pay a round of allocations a step.
+    ModuleString spare;
+    static constexpr std::size_t kMaxSpareBytes = std::size_t{1} << 20;
+
+  private:
+    void rewrite_one_thread(const Derivation& d, Rewriter& rw, const ModuleString& in, Worker& w,
+                            const RulePlan& plan);
+    template <typename Setup>
+    void rewrite_parallel(const Derivation& d, Rewriter& rw, const ModuleString& in, ModuleString& out,
+                          int threads, const Setup& setup);
+    template <typename Setup>
+    bool rewrite_direct(const Derivation& d, Rewriter& rw, const ModuleString& in, ModuleString& out,
+                        int threads, const Setup& setup);
+};
+
+} // namespace plant

@@ -1,0 +1,193 @@
+// Building the rule plan (see plan.hpp): the direct templates, the context table and the
+// symbol kernel's tables, once per list of rule sets.
+#include "plan.hpp"
+
+#include <algorithm>
+#include <utility>
+
+namespace plant {
+
+// Whether some production of `rs` names a query module (?P, ?H, ...) in its predecessor or
+// context: then the turtle pass runs before each step to fill them.
+bool reads_queries(const Program& p, const RuleSet& rs) {
+    auto named = [&](const std::vector<PatternModule>& v) {
+        for (const auto& m : v)
+            if (p.symbols[m.sym].query) return true;
+        return false;
+    };
+    for (const auto& pr : rs.productions)
+        if (named(pr.strict) || named(pr.left) || named(pr.right)) return true;
+    return false;
+}
+
+RulePlan::RulePlan(const Program& p, std::vector<const RuleSet*> rule_sets)
+    : P(p), sets(std::move(rule_sets)) {
+    std::size_t frame = 1;
+    has_prod.assign(P.symbols.size(), 0);
+    for (const RuleSet* rs : sets) {
+        brackets = brackets || rs->needs_brackets || rs->uses_left_new || rs->uses_right_new;
+        for (const auto& pr : rs->productions) {
+            frame = std::max<std::size_t>(frame, pr.frame_size);
+            has_prod[pr.strict[0].sym] = 1;
+            if (pr.strict.size() > 1) multi = true;
+        }
+        left_new = left_new || rs->uses_left_new;
+        right_new = right_new || rs->uses_right_new;
+        queries = queries || reads_queries(P, *rs);
+    }
+    frame_size = frame;
+    // A symbol whose first production always applies (no condition, context or weight, one
+    // predecessor module whose arguments are all bound) needs no matching: with the right
+    // number of parameters, its template is applied at once.
+    direct.assign(P.symbols.size(), nullptr);
+    for (SymbolId s = 0; s < P.symbols.size(); ++s) {
+        for (const RuleSet* rs : sets) {
+            if (rs->by_symbol[s].empty()) continue;
+            const Production& pr = rs->productions[rs->by_symbol[s][0]];
+            bool binds_all = pr.strict.size() == 1;
+            for (const auto& a : pr.strict[0].args) binds_all = binds_all && a.bind;
+            if (binds_all && pr.condition.empty() && pr.weight.empty() && !pr.has_context() &&
+                !pr.has_new_context() && pr.tmpl.valid)
+                direct[s] = &pr;
+            break;
+        }
+        all_direct = all_direct && (!has_prod[s] || direct[s]);
+    }
+    if (brackets && !multi && !left_new && !right_new) build_context_table();
+    // Whether every symbol with productions is rewritten by a direct template or by the
+    // context table: then a step needs no matching beyond a table lookup, and the output of
+    // any module is bounded by the longest template (see Rewriter::run_templates).
+    templated = !multi && !left_new && !right_new;
+    for (SymbolId sym = 0; sym < P.symbols.size() && templated; ++sym) {
+        if (!has_prod[sym]) continue;
+        if (direct[sym]) {
+            max_modules_out = std::max(max_modules_out, direct[sym]->tmpl.syms.size());
+            max_params_out = std::max(max_params_out, direct[sym]->tmpl.params.size());
+        } else if (!ctx_block.empty() && ctx_block[sym] >= 0) {
+            for (const RuleSet* rs : sets)
+                for (std::uint32_t pi : rs->by_symbol[sym]) {
+                    max_modules_out = std::max(max_modules_out, rs->productions[pi].tmpl.syms.size());
+                    max_params_out = std::max(max_params_out, rs->productions[pi].tmpl.params.size());
+                }
+        } else {
+            templated = false;
+        }
+    }
+    if (templated && max_params_out == 0 && max_modules_out <= SymbolSucc::kMax && !ctx_block.empty())
+        build_symbol_kernel();
+}
+
+// The symbol kernel's tables. It needs every rewritten symbol to be parameterless: a direct
+// template whose pattern takes no parameters, or a context table.
+void RulePlan::build_symbol_kernel() {
+    const std::size_t S = P.symbols.size(), K = ctx_keys;
+    for (SymbolId sym = 0; sym < S; ++sym)
+        if (has_prod[sym] && direct[sym] && direct[sym]->strict[0].width != 0)
+            return; // a pattern with parameters
+    auto add = [&](const SuccessorTemplate& t) {
+        SymbolSucc su;
+        std::copy(t.syms.begin(), t.syms.end(), su.syms);
+        su.len = static_cast<std::uint32_t>(t.syms.size());
+        su.fresh = su.len - (t.keep >= 0 ? 1 : 0);
+        succs.push_back(su);
+        return static_cast<std::uint32_t>(succs.size() - 1);
+    };
+    std::vector<std::pair<const Production*, std::uint32_t>> seen; // each production once
+    auto add_production = [&](const Production& pr) {
+        for (const auto& [q, at] : seen)
+            if (q == &pr) return at;
+        seen.emplace_back(&pr, add(pr.tmpl));
+        return seen.back().second;
+    };
+    sym_rows.assign(S, SymbolRow{});
+    for (SymbolId sym = 0; sym < S; ++sym) {
+        SymbolRow& row = sym_rows[sym];
+        row.shape = sym == P.symbols.close_bracket  ? kClose
+                    : sym == P.symbols.open_bracket ? kOpen
+                    : P.ignored[sym]                ? kIgnored
+                                                    : 0;
+        row.key = ctx_key[sym];
+        row.block = static_cast<std::uint32_t>(succ_at.size());
+        SymbolSucc self;
+        self.syms[0] = sym;
+        self.len = 1;
+        if (!has_prod[sym]) {
+            succs.push_back(self);
+            succ_at.push_back(static_cast<std::uint32_t>(succs.size() - 1));
+        } else if (direct[sym]) {
+            succ_at.push_back(add_production(*direct[sym]));
+        } else { // templated: the context table has it
+            succs.push_back(self);
+            const auto self_at = static_cast<std::uint32_t>(succs.size() - 1);
+            row.lmask = ctx_sides[sym] & 1 ? 0xff : 0;
+            row.rmask = ctx_sides[sym] & 2 ? 0xff : 0;
+            for (std::size_t k = 0; k < K * K; ++k) {
+                const Production* pr = ctx_entries[static_cast<std::size_t>(ctx_block[sym]) + k];
+                succ_at.push_back(pr ? add_production(*pr) : self_at);
+            }
+        }
+    }
+    symbol_kernel = true;
+}
+
+// The context table. When every production of a symbol is `l < s > r -> successor` with
+// modules that carry no parameters, at most one context module a side and no condition,
+// weight or new context (ABOP's Fig. 1.31 and other signal-propagation systems), which
+// production applies depends only on the symbols of the two neighbours. A K x K table per
+// such symbol, K being the number of symbols the patterns name plus one for all others,
+// answers that with one lookup instead of trying the productions in turn.
+void RulePlan::build_context_table() {
+    const std::size_t S = P.symbols.size();
+    ctx_block.assign(S, -1);
+    ctx_sides.assign(S, 0);
+    ctx_key.assign(S, 0);
+    std::vector<std::vector<const Production*>> cands(S);
+    auto plain = [&](const PatternModule& m) {
+        return m.width == 0 && m.args.empty() && m.sym != P.symbols.open_bracket &&
+               m.sym != P.symbols.close_bracket;
+    };
+    std::vector<SymbolId> eligible;
+    for (SymbolId sym = 0; sym < S; ++sym) {
+        if (!has_prod[sym] || direct[sym]) continue;
+        bool ok = true;
+        for (const RuleSet* rs : sets)
+            for (std::uint32_t pi : rs->by_symbol[sym]) {
+                const Production& pr = rs->productions[pi];
+                ok = ok && pr.strict.size() == 1 && plain(pr.strict[0]) && pr.left.size() <= 1 &&
+                     pr.right.size() <= 1 && (pr.left.empty() || plain(pr.left[0])) &&
+                     (pr.right.empty() || plain(pr.right[0])) && pr.condition.empty() && pr.weight.empty() &&
+                     !pr.has_new_context() && pr.tmpl.valid;
+                cands[sym].push_back(&pr);
+            }
+        if (!ok) continue;
+        eligible.push_back(sym);
+        for (const Production* pr : cands[sym]) {
+            for (const auto* side : {&pr->left, &pr->right})
+                if (!side->empty() && ctx_key[(*side)[0].sym] == 0) {
+                    if (ctx_keys == 255) return; // too many to tabulate: the general path it is
+                    ctx_key[(*side)[0].sym] = static_cast<std::uint8_t>(ctx_keys++);
+                }
+            if (!pr->left.empty()) ctx_sides[sym] |= 1;
+            if (!pr->right.empty()) ctx_sides[sym] |= 2;
+        }
+    }
+    const std::size_t K = ctx_keys;
+    for (SymbolId sym : eligible) {
+        ctx_block[sym] = static_cast<std::int32_t>(ctx_entries.size());
+        for (std::size_t lk = 0; lk < K; ++lk)
+            for (std::size_t rk = 0; rk < K; ++rk) {
+                const Production* hit = nullptr;
+                for (const Production* pr : cands[sym]) {
+                    bool l = pr->left.empty() || (lk != 0 && ctx_key[pr->left[0].sym] == lk);
+                    bool r = pr->right.empty() || (rk != 0 && ctx_key[pr->right[0].sym] == rk);
+                    if (l && r) {
+                        hit = pr;
+                        break;
+                    }
+                }
+                ctx_entries.push_back(hit);
+            }
+    }
+}
+
+} // namespace plant

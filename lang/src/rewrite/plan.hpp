@@ -1,0 +1,68 @@
+// The rule plan: what rewriting with a list of rule sets needs that does not depend on the
+// string (which symbols have productions, which apply at once, the context table and the symbol
+// kernel's tables). The derivation builds one per list of rule sets and keeps it.
+#pragma once
+
+#include "plant/program.hpp"
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace plant {
+
+// Whether some production of `rs` names a query module (?P, ?H, ...) in its predecessor or
+// context: then the turtle pass runs before each step to fill them.
+bool reads_queries(const Program& p, const RuleSet& rs);
+
+struct RulePlan {
+    RulePlan(const Program& p, std::vector<const RuleSet*> rule_sets);
+
+    // The symbol kernel's tables (see Rewriter::run_symbols). Every symbol has a row, and a
+    // block of successors: one (itself when copied, its direct template) or, for a symbol of
+    // the context table, one per pair of neighbour keys.
+    struct SymbolSucc { // symbols padded to kMax, so that writing one is one fixed-size copy
+        static constexpr std::size_t kMax = 8;
+        SymbolId syms[kMax] = {};
+        std::uint32_t len = 0;
+        std::uint32_t fresh = 0; // modules that get new identities
+    };
+    static constexpr std::uint8_t kIgnored = 1, kOpen = 2, kClose = 3; // shapes; 0: context sees it
+    struct SymbolRow {
+        std::uint32_t block = 0;           // its successors start at succ_at[block]
+        std::uint8_t lmask = 0, rmask = 0; // 0xff: the block is indexed by that neighbour's key
+        std::uint8_t shape = 0;
+        std::uint8_t key = 0; // ctx_key
+    };
+    bool symbol_kernel = false; // Rewriter::run_symbols can rewrite strings without parameters
+    std::vector<SymbolRow> sym_rows;
+    std::vector<std::uint32_t> succ_at; // blocks of indices into succs
+    std::vector<SymbolSucc> succs;
+
+    const Program& P;
+    std::vector<const RuleSet*> sets;
+    std::vector<std::uint8_t> has_prod;
+    std::vector<const Production*> direct;
+    // The context table (see build_context_table): per symbol, the offset of its K x K block in
+    // ctx_entries (-1: no table), and whether its productions read the left or right neighbour.
+    std::vector<std::int32_t> ctx_block;
+    std::vector<std::uint8_t> ctx_sides; // bit 0: left, bit 1: right
+    std::vector<std::uint8_t> ctx_key;   // per symbol: its row/column, 0 for symbols no pattern names
+    std::size_t ctx_keys = 1;
+    std::vector<const Production*> ctx_entries; // nullptr: no production applies
+    std::size_t frame_size = 1;
+    bool brackets = false, multi = false, left_new = false, right_new = false;
+    bool queries = false;   // some pattern names a query module: the turtle pass fills them first
+    bool templated = false; // see the end of the constructor
+    bool all_direct = true; // every symbol with productions has a direct template
+    // Whether a step must rewrite on one thread, left to right (or right to left for `>>`).
+    bool sequential() const { return multi || left_new || right_new; }
+    std::size_t max_modules_out = 1; // the longest template's modules (at least 1: a copy)
+    std::size_t max_params_out = 0;  // and the most parameters a template holds
+
+  private:
+    void build_symbol_kernel();
+    void build_context_table();
+};
+
+} // namespace plant

@@ -1,0 +1,278 @@
+// What the rewriting routes share: the worker a thread rewrites with, the Rewriter (one pass over
+// one string under one rule plan) and the helpers its loops call for every module, kept here as
+// inline functions so that each route's loop can inline them. The routes themselves live in
+// their own files:
+//   general.cpp    run_range: matching, conditions, stochastic choice, production bodies
+//   templated.cpp  run_templates: every rewritten symbol has a template or a context table
+//   direct.cpp     count_direct/write_direct: every successor is a direct template, in place
+//   symbols.cpp    run_symbols: the symbol kernel, for strings without parameters
+//   passes.cpp     run_backward: right to left, for productions with a right new context
+//   context.cpp    the context matchers (old string, new string) and :find
+// Private to the language library (and its unit tests).
+#pragma once
+
+#include "plan.hpp"
+#include "plant/derive.hpp"
+#include "plant/vm.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <optional>
+#include <span>
+
+namespace plant {
+
+constexpr std::int64_t kUnknown = -2;
+
+// Everything one thread needs to rewrite a stretch of the string.
+struct Worker {
+    Worker() = default;
+    explicit Worker(ModuleString&& o) : out(std::move(o)) {}
+    EvalEnv env;
+    std::vector<double> frame;
+    ModuleString out;
+    std::optional<RuntimeError> error;
+    // context neighbours of the module at ctx_at, found once for all its productions
+    std::size_t ctx_at = ~std::size_t{0};
+    std::int64_t ctx_left = kUnknown, ctx_right = kUnknown;
+    std::vector<std::uint16_t>
+        scratch; // Rewriter::run_symbols's keys, when the rewriter has no buffer for them
+};
+
+class Rewriter {
+  public:
+    // `brackets`: where to build the bracket table (a buffer kept from step to step saves an
+    // allocation each step); null: a buffer of the rewriter's own.
+    // `whole`: run_range will be called once, for the whole string, by one thread. Then the
+    // symbol kernel needs no bracket table, and keeps its right keys in `scratch`.
+    Rewriter(const RulePlan& rule_plan, const ModuleString& in,
+             std::vector<std::uint32_t>* brackets = nullptr, std::vector<std::uint16_t>* scratch = nullptr,
+             bool whole = false);
+
+    // The production the context table gives for module i, which has a table and no parameters.
+    // nullptr: none applies.
+    const Production* table_lookup(std::size_t i) const {
+        const SymbolId sym = in.sym[i];
+        std::size_t lk = 0, rk = 0;
+        if (plan.ctx_sides[sym] & 1) {
+            const std::int64_t j = left_step(static_cast<std::int64_t>(i) - 1);
+            if (j >= 0 && in.arity(static_cast<std::size_t>(j)) == 0)
+                lk = plan.ctx_key[in.sym[static_cast<std::size_t>(j)]];
+        }
+        if (plan.ctx_sides[sym] & 2) {
+            const std::size_t j = right_step(i + 1);
+            if (j < n && in.arity(j) == 0) rk = plan.ctx_key[in.sym[j]];
+        }
+        return plan.ctx_entries[static_cast<std::size_t>(plan.ctx_block[sym]) + lk * plan.ctx_keys + rk];
+    }
+
+    // Whether run_range rewrites this string with the symbol kernel (run_symbols).
+    bool kernel_applies() const { return plan.symbol_kernel && in.params.empty() && !in.keep_ids; }
+
+    // Whether production `pr` (pattern, context and condition) matches at module i: the REPL's
+    // :find. Binds the worker's frame.
+    bool matches_at(Worker& w, std::size_t i, const Production& pr);
+
+    // Rewrites modules [b, e) into w.out (general.cpp), by the fastest route the plan and the
+    // string allow.
+    void run_range(Worker& w, std::size_t b, std::size_t e);
+
+    // ---- the direct path (direct.cpp): every module is copied or rewritten by a direct template
+    // Then the size of the output of any stretch is known before writing it, so the output is
+    // allocated once, exactly, and each thread writes its stretch in place.
+    struct Counts {
+        std::size_t modules = 0, params = 0;
+        ModuleId new_ids = 0;
+        bool ok = true;
+    };
+    Counts count_direct(std::size_t b, std::size_t e) const;
+    // Writes the output of modules [b, e) at module m_at and parameter p_at of `out`, whose
+    // arrays are already sized; new identities are numbered from id_at.
+    void write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at,
+                      std::size_t p_at, ModuleId id_at);
+
+    // ---- backward processing for `>>` (passes.cpp)
+    void run_backward(Worker& w);
+    ModuleString assemble_backward(const ModuleString& pieces) const;
+
+  private:
+    template <bool Ids>
+    void write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at,
+                      std::size_t p_at, ModuleId id_at);
+    template <bool Ids> void run_templates(Worker& w, std::size_t b, std::size_t e);
+    template <bool Whole> void run_symbols(Worker& w, std::size_t b, std::size_t e);
+
+    // general.cpp: trying productions, running their successors
+    std::size_t apply(Worker& w, std::size_t i);
+    std::size_t apply_template(Worker& w, std::size_t i, const Production& pr);
+    std::size_t run_body(Worker& w, std::size_t i, const Production& pr);
+    std::size_t choose(Worker& w, std::size_t i, std::size_t set0, std::size_t cand0, std::size_t length = 0);
+    [[noreturn]] void limit_error() const;
+    [[noreturn]] void hole_error(const SuccessorTemplate& t, std::size_t h, double value) const;
+
+    // Writes successor template t, its computed numbers in `values`, at S, PO, PA and ID, its
+    // parameters starting at parameter p of the output. Module t.keep gets the identity `kept`
+    // (the predecessor's), the others new ones counted on from `next_new`. Identities are
+    // written only when Ids.
+    template <bool Ids>
+    static void put_template(const SuccessorTemplate& t, const double* values, std::size_t p, ModuleId kept,
+                             ModuleId& next_new, SymbolId* S, std::uint32_t* PO, double* PA, ModuleId* ID) {
+        const std::size_t m = t.syms.size();
+        if (m != 0) std::memcpy(S, t.syms.data(), m * sizeof(SymbolId));
+        // An erasing or parameterless successor has no parameter storage;
+        // memcpy with a null source is undefined even for zero bytes.
+        if (!t.params.empty()) std::memcpy(PA, t.params.data(), t.params.size() * sizeof(double));
+        for (std::size_t h = 0; h < t.holes.size(); ++h) PA[t.holes[h]] = values[h];
+        const auto p32 = static_cast<std::uint32_t>(p);
+        for (std::size_t j = 0; j < m; ++j) PO[j] = p32 + t.param_end[j];
+        if constexpr (Ids) {
+            for (std::size_t j = 0; j < m; ++j) ID[j] = static_cast<int>(j) == t.keep ? kept : next_new++;
+        } else {
+            next_new += m - (t.keep >= 0 ? 1 : 0);
+        }
+    }
+
+    // The numbers a template computes (its holes), from the bound frame.
+    void compute_holes(Worker& w, const SuccessorTemplate& t, double* values) const {
+        if (t.affine.empty()) {
+            run(t.values, w.frame.data(), w.env, values);
+            return;
+        }
+        const double* f = w.frame.data();
+        for (std::size_t h = 0; h < t.affine.size(); ++h) {
+            const auto& a = t.affine[h];
+            values[h] = a.kind == a.Copy  ? f[a.slot]
+                        : a.kind == a.Mul ? f[a.slot] * a.constant
+                                          : f[a.slot] + a.constant;
+        }
+    }
+
+    void check_holes(const SuccessorTemplate& t, const double* values) const {
+        for (std::size_t h = 0; h < t.holes.size(); ++h)
+            if (!std::isfinite(values[h])) hole_error(t, h, values[h]);
+    }
+
+    // ---- context matching: the walks every route takes per module (the longer matchers, for
+    // several context modules and for the new string, are in context.cpp)
+
+    bool match_in(const ModuleString& s, std::size_t j, const PatternModule& pm, double* frame) const {
+        if (s.sym[j] != pm.sym || s.arity(j) != pm.width) return false;
+        const double* a = s.args(j);
+        for (const auto& pa : pm.args) {
+            if (pa.bind) {
+                for (int k = 0; k < pa.width; ++k) frame[pa.slot + k] = a[k];
+            } else if (!std::isnan(pa.value) && a[0] != pa.value) {
+                return false;
+            }
+            a += pa.width;
+        }
+        return true;
+    }
+
+    bool match_module(std::size_t j, const PatternModule& pm, double* frame) const {
+        return match_in(in, j, pm, frame);
+    }
+
+    // The next module of a left context at or before j: a ']' skips its whole branch, a '['
+    // is stepped over to the parent, ignored modules are stepped over. -1 when there is none.
+    std::int64_t left_step(std::int64_t j) const {
+        while (j >= 0) {
+            SymbolId s = in.sym[static_cast<std::size_t>(j)];
+            if (s == P.symbols.close_bracket) {
+                std::uint32_t m = match[static_cast<std::size_t>(j)];
+                if (m >= n) return -1;
+                j = static_cast<std::int64_t>(m) - 1;
+            } else if (s == P.symbols.open_bracket || P.ignored[s]) {
+                --j;
+            } else {
+                return j;
+            }
+        }
+        return -1;
+    }
+
+    // Matches the left context whose last module is at j (as found by left_step).
+    bool match_left_from(std::int64_t j, const std::vector<PatternModule>& pats, double* frame) const {
+        for (std::size_t k = pats.size(); k-- > 0;) {
+            if (j < 0 || !match_module(static_cast<std::size_t>(j), pats[k], frame)) return false;
+            if (k > 0) j = left_step(j - 1);
+        }
+        return true;
+    }
+
+    // The next module of a right context at or after j, for a pattern module that is not a
+    // bracket: lateral branches are skipped, the end of the branch ends the context. n if none.
+    std::size_t right_step(std::size_t j) const {
+        const SymbolId open = P.symbols.open_bracket, close = P.symbols.close_bracket;
+        while (j < n) {
+            SymbolId s = in.sym[j];
+            if (s == open) {
+                if (match[j] >= n) return n;
+                j = match[j] + 1;
+            } else if (s == close) {
+                return n;
+            } else if (P.ignored[s]) {
+                ++j;
+            } else {
+                return j;
+            }
+        }
+        return n;
+    }
+
+    // context.cpp
+    bool match_right(std::size_t e, std::span<const PatternModule> pats, double* frame) const;
+    bool match_left_new(const ModuleString& out, const std::vector<PatternModule>& pats, double* frame) const;
+    bool match_right_new(const ModuleString& out, const std::vector<PatternModule>& pats,
+                         double* frame) const;
+
+    // Pattern, context and condition. Binds the frame.
+    bool matches(Worker& w, std::size_t i, const Production& pr) {
+        double* frame = w.frame.data();
+        for (std::size_t k = 0; k < pr.strict.size(); ++k)
+            if (i + k >= n || !match_module(i + k, pr.strict[k], frame)) return false;
+        if (!pr.left.empty() || !pr.right.empty()) {
+            // the neighbours found by scanning are the same for every production tried at i
+            if (w.ctx_at != i) {
+                w.ctx_at = i;
+                w.ctx_left = kUnknown;
+                w.ctx_right = kUnknown;
+            }
+            if (!pr.left.empty()) {
+                if (w.ctx_left == kUnknown) w.ctx_left = left_step(static_cast<std::int64_t>(i) - 1);
+                if (!match_left_from(w.ctx_left, pr.left, frame)) return false;
+            }
+            if (!pr.right.empty()) {
+                const std::size_t e = i + pr.strict.size();
+                if (pr.strict.size() == 1 && pr.right[0].sym != P.symbols.open_bracket &&
+                    pr.right[0].sym != P.symbols.close_bracket) {
+                    if (w.ctx_right == kUnknown) w.ctx_right = static_cast<std::int64_t>(right_step(e));
+                    if (static_cast<std::size_t>(w.ctx_right) >= n ||
+                        !match_module(static_cast<std::size_t>(w.ctx_right), pr.right[0], frame))
+                        return false;
+                    if (pr.right.size() > 1 &&
+                        !match_right(static_cast<std::size_t>(w.ctx_right) + 1,
+                                     std::span<const PatternModule>(pr.right).subspan(1), frame))
+                        return false;
+                } else if (!match_right(e, pr.right, frame)) {
+                    return false;
+                }
+            }
+        }
+        if (!pr.left_new.empty() && !match_left_new(w.out, pr.left_new, frame)) return false;
+        if (!pr.right_new.empty() && !match_right_new(w.out, pr.right_new, frame)) return false;
+        if (!pr.condition.empty() && eval_number(pr.condition, frame, w.env) == 0) return false;
+        return true;
+    }
+
+    const RulePlan& plan;
+    const Program& P;
+    const ModuleString& in;
+    const std::size_t n;
+    std::vector<std::uint32_t> own_match;
+    std::vector<std::uint16_t>* kernel_scratch = nullptr; // run_symbols's right keys, kept from step to step
+    const std::uint32_t* match = nullptr;                 // the bracket table (see bracket_table)
+    std::vector<std::size_t> piece_starts; // run_backward: where each piece of the new string starts
+};
+
+} // namespace plant

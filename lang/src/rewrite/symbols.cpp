@@ -1,0 +1,139 @@
+// The symbol kernel: the route for parameterless strings without identities under a plan whose
+// rewritten symbols all have a parameterless direct template or a context table (see
+// RulePlan::build_symbol_kernel).
+#include "rewriter.hpp"
+
+#include <algorithm>
+
+namespace plant {
+
+namespace {
+
+// Resizes one of the output's arrays. Kept out of line: inlined, vector's growth path copied
+// five times into run_symbols more than doubles the loop's code, and the first step (the one a
+// fresh process runs with cold caches) pays for it.
+template <typename Vector> [[gnu::noinline]] void resize(Vector& v, std::size_t size) {
+    v.resize(size);
+}
+
+} // namespace
+
+// run_range for strings without parameters or identities under a plan with a symbol kernel
+// (parameterless context-sensitive systems such as ABOP's Fig. 1.31). A module's successor
+// comes from its symbol's block: itself, its direct template, or the context table's entry
+// for its neighbours' keys; it is written as one fixed-size copy of padded symbols, and
+// parameter offsets are all zero. Neighbours are carried along rather than searched for:
+// - the left key: the key of the last module context sees, saved at each '[' and taken back
+//   at its ']' (left_step settles a ']' whose '[' lies before b);
+// - over the whole string (Whole), the right keys come from one right-to-left pass that does
+//   the same mirrored, and there is no bracket table; on a stretch, right_step finds them.
+template <bool Whole> void Rewriter::run_symbols(Worker& w, std::size_t b, std::size_t e) {
+    using Plan = RulePlan;
+    ModuleString& out = w.out;
+    EvalEnv& env = w.env;
+    const SymbolId* in_sym = in.sym.data();
+    const Plan::SymbolRow* rows = plan.sym_rows.data();
+    const std::uint32_t* succ_at = plan.succ_at.data();
+    const Plan::SymbolSucc* succs = plan.succs.data();
+    const std::size_t K = plan.ctx_keys;
+    const std::size_t Mmax = plan.max_modules_out;
+    constexpr std::size_t kPad = Plan::SymbolSucc::kMax;
+    auto key_of = [&](std::int64_t j) -> std::size_t { return j < 0 ? 0 : rows[in_sym[j]].key; };
+
+    // The right-to-left pass: the key of the last module context sees, saved at each ']'
+    // and taken back at its '[' (going leftwards, a branch is entered at its ']'). A bracket
+    // without a partner has none.
+    // Both passes keep their saved keys on `stack`, which is as deep as the stretch is long.
+    const std::uint16_t* rkey = nullptr;
+    std::uint16_t* stack = nullptr;
+    if constexpr (Whole) {
+        std::vector<std::uint16_t>& scratch = kernel_scratch ? *kernel_scratch : w.scratch;
+        scratch.resize(2 * n + 1);
+        std::uint16_t* keys = scratch.data();
+        stack = keys + n;
+        std::uint16_t right = 0;
+        std::size_t depth = 0;
+        for (std::size_t j = n; j-- > 0;) {
+            const Plan::SymbolRow r = rows[in_sym[j]];
+            keys[j] = right;
+            if (r.shape == 0) {
+                right = r.key;
+            } else if (r.shape == Plan::kClose) {
+                stack[depth++] = right;
+                right = 0;
+            } else if (r.shape == Plan::kOpen) {
+                right = depth ? stack[--depth] : 0;
+            }
+        }
+        rkey = keys;
+    } else {
+        w.scratch.resize(e - b + 1);
+        stack = w.scratch.data();
+    }
+
+    const std::size_t p_end = out.params.size(); // every module written here has none
+    std::size_t m = out.size();
+    std::size_t left = b > 0 ? key_of(left_step(static_cast<std::int64_t>(b) - 1)) : 0;
+    std::size_t depth = 0; // the left keys at the open '['s are on the stack
+    std::uint64_t fresh = 0;
+    std::size_t i = b, next_check = b + 65536;
+    resize(out.sym, std::max(out.sym.capacity(), m)); // the room reserved is written in place
+    while (i < e) {
+        // the modules that fit: each writes at most Mmax, and a copy writes kPad
+        std::size_t room = out.sym.size() >= m + kPad ? (out.sym.size() - m - kPad) / Mmax : 0;
+        if (room == 0) {
+            resize(out.sym, std::max(m + Mmax + kPad, 2 * out.sym.size()));
+            continue;
+        }
+        if (i >= next_check) {
+            next_check = i + 65536;
+            if (env.interrupt && env.interrupt->load())
+                throw RuntimeError{RuntimeErrorKind::Interrupted, Span{}, "interrupted"};
+            if (m > env.max_output) {
+                resize(out.sym, m);
+                limit_error();
+            }
+        }
+        const std::size_t stop = std::min({e, i + room, next_check});
+        SymbolId* S = out.sym.data();
+        for (; i < stop; ++i) {
+            const Plan::SymbolRow row = rows[in_sym[i]];
+            std::size_t at = row.block;
+            if constexpr (Whole) {
+                at += (left & row.lmask) * K + (rkey[i] & row.rmask);
+            } else if (row.lmask | row.rmask) {
+                const std::size_t j = row.rmask ? right_step(i + 1) : n;
+                at += (left & row.lmask) * K + (j < n ? rows[in_sym[j]].key : 0);
+            }
+            const Plan::SymbolSucc& su = succs[succ_at[at]];
+            std::memcpy(S + m, su.syms, sizeof su.syms);
+            m += su.len;
+            fresh += su.fresh;
+            if (row.shape == 0) {
+                left = row.key;
+            } else if (row.shape == Plan::kOpen) {
+                stack[depth++] = static_cast<std::uint16_t>(left);
+            } else if (row.shape == Plan::kClose) {
+                if (depth == 0) // a branch opened before b, or never
+                    left = Whole ? 0 : key_of(left_step(static_cast<std::int64_t>(i)));
+                else
+                    left = stack[--depth];
+            }
+        }
+    }
+    if (m > env.max_output) {
+        resize(out.sym, m);
+        limit_error();
+    }
+    resize(out.sym, m);
+    const std::size_t m0 = out.poff.size();
+    resize(out.poff, m + 1);
+    std::fill(out.poff.begin() + static_cast<std::ptrdiff_t>(m0), out.poff.end(),
+              static_cast<std::uint32_t>(p_end));
+    env.new_count += static_cast<ModuleId>(fresh);
+}
+
+template void Rewriter::run_symbols<true>(Worker&, std::size_t, std::size_t);
+template void Rewriter::run_symbols<false>(Worker&, std::size_t, std::size_t);
+
+} // namespace plant
