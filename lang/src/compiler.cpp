@@ -398,10 +398,10 @@ ValueType Compiler::compile_expr(Ctx& c, const ast::Expr& e) {
     }
     case K::Method: {
         const ast::Expr& obj = *e.args[0];
-        std::size_t env = P_.environment_names.size();
+        std::size_t env = P_.environments.size();
         if (obj.kind == K::Name)
-            for (std::size_t k = 0; k < P_.environment_names.size(); ++k)
-                if (P_.environment_names[k] == obj.text && P_.environments[k]) env = k;
+            for (std::size_t k = 0; k < P_.environments.size(); ++k)
+                if (P_.environments[k].name == obj.text && P_.environments[k].kind) env = k;
         if (env < P_.environments.size()) return compile_env_call(c, e, env);
         if (obj.kind == K::Name && env_names_.count(obj.text)) {
             diags_->error(
@@ -495,9 +495,9 @@ ValueType Compiler::compile_binary(Ctx& c, const ast::Expr& e) {
 }
 
 ValueType Compiler::compile_env_call(Ctx& c, const ast::Expr& e, std::size_t env) {
-    const Environment& object = *P_.environments[env];
-    const std::string& env_name = P_.environment_names[env];
-    const auto& methods = object.methods();
+    const EnvironmentDecl& decl = P_.environments[env];
+    const std::string& env_name = decl.name;
+    const auto& methods = decl.kind->methods;
     std::size_t m = 0;
     while (m < methods.size() && methods[m].name != e.text) ++m;
     if (m == methods.size()) {
@@ -512,7 +512,7 @@ ValueType Compiler::compile_env_call(Ctx& c, const ast::Expr& e, std::size_t env
         return ValueType::Number;
     }
     const EnvMethod& method = methods[m];
-    if (method.hook_only && c.kind != CtxKind::Hook)
+    if (method.access == EnvAccess::Edit && c.kind != CtxKind::Hook)
         diags_->error(e.span, fmt::format("'{}.{}' changes the environment and can be called only in hooks "
                                           "(on start, on before_step, on after_step, on end)",
                                           env_name, e.text));
@@ -1045,11 +1045,11 @@ void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list, Span span)
                 // ?E(env, slots...): the first argument names an environment, which is kept as its index
                 if (communication && i == 0) {
                     const ast::Expr& a = *m.args[0];
-                    std::size_t env = P_.environment_names.size();
+                    std::size_t env = P_.environments.size();
                     if (a.kind == ast::ExprKind::Name)
-                        for (std::size_t e = 0; e < P_.environment_names.size(); ++e)
-                            if (P_.environment_names[e] == a.text) env = e;
-                    if (env == P_.environment_names.size()) {
+                        for (std::size_t e = 0; e < P_.environments.size(); ++e)
+                            if (P_.environments[e].name == a.text) env = e;
+                    if (env == P_.environments.size()) {
                         diags_->error(a.span,
                                       "the first argument of ?E names an environment, as in ?E(sun, 0)");
                         emit_const(c, -1, a.span);

@@ -484,10 +484,13 @@ void Compiler::compile_environment(const ast::ShapeDecl& s) {
             return;
         }
     }
-    P_.environment_names.push_back(s.name);
-    P_.environments.emplace_back();  // null until made
+    P_.environments.emplace_back();
+    EnvironmentDecl& decl = P_.environments.back(); // without an object until made
+    decl.name = s.name;
+    decl.kind_name = s.kind;
+    decl.span = s.span;
     if (!opts_.environments) return; // no runtime: using it is reported where it is used
-    std::vector<EnvArg> args;
+    std::vector<EnvArg>& args = decl.args;
     for (std::size_t i = 0; i < s.args.size(); ++i) {
         if (s.args[i]->kind == ast::ExprKind::String) { // a file, relative to the grammar
             EnvArg a;
@@ -516,7 +519,8 @@ void Compiler::compile_environment(const ast::ShapeDecl& s) {
                       error.empty() ? fmt::format("unknown environment kind '{}'", s.kind) : error);
         return;
     }
-    P_.environments.back() = std::shared_ptr<Environment>(std::move(env));
+    decl.kind = &env->kind();
+    decl.initial = std::shared_ptr<const Environment>(std::move(env));
 }
 
 void Compiler::compile_curve(const ast::ShapeDecl& s) {
@@ -751,20 +755,22 @@ std::unique_ptr<Program> Compiler::compile(std::uint32_t main_file) {
     }
     for (const ast::ShapeDecl* s : P_.deferred.curves) compile_curve(*s); // before the code that calls them
     for (const ast::ShapeDecl* s : P_.deferred.envs) compile_environment(*s);
-    // `module Seg(len, r) bound ivy;` needs ivy to be a climber
+    // `module Seg(len, r) bound ivy;` needs ivy to be of a kind that holds segments (a climber)
     for (const auto& info : P_.symbols.all()) {
         if (info.bound_to.empty()) continue;
-        auto it = env_names_.find(info.bound_to);
-        if (it == env_names_.end())
+        const EnvironmentDecl* decl = nullptr;
+        for (const EnvironmentDecl& d : P_.environments)
+            if (d.name == info.bound_to) decl = &d;
+        if (!decl)
             diags_->error(info.decl_span,
                           fmt::format("module '{}' is bound to '{}', which is not an environment; "
                                       "declare it first, as in env {} = climber(...);",
                                       info.name, info.bound_to, info.bound_to));
-        else if (it->second != "climber")
+        else if (decl->kind && !decl->kind->holds_segments)
             diags_->error(info.decl_span,
                           fmt::format("module '{}' is bound to '{}', which is not a climber (it is "
                                       "'{}'); only a climber can hold segments",
-                                      info.name, info.bound_to, it->second));
+                                      info.name, info.bound_to, decl->kind_name));
     }
     for (std::uint32_t i = 0; i < P_.functions.size(); ++i) ensure_function_compiled(i);
     for (const ast::ShapeDecl* s : P_.deferred.surfaces) compile_surface(*s);

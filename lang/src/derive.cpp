@@ -99,6 +99,7 @@ void Derivation::rewrite(const ModuleString& in, ModuleString& out, const RulePl
     Rewriter rw(plan, in, &brackets_, &kernel_scratch_, threads == 1);
     auto setup = [&](Worker& w) {
         w.env.prog = &prog_;
+        w.env.run = &run_;
         w.env.globals = const_cast<double*>(globals_.data()); // read-only during rewriting
         w.env.seed = seed_;
         w.env.phase = phase;
@@ -364,6 +365,8 @@ void Derivation::run_hook(HookKind kind) {
     EvalEnv env;
     HookEffects effects;
     env.prog = &prog_;
+    env.run = &run_;
+    env.hook_run = &run_; // hooks alone change environments
     env.globals = globals_.data();
     env.seed = seed_;
     env.phase = (static_cast<std::uint64_t>(step_) << 16) | (0xF000u + k);
@@ -384,10 +387,10 @@ void Derivation::run_hook(HookKind kind) {
 }
 
 void Derivation::start() {
-    for (const auto& env : prog_.environments)
-        if (env) env->reset();
+    run_ = RunState(prog_); // the environments as declared: a second start begins afresh
     EvalEnv env;
     env.prog = &prog_;
+    env.run = &run_;
     env.globals = globals_.data();
     auto setting = [&](const Code& c, double fallback) {
         return c.empty() ? fallback : eval_number(c, nullptr, env);
@@ -449,9 +452,9 @@ bool Derivation::step() {
     run_hook(HookKind::BeforeStep);
     if (stopped_) return false;
     const RulePlan& plan = step_plan();
-    // the turtle pass fills query modules and shows the environments the plant as it is now
-    if ((plan.queries || !prog_.environments.empty()) && opt_.queries)
-        opt_.queries->fill_queries(*this, current_);
+    // the environment phase: the plant as it is now meets its environments, query modules are filled
+    if ((plan.queries || !prog_.environments.empty()) && opt_.environment_phase)
+        opt_.environment_phase->run(*this, run_, current_);
     // (moved rather than swapped: an empty ModuleString would allocate its first offset; a
     // moved-from one is only ever cleared, which restores it)
     ModuleString next(std::move(spare_.s));
@@ -494,6 +497,8 @@ std::vector<std::size_t> find_matches(const Derivation& d, const Program& progra
     Rewriter rw(plan, s);
     Worker w;
     w.env.prog = &program;
+    // another program (the REPL's :find compiles one) sees its environments as declared
+    w.env.run = &program == &d.program() ? &d.run_state() : nullptr;
     std::vector<double> globals = const_cast<Derivation&>(d).globals();
     w.env.globals = globals.data();
     w.env.seed = d.seed();

@@ -32,7 +32,7 @@ struct SymbolInfo {
     int max_arity = -1;    // for built-ins: the most parameters accepted
     std::vector<ValueType> param_types;
     std::vector<std::string> param_names;
-    std::string bound_to; // climber environment for physics-bound segments
+    std::string bound_to; // the environment that holds its segments (`bound ivy`)
     Span decl_span;
 };
 
@@ -106,7 +106,7 @@ enum class Op : std::uint8_t {
     LoadMulConst, // push frame[a] * consts[b]
     LoadAddConst, // push frame[a] + consts[b]
     Curve,        // replace t on top of the stack by curves[a](t)
-    EnvCall,      // environments[a]->call(b, n argument numbers), pushes the result
+    EnvCall,      // method b of environment a (n argument numbers), pushes the result
 };
 
 struct Instr {
@@ -237,6 +237,28 @@ struct SurfaceDef {
 };
 
 class Environment;
+struct EnvironmentKind;
+
+// One evaluated constructor argument: `key: value` (key empty when positional).
+struct EnvArg {
+    std::string key;
+    ValueType type = ValueType::Number; // String for a quoted file name, in `text`
+    double v[3] = {0, 0, 0};
+    std::string text; // a string argument; a file path resolved against the grammar
+    Span span;
+};
+
+// `env name = kind(key: value, ...);` as compiled: the declaration, and the object as declared,
+// made and checked once by the compiler (a mesh file is read once). Neither changes after
+// compilation: every derivation works on its own clone (RunState, run_state.hpp).
+struct EnvironmentDecl {
+    std::string name;
+    std::string kind_name;
+    std::vector<EnvArg> args; // evaluated
+    Span span;
+    const EnvironmentKind* kind = nullptr;      // its methods; null without a runtime or on error
+    std::shared_ptr<const Environment> initial; // null without a runtime or on error
+};
 
 struct Program {
     SymbolTable symbols;
@@ -264,8 +286,7 @@ struct Program {
     Deferred deferred;
     std::vector<SurfaceDef> surfaces;
     std::vector<CurveDef> curves;
-    std::vector<std::shared_ptr<Environment>> environments; // `env` declarations, in file order
-    std::vector<std::string> environment_names;
+    std::vector<EnvironmentDecl> environments;     // `env` declarations, in file order
     std::vector<std::unique_ptr<ast::File>> files; // the syntax trees the program was built from
 
     int group_index(std::string_view name) const;

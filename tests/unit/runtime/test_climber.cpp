@@ -1,8 +1,8 @@
 // The climber environment end to end: grammars whose bound modules are particles.
 #include "helpers.hpp"
 #include "plant/climber.hpp"
+#include "plant/environment_phase.hpp"
 #include "plant/environments.hpp"
-#include "plant/query.hpp"
 #include "plant/skeleton.hpp"
 #include "plant/turtle.hpp"
 
@@ -23,6 +23,15 @@ struct Grown {
     std::size_t particles = 0;
 };
 
+// The derivation's climber: its first environment, in these grammars.
+const Climber& climber_of(const Derivation& d) {
+    REQUIRE(d.run_state().size() > 0);
+    const Environment* env = d.run_state().environment(0);
+    REQUIRE(env);
+    REQUIRE(&env->kind() == &climber_kind());
+    return static_cast<const Climber&>(*env);
+}
+
 Grown grow(const std::string& text, int threads = 1) {
     Grown g;
     CompileOptions opts;
@@ -30,16 +39,15 @@ Grown grow(const std::string& text, int threads = 1) {
     g.compiled = test::compile(text, opts);
     INFO(g.compiled->rendered());
     REQUIRE(g.compiled->program);
-    TurtleQueryPass queries;
+    TurtleEnvironmentPhase phase;
     DeriveOptions o;
-    o.queries = &queries;
+    o.environment_phase = &phase;
     o.threads = threads;
     Derivation d(*g.compiled->program, o);
     d.run();
     g.string = format_string(*g.compiled->program, d.string(), false);
     g.skeleton = build_skeleton(*g.compiled->program, d.interpreted(d.string()), turtle_options(d));
-    for (const auto& env : g.compiled->program->environments)
-        if (auto* c = dynamic_cast<Climber*>(env.get())) g.particles = c->world().size();
+    g.particles = climber_of(d).world().size();
     return g;
 }
 
@@ -150,9 +158,9 @@ TEST_CASE("climber: a grammar grows the same plant for a seed, on any thread cou
     opts.environments = runtime_environments();
     auto c = test::compile(text, opts);
     REQUIRE(c->program);
-    TurtleQueryPass queries;
+    TurtleEnvironmentPhase phase;
     DeriveOptions o;
-    o.queries = &queries;
+    o.environment_phase = &phase;
     std::string first, second;
     for (std::string* out : {&first, &second}) {
         Derivation d(*c->program, o);

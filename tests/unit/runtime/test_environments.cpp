@@ -33,7 +33,7 @@ EnvArg num_arg(const char* key, double v) {
 }
 double ask(const Environment& e, std::size_t method, std::vector<double> args) {
     double r[3] = {0, 0, 0};
-    e.call(method, args.data(), r);
+    e.query(method, args.data(), r);
     return r[0];
 }
 
@@ -62,9 +62,9 @@ TEST_CASE("proximity: distance to other stems, the asking stem and its branching
     Skeleton sk = build_skeleton(*c->program, d.string(), TurtleOptions{});
     REQUIRE(sk.axes.size() == 2);
     auto env = make("proximity", {num_arg("radius", 1.5)});
-    auto* prox = dynamic_cast<SkeletonEnvironment*>(env.get());
+    Environment* prox = env.get();
     REQUIRE(prox);
-    prox->update(sk);
+    prox->see(sk);
     // the branch goes from (0, 2, 0) to (-2, 2, 0); the main stem from (0, 0, 0) to (0, 3, 0)
     const ModuleId branch_module = sk.axes[1].points[2].id; // the branch's second F
     const ModuleId main_module = sk.axes[0].points[1].id;
@@ -88,7 +88,7 @@ TEST_CASE("proximity: clearance of a stem from older stems only", "[environments
     Skeleton sk = build_skeleton(*c->program, d.string(), TurtleOptions{});
     REQUIRE(sk.axes.size() == 3);
     auto env = make("proximity", {num_arg("radius", 1.5)});
-    dynamic_cast<SkeletonEnvironment&>(*env).update(sk);
+    env->see(sk);
     const double main_id = double(sk.axes[0].points[1].id), a_id = double(sk.axes[1].points[1].id),
                  b_id = double(sk.axes[2].points[1].id);
     REQUIRE(a_id < b_id);
@@ -149,7 +149,7 @@ TEST_CASE("light: exposure falls behind occupied cells toward the light", "[envi
     Skeleton sk = build_skeleton(*c->program, d.string(), TurtleOptions{});
     auto env =
         make("light", {vec_arg("direction", 0, 1, 0), num_arg("resolution", 10), num_arg("opacity", 0.5)});
-    dynamic_cast<SkeletonEnvironment&>(*env).update(sk);
+    env->see(sk);
     CHECK(ask(*env, 0, {0, 10.5, 0}) == Approx(1.0)); // above the plant: full light
     CHECK(ask(*env, 1, {1.5, 3, 0}) >= 1);            // under the +x... layer at y = 5
     CHECK(ask(*env, 0, {1.5, 3, 0}) < 1.0);
