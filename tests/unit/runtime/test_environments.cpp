@@ -171,3 +171,27 @@ TEST_CASE("obstacles: signed distance to a loaded mesh", "[environments]") {
     CHECK(!runtime_environments()("obstacles", {mesh}, error));
     CHECK(error == "obstacles: cannot load the mesh '/nonexistent.obj'");
 }
+
+TEST_CASE("environment_kinds: every kind's method table, without making an environment", "[environments]") {
+    std::vector<std::string> names;
+    for (const EnvironmentKind* kind : environment_kinds()) {
+        names.push_back(kind->name);
+        CHECK(std::string(kind->doc) != "");
+        CHECK(!kind->methods.empty());
+        for (std::size_t m = 0; m < kind->methods.size(); ++m) {
+            const EnvMethod& row = kind->methods[m];
+            INFO(kind->name << "." << row.name);
+            CHECK(row.index == m);
+            CHECK(std::string(row.doc) != "");
+            CHECK(kind->method(row.name) == &row);
+            // only a kind that holds segments (the climber) has edits
+            if (row.access == EnvAccess::Edit) CHECK(kind->holds_segments);
+        }
+    }
+    CHECK(names ==
+          std::vector<std::string>{"ellipsoid", "envelope", "proximity", "light", "obstacles", "climber"});
+    // a made environment answers with its kind's table
+    auto e = make("ellipsoid", {});
+    CHECK(&e->kind() == environment_kinds()[0]);
+    CHECK(e->kind().method("contains_scaled")->args.size() == 2);
+}
