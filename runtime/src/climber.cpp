@@ -334,17 +334,27 @@ glm::dvec3 Climber::grow_dir(const glm::dvec3& p, const glm::dvec3& h) const {
     return f;
 }
 
-std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::string& error) {
+namespace {
+
+// What `climber(...)` says, read argument by argument, then checked as a whole.
+struct ClimberArgs {
     physics::Settings s;
-    s.fixed_stiffness = 1.0; // the paper used s = 1 for most results
     Climber::Config c;
-    ObstacleArgs shapes("climber");
+    ObstacleArgs shapes{"climber"};
     std::vector<glm::dvec3> attract, emit_at, emit_v;
     std::vector<double> attract_r, attract_s, emit_r;
     double friction = 0.5, elasticity = 0.0, break_threshold = 0;
-    glm::dvec3 wind(0.0);
+    glm::dvec3 wind{0.0};
     std::vector<std::string> meshes;
     double mesh_cell = 0.05;
+    bool air_min = false, air_max = false;
+
+    ClimberArgs() { s.fixed_stiffness = 1.0; } // the paper used s = 1 for most results
+    bool read(const EnvArg& a, std::string& error);
+    bool check(std::string& error);
+};
+
+bool ClimberArgs::read(const EnvArg& a, std::string& error) {
     // besides the obstacle shapes (ObstacleArgs) and meshes
     static const char* numbers[] = {
         "substeps",     "iterations",       "stiffness",          "stiffening_time", "break_threshold",
@@ -355,123 +365,121 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
         "air_coupling", "mesh_cell",        "attractor_reach",    "emitter_radius"};
     static const char* vectors[] = {"gravity", "light",   "wind",    "attractor",
                                     "air_min", "air_max", "emitter", "emitter_velocity"};
-    bool air_min = false, air_max = false;
-    for (const auto& a : args) {
-        if (a.key == "mesh") {
-            if (!shapes.mesh(a, error)) return nullptr;
-            meshes.push_back(a.text);
-            continue;
-        }
-        if (ObstacleArgs::is_shape(a.key)) {
-            if (!shapes.read(a, error)) return nullptr;
-            continue;
-        }
-        bool is_number =
-            std::any_of(std::begin(numbers), std::end(numbers), [&](const char* k) { return a.key == k; });
-        bool is_vector =
-            std::any_of(std::begin(vectors), std::end(vectors), [&](const char* k) { return a.key == k; });
-        if (!is_number && !is_vector) {
-            error = a.key.empty() ? "climber: arguments are named, as in climber(gravity: vec3(0, -9.81, 0))"
-                                  : fmt::format("climber: unknown argument '{}'", a.key);
-            return nullptr;
-        }
-        if (is_vector != (a.type == ValueType::Vec3)) {
-            error = fmt::format("climber: '{}' must be a {}", a.key, is_vector ? "vec3" : "number");
-            return nullptr;
-        }
-        const double x = a.v[0];
-        const glm::dvec3 v(a.v[0], a.v[1], a.v[2]);
-        if (a.key == "substeps")
-            c.substeps = static_cast<int>(std::clamp(x, 0.0, 1000.0));
-        else if (a.key == "iterations")
-            s.iterations = static_cast<int>(std::clamp(x, 1.0, 100.0));
-        else if (a.key == "stiffness")
-            s.fixed_stiffness = x; // negative: grows with age, s = t_l / t_m
-        else if (a.key == "stiffening_time")
-            s.stiffening_time = std::max(x, 1e-6);
-        else if (a.key == "break_threshold")
-            break_threshold = std::max(x, 0.0);
-        else if (a.key == "damping")
-            s.damping = std::clamp(x, 0.0, 1.0);
-        else if (a.key == "density")
-            s.density = std::max(x, 1e-9);
-        else if (a.key == "phototropism")
-            c.phototropism = std::max(x, 0.0);
-        else if (a.key == "adaption")
-            c.adaption = std::clamp(x, 0.0, 1.0);
-        else if (a.key == "adaption_range")
-            c.adaption_range = std::max(x, 0.0);
-        else if (a.key == "response")
-            c.response = std::max(x, 0.0);
-        else if (a.key == "anchor")
-            c.anchor = std::clamp(x, 0.0, 1.0);
-        else if (a.key == "anchor_range")
-            c.anchor_range = std::max(x, 0.0);
-        else if (a.key == "anchor_release")
-            c.anchor_release = std::max(x, 0.0);
-        else if (a.key == "friction")
-            friction = std::clamp(x, 0.0, 1.0);
-        else if (a.key == "elasticity")
-            elasticity = std::clamp(x, 0.0, 1.0);
-        else if (a.key == "attractor_radius")
-            attract_r.push_back(x);
-        else if (a.key == "attractor_strength")
-            attract_s.push_back(x);
-        else if (a.key == "threads")
-            s.threads = static_cast<int>(std::clamp(x, 1.0, 256.0));
-        else if (a.key == "light_cell")
-            c.light_cell = std::max(x, 1e-3);
-        else if (a.key == "opacity")
-            c.opacity = std::max(x, 0.0);
-        else if (a.key == "gravity")
-            s.gravity = v;
-        else if (a.key == "light")
-            c.light = v;
-        else if (a.key == "wind")
-            wind = v;
-        else if (a.key == "attractor")
-            attract.push_back(v);
-        else if (a.key == "emitter")
-            emit_at.push_back(v);
-        else if (a.key == "emitter_velocity")
-            emit_v.push_back(v);
-        else if (a.key == "emitter_radius")
-            emit_r.push_back(std::max(x, 1e-3));
-        else if (a.key == "air_min")
-            c.fluid.domain_lo = v, air_min = true;
-        else if (a.key == "air_max")
-            c.fluid.domain_hi = v, air_max = true;
-        else if (a.key == "air_spacing")
-            c.fluid.spacing = std::max(x, 1e-3), c.fluid.support = 2 * c.fluid.spacing;
-        else if (a.key == "air_density")
-            c.fluid.rest_density = std::max(x, 1e-6);
-        else if (a.key == "air_viscosity")
-            c.fluid.viscosity = std::max(x, 0.0);
-        else if (a.key == "air_stiffness")
-            c.fluid.stiffness = std::max(x, 1e-6);
-        else if (a.key == "air_coupling")
-            c.fluid.coupling = std::max(x, 0.0);
-        else if (a.key == "mesh_cell")
-            mesh_cell = std::max(x, 1e-3);
-        else if (a.key == "attractor_reach")
-            c.attractor_reach = std::max(x, 0.0);
+    if (a.key == "mesh") {
+        if (!shapes.mesh(a, error)) return false;
+        meshes.push_back(a.text);
+        return true;
     }
-    if (!shapes.paired(error)) return nullptr;
+    if (ObstacleArgs::is_shape(a.key)) return shapes.read(a, error);
+    bool is_number =
+        std::any_of(std::begin(numbers), std::end(numbers), [&](const char* k) { return a.key == k; });
+    bool is_vector =
+        std::any_of(std::begin(vectors), std::end(vectors), [&](const char* k) { return a.key == k; });
+    if (!is_number && !is_vector) {
+        error = a.key.empty() ? "climber: arguments are named, as in climber(gravity: vec3(0, -9.81, 0))"
+                              : fmt::format("climber: unknown argument '{}'", a.key);
+        return false;
+    }
+    if (is_vector != (a.type == ValueType::Vec3)) {
+        error = fmt::format("climber: '{}' must be a {}", a.key, is_vector ? "vec3" : "number");
+        return false;
+    }
+    const double x = a.v[0];
+    const glm::dvec3 v(a.v[0], a.v[1], a.v[2]);
+    if (a.key == "substeps")
+        c.substeps = static_cast<int>(std::clamp(x, 0.0, 1000.0));
+    else if (a.key == "iterations")
+        s.iterations = static_cast<int>(std::clamp(x, 1.0, 100.0));
+    else if (a.key == "stiffness")
+        s.fixed_stiffness = x; // negative: grows with age, s = t_l / t_m
+    else if (a.key == "stiffening_time")
+        s.stiffening_time = std::max(x, 1e-6);
+    else if (a.key == "break_threshold")
+        break_threshold = std::max(x, 0.0);
+    else if (a.key == "damping")
+        s.damping = std::clamp(x, 0.0, 1.0);
+    else if (a.key == "density")
+        s.density = std::max(x, 1e-9);
+    else if (a.key == "phototropism")
+        c.phototropism = std::max(x, 0.0);
+    else if (a.key == "adaption")
+        c.adaption = std::clamp(x, 0.0, 1.0);
+    else if (a.key == "adaption_range")
+        c.adaption_range = std::max(x, 0.0);
+    else if (a.key == "response")
+        c.response = std::max(x, 0.0);
+    else if (a.key == "anchor")
+        c.anchor = std::clamp(x, 0.0, 1.0);
+    else if (a.key == "anchor_range")
+        c.anchor_range = std::max(x, 0.0);
+    else if (a.key == "anchor_release")
+        c.anchor_release = std::max(x, 0.0);
+    else if (a.key == "friction")
+        friction = std::clamp(x, 0.0, 1.0);
+    else if (a.key == "elasticity")
+        elasticity = std::clamp(x, 0.0, 1.0);
+    else if (a.key == "attractor_radius")
+        attract_r.push_back(x);
+    else if (a.key == "attractor_strength")
+        attract_s.push_back(x);
+    else if (a.key == "threads")
+        s.threads = static_cast<int>(std::clamp(x, 1.0, 256.0));
+    else if (a.key == "light_cell")
+        c.light_cell = std::max(x, 1e-3);
+    else if (a.key == "opacity")
+        c.opacity = std::max(x, 0.0);
+    else if (a.key == "gravity")
+        s.gravity = v;
+    else if (a.key == "light")
+        c.light = v;
+    else if (a.key == "wind")
+        wind = v;
+    else if (a.key == "attractor")
+        attract.push_back(v);
+    else if (a.key == "emitter")
+        emit_at.push_back(v);
+    else if (a.key == "emitter_velocity")
+        emit_v.push_back(v);
+    else if (a.key == "emitter_radius")
+        emit_r.push_back(std::max(x, 1e-3));
+    else if (a.key == "air_min")
+        c.fluid.domain_lo = v, air_min = true;
+    else if (a.key == "air_max")
+        c.fluid.domain_hi = v, air_max = true;
+    else if (a.key == "air_spacing")
+        c.fluid.spacing = std::max(x, 1e-3), c.fluid.support = 2 * c.fluid.spacing;
+    else if (a.key == "air_density")
+        c.fluid.rest_density = std::max(x, 1e-6);
+    else if (a.key == "air_viscosity")
+        c.fluid.viscosity = std::max(x, 0.0);
+    else if (a.key == "air_stiffness")
+        c.fluid.stiffness = std::max(x, 1e-6);
+    else if (a.key == "air_coupling")
+        c.fluid.coupling = std::max(x, 0.0);
+    else if (a.key == "mesh_cell")
+        mesh_cell = std::max(x, 1e-3);
+    else if (a.key == "attractor_reach")
+        c.attractor_reach = std::max(x, 0.0);
+    return true;
+}
+
+bool ClimberArgs::check(std::string& error) {
+    if (!shapes.paired(error)) return false;
     if (attract_r.size() > attract.size() || attract_s.size() > attract.size()) {
         error = "climber: an attractor_radius or attractor_strength without an attractor";
-        return nullptr;
+        return false;
     }
     if (air_min != air_max) {
         error = "climber: give both air_min and air_max for SPH air, or neither";
-        return nullptr;
+        return false;
     }
     if (emit_v.size() != emit_at.size() || emit_r.size() > emit_at.size()) {
         error = "climber: give each emitter an emitter_velocity (and at most one emitter_radius)";
-        return nullptr;
+        return false;
     }
     if (!emit_at.empty() && !air_min) {
         error = "climber: an emitter blows SPH air: give air_min and air_max too";
-        return nullptr;
+        return false;
     }
     for (std::size_t i = 0; i < emit_at.size(); ++i)
         c.fluid.emitters.push_back({emit_at[i], i < emit_r.size() ? emit_r[i] : 0.2, emit_v[i]});
@@ -483,13 +491,13 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
         c.fluid.domain_hi = hi;
         if (!finite(lo) || !finite(hi)) {
             error = "climber: air_min and air_max must be finite";
-            return nullptr;
+            return false;
         }
         // counted as Fluid::fill will fill it: at least one particle along each axis
         glm::dvec3 cells = glm::max(glm::floor((hi - lo) / c.fluid.spacing + 1e-9), glm::dvec3(1.0));
         if (cells.x * cells.y * cells.z > 200000) {
             error = "climber: the air box holds more than 200,000 particles at this air_spacing";
-            return nullptr;
+            return false;
         }
         c.fluid.wind = wind;
         c.fluid.threads = s.threads;
@@ -498,29 +506,39 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
     }
     if (glm::length(c.light) == 0) {
         error = "climber: 'light' must not be zero";
-        return nullptr;
+        return false;
     }
     for (std::size_t i = 0; i < attract.size(); ++i)
         c.attractors.push_back({attract[i], i < attract_r.size() ? attract_r[i] : 0.3,
                                 i < attract_s.size() ? attract_s[i] : 1.0});
-    auto climber = std::make_unique<Climber>(s, c);
+    return true;
+}
+
+} // namespace
+
+std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::string& error) {
+    ClimberArgs p;
+    for (const auto& a : args)
+        if (!p.read(a, error)) return nullptr;
+    if (!p.check(error)) return nullptr;
+    auto climber = std::make_unique<Climber>(p.s, p.c);
     physics::World& w = climber->world();
-    w.set_break_threshold(break_threshold);
-    w.set_wind(wind);
+    w.set_break_threshold(p.break_threshold);
+    w.set_wind(p.wind);
     auto add = [&](physics::Obstacle o) {
-        o.friction = friction;
-        o.elasticity = elasticity;
+        o.friction = p.friction;
+        o.elasticity = p.elasticity;
         w.add_obstacle(o);
     };
     std::vector<physics::Obstacle> obstacles;
-    if (!shapes.shapes(obstacles, error)) return nullptr;
+    if (!p.shapes.shapes(obstacles, error)) return nullptr;
     for (const physics::Obstacle& o : obstacles) add(o);
-    for (const auto& path : meshes) {
+    for (const auto& path : p.meshes) {
         std::vector<Triangle> mesh;
         if (!load_triangles(path, mesh, "climber", error)) return nullptr;
         physics::Obstacle o;
         o.kind = physics::Obstacle::Grid;
-        o.grid = distance_grid(mesh, mesh_cell, 4 * mesh_cell + c.adaption_range);
+        o.grid = distance_grid(mesh, p.mesh_cell, 4 * p.mesh_cell + p.c.adaption_range);
         std::vector<glm::dvec3> shown;
         for (const auto& t : mesh) shown.insert(shown.end(), {t.a, t.b, t.c});
         climber->show_mesh(w.obstacles().size(), std::move(shown));
