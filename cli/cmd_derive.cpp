@@ -1,7 +1,7 @@
 // plant derive / plant check
 #include "commands.hpp"
 
-#include "plant/query.hpp"
+#include "plant/environment_phase.hpp"
 
 #include <fmt/format.h>
 
@@ -46,8 +46,8 @@ int derive_main(const DeriveCmd& c) {
         if (progress) std::cerr << fmt::format("\rstep {}: {} modules   ", s.step, s.modules) << std::flush;
     };
     opt.on_print = [](const std::string& text) { std::cerr << text; };
-    TurtleQueryPass queries;
-    opt.queries = &queries;
+    TurtleEnvironmentPhase phase;
+    opt.environment_phase = &phase;
     Derivation d(*program, opt);
     bool ok = run_derivation(d, sources, c.g.color);
     if (progress) std::cerr << "\r\x1b[K" << std::flush;

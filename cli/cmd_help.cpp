@@ -55,77 +55,37 @@ int help_builtins(const HelpArgs& a) {
     return kOk;
 }
 
-// The environment kinds the runtime makes, each with arguments it accepts, so that its methods can
-// be listed from a live object. TODO(lead): when the environments expose each kind's method table
-// without constructing one, read that instead of `example` (runtime/src/environments.cpp).
-struct EnvKind {
-    const char* kind;
-    const char* summary;
-    std::vector<EnvArg> (*example)();
-};
-
-EnvArg vec_arg(const char* key, double x, double y, double z) {
-    EnvArg a;
-    a.key = key;
-    a.type = ValueType::Vec3;
-    a.v[0] = x, a.v[1] = y, a.v[2] = z;
-    return a;
-}
-
-std::vector<EnvArg> no_args() {
-    return {};
-}
-
-std::vector<EnvArg> envelope_args() {
-    return {vec_arg("top", 0, 2, 0), vec_arg("bottom", 0, 0, 0), vec_arg("px", 1, 1, 0),
-            vec_arg("pz", 0, 1, 1),  vec_arg("nx", -1, 1, 0),    vec_arg("nz", 0, 1, -1)};
-}
-
-const EnvKind kEnvKinds[] = {
-    {"ellipsoid", "an ellipsoid given by center and radii: inside tests and levels", no_args},
-    {"envelope", "Cescatti's asymmetric crown envelope", envelope_args},
-    {"proximity", "distances between the plant's stems, for density control", no_args},
-    {"light", "self-shading: light reaching a point through the plant's occupied cells", no_args},
-    {"obstacles", "spheres, boxes, planes and meshes: signed distance and inside tests", no_args},
-    {"climber", "a particle world the plant's bound modules live in (docs/physics.md)", no_args},
-};
-
-int help_env_kind(const EnvKind& k, const HelpArgs& a) {
-    std::string error;
-    auto env = runtime_environments()(k.kind, k.example(), error);
-    if (!env) {
-        std::cerr << fmt::format("plant: internal error: cannot list the methods of '{}': {}\n", k.kind,
-                                 error);
-        return kRuntime;
-    }
+int help_env_kind(const EnvironmentKind& k, const HelpArgs& a) {
     std::vector<std::pair<std::string, std::string>> rows;
-    for (const auto& m : env->methods()) {
+    for (const EnvMethod& m : k.methods) {
         if (a.names) {
             std::cout << m.name << "\n";
             continue;
         }
-        rows.emplace_back(signature(m.name.c_str(), m.args, m.result),
-                          std::string(m.doc) + (m.hook_only ? " (in hooks only)" : ""));
+        std::vector<ValueType> args(m.args.types.begin(), m.args.types.begin() + m.args.size());
+        rows.emplace_back(signature(m.name, args, m.result),
+                          std::string(m.doc) + (m.access == EnvAccess::Edit ? " (in hooks only)" : ""));
     }
     if (a.names) return kOk;
-    std::cout << fmt::format("{}: {}. Methods (called as NAME.method(...)):\n", k.kind, k.summary);
+    std::cout << fmt::format("{}: {}. Methods (called as NAME.method(...)):\n", k.name, k.doc);
     print_columns(rows);
     return kOk;
 }
 
 int help_env(const HelpArgs& a) {
+    const auto kinds = environment_kinds();
     if (a.words.size() > 1) {
-        for (const auto& k : kEnvKinds)
-            if (a.words[1] == k.kind) return help_env_kind(k, a);
-        std::string kinds;
-        for (const auto& k : kEnvKinds) kinds += (kinds.empty() ? "" : ", ") + std::string(k.kind);
-        std::cerr << fmt::format("plant: no environment kind '{}'; the kinds are {}\n", a.words[1], kinds);
+        for (const EnvironmentKind* k : kinds)
+            if (a.words[1] == k->name) return help_env_kind(*k, a);
+        std::string names;
+        for (const EnvironmentKind* k : kinds) names += (names.empty() ? "" : ", ") + std::string(k->name);
+        std::cerr << fmt::format("plant: no environment kind '{}'; the kinds are {}\n", a.words[1], names);
         return kUsage;
     }
     std::vector<std::pair<std::string, std::string>> rows;
-    for (const auto& k : kEnvKinds) {
-        if (a.names) std::cout << k.kind << "\n";
-        rows.emplace_back(k.kind, k.summary);
+    for (const EnvironmentKind* k : kinds) {
+        if (a.names) std::cout << k->name << "\n";
+        rows.emplace_back(k->name, k->doc);
     }
     if (a.names) return kOk;
     std::cout << "Environment kinds (env NAME = KIND(key: value, ...); 'plant help env KIND' lists its "

@@ -2,10 +2,10 @@
 #include "commands.hpp"
 #include "outputs.hpp"
 
+#include "plant/environment_phase.hpp"
 #include "plant/export.hpp"
 #include "plant/export_text.hpp"
 #include "plant/mesh.hpp"
-#include "plant/query.hpp"
 
 #include <fmt/format.h>
 
@@ -61,8 +61,8 @@ int run_main(RunCmd& c) {
     const bool progress = isatty(2) != 0;
     auto t0 = std::chrono::steady_clock::now();
     DeriveOptions opt = derive_options(c.g);
-    TurtleQueryPass queries;
-    opt.queries = &queries;
+    TurtleEnvironmentPhase phase;
+    opt.environment_phase = &phase;
     opt.on_print = [](const std::string& text) { std::cerr << text; };
     opt.on_step = [&](const StepStats& s) {
         if (progress) std::cerr << fmt::format("\rstep {}: {} modules   ", s.step, s.modules) << std::flush;

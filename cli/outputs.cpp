@@ -103,11 +103,11 @@ std::string known_extensions() {
 
 // The environments' obstacles as one more prototype, placed once where it is: flat-shaded
 // triangles in a stone grey.
-static void add_environments(const Program& program, Scene& scene) {
+static void add_environments(const RunState& environments, Scene& scene) {
     std::vector<glm::dvec3> tris;
     const glm::dvec3 lo(scene.bounds_min), hi(scene.bounds_max);
-    for (const auto& env : program.environments)
-        if (env) env->geometry(tris, lo, hi);
+    for (std::size_t e = 0; e < environments.size(); ++e)
+        if (const Environment* env = environments.environment(e)) env->geometry(tris, lo, hi);
     if (tris.size() < 3) return;
     MeshPart part;
     for (std::size_t k = 0; k + 2 < tris.size(); k += 3) {
@@ -155,7 +155,7 @@ OutputSummary write_outputs(const Program& program, const Derivation& d,
         MeshOptions mo;
         mo.sides = options.sides;
         scene = build_scene(program, skeleton, mo);
-        if (options.obstacles) add_environments(program, scene);
+        if (options.obstacles) add_environments(d.run_state(), scene);
     }
     // All or nothing: every file is first written under a temporary name beside its target
     // (same extension, which the writers go by); only when all succeeded are they renamed.

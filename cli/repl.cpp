@@ -4,9 +4,9 @@
 #include "repl.hpp"
 
 #include "outputs.hpp"
+#include "plant/environment_phase.hpp"
 #include "plant/environments.hpp"
 #include "plant/export.hpp"
-#include "plant/query.hpp"
 #include "plant/vm.hpp"
 #include "repl_text.hpp"
 
@@ -30,8 +30,8 @@ DeriveOptions Session::options() const {
     o.seed = seed_;
     o.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     o.interrupt = interrupt_;
-    static TurtleQueryPass queries;
-    o.queries = &queries;
+    static TurtleEnvironmentPhase phase;
+    o.environment_phase = &phase;
     std::ostream* out = &out_;
     o.on_print = [out](const std::string& text) { *out << text; };
     return o;
@@ -388,11 +388,9 @@ bool Session::back_to(int k) {
     if (edits_.size() < before)
         out_ << fmt::format("undid {} edit{} made at step {} or later\n", before - edits_.size(),
                             before - edits_.size() == 1 ? "" : "s", k);
-    // an environment that evolves (a climber's particles) is where the later steps left it:
-    // derive again up to step k; the earlier string alone would not bring its state back
-    bool evolves = std::any_of(program_->environments.begin(), program_->environments.end(),
-                               [](const auto& e) { return e && e->evolves(); });
-    return (evolves || edits_.size() < before) && rebuild(k);
+    // each kept step has its own copy of the environments (a climber's particles): only undone
+    // edits need the steps derived again, without them
+    return edits_.size() < before && rebuild(k);
 }
 
 void Session::edit(std::string statements) {
@@ -422,11 +420,9 @@ bool Session::is_edit(const std::string& line) const {
     std::size_t dot = line.find('.'), paren = line.find('(');
     if (dot == std::string::npos || paren == std::string::npos || paren < dot) return false;
     std::string env = trim(line.substr(0, dot)), method = trim(line.substr(dot + 1, paren - dot - 1));
-    for (std::size_t k = 0; k < program_->environment_names.size() && k < program_->environments.size();
-         ++k) {
-        if (program_->environment_names[k] != env || !program_->environments[k]) continue;
-        for (const auto& m : program_->environments[k]->methods())
-            if (m.name == method) return m.hook_only;
+    for (const EnvironmentDecl& d : program_->environments) {
+        if (d.name != env || !d.kind) continue;
+        if (const EnvMethod* m = d.kind->method(method)) return m->access == EnvAccess::Edit;
     }
     return false;
 }

@@ -102,7 +102,7 @@ class Session {
     // A line calling a hook-only environment method (ivy.cut(12)): an edit, not an expression.
     bool is_edit(const std::string& line) const;
     // Going back to step k: uses and edits made after it are forgotten. Whether it derived again
-    // (it does when an environment evolves or edits were undone).
+    // (it does when edits were undone: the steps kept have their own environments).
     bool back_to(int k);
     Derivation& current() { return *history_.back(); }
     DeriveOptions options() const;

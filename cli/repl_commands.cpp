@@ -239,7 +239,7 @@ std::vector<std::string> Session::completions(const std::string& before) const {
         if (all || kind == ReplCompletion::Groups)
             for (const auto& g : program_->groups) out.push_back(g.name);
         if (all) {
-            for (const auto& e : program_->environment_names) out.push_back(e);
+            for (const auto& e : program_->environments) out.push_back(e.name);
             for (const auto& c : program_->curves) out.push_back(c.name);
             for (const auto& f : program_->functions) out.push_back(f.name);
         }

@@ -36,9 +36,8 @@ int main(int argc, char** argv) {
     r.key = "radius";
     r.v[0] = radius;
     auto env = runtime_environments()("proximity", {r}, error);
-    auto* prox = dynamic_cast<SkeletonEnvironment*>(env.get());
     auto t0 = std::chrono::steady_clock::now();
-    prox->update(sk);
+    env->see(sk);
     double update_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     // query points spread over the plant's bounding box, asked for by modules of the plant
@@ -50,7 +49,7 @@ int main(int argc, char** argv) {
         double u = (x & 0xffff) / 65535.0, v = ((x >> 16) & 0xffff) / 65535.0;
         double args[4] = {lo.x + (hi.x - lo.x) * u, lo.y + (hi.y - lo.y) * v, 0, double((x >> 32) % 1000)};
         double res[3];
-        env->call(0, args, res);
+        env->query(0, args, res);
         sum += res[0];
     }
     double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -1,5 +1,5 @@
 // The whole-program checks, in one place: -D values that name no param, modules bound to
-// something that is not a climber, rule groups that read new context both ways, productions
+// something that cannot hold segments, rule groups that read new context both ways, productions
 // shadowed by an earlier one or with a condition that is always false, and, after everything
 // is compiled, letter runs read as separate letters that mean nothing, productions that can
 // never apply and rule groups never selected.
@@ -27,21 +27,23 @@ void Compiler::check_defines_used() {
     }
 }
 
-// `module Seg(len, r) bound ivy;` needs ivy to be a climber
+// `module Seg(len, r) bound ivy;` needs ivy to be of a kind that holds segments (a climber)
 void Compiler::check_bound_modules() {
     for (const auto& info : P_.symbols.all()) {
         if (info.bound_to.empty()) continue;
-        auto it = env_names_.find(info.bound_to);
-        if (it == env_names_.end())
+        const EnvironmentDecl* decl = nullptr;
+        for (const EnvironmentDecl& d : P_.environments)
+            if (d.name == info.bound_to) decl = &d;
+        if (!decl)
             diags_->error(info.decl_span,
                           fmt::format("module '{}' is bound to '{}', which is not an environment; "
                                       "declare it first, as in env {} = climber(...);",
                                       info.name, info.bound_to, info.bound_to));
-        else if (it->second != "climber")
+        else if (decl->kind && !decl->kind->holds_segments)
             diags_->error(info.decl_span,
                           fmt::format("module '{}' is bound to '{}', which is not a climber (it is "
                                       "'{}'); only a climber can hold segments",
-                                      info.name, info.bound_to, it->second));
+                                      info.name, info.bound_to, decl->kind_name));
     }
 }
 

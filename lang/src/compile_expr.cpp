@@ -287,10 +287,10 @@ ValueType Compiler::compile_name(Ctx& c, const ast::Expr& e) {
 ValueType Compiler::compile_method(Ctx& c, const ast::Expr& e) {
     using K = ast::ExprKind;
     const ast::Expr& obj = *e.args[0];
-    std::size_t env = P_.environment_names.size();
+    std::size_t env = P_.environments.size();
     if (obj.kind == K::Name)
-        for (std::size_t k = 0; k < P_.environment_names.size(); ++k)
-            if (P_.environment_names[k] == obj.text && P_.environments[k]) env = k;
+        for (std::size_t k = 0; k < P_.environments.size(); ++k)
+            if (P_.environments[k].name == obj.text && P_.environments[k].kind) env = k;
     if (env < P_.environments.size()) return compile_env_call(c, e, env);
     if (obj.kind == K::Name && env_names_.count(obj.text)) {
         diags_->error(

@@ -158,11 +158,11 @@ void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list) {
                 // ?E(env, slots...): the first argument names an environment, which is kept as its index
                 if (communication && i == 0) {
                     const ast::Expr& a = *m.args[0];
-                    std::size_t env = P_.environment_names.size();
+                    std::size_t env = P_.environments.size();
                     if (a.kind == ast::ExprKind::Name)
-                        for (std::size_t e = 0; e < P_.environment_names.size(); ++e)
-                            if (P_.environment_names[e] == a.text) env = e;
-                    if (env == P_.environment_names.size()) {
+                        for (std::size_t e = 0; e < P_.environments.size(); ++e)
+                            if (P_.environments[e].name == a.text) env = e;
+                    if (env == P_.environments.size()) {
                         diags_->error(a.span,
                                       "the first argument of ?E names an environment, as in ?E(sun, 0)");
                         emit_const(c, -1, a.span);

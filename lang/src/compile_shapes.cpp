@@ -114,10 +114,13 @@ void Compiler::compile_environment(const ast::ShapeDecl& s) {
             return;
         }
     }
-    P_.environment_names.push_back(s.name);
-    P_.environments.emplace_back();  // null until made
+    P_.environments.emplace_back();
+    EnvironmentDecl& decl = P_.environments.back(); // without an object until made
+    decl.name = s.name;
+    decl.kind_name = s.kind;
+    decl.span = s.span;
     if (!opts_.environments) return; // no runtime: using it is reported where it is used
-    std::vector<EnvArg> args;
+    std::vector<EnvArg>& args = decl.args;
     for (std::size_t i = 0; i < s.args.size(); ++i) {
         if (s.args[i]->kind == ast::ExprKind::String) { // a file, relative to the grammar
             EnvArg a;
@@ -146,13 +149,14 @@ void Compiler::compile_environment(const ast::ShapeDecl& s) {
                       error.empty() ? fmt::format("unknown environment kind '{}'", s.kind) : error);
         return;
     }
-    P_.environments.back() = std::shared_ptr<Environment>(std::move(env));
+    decl.kind = &env->kind();
+    decl.initial = std::shared_ptr<const Environment>(std::move(env));
 }
 
 ValueType Compiler::compile_env_call(Ctx& c, const ast::Expr& e, std::size_t env) {
-    const Environment& object = *P_.environments[env];
-    const std::string& env_name = P_.environment_names[env];
-    const auto& methods = object.methods();
+    const EnvironmentDecl& decl = P_.environments[env];
+    const std::string& env_name = decl.name;
+    const auto& methods = decl.kind->methods;
     std::size_t m = 0;
     while (m < methods.size() && methods[m].name != e.text) ++m;
     if (m == methods.size()) {
@@ -167,7 +171,7 @@ ValueType Compiler::compile_env_call(Ctx& c, const ast::Expr& e, std::size_t env
         return ValueType::Number;
     }
     const EnvMethod& method = methods[m];
-    if (method.hook_only && c.kind != CtxKind::Hook)
+    if (method.access == EnvAccess::Edit && c.kind != CtxKind::Hook)
         diags_->error(e.span, fmt::format("'{}.{}' changes the environment and can be called only in hooks "
                                           "({})",
                                           env_name, e.text, ast::hook_list("on ", ", ")));

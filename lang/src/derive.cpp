@@ -59,6 +59,8 @@ void Derivation::run_hook(HookKind kind) {
     EvalEnv env;
     HookEffects effects;
     env.prog = &prog_;
+    env.run = &run_;
+    env.hook_run = &run_; // hooks alone change environments
     env.globals = globals_.data();
     env.seed = seed_;
     env.phase = stream::hook(step_, k);
@@ -79,10 +81,10 @@ void Derivation::run_hook(HookKind kind) {
 }
 
 void Derivation::start() {
-    for (const auto& env : prog_.environments)
-        if (env) env->reset();
+    run_ = RunState(prog_); // the environments as declared: a second start begins afresh
     EvalEnv env;
     env.prog = &prog_;
+    env.run = &run_;
     env.globals = globals_.data();
     auto setting = [&](const Code& c, double fallback) {
         return c.empty() ? fallback : eval_number(c, nullptr, env);
@@ -147,9 +149,9 @@ bool Derivation::step() {
     run_hook(HookKind::BeforeStep);
     if (stopped_) return false;
     const RulePlan& plan = engine_->step_plan(*this);
-    // the turtle pass fills query modules and shows the environments the plant as it is now
-    if ((plan.queries || !prog_.environments.empty()) && opt_.queries)
-        opt_.queries->fill_queries(*this, current_);
+    // the environment phase: the plant as it is now meets its environments, query modules are filled
+    if ((plan.queries || !prog_.environments.empty()) && opt_.environment_phase)
+        opt_.environment_phase->run(*this, run_, current_);
     // (moved rather than swapped: an empty ModuleString would allocate its first offset; a
     // moved-from one is only ever cleared, which restores it)
     ModuleString next(std::move(engine_->spare));

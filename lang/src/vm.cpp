@@ -5,6 +5,7 @@
 #include "plant/builtins.hpp"
 #include "plant/environment.hpp"
 #include "plant/random.hpp"
+#include "plant/run_state.hpp"
 
 #include <fmt/format.h>
 
@@ -478,12 +479,20 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
             st[sp - 1] = env.prog->curves[static_cast<std::size_t>(I.a)](st[sp - 1]);
             break;
         case Op::EnvCall: {
-            const auto& object = *env.prog->environments[static_cast<std::size_t>(I.a)];
+            const auto e = static_cast<std::size_t>(I.a);
+            const EnvironmentDecl& decl = env.prog->environments[e];
+            const EnvMethod& method = decl.kind->methods[I.b];
             sp -= I.n;
             double r[3] = {0, 0, 0};
-            object.call(I.b, st + sp, r);
-            const ValueType t = object.methods()[I.b].result;
-            for (int k = 0; k < value_width(t); ++k) st[sp++] = r[k];
+            if (method.access == EnvAccess::Edit) {
+                // the compiler allows edits in hooks only, and only hooks run with hook_run set
+                if (!env.hook_run) fail(code, pc, "an environment can be changed only in hooks");
+                env.hook_run->environment(e)->edit(I.b, st + sp);
+            } else {
+                const Environment* object = env.run ? env.run->environment(e) : decl.initial.get();
+                object->query(I.b, st + sp, r);
+            }
+            for (int k = 0; k < value_width(method.result); ++k) st[sp++] = r[k];
             break;
         }
         }

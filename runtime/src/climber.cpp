@@ -1,6 +1,7 @@
 // The climber environment: a physics::World driven by the grammar's bound modules.
 #include "plant/climber.hpp"
 
+#include "obstacle_args.hpp"
 #include "triangle_mesh.hpp"
 
 #include <fmt/format.h>
@@ -27,45 +28,40 @@ glm::dquat quat_of(const glm::dmat3& frame) {
 
 } // namespace
 
-const std::vector<EnvMethod>& Climber::methods() const {
-    static const std::vector<EnvMethod> m = [] {
-        std::vector<EnvMethod> v = {
-            {"grow_dir",
-             {V, V},
-             V,
-             "heading h at p turned by surface adaption (Eq. 6), attractors and phototropism (Eq. 7)",
-             false},
-            {"occlusion", {V}, N, "light occlusion at p by the plant's particles, 0 to 1", true},
-            {"anchored", {N}, N, "1 when module id's particle is anchored to a surface", false},
-            {"particles", {}, N, "particles in the world", false},
-            {"seeded",
-             {N},
-             N,
-             "1 in the step after a hook seeded a branch at module id (ivy.seed(id))",
-             false},
-            {"pull",
-             {N, V},
-             N,
-             "hold module id's particle at a point through the next step's physics",
-             false},
-            {"cut", {N}, N, "cut the branch at module id: it leaves the string", false},
-            {"wind", {V}, N, "set the wind (vec3(0, 0, 0): off)", false},
-            {"move",
-             {N, V},
-             N,
-             "move obstacle k (in the order declared: spheres, boxes, planes, meshes) by a vector",
-             false},
-            {"seed", {N}, N, "seed a new branch at module id: ivy.seeded(id) holds in the next step", false},
-            {"emit",
-             {N, V},
-             N,
-             "set emitter k's air velocity (in the order declared; vec3(0, 0, 0): off)",
-             false},
-        };
-        for (std::size_t k = 5; k < v.size(); ++k) v[k].hook_only = true;
-        return v;
-    }();
-    return m;
+namespace {
+
+constexpr EnvAccess Pure = EnvAccess::Pure, Edit = EnvAccess::Edit;
+using M = ClimberMethod;
+
+constexpr EnvMethod kClimberMethods[] = {
+    env_method(M::GrowDir, "grow_dir", {V, V}, V, Pure, false,
+               "heading h at p turned by surface adaption (Eq. 6), attractors and phototropism (Eq. 7)"),
+    env_method(M::Occlusion, "occlusion", {V}, N, Pure, true,
+               "light occlusion at p by the plant's particles, 0 to 1"),
+    env_method(M::Anchored, "anchored", {N}, N, Pure, false,
+               "1 when module id's particle is anchored to a surface"),
+    env_method(M::Particles, "particles", {}, N, Pure, false, "particles in the world"),
+    env_method(M::Seeded, "seeded", {N}, N, Pure, false,
+               "1 in the step after a hook seeded a branch at module id (ivy.seed(id))"),
+    env_method(M::Pull, "pull", {N, V}, N, Edit, false,
+               "hold module id's particle at a point through the next step's physics"),
+    env_method(M::Cut, "cut", {N}, N, Edit, false, "cut the branch at module id: it leaves the string"),
+    env_method(M::Wind, "wind", {V}, N, Edit, false, "set the wind (vec3(0, 0, 0): off)"),
+    env_method(M::Move, "move", {N, V}, N, Edit, false,
+               "move obstacle k (in the order declared: spheres, boxes, planes, meshes) by a vector"),
+    env_method(M::Seed, "seed", {N}, N, Edit, false,
+               "seed a new branch at module id: ivy.seeded(id) holds in the next step"),
+    env_method(M::Emit, "emit", {N, V}, N, Edit, false,
+               "set emitter k's air velocity (in the order declared; vec3(0, 0, 0): off)"),
+};
+static_assert(method_table(kClimberMethods, M::Emit));
+
+} // namespace
+
+const EnvironmentKind& climber_kind() {
+    static constexpr EnvironmentKind kind{
+        "climber", "the particle physics behind bound segments (Hädrich et al. 2017)", kClimberMethods, true};
+    return kind;
 }
 
 physics::Handle Climber::particle(ModuleId id) const {
@@ -85,52 +81,61 @@ bool finite(const glm::dvec3& v) {
 
 } // namespace
 
-void Climber::call(std::size_t method, const double* a, double* r) const {
-    // editing calls with a non-finite vector or index are ignored: they would poison the world
-    if (method >= 5 && method != 6 && method != 9 && !finite(vec(method == 7 ? a : a + 1))) return;
-    switch (method) {
-    case 0: {
+void Climber::query(std::size_t method, const double* a, double* r) const {
+    switch (static_cast<M>(method)) {
+    case M::GrowDir: {
         glm::dvec3 g = grow_dir(vec(a), vec(a + 3));
         r[0] = g.x, r[1] = g.y, r[2] = g.z;
         return;
     }
-    case 1:
+    case M::Occlusion:
         r[0] = occlusion(vec(a));
         return;
-    case 2: {
+    case M::Anchored: {
         physics::Handle h = particle(id_of(a[0]));
         r[0] = h.valid() && world_.alive(h) && world_.anchored(h) ? 1 : 0;
         return;
     }
-    case 3:
+    case M::Particles:
         r[0] = static_cast<double>(particle_of_.size());
         return;
-    case 4:
+    case M::Seeded:
         r[0] = seeded_.count(id_of(a[0])) ? 1 : 0;
         return;
-    case 5:
+    default: // edits: not queries
+        r[0] = 0;
+    }
+}
+
+void Climber::edit(std::size_t method, const double* a) {
+    const auto m = static_cast<M>(method);
+    // edits with a non-finite vector are ignored: they would poison the world
+    const bool vector = m == M::Pull || m == M::Wind || m == M::Move || m == M::Emit;
+    if (vector && !finite(vec(m == M::Wind ? a : a + 1))) return;
+    switch (m) {
+    case M::Pull:
         pulls_.emplace_back(id_of(a[0]), vec(a + 1));
         return;
-    case 6:
+    case M::Cut:
         cuts_.push_back(id_of(a[0]));
         return;
-    case 7:
+    case M::Wind:
         wind_ = vec(a);
         wind_changed_ = true;
         return;
-    case 8:
+    case M::Move:
         if (std::isfinite(a[0]) && a[0] >= 0 && a[0] < 1e9)
             moves_.emplace_back(static_cast<std::size_t>(a[0]), vec(a + 1));
         return;
-    case 9:
+    case M::Seed:
         seed_requests_.push_back(id_of(a[0]));
         return;
-    case 10:
+    case M::Emit:
         if (std::isfinite(a[0]) && a[0] >= 0 && a[0] < 1e9)
             emits_.emplace_back(static_cast<std::size_t>(a[0]), vec(a + 1));
         return;
-    default:
-        r[0] = 0;
+    default: // queries: not edits
+        return;
     }
 }
 
@@ -163,40 +168,20 @@ void Climber::geometry(std::vector<glm::dvec3>& triangles, const glm::dvec3& lo,
     }
 }
 
-void Climber::reset() {
-    world_ = initial_;
-    attractors_ = config_.attractors;
-    fluid_ = initial_fluid_;
-    particle_of_.clear();
-    roots_.clear();
-    seen_.clear();
-    detached_.clear();
-    pending_.clear();
-    pulls_.clear();
-    cuts_.clear();
-    moves_.clear();
-    seed_requests_.clear();
-    seeded_.clear();
-    emits_.clear();
-    wind_changed_ = false;
-    light_.clear();
-}
-
-void Climber::begin_sync() {
+void Climber::begin_segments() {
     seen_.clear();
     pending_.clear();
 }
 
-void Climber::observe(ModuleId id, ModuleId parent, const glm::dvec3& from, const glm::dvec3& to,
-                      const glm::dmat3& frame, double radius, double length) {
-    if (particle_of_.count(id)) {
-        seen_.insert(id);
+void Climber::segment(const BoundSegment& s) {
+    if (particle_of_.count(s.id)) {
+        seen_.insert(s.id);
         return;
     }
-    pending_.push_back(Pending{id, parent, from, to, frame, radius, length});
+    pending_.push_back(s);
 }
 
-void Climber::advance() {
+void Climber::advance(std::set<ModuleId>& left) {
     // particles whose modules the grammar removed go too
     for (auto it = particle_of_.begin(); it != particle_of_.end();) {
         if (seen_.count(it->first)) {
@@ -207,7 +192,7 @@ void Climber::advance() {
         it = particle_of_.erase(it);
     }
     // new bound modules become particles where the turtle drew them
-    for (const Pending& p : pending_) {
+    for (const BoundSegment& p : pending_) {
         const double r = std::isfinite(p.radius) ? std::clamp(p.radius, 1e-4, 1e6) : 1e-4;
         const double length = std::isfinite(p.length) ? std::clamp(p.length, 0.0, 1e6) : 0.0;
         const glm::dvec3 radii(r, std::max(length / 2, r), r);
@@ -233,7 +218,7 @@ void Climber::advance() {
     // instead of circling a sample (as a space-colonization attractor is removed once reached)
     if (!attractors_.empty()) {
         const double reach2 = config_.attractor_reach * config_.attractor_reach;
-        for (const Pending& p : pending_)
+        for (const BoundSegment& p : pending_)
             std::erase_if(attractors_, [&](const Attractor& a) {
                 const glm::dvec3 d = a.point - p.to;
                 return glm::dot(d, d) < reach2;
@@ -241,7 +226,6 @@ void Climber::advance() {
     }
     pending_.clear();
     // edits from hooks
-    detached_.clear();
     for (ModuleId id : cuts_) {
         physics::Handle h = particle(id);
         if (h.valid() && world_.alive(h)) world_.remove(h);
@@ -281,7 +265,7 @@ void Climber::advance() {
             ++it;
             continue;
         }
-        detached_.insert(it->first);
+        left.insert(it->first);
         world_.remove(it->second); // a broken-off part is no longer drawn, so no longer simulated
         it = particle_of_.erase(it);
     }
@@ -350,159 +334,152 @@ glm::dvec3 Climber::grow_dir(const glm::dvec3& p, const glm::dvec3& h) const {
     return f;
 }
 
-std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::string& error) {
+namespace {
+
+// What `climber(...)` says, read argument by argument, then checked as a whole.
+struct ClimberArgs {
     physics::Settings s;
-    s.fixed_stiffness = 1.0; // the paper used s = 1 for most results
     Climber::Config c;
-    std::vector<glm::dvec3> sphere, box_min, box_max, plane_p, plane_n, attract, emit_at, emit_v;
-    std::vector<double> sphere_r, attract_r, attract_s, emit_r;
+    ObstacleArgs shapes{"climber"};
+    std::vector<glm::dvec3> attract, emit_at, emit_v;
+    std::vector<double> attract_r, attract_s, emit_r;
     double friction = 0.5, elasticity = 0.0, break_threshold = 0;
-    glm::dvec3 wind(0.0);
+    glm::dvec3 wind{0.0};
     std::vector<std::string> meshes;
     double mesh_cell = 0.05;
-    static const char* numbers[] = {
-        "substeps",      "iterations",    "stiffness",        "stiffening_time",    "break_threshold",
-        "damping",       "density",       "phototropism",     "adaption",           "adaption_range",
-        "response",      "anchor",        "anchor_range",     "anchor_release",     "friction",
-        "elasticity",    "sphere_radius", "attractor_radius", "attractor_strength", "threads",
-        "light_cell",    "opacity",       "air_spacing",      "air_density",        "air_viscosity",
-        "air_stiffness", "air_coupling",  "mesh_cell",        "attractor_reach",    "emitter_radius"};
-    static const char* vectors[] = {
-        "gravity",      "light",     "wind",    "sphere",  "box_min", "box_max",         "plane_point",
-        "plane_normal", "attractor", "air_min", "air_max", "emitter", "emitter_velocity"};
     bool air_min = false, air_max = false;
-    for (const auto& a : args) {
-        if (a.key == "mesh") {
-            if (a.type != ValueType::String) {
-                error = "climber: 'mesh' is a quoted file name, as in mesh: \"rock.obj\"";
-                return nullptr;
-            }
-            meshes.push_back(a.text);
-            continue;
-        }
-        bool is_number =
-            std::any_of(std::begin(numbers), std::end(numbers), [&](const char* k) { return a.key == k; });
-        bool is_vector =
-            std::any_of(std::begin(vectors), std::end(vectors), [&](const char* k) { return a.key == k; });
-        if (!is_number && !is_vector) {
-            error = a.key.empty() ? "climber: arguments are named, as in climber(gravity: vec3(0, -9.81, 0))"
-                                  : fmt::format("climber: unknown argument '{}'", a.key);
-            return nullptr;
-        }
-        if (is_vector != (a.type == ValueType::Vec3)) {
-            error = fmt::format("climber: '{}' must be a {}", a.key, is_vector ? "vec3" : "number");
-            return nullptr;
-        }
-        const double x = a.v[0];
-        const glm::dvec3 v(a.v[0], a.v[1], a.v[2]);
-        if (a.key == "substeps")
-            c.substeps = static_cast<int>(std::clamp(x, 0.0, 1000.0));
-        else if (a.key == "iterations")
-            s.iterations = static_cast<int>(std::clamp(x, 1.0, 100.0));
-        else if (a.key == "stiffness")
-            s.fixed_stiffness = x; // negative: grows with age, s = t_l / t_m
-        else if (a.key == "stiffening_time")
-            s.stiffening_time = std::max(x, 1e-6);
-        else if (a.key == "break_threshold")
-            break_threshold = std::max(x, 0.0);
-        else if (a.key == "damping")
-            s.damping = std::clamp(x, 0.0, 1.0);
-        else if (a.key == "density")
-            s.density = std::max(x, 1e-9);
-        else if (a.key == "phototropism")
-            c.phototropism = std::max(x, 0.0);
-        else if (a.key == "adaption")
-            c.adaption = std::clamp(x, 0.0, 1.0);
-        else if (a.key == "adaption_range")
-            c.adaption_range = std::max(x, 0.0);
-        else if (a.key == "response")
-            c.response = std::max(x, 0.0);
-        else if (a.key == "anchor")
-            c.anchor = std::clamp(x, 0.0, 1.0);
-        else if (a.key == "anchor_range")
-            c.anchor_range = std::max(x, 0.0);
-        else if (a.key == "anchor_release")
-            c.anchor_release = std::max(x, 0.0);
-        else if (a.key == "friction")
-            friction = std::clamp(x, 0.0, 1.0);
-        else if (a.key == "elasticity")
-            elasticity = std::clamp(x, 0.0, 1.0);
-        else if (a.key == "sphere_radius")
-            sphere_r.push_back(x);
-        else if (a.key == "attractor_radius")
-            attract_r.push_back(x);
-        else if (a.key == "attractor_strength")
-            attract_s.push_back(x);
-        else if (a.key == "threads")
-            s.threads = static_cast<int>(std::clamp(x, 1.0, 256.0));
-        else if (a.key == "light_cell")
-            c.light_cell = std::max(x, 1e-3);
-        else if (a.key == "opacity")
-            c.opacity = std::max(x, 0.0);
-        else if (a.key == "gravity")
-            s.gravity = v;
-        else if (a.key == "light")
-            c.light = v;
-        else if (a.key == "wind")
-            wind = v;
-        else if (a.key == "sphere")
-            sphere.push_back(v);
-        else if (a.key == "box_min")
-            box_min.push_back(v);
-        else if (a.key == "box_max")
-            box_max.push_back(v);
-        else if (a.key == "plane_point")
-            plane_p.push_back(v);
-        else if (a.key == "plane_normal")
-            plane_n.push_back(v);
-        else if (a.key == "attractor")
-            attract.push_back(v);
-        else if (a.key == "emitter")
-            emit_at.push_back(v);
-        else if (a.key == "emitter_velocity")
-            emit_v.push_back(v);
-        else if (a.key == "emitter_radius")
-            emit_r.push_back(std::max(x, 1e-3));
-        else if (a.key == "air_min")
-            c.fluid.domain_lo = v, air_min = true;
-        else if (a.key == "air_max")
-            c.fluid.domain_hi = v, air_max = true;
-        else if (a.key == "air_spacing")
-            c.fluid.spacing = std::max(x, 1e-3), c.fluid.support = 2 * c.fluid.spacing;
-        else if (a.key == "air_density")
-            c.fluid.rest_density = std::max(x, 1e-6);
-        else if (a.key == "air_viscosity")
-            c.fluid.viscosity = std::max(x, 0.0);
-        else if (a.key == "air_stiffness")
-            c.fluid.stiffness = std::max(x, 1e-6);
-        else if (a.key == "air_coupling")
-            c.fluid.coupling = std::max(x, 0.0);
-        else if (a.key == "mesh_cell")
-            mesh_cell = std::max(x, 1e-3);
-        else if (a.key == "attractor_reach")
-            c.attractor_reach = std::max(x, 0.0);
+
+    ClimberArgs() { s.fixed_stiffness = 1.0; } // the paper used s = 1 for most results
+    bool read(const EnvArg& a, std::string& error);
+    bool check(std::string& error);
+};
+
+bool ClimberArgs::read(const EnvArg& a, std::string& error) {
+    // besides the obstacle shapes (ObstacleArgs) and meshes
+    static const char* numbers[] = {
+        "substeps",     "iterations",       "stiffness",          "stiffening_time", "break_threshold",
+        "damping",      "density",          "phototropism",       "adaption",        "adaption_range",
+        "response",     "anchor",           "anchor_range",       "anchor_release",  "friction",
+        "elasticity",   "attractor_radius", "attractor_strength", "threads",         "light_cell",
+        "opacity",      "air_spacing",      "air_density",        "air_viscosity",   "air_stiffness",
+        "air_coupling", "mesh_cell",        "attractor_reach",    "emitter_radius"};
+    static const char* vectors[] = {"gravity", "light",   "wind",    "attractor",
+                                    "air_min", "air_max", "emitter", "emitter_velocity"};
+    if (a.key == "mesh") {
+        if (!shapes.mesh(a, error)) return false;
+        meshes.push_back(a.text);
+        return true;
     }
-    if (sphere.size() != sphere_r.size() || box_min.size() != box_max.size() ||
-        plane_p.size() != plane_n.size()) {
-        error = "climber: give each sphere a sphere_radius, each box_min a box_max and each plane_point a "
-                "plane_normal";
-        return nullptr;
+    if (ObstacleArgs::is_shape(a.key)) return shapes.read(a, error);
+    bool is_number =
+        std::any_of(std::begin(numbers), std::end(numbers), [&](const char* k) { return a.key == k; });
+    bool is_vector =
+        std::any_of(std::begin(vectors), std::end(vectors), [&](const char* k) { return a.key == k; });
+    if (!is_number && !is_vector) {
+        error = a.key.empty() ? "climber: arguments are named, as in climber(gravity: vec3(0, -9.81, 0))"
+                              : fmt::format("climber: unknown argument '{}'", a.key);
+        return false;
     }
+    if (is_vector != (a.type == ValueType::Vec3)) {
+        error = fmt::format("climber: '{}' must be a {}", a.key, is_vector ? "vec3" : "number");
+        return false;
+    }
+    const double x = a.v[0];
+    const glm::dvec3 v(a.v[0], a.v[1], a.v[2]);
+    if (a.key == "substeps")
+        c.substeps = static_cast<int>(std::clamp(x, 0.0, 1000.0));
+    else if (a.key == "iterations")
+        s.iterations = static_cast<int>(std::clamp(x, 1.0, 100.0));
+    else if (a.key == "stiffness")
+        s.fixed_stiffness = x; // negative: grows with age, s = t_l / t_m
+    else if (a.key == "stiffening_time")
+        s.stiffening_time = std::max(x, 1e-6);
+    else if (a.key == "break_threshold")
+        break_threshold = std::max(x, 0.0);
+    else if (a.key == "damping")
+        s.damping = std::clamp(x, 0.0, 1.0);
+    else if (a.key == "density")
+        s.density = std::max(x, 1e-9);
+    else if (a.key == "phototropism")
+        c.phototropism = std::max(x, 0.0);
+    else if (a.key == "adaption")
+        c.adaption = std::clamp(x, 0.0, 1.0);
+    else if (a.key == "adaption_range")
+        c.adaption_range = std::max(x, 0.0);
+    else if (a.key == "response")
+        c.response = std::max(x, 0.0);
+    else if (a.key == "anchor")
+        c.anchor = std::clamp(x, 0.0, 1.0);
+    else if (a.key == "anchor_range")
+        c.anchor_range = std::max(x, 0.0);
+    else if (a.key == "anchor_release")
+        c.anchor_release = std::max(x, 0.0);
+    else if (a.key == "friction")
+        friction = std::clamp(x, 0.0, 1.0);
+    else if (a.key == "elasticity")
+        elasticity = std::clamp(x, 0.0, 1.0);
+    else if (a.key == "attractor_radius")
+        attract_r.push_back(x);
+    else if (a.key == "attractor_strength")
+        attract_s.push_back(x);
+    else if (a.key == "threads")
+        s.threads = static_cast<int>(std::clamp(x, 1.0, 256.0));
+    else if (a.key == "light_cell")
+        c.light_cell = std::max(x, 1e-3);
+    else if (a.key == "opacity")
+        c.opacity = std::max(x, 0.0);
+    else if (a.key == "gravity")
+        s.gravity = v;
+    else if (a.key == "light")
+        c.light = v;
+    else if (a.key == "wind")
+        wind = v;
+    else if (a.key == "attractor")
+        attract.push_back(v);
+    else if (a.key == "emitter")
+        emit_at.push_back(v);
+    else if (a.key == "emitter_velocity")
+        emit_v.push_back(v);
+    else if (a.key == "emitter_radius")
+        emit_r.push_back(std::max(x, 1e-3));
+    else if (a.key == "air_min")
+        c.fluid.domain_lo = v, air_min = true;
+    else if (a.key == "air_max")
+        c.fluid.domain_hi = v, air_max = true;
+    else if (a.key == "air_spacing")
+        c.fluid.spacing = std::max(x, 1e-3), c.fluid.support = 2 * c.fluid.spacing;
+    else if (a.key == "air_density")
+        c.fluid.rest_density = std::max(x, 1e-6);
+    else if (a.key == "air_viscosity")
+        c.fluid.viscosity = std::max(x, 0.0);
+    else if (a.key == "air_stiffness")
+        c.fluid.stiffness = std::max(x, 1e-6);
+    else if (a.key == "air_coupling")
+        c.fluid.coupling = std::max(x, 0.0);
+    else if (a.key == "mesh_cell")
+        mesh_cell = std::max(x, 1e-3);
+    else if (a.key == "attractor_reach")
+        c.attractor_reach = std::max(x, 0.0);
+    return true;
+}
+
+bool ClimberArgs::check(std::string& error) {
+    if (!shapes.paired(error)) return false;
     if (attract_r.size() > attract.size() || attract_s.size() > attract.size()) {
         error = "climber: an attractor_radius or attractor_strength without an attractor";
-        return nullptr;
+        return false;
     }
     if (air_min != air_max) {
         error = "climber: give both air_min and air_max for SPH air, or neither";
-        return nullptr;
+        return false;
     }
     if (emit_v.size() != emit_at.size() || emit_r.size() > emit_at.size()) {
         error = "climber: give each emitter an emitter_velocity (and at most one emitter_radius)";
-        return nullptr;
+        return false;
     }
     if (!emit_at.empty() && !air_min) {
         error = "climber: an emitter blows SPH air: give air_min and air_max too";
-        return nullptr;
+        return false;
     }
     for (std::size_t i = 0; i < emit_at.size(); ++i)
         c.fluid.emitters.push_back({emit_at[i], i < emit_r.size() ? emit_r[i] : 0.2, emit_v[i]});
@@ -514,13 +491,13 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
         c.fluid.domain_hi = hi;
         if (!finite(lo) || !finite(hi)) {
             error = "climber: air_min and air_max must be finite";
-            return nullptr;
+            return false;
         }
         // counted as Fluid::fill will fill it: at least one particle along each axis
         glm::dvec3 cells = glm::max(glm::floor((hi - lo) / c.fluid.spacing + 1e-9), glm::dvec3(1.0));
         if (cells.x * cells.y * cells.z > 200000) {
             error = "climber: the air box holds more than 200,000 particles at this air_spacing";
-            return nullptr;
+            return false;
         }
         c.fluid.wind = wind;
         c.fluid.threads = s.threads;
@@ -529,57 +506,45 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
     }
     if (glm::length(c.light) == 0) {
         error = "climber: 'light' must not be zero";
-        return nullptr;
+        return false;
     }
     for (std::size_t i = 0; i < attract.size(); ++i)
         c.attractors.push_back({attract[i], i < attract_r.size() ? attract_r[i] : 0.3,
                                 i < attract_s.size() ? attract_s[i] : 1.0});
-    auto climber = std::make_unique<Climber>(s, c);
+    return true;
+}
+
+} // namespace
+
+std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::string& error) {
+    ClimberArgs p;
+    for (const auto& a : args)
+        if (!p.read(a, error)) return nullptr;
+    if (!p.check(error)) return nullptr;
+    auto climber = std::make_unique<Climber>(p.s, p.c);
     physics::World& w = climber->world();
-    w.set_break_threshold(break_threshold);
-    w.set_wind(wind);
+    w.set_break_threshold(p.break_threshold);
+    w.set_wind(p.wind);
     auto add = [&](physics::Obstacle o) {
-        o.friction = friction;
-        o.elasticity = elasticity;
+        o.friction = p.friction;
+        o.elasticity = p.elasticity;
         w.add_obstacle(o);
     };
-    for (std::size_t i = 0; i < sphere.size(); ++i) {
-        physics::Obstacle o;
-        o.kind = physics::Obstacle::Sphere;
-        o.a = sphere[i];
-        o.b = glm::dvec3(sphere_r[i], 0, 0);
-        add(o);
-    }
-    for (std::size_t i = 0; i < box_min.size(); ++i) {
-        physics::Obstacle o;
-        o.kind = physics::Obstacle::Box;
-        o.a = glm::min(box_min[i], box_max[i]);
-        o.b = glm::max(box_min[i], box_max[i]);
-        add(o);
-    }
-    for (std::size_t i = 0; i < plane_p.size(); ++i) {
-        if (glm::length(plane_n[i]) == 0) {
-            error = "climber: a plane_normal must not be zero";
-            return nullptr;
-        }
-        physics::Obstacle o;
-        o.kind = physics::Obstacle::Plane;
-        o.a = plane_p[i];
-        o.b = glm::normalize(plane_n[i]);
-        add(o);
-    }
-    for (const auto& path : meshes) {
+    std::vector<physics::Obstacle> obstacles;
+    if (!p.shapes.shapes(obstacles, error)) return nullptr;
+    for (const physics::Obstacle& o : obstacles) add(o);
+    for (const auto& path : p.meshes) {
         std::vector<Triangle> mesh;
         if (!load_triangles(path, mesh, "climber", error)) return nullptr;
         physics::Obstacle o;
         o.kind = physics::Obstacle::Grid;
-        o.grid = distance_grid(mesh, mesh_cell, 4 * mesh_cell + c.adaption_range);
+        o.grid = distance_grid(mesh, p.mesh_cell, 4 * p.mesh_cell + p.c.adaption_range);
         std::vector<glm::dvec3> shown;
         for (const auto& t : mesh) shown.insert(shown.end(), {t.a, t.b, t.c});
         climber->show_mesh(w.obstacles().size(), std::move(shown));
         add(o);
     }
-    climber->remember_initial();
+    climber->fill_air();
     return climber;
 }
 

@@ -4,6 +4,7 @@
 
 #include "plant/climber.hpp"
 
+#include "obstacle_args.hpp"
 #include "triangle_mesh.hpp"
 
 #include <fmt/format.h>
@@ -22,6 +23,7 @@ namespace {
 constexpr ValueType N = ValueType::Number;
 constexpr ValueType V = ValueType::Vec3;
 constexpr ValueType B = ValueType::Bool;
+constexpr EnvAccess Pure = EnvAccess::Pure;
 
 glm::dvec3 vec(const EnvArg& a) {
     return {a.v[0], a.v[1], a.v[2]};
@@ -33,7 +35,7 @@ glm::dvec3 vec(const double* a) {
 // Reads keyword arguments of one kind, checking names and types.
 class Args {
   public:
-    Args(const std::string& kind, const std::vector<EnvArg>& args, std::string& error)
+    Args(const char* kind, const std::vector<EnvArg>& args, std::string& error)
         : kind_(kind), args_(args), error_(error) {}
     const EnvArg* find(const std::string& key, ValueType type) {
         for (const auto& a : args_) {
@@ -67,42 +69,46 @@ class Args {
     bool ok() const { return error_.empty(); }
 
   private:
-    const std::string& kind_;
+    const char* kind_;
     const std::vector<EnvArg>& args_;
     std::string& error_;
 };
 
 // ---- ellipsoid -----------------------------------------------------------------------------
 
+enum class EllipsoidMethod : std::uint8_t { Contains, ContainsScaled, Level, Distance };
+constexpr EnvMethod kEllipsoidMethods[] = {
+    env_method(EllipsoidMethod::Contains, "contains", {V}, B, Pure, true, "p inside the ellipsoid"),
+    env_method(EllipsoidMethod::ContainsScaled, "contains_scaled", {V, N}, B, Pure, false,
+               "p inside the ellipsoid scaled by g about its center"),
+    env_method(EllipsoidMethod::Level, "level", {V}, N, Pure, true,
+               "|(p - center) / radii|: below 1 inside, 1 on the surface"),
+    env_method(EllipsoidMethod::Distance, "distance", {V}, N, Pure, true,
+               "signed distance to the surface along the ray from the center (negative inside)"),
+};
+static_assert(method_table(kEllipsoidMethods, EllipsoidMethod::Distance));
+constexpr EnvironmentKind kEllipsoid{"ellipsoid", "an ellipsoid: center, radii", kEllipsoidMethods};
+
 class Ellipsoid : public Environment {
   public:
     Ellipsoid(glm::dvec3 center, glm::dvec3 radii) : center_(center), radii_(radii) {}
-    const std::vector<EnvMethod>& methods() const override {
-        static const std::vector<EnvMethod> m = {
-            {"contains", {V}, B, "p inside the ellipsoid"},
-            {"contains_scaled", {V, N}, B, "p inside the ellipsoid scaled by g about its center", false},
-            {"level", {V}, N, "|(p - center) / radii|: below 1 inside, 1 on the surface"},
-            {"distance",
-             {V},
-             N,
-             "signed distance to the surface along the ray from the center (negative inside)"},
-        };
-        return m;
-    }
-    void call(std::size_t method, const double* a, double* r) const override {
+    const EnvironmentKind& kind() const override { return kEllipsoid; }
+    std::unique_ptr<Environment> clone() const override { return std::make_unique<Ellipsoid>(*this); }
+    void query(std::size_t method, const double* a, double* r) const override {
         const glm::dvec3 p = vec(a);
         double level = glm::length((p - center_) / radii_);
-        switch (method) {
-        case 0:
+        switch (static_cast<EllipsoidMethod>(method)) {
+        case EllipsoidMethod::Contains:
             r[0] = level <= 1.0;
             break;
-        case 1:
+        case EllipsoidMethod::ContainsScaled:
             r[0] = a[3] > 0 && level <= a[3];
             break;
-        case 2:
+        case EllipsoidMethod::Level:
             r[0] = level;
             break;
-        default: // the surface point on the ray from the center through p is center + (p - center) / level
+        case EllipsoidMethod::Distance:
+            // the surface point on the ray from the center through p is center + (p - center) / level
             r[0] = level > 0 ? glm::length(p - center_) * (1 - 1 / level)
                              : -std::min({radii_.x, radii_.y, radii_.z});
             break;
@@ -119,23 +125,23 @@ class Ellipsoid : public Environment {
 // cells around its point. Each segment knows its axis, so the asking stem's own segments are
 // skipped, and so is every segment that touches the stem's branching point (its base, where its
 // parent and its siblings meet it).
-class Proximity : public SkeletonEnvironment {
+enum class ProximityMethod : std::uint8_t { Distance, Clearance };
+constexpr EnvMethod kProximityMethods[] = {
+    env_method(ProximityMethod::Distance, "distance", {V, N}, N, Pure, true,
+               "distance from p to the nearest segment of another stem than module id's (at most radius)"),
+    env_method(ProximityMethod::Clearance, "clearance", {N}, N, Pure, true,
+               "smallest distance from a node of module id's stem to an older stem (at most radius)"),
+};
+static_assert(method_table(kProximityMethods, ProximityMethod::Clearance));
+constexpr EnvironmentKind kProximity{"proximity", "distances between the plant's stems: radius",
+                                     kProximityMethods};
+
+class Proximity : public Environment {
   public:
     explicit Proximity(double radius) : radius_(radius) {}
-    const std::vector<EnvMethod>& methods() const override {
-        static const std::vector<EnvMethod> m = {
-            {"distance",
-             {V, N},
-             N,
-             "distance from p to the nearest segment of another stem than module id's (at most radius)"},
-            {"clearance",
-             {N},
-             N,
-             "smallest distance from a node of module id's stem to an older stem (at most radius)"},
-        };
-        return m;
-    }
-    void update(const Skeleton& sk) override {
+    const EnvironmentKind& kind() const override { return kProximity; }
+    std::unique_ptr<Environment> clone() const override { return std::make_unique<Proximity>(*this); }
+    void see(const Skeleton& sk) override {
         segments_.clear();
         axis_of_.clear();
         base_.clear();
@@ -188,12 +194,15 @@ class Proximity : public SkeletonEnvironment {
         for (std::uint32_t i = 0; i < segments_.size(); ++i)
             each_cell(segments_[i], [&](std::size_t c) { entries_[fill[c]++] = i; });
     }
-    void call(std::size_t method, const double* a, double* r) const override {
-        if (method == 0) {
+    void query(std::size_t method, const double* a, double* r) const override {
+        switch (static_cast<ProximityMethod>(method)) {
+        case ProximityMethod::Distance:
             r[0] = distance(vec(a), axis_of(a[3]), false);
-            return;
+            break;
+        case ProximityMethod::Clearance:
+            r[0] = clearance(axis_of(a[0]));
+            break;
         }
-        r[0] = clearance(axis_of(a[0]));
     }
     // ?E(space, distance, clearance): the asking stem is the axis the turtle was drawing there
     // (a ?E module is not a segment, so its own identity names no stem).
@@ -285,19 +294,24 @@ class Proximity : public SkeletonEnvironment {
 
 // ---- obstacles -----------------------------------------------------------------------------
 
+enum class ObstaclesMethod : std::uint8_t { Distance, Inside };
+constexpr EnvMethod kObstaclesMethods[] = {
+    env_method(ObstaclesMethod::Distance, "distance", {V}, N, Pure, true,
+               "signed distance to the nearest obstacle (negative inside)"),
+    env_method(ObstaclesMethod::Inside, "inside", {V}, B, Pure, true, "p inside an obstacle"),
+};
+static_assert(method_table(kObstaclesMethods, ObstaclesMethod::Inside));
+constexpr EnvironmentKind kObstacles{"obstacles", "spheres, boxes, planes and meshes, as signed distances",
+                                     kObstaclesMethods};
+
 class Obstacles : public Environment {
   public:
     // spheres, boxes and planes as the climbers' physics has them (one distance function for both)
     std::vector<physics::Obstacle> shapes;
     std::vector<Triangle> triangles; // of loaded meshes, each a closed surface with outward faces
 
-    const std::vector<EnvMethod>& methods() const override {
-        static const std::vector<EnvMethod> m = {
-            {"distance", {V}, N, "signed distance to the nearest obstacle (negative inside)"},
-            {"inside", {V}, B, "p inside an obstacle"},
-        };
-        return m;
-    }
+    const EnvironmentKind& kind() const override { return kObstacles; }
+    std::unique_ptr<Environment> clone() const override { return std::make_unique<Obstacles>(*this); }
     double distance(const glm::dvec3& p) const {
         double d = std::numeric_limits<double>::infinity();
         for (const auto& o : shapes) d = std::min(d, o.distance(p));
@@ -308,9 +322,16 @@ class Obstacles : public Environment {
         for (const auto& o : shapes) obstacle_triangles(o, lo, hi, out);
         for (const auto& t : triangles) out.insert(out.end(), {t.a, t.b, t.c});
     }
-    void call(std::size_t method, const double* a, double* r) const override {
+    void query(std::size_t method, const double* a, double* r) const override {
         double d = distance(vec(a));
-        r[0] = method == 0 ? (std::isfinite(d) ? d : 1e300) : (d < 0 ? 1.0 : 0.0);
+        switch (static_cast<ObstaclesMethod>(method)) {
+        case ObstaclesMethod::Distance:
+            r[0] = std::isfinite(d) ? d : 1e300;
+            break;
+        case ObstaclesMethod::Inside:
+            r[0] = d < 0 ? 1.0 : 0.0;
+            break;
+        }
     }
 };
 
@@ -321,6 +342,15 @@ class Obstacles : public Environment {
 // sides (each at its own height), C1 and C2 the shapes above and below the peripheral line.
 // Between two neighbouring peripheral points the line is a quarter ellipse; above it the crown
 // is the superellipse (r/R)^C1 + ((y - Y)/(top - Y))^C1 = 1, below it the same with C2.
+enum class EnvelopeMethod : std::uint8_t { Contains, Level };
+constexpr EnvMethod kEnvelopeMethods[] = {
+    env_method(EnvelopeMethod::Contains, "contains", {V}, B, Pure, true, "p inside the envelope"),
+    env_method(EnvelopeMethod::Level, "level", {V}, N, Pure, true,
+               "how far out p is: below 1 inside, 1 on the surface"),
+};
+static_assert(method_table(kEnvelopeMethods, EnvelopeMethod::Level));
+constexpr EnvironmentKind kEnvelope{"envelope", "Cescatti's asymmetric crown envelope", kEnvelopeMethods};
+
 class Envelope : public Environment {
   public:
     glm::dvec3 top, bottom;
@@ -328,13 +358,8 @@ class Envelope : public Environment {
     double height[4];
     double c_top = 2, c_bottom = 2;
 
-    const std::vector<EnvMethod>& methods() const override {
-        static const std::vector<EnvMethod> m = {
-            {"contains", {V}, B, "p inside the envelope"},
-            {"level", {V}, N, "how far out p is: below 1 inside, 1 on the surface"},
-        };
-        return m;
-    }
+    const EnvironmentKind& kind() const override { return kEnvelope; }
+    std::unique_ptr<Environment> clone() const override { return std::make_unique<Envelope>(*this); }
     double level(const glm::dvec3& p) const {
         const double dx = p.x - bottom.x, dz = p.z - bottom.z;
         const double r = std::hypot(dx, dz);
@@ -355,9 +380,16 @@ class Envelope : public Environment {
         double h = std::max(Y - bottom.y, 1e-12);
         return std::pow(std::pow(r / R, c_bottom) + std::pow((Y - p.y) / h, c_bottom), 1 / c_bottom);
     }
-    void call(std::size_t method, const double* a, double* r) const override {
+    void query(std::size_t method, const double* a, double* r) const override {
         double l = level(vec(a));
-        r[0] = method == 0 ? (l <= 1.0 ? 1.0 : 0.0) : l;
+        switch (static_cast<EnvelopeMethod>(method)) {
+        case EnvelopeMethod::Contains:
+            r[0] = l <= 1.0 ? 1.0 : 0.0;
+            break;
+        case EnvelopeMethod::Level:
+            r[0] = l;
+            break;
+        }
     }
 };
 
@@ -366,18 +398,25 @@ class Envelope : public Environment {
 // Occlusion by the plant itself: the plant's box is cut into resolution^3 cells; a cell a
 // segment passes through (or an organ sits in) is occupied. A point's exposure is the fraction
 // of light left after the occupied cells between it and the light, each keeping (1 - opacity).
-class Light : public SkeletonEnvironment {
+enum class LightMethod : std::uint8_t { Exposure, Occlusion };
+constexpr EnvMethod kLightMethods[] = {
+    env_method(LightMethod::Exposure, "exposure", {V}, N, Pure, true,
+               "fraction of the light reaching p, from 0 (shaded) to 1"),
+    env_method(LightMethod::Occlusion, "occlusion", {V}, N, Pure, true,
+               "occupied cells between p and the light"),
+};
+static_assert(method_table(kLightMethods, LightMethod::Occlusion));
+constexpr EnvironmentKind kLight{
+    "light", "self-shading by the plant's segments and organs: direction, resolution, opacity",
+    kLightMethods};
+
+class Light : public Environment {
   public:
     Light(glm::dvec3 toward_light, int resolution, double opacity)
         : dir_(glm::normalize(toward_light)), res_(resolution), opacity_(opacity) {}
-    const std::vector<EnvMethod>& methods() const override {
-        static const std::vector<EnvMethod> m = {
-            {"exposure", {V}, N, "fraction of the light reaching p, from 0 (shaded) to 1"},
-            {"occlusion", {V}, N, "occupied cells between p and the light"},
-        };
-        return m;
-    }
-    void update(const Skeleton& sk) override {
+    const EnvironmentKind& kind() const override { return kLight; }
+    std::unique_ptr<Environment> clone() const override { return std::make_unique<Light>(*this); }
+    void see(const Skeleton& sk) override {
         lo_ = glm::dvec3(std::numeric_limits<double>::max());
         glm::dvec3 hi(-std::numeric_limits<double>::max());
         for (const auto& a : sk.axes)
@@ -401,9 +440,16 @@ class Light : public SkeletonEnvironment {
             }
         for (const auto& o : sk.organs) mark(glm::dvec3(o.transform[3]));
     }
-    void call(std::size_t method, const double* a, double* r) const override {
+    void query(std::size_t method, const double* a, double* r) const override {
         int count = occlusion(vec(a));
-        r[0] = method == 0 ? std::pow(1 - opacity_, count) : count;
+        switch (static_cast<LightMethod>(method)) {
+        case LightMethod::Exposure:
+            r[0] = std::pow(1 - opacity_, count);
+            break;
+        case LightMethod::Occlusion:
+            r[0] = count;
+            break;
+        }
     }
 
   private:
@@ -453,155 +499,138 @@ class Light : public SkeletonEnvironment {
     std::vector<std::uint8_t> occupied_;
 };
 
+using Made = std::unique_ptr<Environment>;
+
+Made make_ellipsoid(const std::vector<EnvArg>& args, std::string& error) {
+    Args a("ellipsoid", args, error);
+    if (!a.only({"center", "radii"})) return nullptr;
+    const EnvArg* c = a.find("center", V);
+    const EnvArg* r = a.find("radii", V);
+    if (!a.ok()) return nullptr;
+    glm::dvec3 radii = r ? vec(*r) : glm::dvec3(1.0);
+    if (radii.x <= 0 || radii.y <= 0 || radii.z <= 0) {
+        error = "ellipsoid: radii must be positive";
+        return nullptr;
+    }
+    return std::make_unique<Ellipsoid>(c ? vec(*c) : glm::dvec3(0.0), radii);
+}
+
+Made make_proximity(const std::vector<EnvArg>& args, std::string& error) {
+    Args a("proximity", args, error);
+    if (!a.only({"radius"})) return nullptr;
+    const EnvArg* r = a.find("radius", N);
+    if (!a.ok()) return nullptr;
+    double radius = r ? r->v[0] : 1.0;
+    if (!(radius > 0)) {
+        error = "proximity: radius must be positive";
+        return nullptr;
+    }
+    return std::make_unique<Proximity>(radius);
+}
+
+Made make_obstacles(const std::vector<EnvArg>& args, std::string& error) {
+    Args a("obstacles", args, error);
+    if (!a.only({"sphere", "sphere_radius", "box_min", "box_max", "plane_point", "plane_normal", "mesh"}))
+        return nullptr;
+    auto o = std::make_unique<Obstacles>();
+    ObstacleArgs shapes("obstacles");
+    for (const auto& arg : args) {
+        if (arg.key == "mesh") {
+            if (!shapes.mesh(arg, error)) return nullptr;
+            if (!load_triangles(arg.text, o->triangles, "obstacles", error)) return nullptr;
+            continue;
+        }
+        if (!shapes.read(arg, error)) return nullptr;
+    }
+    if (!shapes.paired(error) || !shapes.shapes(o->shapes, error)) return nullptr;
+    return o;
+}
+
+Made make_envelope(const std::vector<EnvArg>& args, std::string& error) {
+    Args a("envelope", args, error);
+    if (!a.only({"top", "bottom", "px", "pz", "nx", "nz", "top_shape", "bottom_shape"})) return nullptr;
+    auto e = std::make_unique<Envelope>();
+    const EnvArg *t = a.find("top", V), *b = a.find("bottom", V);
+    const EnvArg* side[4] = {a.find("px", V), a.find("pz", V), a.find("nx", V), a.find("nz", V)};
+    const EnvArg *ct = a.find("top_shape", N), *cb = a.find("bottom_shape", N);
+    if (!a.ok()) return nullptr;
+    if (!t || !b || !side[0] || !side[1] || !side[2] || !side[3]) {
+        error = "envelope: needs top, bottom and the four widest points px, pz, nx, nz";
+        return nullptr;
+    }
+    e->top = vec(*t);
+    e->bottom = vec(*b);
+    const double rad[4] = {side[0]->v[0] - e->bottom.x, side[1]->v[2] - e->bottom.z,
+                           e->bottom.x - side[2]->v[0], e->bottom.z - side[3]->v[2]};
+    for (int k = 0; k < 4; ++k) {
+        e->radius[k] = rad[k];
+        e->height[k] = side[k]->v[1];
+        if (!(rad[k] > 0) || e->height[k] >= e->top.y || e->height[k] <= e->bottom.y) {
+            error = "envelope: each widest point lies on its own side of the axis through the bottom "
+                    "point, "
+                    "between the bottom and the top";
+            return nullptr;
+        }
+    }
+    e->c_top = ct ? ct->v[0] : 2.0;
+    e->c_bottom = cb ? cb->v[0] : 2.0;
+    if (!(e->c_top > 0) || !(e->c_bottom > 0)) {
+        error = "envelope: the shape coefficients must be positive";
+        return nullptr;
+    }
+    return e;
+}
+
+Made make_light(const std::vector<EnvArg>& args, std::string& error) {
+    Args a("light", args, error);
+    if (!a.only({"direction", "resolution", "opacity"})) return nullptr;
+    const EnvArg *d = a.find("direction", V), *res = a.find("resolution", N), *op = a.find("opacity", N);
+    if (!a.ok()) return nullptr;
+    glm::dvec3 dir = d ? vec(*d) : glm::dvec3(0, 1, 0);
+    int resolution = res ? static_cast<int>(res->v[0]) : 32;
+    double opacity = op ? op->v[0] : 0.3;
+    if (glm::length(dir) == 0 || resolution < 1 || resolution > 512 || !(opacity >= 0 && opacity <= 1)) {
+        error = "light: direction must not be zero, resolution 1 to 512, opacity 0 to 1";
+        return nullptr;
+    }
+    return std::make_unique<Light>(dir, resolution, opacity);
+}
+
+// The runtime's kinds: one row each, in the order messages and `plant help env` list them.
+struct KindRow {
+    const EnvironmentKind* kind;
+    Made (*make)(const std::vector<EnvArg>& args, std::string& error);
+};
+const KindRow kKinds[] = {
+    {&kEllipsoid, make_ellipsoid}, {&kEnvelope, make_envelope},   {&kProximity, make_proximity},
+    {&kLight, make_light},         {&kObstacles, make_obstacles}, {&climber_kind(), make_climber},
+};
+
 } // namespace
 
 EnvironmentFactory runtime_environments() {
-    return [](const std::string& kind, const std::vector<EnvArg>& args,
-              std::string& error) -> std::unique_ptr<Environment> {
-        Args a(kind, args, error);
-        if (kind == "ellipsoid") {
-            if (!a.only({"center", "radii"})) return nullptr;
-            const EnvArg* c = a.find("center", V);
-            const EnvArg* r = a.find("radii", V);
-            if (!a.ok()) return nullptr;
-            glm::dvec3 radii = r ? vec(*r) : glm::dvec3(1.0);
-            if (radii.x <= 0 || radii.y <= 0 || radii.z <= 0) {
-                error = "ellipsoid: radii must be positive";
-                return nullptr;
-            }
-            return std::make_unique<Ellipsoid>(c ? vec(*c) : glm::dvec3(0.0), radii);
-        }
-        if (kind == "proximity") {
-            if (!a.only({"radius"})) return nullptr;
-            const EnvArg* r = a.find("radius", N);
-            if (!a.ok()) return nullptr;
-            double radius = r ? r->v[0] : 1.0;
-            if (!(radius > 0)) {
-                error = "proximity: radius must be positive";
-                return nullptr;
-            }
-            return std::make_unique<Proximity>(radius);
-        }
-        if (kind == "obstacles") {
-            if (!a.only(
-                    {"sphere", "sphere_radius", "box_min", "box_max", "plane_point", "plane_normal", "mesh"}))
-                return nullptr;
-            auto o = std::make_unique<Obstacles>();
-            // shapes pair up in the order they are written: each sphere with the next radius, ...
-            std::vector<glm::dvec3> centers, box_min, box_max, plane_p, plane_n;
-            std::vector<double> radii;
-            for (const auto& arg : args) {
-                if (arg.key == "mesh") {
-                    if (arg.type != ValueType::String) {
-                        error = "obstacles: 'mesh' is a quoted file name, as in mesh: \"rock.obj\"";
-                        return nullptr;
-                    }
-                    if (!load_triangles(arg.text, o->triangles, "obstacles", error)) return nullptr;
-                    continue;
-                }
-                bool is_vec = arg.type == V;
-                bool want_vec = arg.key != "sphere_radius";
-                if (is_vec != want_vec) {
-                    error =
-                        fmt::format("obstacles: '{}' must be a {}", arg.key, want_vec ? "vec3" : "number");
-                    return nullptr;
-                }
-                if (arg.key == "sphere")
-                    centers.push_back(vec(arg));
-                else if (arg.key == "sphere_radius")
-                    radii.push_back(arg.v[0]);
-                else if (arg.key == "box_min")
-                    box_min.push_back(vec(arg));
-                else if (arg.key == "box_max")
-                    box_max.push_back(vec(arg));
-                else if (arg.key == "plane_point")
-                    plane_p.push_back(vec(arg));
-                else
-                    plane_n.push_back(vec(arg));
-            }
-            if (centers.size() != radii.size() || box_min.size() != box_max.size() ||
-                plane_p.size() != plane_n.size()) {
-                error = "obstacles: give each sphere a sphere_radius, each box_min a box_max and each "
-                        "plane_point a "
-                        "plane_normal";
-                return nullptr;
-            }
-            auto add = [&](physics::Obstacle::Kind shape_kind, const glm::dvec3& first,
-                           const glm::dvec3& second) {
-                physics::Obstacle shape;
-                shape.kind = shape_kind, shape.a = first, shape.b = second;
-                o->shapes.push_back(shape);
-            };
-            for (std::size_t i = 0; i < centers.size(); ++i)
-                add(physics::Obstacle::Sphere, centers[i], glm::dvec3(radii[i], 0, 0));
-            for (std::size_t i = 0; i < box_min.size(); ++i)
-                add(physics::Obstacle::Box, glm::min(box_min[i], box_max[i]),
-                    glm::max(box_min[i], box_max[i]));
-            for (std::size_t i = 0; i < plane_p.size(); ++i) {
-                if (glm::length(plane_n[i]) == 0) {
-                    error = "obstacles: a plane_normal must not be zero";
-                    return nullptr;
-                }
-                add(physics::Obstacle::Plane, plane_p[i], glm::normalize(plane_n[i]));
-            }
-            return o;
-        }
-        if (kind == "envelope") {
-            if (!a.only({"top", "bottom", "px", "pz", "nx", "nz", "top_shape", "bottom_shape"}))
-                return nullptr;
-            auto e = std::make_unique<Envelope>();
-            const EnvArg *t = a.find("top", V), *b = a.find("bottom", V);
-            const EnvArg* side[4] = {a.find("px", V), a.find("pz", V), a.find("nx", V), a.find("nz", V)};
-            const EnvArg *ct = a.find("top_shape", N), *cb = a.find("bottom_shape", N);
-            if (!a.ok()) return nullptr;
-            if (!t || !b || !side[0] || !side[1] || !side[2] || !side[3]) {
-                error = "envelope: needs top, bottom and the four widest points px, pz, nx, nz";
-                return nullptr;
-            }
-            e->top = vec(*t);
-            e->bottom = vec(*b);
-            const double rad[4] = {side[0]->v[0] - e->bottom.x, side[1]->v[2] - e->bottom.z,
-                                   e->bottom.x - side[2]->v[0], e->bottom.z - side[3]->v[2]};
-            for (int k = 0; k < 4; ++k) {
-                e->radius[k] = rad[k];
-                e->height[k] = side[k]->v[1];
-                if (!(rad[k] > 0) || e->height[k] >= e->top.y || e->height[k] <= e->bottom.y) {
-                    error = "envelope: each widest point lies on its own side of the axis through the bottom "
-                            "point, "
-                            "between the bottom and the top";
-                    return nullptr;
-                }
-            }
-            e->c_top = ct ? ct->v[0] : 2.0;
-            e->c_bottom = cb ? cb->v[0] : 2.0;
-            if (!(e->c_top > 0) || !(e->c_bottom > 0)) {
-                error = "envelope: the shape coefficients must be positive";
-                return nullptr;
-            }
-            return e;
-        }
-        if (kind == "light") {
-            if (!a.only({"direction", "resolution", "opacity"})) return nullptr;
-            const EnvArg *d = a.find("direction", V), *res = a.find("resolution", N),
-                         *op = a.find("opacity", N);
-            if (!a.ok()) return nullptr;
-            glm::dvec3 dir = d ? vec(*d) : glm::dvec3(0, 1, 0);
-            int resolution = res ? static_cast<int>(res->v[0]) : 32;
-            double opacity = op ? op->v[0] : 0.3;
-            if (glm::length(dir) == 0 || resolution < 1 || resolution > 512 ||
-                !(opacity >= 0 && opacity <= 1)) {
-                error = "light: direction must not be zero, resolution 1 to 512, opacity 0 to 1";
-                return nullptr;
-            }
-            return std::make_unique<Light>(dir, resolution, opacity);
-        }
-        if (kind == "climber") return make_climber(args, error);
-        error = fmt::format(
-            "unknown environment kind '{}': this version has ellipsoid, envelope, proximity, light, "
-            "obstacles and climber",
-            kind);
+    return [](const std::string& kind, const std::vector<EnvArg>& args, std::string& error) -> Made {
+        for (const KindRow& row : kKinds)
+            if (kind == row.kind->name) return row.make(args, error);
+        std::string names;
+        for (std::size_t k = 0; k < std::size(kKinds); ++k)
+            names += fmt::format("{}{}",
+                                 k == 0                       ? ""
+                                 : k + 1 == std::size(kKinds) ? " and "
+                                                              : ", ",
+                                 kKinds[k].kind->name);
+        error = fmt::format("unknown environment kind '{}': this version has {}", kind, names);
         return nullptr;
     };
+}
+
+std::span<const EnvironmentKind* const> environment_kinds() {
+    static const std::vector<const EnvironmentKind*> kinds = [] {
+        std::vector<const EnvironmentKind*> v;
+        for (const KindRow& row : kKinds) v.push_back(row.kind);
+        return v;
+    }();
+    return kinds;
 }
 
 } // namespace plant

@@ -263,8 +263,10 @@ void interpret(const Program& program, const ModuleString& s, const TurtleOption
 
 TurtleOptions turtle_options(const Derivation& d) {
     TurtleOptions o{d.default_angle(), d.default_step(), d.default_width(), {}};
-    for (const auto& env : d.program().environments)
-        if (const auto* p = dynamic_cast<const BoundPoses*>(env.get())) o.poses.push_back(p);
+    const RunState& state = d.run_state();
+    for (std::size_t e = 0; e < state.size(); ++e)
+        if (const Environment* env = state.environment(e); env && env->kind().holds_segments)
+            o.poses.push_back(env);
     return o;
 }
 

@@ -6,6 +6,7 @@
 #include "plant/diagnostics.hpp"
 #include "plant/module_string.hpp"
 #include "plant/program.hpp"
+#include "plant/run_state.hpp"
 
 #include <atomic>
 #include <functional>
@@ -36,13 +37,17 @@ class EngineHandle {
 };
 } // namespace detail
 
-// Implemented by the runtime: interprets the string with the turtle and writes the position,
-// heading, up or left vector into every query module (?P ?H ?U ?L). Called before a step whose
-// productions read query modules.
-class QueryPass {
+// The environment phase of a step, implemented by the runtime (runtime's environment_phase.hpp):
+// the plant as it is now meets its environments. It runs after `on before_step` and before the
+// rewrite, in steps whose productions read query modules or whose program declares
+// environments, and in this order: environments that hold segments are shown the modules bound
+// to them and advance (a climber runs its physics; what broke off leaves the string), every
+// environment sees the plant, ?E modules are answered, and ?P ?H ?U ?L modules receive the
+// turtle's position, heading, up or left vector.
+class EnvironmentPhase {
   public:
-    virtual ~QueryPass() = default;
-    virtual void fill_queries(const Derivation& derivation, ModuleString& string) = 0;
+    virtual ~EnvironmentPhase() = default;
+    virtual void run(const Derivation& derivation, RunState& state, ModuleString& string) = 0;
 };
 
 struct StepStats {
@@ -57,8 +62,8 @@ struct DeriveOptions {
     std::optional<std::uint64_t> seed; // overrides the grammar's `seed S;`
     int threads = 1;
     std::size_t max_modules = 50'000'000;
-    std::size_t max_bytes = std::size_t{8} << 30; // estimate of the string's memory
-    QueryPass* queries = nullptr;
+    std::size_t max_bytes = std::size_t{8} << 30;  // estimate of the string's memory
+    EnvironmentPhase* environment_phase = nullptr; // none: environments never see the plant
     std::function<void(const StepStats&)> on_step;
     std::function<void(const std::string&)> on_print; // output of print(...) in hooks
     const std::atomic<bool>* interrupt = nullptr;     // set asynchronously to abandon a step
@@ -101,6 +106,9 @@ class Derivation {
     void set_seed(std::uint64_t seed) { seed_ = seed; }
     ModuleId next_id() const;
     const Program& program() const { return prog_; }
+    // The live environments, made from the program's declarations by start().
+    const RunState& run_state() const { return run_; }
+    RunState& run_state() { return run_; }
     // Whether the string keeps module identities (see DeriveOptions::identities).
     bool keeps_identities() const { return current_.keep_ids; }
 
@@ -114,6 +122,7 @@ class Derivation {
 
     const Program& prog_;
     DeriveOptions opt_;
+    RunState run_; // copied with the derivation
     ModuleString current_;
     std::vector<double> globals_;
     int step_ = 0;

@@ -31,7 +31,7 @@ struct SymbolInfo {
     int arity = -1;        // declared parameter count; -1 when any count is accepted
     std::vector<ValueType> param_types;
     std::vector<std::string> param_names;
-    std::string bound_to; // climber environment for physics-bound segments
+    std::string bound_to; // the environment that holds its segments (`bound ivy`)
     Span decl_span;
 };
 
@@ -244,6 +244,28 @@ struct SurfaceDef {
 };
 
 class Environment;
+struct EnvironmentKind;
+
+// One evaluated constructor argument: `key: value` (key empty when positional).
+struct EnvArg {
+    std::string key;
+    ValueType type = ValueType::Number; // String for a quoted file name, in `text`
+    double v[3] = {0, 0, 0};
+    std::string text; // a string argument; a file path resolved against the grammar
+    Span span;
+};
+
+// `env name = kind(key: value, ...);` as compiled: the declaration, and the object as declared,
+// made and checked once by the compiler (a mesh file is read once). Neither changes after
+// compilation: every derivation works on its own clone (RunState, run_state.hpp).
+struct EnvironmentDecl {
+    std::string name;
+    std::string kind_name;
+    std::vector<EnvArg> args; // evaluated
+    Span span;
+    const EnvironmentKind* kind = nullptr;      // its methods; null without a runtime or on error
+    std::shared_ptr<const Environment> initial; // null without a runtime or on error
+};
 
 struct Program {
     SymbolTable symbols;
@@ -270,9 +292,8 @@ struct Program {
 
     std::vector<SurfaceDef> surfaces;
     std::vector<CurveDef> curves;
-    std::vector<std::shared_ptr<Environment>> environments; // `env` declarations, in file order
-    std::vector<std::string> environment_names;
-    std::vector<ProgramFile> files; // in the order they were read: the main file first
+    std::vector<EnvironmentDecl> environments; // `env` declarations, in file order
+    std::vector<ProgramFile> files;            // in the order they were read: the main file first
 
     int group_index(std::string_view name) const;
 };

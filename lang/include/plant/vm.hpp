@@ -20,8 +20,15 @@ struct HookEffects {
 // the step so identities do not depend on how the string was split between threads.
 inline constexpr ModuleId kNewIdBit = ModuleId{1} << 63;
 
+class RunState;
+
 struct EvalEnv {
     const Program* prog = nullptr;
+    // The derivation's environments (run_state.hpp): method calls read them. Null for constants
+    // the compiler evaluates, which see the environments as declared.
+    const RunState* run = nullptr;
+    // The same, non-null only while a hook runs (one thread): edit methods change them.
+    RunState* hook_run = nullptr;
     double* globals = nullptr;
     std::uint64_t seed = 0;
     std::uint64_t phase = 0;    // derivation step and pass

@@ -152,6 +152,8 @@ std::vector<std::size_t> find_matches(const Derivation& d, const Program& progra
     Rewriter rw(plan, s);
     Worker w;
     w.env.prog = &program;
+    // another program (the REPL's :find compiles one) sees its environments as declared
+    w.env.run = &program == &d.program() ? &d.run_state() : nullptr;
     std::vector<double> globals = const_cast<Derivation&>(d).globals();
     w.env.globals = globals.data();
     w.env.seed = d.seed();

@@ -86,6 +86,7 @@ void Engine::rewrite(const Derivation& d, const ModuleString& in, ModuleString& 
     Rewriter rw(plan, in, &brackets, &kernel_scratch, threads == 1);
     auto setup = [&](Worker& w) {
         w.env.prog = &d.prog_;
+        w.env.run = &d.run_;
         w.env.globals = const_cast<double*>(d.globals_.data()); // read-only during rewriting
         w.env.seed = d.seed_;
         w.env.phase = phase;

@@ -1,12 +1,13 @@
 // The `climber` environment: the particle runtime (runtime/physics/) behind a grammar
-// (LANGUAGE.md sections 8 and 10; Hädrich et al. 2017).
+// (docs/language.md, environments and bound modules; Hädrich et al. 2017).
 //
 //   env ivy = climber(gravity: vec3(0, -9.81, 0), substeps: 4, stiffness: 1, break_threshold: 0.5,
 //                     light: vec3(-1, 1, 0), phototropism: 0.5, adaption: 0.5, anchor: 0.3,
 //                     box_min: ..., box_max: ..., attractor: vec3(...), attractor_radius: 0.3);
 //   module Seg(len, r) bound ivy;
 //
-// Before every step the string is drawn once by the turtle: each bound module without a particle
+// In the environment phase of every step the string is drawn once by the turtle: each bound
+// module without a particle
 // gets one where the turtle put its segment's end, child of the particle of the bound module
 // before it on its path (a plant's first one hangs from a fixed root at its segment's start).
 // Particles whose modules left the string are removed. Then the world runs `substeps` steps of
@@ -14,9 +15,10 @@
 // of its branch. Every turtle pass (queries, skeleton, meshes) draws bound modules at their
 // particles.
 //
-// Methods: grow_dir(p, h) (h turned by surface adaption, Eq. 6, by painted attractors and by
-// phototropism weighted by occlusion, Eq. 7), occlusion(p), anchored(id), particles(), seeded(id);
-// in hooks only: pull(id, target), cut(id), wind(a), move(k, delta), seed(id), emit(k, velocity).
+// Methods (ClimberMethod and its table in climber.cpp): grow_dir(p, h) (h turned by surface
+// adaption, Eq. 6, by painted attractors and by phototropism weighted by occlusion, Eq. 7),
+// occlusion(p), anchored(id), particles(), seeded(id); edits, in hooks only: pull(id, target),
+// cut(id), wind(a), move(k, delta), seed(id), emit(k, velocity).
 //
 // With air_min and air_max the climber also runs SPH air in that box (section 5.3): each 25 ms
 // physics step runs ten 2.5 ms air steps coupled both ways with the full-grown particles, and
@@ -44,7 +46,25 @@
 
 namespace plant {
 
-class Climber : public Environment, public BoundPoses {
+// A climber's methods, in the order of its table (climber.cpp).
+enum class ClimberMethod : std::uint8_t {
+    GrowDir,
+    Occlusion,
+    Anchored,
+    Particles,
+    Seeded,
+    // edits
+    Pull,
+    Cut,
+    Wind,
+    Move,
+    Seed,
+    Emit,
+};
+
+const EnvironmentKind& climber_kind();
+
+class Climber : public Environment {
   public:
     struct Attractor {
         glm::dvec3 point;
@@ -69,18 +89,14 @@ class Climber : public Environment, public BoundPoses {
     };
 
     Climber(physics::Settings settings, Config config) : world_(settings), config_(std::move(config)) {}
-    // Keeps the world as it is now (settings and obstacles) for reset().
-    void remember_initial() {
-        initial_ = world_;
+    // Fills the air box, once the world has its settings and obstacles: the climber as declared.
+    void fill_air() {
         attractors_ = config_.attractors;
         if (config_.air) {
             fluid_ = physics::Fluid(config_.fluid);
             fluid_.fill(config_.fluid.domain_lo, config_.fluid.domain_hi);
         }
-        initial_fluid_ = fluid_;
     }
-    void reset() override;
-    bool evolves() const override { return true; }
     void geometry(std::vector<glm::dvec3>& triangles, const glm::dvec3& lo,
                   const glm::dvec3& hi) const override;
     // A loaded mesh's triangles for obstacle k (a sampled grid), to show it.
@@ -89,19 +105,18 @@ class Climber : public Environment, public BoundPoses {
     }
 
     // Environment
-    const std::vector<EnvMethod>& methods() const override;
-    void call(std::size_t method, const double* args, double* result) const override;
-    // BoundPoses
+    const EnvironmentKind& kind() const override { return climber_kind(); }
+    // The particles, the air and the edits asked for: a copied derivation's climber goes on alone.
+    std::unique_ptr<Environment> clone() const override { return std::make_unique<Climber>(*this); }
+    void query(std::size_t method, const double* args, double* result) const override;
+    void edit(std::size_t method, const double* args) override;
     bool pose(ModuleId id, glm::dvec3& position, glm::dmat3& frame) const override;
 
-    // The step's sync, driven by the query pass: begin, observe every bound module the turtle
-    // drew (in string order), advance.
-    void begin_sync();
-    void observe(ModuleId id, ModuleId parent, const glm::dvec3& from, const glm::dvec3& to,
-                 const glm::dmat3& frame, double radius, double length);
-    void advance();
-    // Modules whose particles broke off or were cut in the last advance.
-    const std::set<ModuleId>& detached() const { return detached_; }
+    // The environment phase: begin, be shown every bound module the turtle drew (in string
+    // order), advance; `left` receives the modules whose particles broke off or were cut.
+    void begin_segments() override;
+    void segment(const BoundSegment& s) override;
+    void advance(std::set<ModuleId>& left) override;
 
     physics::World& world() { return world_; }
     const physics::World& world() const { return world_; }
@@ -115,29 +130,23 @@ class Climber : public Environment, public BoundPoses {
     void rebuild_occupancy();
 
     std::vector<Attractor> attractors_; // the painted samples not yet reached
-    physics::World world_, initial_;
-    physics::Fluid fluid_, initial_fluid_;
+    physics::World world_;
+    physics::Fluid fluid_;
     Config config_;
     std::map<ModuleId, physics::Handle> particle_of_; // ordered: removals happen in id order
     std::vector<physics::Handle> roots_;              // the fixed roots made for plants' first segments
     std::vector<std::pair<std::size_t, std::vector<glm::dvec3>>> meshes_; // obstacle index, its triangles
-    std::set<ModuleId> seen_, detached_;
-    struct Pending {
-        ModuleId id, parent;
-        glm::dvec3 from, to;
-        glm::dmat3 frame;
-        double radius, length;
-    };
-    std::vector<Pending> pending_;
-    // edits asked for by hooks (call() is const: hooks are the only callers, one at a time)
-    mutable std::vector<std::pair<ModuleId, glm::dvec3>> pulls_;
-    mutable std::vector<ModuleId> cuts_;
-    mutable std::vector<std::pair<std::size_t, glm::dvec3>> moves_;
-    mutable std::vector<ModuleId> seed_requests_;
-    mutable std::vector<std::pair<std::size_t, glm::dvec3>> emits_; // emitter, its new velocity
+    std::set<ModuleId> seen_;
+    std::vector<BoundSegment> pending_; // bound modules without a particle yet
+    // edits asked for by hooks since the last advance
+    std::vector<std::pair<ModuleId, glm::dvec3>> pulls_;
+    std::vector<ModuleId> cuts_;
+    std::vector<std::pair<std::size_t, glm::dvec3>> moves_;
+    std::vector<ModuleId> seed_requests_;
+    std::vector<std::pair<std::size_t, glm::dvec3>> emits_; // emitter, its new velocity
     std::set<ModuleId> seeded_;
-    mutable glm::dvec3 wind_{0.0};
-    mutable bool wind_changed_ = false;
+    glm::dvec3 wind_{0.0};
+    bool wind_changed_ = false;
     physics::LightGrid light_; // the particles, for occlusion
 };
 

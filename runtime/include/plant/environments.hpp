@@ -1,5 +1,6 @@
-// The environment kinds of the runtime (LANGUAGE.md section 8), made by `runtime_environments()`
-// for the compiler and updated from the skeleton after every turtle pass.
+// The environment kinds of the runtime (docs/language.md, environments), made by
+// `runtime_environments()` for the compiler; each derivation's clones see the plant in the
+// environment phase of every step (environment_phase.hpp).
 //
 //   env crown = ellipsoid(center: vec3(0, 4, 0), radii: vec3(3, 2, 3));
 //     crown.contains(p)          p inside the ellipsoid
@@ -26,14 +27,15 @@
 #include "plant/environment.hpp"
 #include "plant/skeleton.hpp"
 
+#include <span>
+
 namespace plant {
 
-// An environment that sees the plant: the turtle pass calls update() before each step.
-class SkeletonEnvironment : public Environment {
-  public:
-    virtual void update(const Skeleton& skeleton) = 0;
-};
-
+// Makes the runtime's kinds, by name.
 EnvironmentFactory runtime_environments();
+
+// Every kind the runtime has, in the order its messages list them, with its method table
+// (for `plant help env KIND`); nothing is made.
+std::span<const EnvironmentKind* const> environment_kinds();
 
 } // namespace plant

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "plant/diagnostics.hpp"
+#include "plant/environment.hpp" // BoundPoses
 #include "plant/module_string.hpp"
 #include "plant/program.hpp"
 
@@ -58,16 +59,6 @@ class TurtleSink {
     virtual void organ(const TurtleOrgan&) {}
     // The turtle reached a query module (?P ?H ?U ?L).
     virtual void query(std::size_t /*module*/, const TurtleState&) {}
-};
-
-// Where a physics environment holds the segments of modules bound to it (`module Seg(len, r)
-// bound ivy;`): the turtle draws such a module's segment from where it stands to the particle's
-// position and takes the particle's frame. A module without a particle yet is drawn like F(len).
-class BoundPoses {
-  public:
-    virtual ~BoundPoses() = default;
-    // The particle of module `id`: its position and its frame (+y heading, -x left, +z up).
-    virtual bool pose(ModuleId id, glm::dvec3& position, glm::dmat3& frame) const = 0;
 };
 
 struct TurtleOptions {

@@ -1,8 +1,8 @@
 // The climber environment end to end: grammars whose bound modules are particles.
 #include "helpers.hpp"
 #include "plant/climber.hpp"
+#include "plant/environment_phase.hpp"
 #include "plant/environments.hpp"
-#include "plant/query.hpp"
 #include "plant/skeleton.hpp"
 #include "plant/turtle.hpp"
 
@@ -23,6 +23,15 @@ struct Grown {
     std::size_t particles = 0;
 };
 
+// The derivation's climber: its first environment, in these grammars.
+const Climber& climber_of(const Derivation& d) {
+    REQUIRE(d.run_state().size() > 0);
+    const Environment* env = d.run_state().environment(0);
+    REQUIRE(env);
+    REQUIRE(&env->kind() == &climber_kind());
+    return static_cast<const Climber&>(*env);
+}
+
 Grown grow(const std::string& text, int threads = 1) {
     Grown g;
     CompileOptions opts;
@@ -30,16 +39,15 @@ Grown grow(const std::string& text, int threads = 1) {
     g.compiled = test::compile(text, opts);
     INFO(g.compiled->rendered());
     REQUIRE(g.compiled->program);
-    TurtleQueryPass queries;
+    TurtleEnvironmentPhase phase;
     DeriveOptions o;
-    o.queries = &queries;
+    o.environment_phase = &phase;
     o.threads = threads;
     Derivation d(*g.compiled->program, o);
     d.run();
     g.string = format_string(*g.compiled->program, d.string(), false);
     g.skeleton = build_skeleton(*g.compiled->program, d.interpreted(d.string()), turtle_options(d));
-    for (const auto& env : g.compiled->program->environments)
-        if (auto* c = dynamic_cast<Climber*>(env.get())) g.particles = c->world().size();
+    g.particles = climber_of(d).world().size();
     return g;
 }
 
@@ -145,14 +153,14 @@ TEST_CASE("climber: a grammar grows the same plant for a seed, on any thread cou
     Grown a = grow(text, 1), b = grow(text, 2);
     CHECK(a.string == b.string);
     CHECK(count(a.string, "Seg(") > 60);
-    // one compiled program derived twice: the climber starts over (Environment::reset)
+    // one compiled program derived twice: each derivation starts from the climber as declared
     CompileOptions opts;
     opts.environments = runtime_environments();
     auto c = test::compile(text, opts);
     REQUIRE(c->program);
-    TurtleQueryPass queries;
+    TurtleEnvironmentPhase phase;
     DeriveOptions o;
-    o.queries = &queries;
+    o.environment_phase = &phase;
     std::string first, second;
     for (std::string* out : {&first, &second}) {
         Derivation d(*c->program, o);
@@ -161,6 +169,95 @@ TEST_CASE("climber: a grammar grows the same plant for a seed, on any thread cou
     }
     CHECK(first == second);
     CHECK(first == a.string);
+}
+
+namespace {
+
+struct Compiled {
+    std::unique_ptr<test::Compiled> compiled;
+    TurtleEnvironmentPhase phase;
+    DeriveOptions options;
+};
+
+std::unique_ptr<Compiled> compile_climber(const std::string& text) {
+    auto c = std::make_unique<Compiled>();
+    CompileOptions opts;
+    opts.environments = runtime_environments();
+    c->compiled = test::compile(text, opts);
+    INFO(c->compiled->rendered());
+    REQUIRE(c->compiled->program);
+    c->options.environment_phase = &c->phase;
+    return c;
+}
+
+std::string text_of(const Derivation& d) {
+    return format_string(d.program(), d.string(), true);
+}
+
+} // namespace
+
+TEST_CASE("climber: a derivation copied mid-way goes on like the original, particles and all", "[climber]") {
+    // the wall scene of the library, with SPH air around it and a hook that switches the wind
+    // after the copy: the particles, the air and the edits are all part of what is copied
+    for (const char* air :
+         {"", ", air_min: vec3(-0.4, 0, -0.4), air_max: vec3(0.4, 0.6, 0.2), air_spacing: 0.1"}) {
+        auto c = compile_climber(fmt::format(
+            "import climber with {{ N = 2, BP = 0.3, steps = 16, shoot_length = 16 }};\n"
+            "env ivy = climber(box_min: vec3(-1, 0, -0.2), box_max: vec3(1, 3, 0), adaption: 0.8, "
+            "anchor: 0.5, phototropism: 0.3{});\nseed 3;\n"
+            "on before_step {{ if step() == 10 {{ ivy.wind(vec3(2, 0, 1)); }} }}\n",
+            air));
+        Derivation original(*c->compiled->program, c->options);
+        original.start();
+        for (int k = 0; k < 8; ++k) original.step();
+        Derivation copy(original);
+        const std::uint64_t at_copy = climber_of(copy).world().state_hash();
+        CHECK(climber_of(original).world().state_hash() == at_copy);
+        // the original's steps leave the copy where it was
+        original.step();
+        CHECK(climber_of(copy).world().state_hash() == at_copy);
+        CHECK(climber_of(original).world().state_hash() != at_copy);
+        copy.step();
+        for (int k = 0; k < 7; ++k) {
+            original.step();
+            copy.step();
+        }
+        CHECK(original.steps_done() == 16);
+        CHECK(copy.steps_done() == 16);
+        CHECK(text_of(copy) == text_of(original));
+        CHECK(climber_of(copy).world().size() == climber_of(original).world().size());
+        CHECK(climber_of(copy).world().state_hash() == climber_of(original).world().state_hash());
+        CHECK(climber_of(original).world().size() > 10);
+    }
+}
+
+TEST_CASE("climber: a derivation leaves the compiled program as it was, so it derives again the same",
+          "[climber]") {
+    auto c = compile_climber(
+        "import climber with { N = 2, BP = 0.3, steps = 12, shoot_length = 12 };\n"
+        "env ivy = climber(box_min: vec3(-1, 0, -0.2), box_max: vec3(1, 3, 0), adaption: 0.8, anchor: 0.5);\n"
+        "seed 4;\n");
+    const Program& program = *c->compiled->program;
+    REQUIRE(program.environments.size() == 1);
+    const EnvironmentDecl& decl = program.environments[0];
+    REQUIRE(decl.kind == &climber_kind());
+    const auto& declared = static_cast<const Climber&>(*decl.initial);
+    const std::uint64_t declared_hash = declared.world().state_hash();
+    CHECK(declared.world().size() == 0);
+    std::string first, second;
+    std::uint64_t first_hash = 0, second_hash = 0;
+    for (auto [text, hash] : {std::pair{&first, &first_hash}, std::pair{&second, &second_hash}}) {
+        Derivation d(program, c->options);
+        d.run();
+        *text = text_of(d);
+        *hash = climber_of(d).world().state_hash();
+        // the declared climber is not the one that grew
+        CHECK(declared.world().size() == 0);
+        CHECK(declared.world().state_hash() == declared_hash);
+    }
+    CHECK(first == second);
+    CHECK(first_hash == second_hash);
+    CHECK(first_hash != declared_hash);
 }
 
 TEST_CASE("climber: SPH air blowing past a stem pushes it downwind", "[climber]") {

@@ -33,7 +33,7 @@ EnvArg num_arg(const char* key, double v) {
 }
 double ask(const Environment& e, std::size_t method, std::vector<double> args) {
     double r[3] = {0, 0, 0};
-    e.call(method, args.data(), r);
+    e.query(method, args.data(), r);
     return r[0];
 }
 
@@ -62,9 +62,9 @@ TEST_CASE("proximity: distance to other stems, the asking stem and its branching
     Skeleton sk = build_skeleton(*c->program, d.string(), TurtleOptions{});
     REQUIRE(sk.axes.size() == 2);
     auto env = make("proximity", {num_arg("radius", 1.5)});
-    auto* prox = dynamic_cast<SkeletonEnvironment*>(env.get());
+    Environment* prox = env.get();
     REQUIRE(prox);
-    prox->update(sk);
+    prox->see(sk);
     // the branch goes from (0, 2, 0) to (-2, 2, 0); the main stem from (0, 0, 0) to (0, 3, 0)
     const ModuleId branch_module = sk.axes[1].points[2].id; // the branch's second F
     const ModuleId main_module = sk.axes[0].points[1].id;
@@ -88,7 +88,7 @@ TEST_CASE("proximity: clearance of a stem from older stems only", "[environments
     Skeleton sk = build_skeleton(*c->program, d.string(), TurtleOptions{});
     REQUIRE(sk.axes.size() == 3);
     auto env = make("proximity", {num_arg("radius", 1.5)});
-    dynamic_cast<SkeletonEnvironment&>(*env).update(sk);
+    env->see(sk);
     const double main_id = double(sk.axes[0].points[1].id), a_id = double(sk.axes[1].points[1].id),
                  b_id = double(sk.axes[2].points[1].id);
     REQUIRE(a_id < b_id);
@@ -149,7 +149,7 @@ TEST_CASE("light: exposure falls behind occupied cells toward the light", "[envi
     Skeleton sk = build_skeleton(*c->program, d.string(), TurtleOptions{});
     auto env =
         make("light", {vec_arg("direction", 0, 1, 0), num_arg("resolution", 10), num_arg("opacity", 0.5)});
-    dynamic_cast<SkeletonEnvironment&>(*env).update(sk);
+    env->see(sk);
     CHECK(ask(*env, 0, {0, 10.5, 0}) == Approx(1.0)); // above the plant: full light
     CHECK(ask(*env, 1, {1.5, 3, 0}) >= 1);            // under the +x... layer at y = 5
     CHECK(ask(*env, 0, {1.5, 3, 0}) < 1.0);
@@ -170,4 +170,28 @@ TEST_CASE("obstacles: signed distance to a loaded mesh", "[environments]") {
     mesh.text = "/nonexistent.obj";
     CHECK(!runtime_environments()("obstacles", {mesh}, error));
     CHECK(error == "obstacles: cannot load the mesh '/nonexistent.obj'");
+}
+
+TEST_CASE("environment_kinds: every kind's method table, without making an environment", "[environments]") {
+    std::vector<std::string> names;
+    for (const EnvironmentKind* kind : environment_kinds()) {
+        names.push_back(kind->name);
+        CHECK(std::string(kind->doc) != "");
+        CHECK(!kind->methods.empty());
+        for (std::size_t m = 0; m < kind->methods.size(); ++m) {
+            const EnvMethod& row = kind->methods[m];
+            INFO(kind->name << "." << row.name);
+            CHECK(row.index == m);
+            CHECK(std::string(row.doc) != "");
+            CHECK(kind->method(row.name) == &row);
+            // only a kind that holds segments (the climber) has edits
+            if (row.access == EnvAccess::Edit) CHECK(kind->holds_segments);
+        }
+    }
+    CHECK(names ==
+          std::vector<std::string>{"ellipsoid", "envelope", "proximity", "light", "obstacles", "climber"});
+    // a made environment answers with its kind's table
+    auto e = make("ellipsoid", {});
+    CHECK(&e->kind() == environment_kinds()[0]);
+    CHECK(e->kind().method("contains_scaled")->args.size() == 2);
 }

@@ -1,5 +1,5 @@
 #include "helpers.hpp"
-#include "plant/query.hpp"
+#include "plant/environment_phase.hpp"
 #include "plant/skeleton.hpp"
 
 #include <catch2/catch.hpp>
@@ -132,9 +132,9 @@ TEST_CASE("query modules read the turtle after interpretation rules (the L-Py ca
         rules { ?P(x, y, z) -> R(x, y, z); }
     )");
     REQUIRE(c->program);
-    TurtleQueryPass q;
+    TurtleEnvironmentPhase q;
     DeriveOptions o;
-    o.queries = &q;
+    o.environment_phase = &q;
     Derivation d(*c->program, o);
     d.run();
     CHECK(format_string(*c->program, d.string()) == "I(10)R(0,10,0)");
@@ -148,9 +148,9 @@ TEST_CASE("?H ?U ?L read the frame, and a vec3 binding reads all three numbers",
         rules { ?H(v) -> R(v); ?L(v) -> R(v); ?U(v) -> R(v); }
     )");
     REQUIRE(c->program);
-    TurtleQueryPass q;
+    TurtleEnvironmentPhase q;
     DeriveOptions o;
-    o.queries = &q;
+    o.environment_phase = &q;
     Derivation d(*c->program, o);
     d.run();
     const ModuleString& s = d.string();

@@ -2,8 +2,8 @@
 // skeleton the turtle draws from every grammar in grammars/rose/ and several seeds.
 #include "plant/compiler.hpp"
 #include "plant/derive.hpp"
+#include "plant/environment_phase.hpp"
 #include "plant/environments.hpp"
-#include "plant/query.hpp"
 #include "plant/skeleton.hpp"
 #include "plant/turtle.hpp"
 
@@ -54,11 +54,11 @@ Rose grow(const std::string& path, std::uint64_t seed,
     auto program = compile_file(sources, path, co, diags);
     INFO(render_all(diags, sources));
     REQUIRE(program);
-    TurtleQueryPass queries;
+    TurtleEnvironmentPhase phase;
     DeriveOptions opt;
     opt.seed = seed;
     opt.threads = threads;
-    opt.queries = &queries;
+    opt.environment_phase = &phase;
     Derivation d(*program, opt);
     d.run();
 

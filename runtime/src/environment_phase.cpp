@@ -1,7 +1,9 @@
-#include "plant/query.hpp"
+// The environment phase of a step: climbers, the environments that see the plant, ?E and the
+// turtle's query modules, in the order environment_phase.hpp gives.
+#include "plant/environment_phase.hpp"
 
-#include "plant/climber.hpp"
-#include "plant/environments.hpp"
+#include "plant/environment.hpp"
+#include "plant/run_state.hpp"
 #include "plant/skeleton.hpp"
 #include "plant/turtle.hpp"
 
@@ -39,58 +41,58 @@ class QuerySink : public TurtleSink {
     const ModuleString& string_;
 };
 
-// Shows each climber the segments of the modules bound to it, in string order.
-class ClimberSink : public TurtleSink {
+// Shows each environment that holds segments the segments of the modules bound to it, in
+// string order.
+class BoundSink : public TurtleSink {
   public:
-    ClimberSink(const ModuleString& s, const std::vector<Climber*>& by_symbol,
-                const std::unordered_set<ModuleId>& own)
+    BoundSink(const ModuleString& s, const std::vector<Environment*>& by_symbol,
+              const std::unordered_set<ModuleId>& own)
         : string_(s), by_symbol_(by_symbol), own_(own) {}
     void segment(const TurtleSegment& seg) override {
         const SymbolId sym = string_.sym[seg.module];
-        Climber* c = sym < by_symbol_.size() ? by_symbol_[sym] : nullptr;
-        if (!c || !own_.count(seg.id)) return;
+        Environment* holder = sym < by_symbol_.size() ? by_symbol_[sym] : nullptr;
+        if (!holder || !own_.count(seg.id)) return;
         const TurtleState& t = *seg.state;
         const double len = string_.arity(seg.module) > 0 ? string_.args(seg.module)[0] : t.step;
-        c->observe(seg.id, t.bound_parent, seg.from, seg.to, glm::dmat3(-t.left, t.heading, t.up),
-                   t.width / 2, len);
+        holder->segment(BoundSegment{seg.id, t.bound_parent, seg.from, seg.to,
+                                     glm::dmat3(-t.left, t.heading, t.up), t.width / 2, len});
     }
 
   private:
     const ModuleString& string_;
-    const std::vector<Climber*>& by_symbol_;
+    const std::vector<Environment*>& by_symbol_;
     const std::unordered_set<ModuleId>& own_;
 };
 
-// The climbers' part of a step (climber.hpp): place new bound modules' particles, run the
-// physics, and cut what broke off out of the string.
-void advance_climbers(const Derivation& d, ModuleString& string) {
+// Part 1 (climber.hpp): place new bound modules' particles, run the physics, and cut what broke
+// off out of the string.
+void advance_bound(const Derivation& d, RunState& state, ModuleString& string) {
     const Program& p = d.program();
-    std::vector<Climber*> by_symbol(p.symbols.size(), nullptr);
-    std::vector<Climber*> climbers;
+    std::vector<Environment*> by_symbol(p.symbols.size(), nullptr);
+    std::vector<Environment*> holders;
     for (std::size_t k = 0; k < p.symbols.size(); ++k) {
         const std::string& env = p.symbols.all()[k].bound_to;
         if (env.empty()) continue;
-        for (std::size_t e = 0; e < p.environments.size(); ++e)
-            if (p.environment_names[e] == env)
-                if (auto* c = dynamic_cast<Climber*>(p.environments[e].get())) by_symbol[k] = c;
+        for (std::size_t e = 0; e < state.size(); ++e)
+            if (p.environments[e].name == env && state.environment(e) &&
+                state.environment(e)->kind().holds_segments)
+                by_symbol[k] = state.environment(e);
     }
-    for (const auto& env : p.environments)
-        if (auto* c = dynamic_cast<Climber*>(env.get())) climbers.push_back(c);
-    if (climbers.empty()) return;
+    for (std::size_t e = 0; e < state.size(); ++e)
+        if (state.environment(e) && state.environment(e)->kind().holds_segments)
+            holders.push_back(state.environment(e));
+    if (holders.empty()) return;
     ModuleString interpreted = d.interpreted(string);
-    for (Climber* c : climbers) c->begin_sync();
+    for (Environment* h : holders) h->begin_segments();
     // only modules of the string itself hold particles: one an interpretation rule made has an
     // identity that the next step may give to another module
     std::unordered_set<ModuleId> own;
     for (std::size_t i = 0; i < string.size(); ++i)
         if (string.sym[i] < by_symbol.size() && by_symbol[string.sym[i]]) own.insert(string.id(i));
-    ClimberSink sink(interpreted, by_symbol, own);
+    BoundSink sink(interpreted, by_symbol, own);
     interpret(p, interpreted, turtle_options(d), sink);
     std::set<ModuleId> gone;
-    for (Climber* c : climbers) {
-        c->advance();
-        gone.insert(c->detached().begin(), c->detached().end());
-    }
+    for (Environment* h : holders) h->advance(gone);
     if (!gone.empty())
         cut_branches(string, p.symbols.open_bracket, p.symbols.close_bracket,
                      [&](std::size_t i) { return gone.count(string.id(i)) > 0; });
@@ -124,32 +126,32 @@ class BothSinks : public TurtleSink {
     TurtleSink* b_;
 };
 
-void TurtleQueryPass::fill_queries(const Derivation& d, ModuleString& string) {
+void TurtleEnvironmentPhase::run(const Derivation& d, RunState& state, ModuleString& string) {
     const Program& p = d.program();
-    advance_climbers(d, string);
+    advance_bound(d, state, string);
     ModuleString interpreted = d.interpreted(string);
     QuerySink sink(p, interpreted);
     std::optional<SkeletonBuilder> skeleton;
-    if (!p.environments.empty()) skeleton.emplace(p, interpreted);
+    if (!state.empty()) skeleton.emplace(p, interpreted);
     BothSinks both(sink, skeleton ? &*skeleton : nullptr);
     interpret(p, interpreted, turtle_options(d), both);
     if (skeleton) {
         Skeleton sk = skeleton->take();
-        for (const auto& env : p.environments)
-            if (auto* seeing = dynamic_cast<SkeletonEnvironment*>(env.get())) seeing->update(sk);
+        for (std::size_t e = 0; e < state.size(); ++e)
+            if (Environment* env = state.environment(e)) env->see(sk);
     }
-    // ?E(env, slots...): the named environment answers at the module's position (LANGUAGE.md
-    // section 8, open L-systems' communication modules)
+    // ?E(env, slots...): the named environment answers at the module's position (docs/language.md,
+    // environments; open L-systems' communication modules)
     const auto e_symbol = p.symbols.find("?E");
     for (std::size_t i = 0; e_symbol && i < string.size(); ++i) {
         if (string.sym[i] != *e_symbol || string.arity(i) < 2) continue;
         auto it = sink.positions.find(string.id(i));
         double* a = string.params.data() + string.poff[i];
         const auto env = static_cast<std::size_t>(a[0]);
-        if (it == sink.positions.end() || a[0] < 0 || env >= p.environments.size() || !p.environments[env])
+        if (it == sink.positions.end() || a[0] < 0 || env >= state.size() || !state.environment(env))
             continue;
-        p.environments[env]->communicate(it->second.position, string.id(i), it->second.axis, a + 1,
-                                         string.arity(i) - 1);
+        state.environment(env)->communicate(it->second.position, string.id(i), it->second.axis, a + 1,
+                                            string.arity(i) - 1);
     }
     for (std::size_t i = 0; i < string.size(); ++i) {
         if (!p.symbols[string.sym[i]].query || string.arity(i) != 3) continue;
