@@ -176,3 +176,21 @@ TEST_CASE("G draws like F, and colors come from the color module and SetColor", 
     CHECK(pts[5].module == "F");
     CHECK(pts[5].id != 0);
 }
+
+TEST_CASE("every row of the turtle-symbol table is registered with its operation", "[turtle]") {
+    SymbolTable table;
+    for (const TurtleSymbol& row : kTurtleSymbols) {
+        auto id = table.find(row.name);
+        REQUIRE(id);
+        const SymbolInfo& info = table[*id];
+        CHECK(info.turtle == (row.kind == TurtleKind::Turtle));
+        CHECK(info.query == (row.kind == TurtleKind::Query));
+        CHECK(info.turtle_op == (row.prefix ? TurtleOp::None : row.op)); // a bare '~' does nothing
+        CHECK(row.min_params <= row.max_params);
+        CHECK(!row.doc.empty());
+    }
+    // "~name" places a surface; any other new name has no turtle meaning
+    CHECK(table[table.intern("~leaf")].turtle_op == TurtleOp::Surface);
+    CHECK(table[table.intern("Apex")].turtle_op == TurtleOp::None);
+    CHECK(turtle_symbol(TurtleOp::Sphere)->name == "@O");
+}
