@@ -2,11 +2,7 @@
 // one triangle mesh with vertex normals (and texture coordinates for .obj and .ply).
 #include "plant/export.hpp"
 
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <OpenMesh/Core/IO/MeshIO.hh>
-#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
-#pragma GCC diagnostic pop
+#include "openmesh.hpp"
 
 #include <glm/glm.hpp>
 
@@ -28,18 +24,10 @@ namespace plant {
 namespace {
 
 namespace fs = std::filesystem;
-using Mesh = OpenMesh::TriMesh_ArrayKernelT<>;
+using Mesh = OpenMeshTriangles;
 
 std::string quoted(const std::string& s) {
     return "'" + s + "'";
-}
-
-void quiet_openmesh() {
-    static std::once_flag once;
-    std::call_once(once, [] {
-        omlog().disable(); // the OBJ writer logs to stdout
-        omerr().disable(); // add_face reports complex edges; they are handled below
-    });
 }
 
 glm::vec3 unit_or_up(glm::vec3 n) {

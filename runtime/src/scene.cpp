@@ -4,11 +4,7 @@
 
 #include "plant/export.hpp"
 
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <OpenMesh/Core/IO/MeshIO.hh>
-#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
-#pragma GCC diagnostic pop
+#include "openmesh.hpp"
 
 #include <fmt/format.h>
 
@@ -100,12 +96,10 @@ MeshPart sphere_prototype() {
 }
 
 MeshPart loaded_prototype(const SurfaceDef& s) {
-    using Mesh = OpenMesh::TriMesh_ArrayKernelT<>;
-    Mesh mesh;
+    OpenMeshTriangles mesh;
     mesh.request_vertex_normals();
     mesh.request_face_normals();
-    omlog().disable();
-    omerr().disable(); // failures are reported as our own diagnostics
+    quiet_openmesh(); // failures are reported as our own diagnostics
     OpenMesh::IO::Options opt;
     if (!OpenMesh::IO::read_mesh(mesh, s.path, opt))
         throw RuntimeError(s.span, fmt::format("cannot load surface '{}' from '{}'", s.name, s.path));

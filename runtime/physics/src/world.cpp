@@ -3,6 +3,7 @@
 
 #include "parallel.hpp"
 #include "plant/physics/light.hpp"
+#include "plant/random.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -718,17 +719,9 @@ void World::step() {
 
 namespace {
 
-// Counter-based random numbers, as the language's: a draw depends on (seed, particle, draw).
+// Counter-based random numbers (plant/random.hpp): a draw depends on (seed, particle, draw).
 double random_unit(std::uint64_t seed, std::uint64_t particle, std::uint64_t draw) {
-    auto mix = [](std::uint64_t z) {
-        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-        z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-        return z ^ (z >> 31);
-    };
-    std::uint64_t h = mix(seed + 0x9e3779b97f4a7c15ULL);
-    h = mix(h ^ (particle * 0xd1b54a32d192ed03ULL));
-    h = mix(h ^ (draw * 0x8cb92ba72f3d8dd7ULL + 0x2545f4914f6cdd1dULL));
-    return static_cast<double>(h >> 11) * 0x1.0p-53;
+    return plant::random_unit(plant::random_bits(seed, particle, draw));
 }
 
 glm::dquat heading_to(const glm::dvec3& forward) {
