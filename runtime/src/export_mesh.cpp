@@ -85,7 +85,7 @@ class Flattener {
 
 } // namespace
 
-void write_mesh_file(const Scene& scene, const std::string& path) {
+void write_mesh_file(const Scene& given, const std::string& path) {
     std::string ext = fs::path(path).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(),
                    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
@@ -93,6 +93,8 @@ void write_mesh_file(const Scene& scene, const std::string& path) {
         throw ExportError("cannot write " + quoted(path) +
                           ": a mesh file name must end in .obj, .ply or .off");
     quiet_openmesh();
+    Scene flattened;
+    const Scene& scene = exported_scene(given, flattened, "mesh export");
 
     Mesh mesh;
     mesh.request_vertex_normals();
@@ -100,10 +102,6 @@ void write_mesh_file(const Scene& scene, const std::string& path) {
     {
         std::size_t nv = scene.tubes.positions.size(), nf = scene.tubes.triangle_count();
         for (const Instance& inst : scene.instances) {
-            if (inst.prototype >= scene.prototypes.size())
-                throw ExportError("mesh export: an instance places prototype " +
-                                  std::to_string(inst.prototype) + " but the scene has " +
-                                  std::to_string(scene.prototypes.size()));
             nv += scene.prototypes[inst.prototype].positions.size();
             nf += scene.prototypes[inst.prototype].triangle_count();
         }

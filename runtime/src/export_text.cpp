@@ -59,7 +59,8 @@ std::string skeleton_json(const Skeleton& sk) {
     for (std::size_t o = 0; o < sk.organs.size(); ++o) {
         const SkeletonOrgan& g = sk.organs[o];
         out += o ? ",\n" : "\n";
-        fmt::format_to(std::back_inserter(out), "{{\"shape\":{},\"matrix\":[", json_string(g.shape));
+        fmt::format_to(std::back_inserter(out), "{{\"shape\":{},\"matrix\":[",
+                       json_string(organ_label(g.shape)));
         for (int c = 0; c < 4; ++c)
             for (int r = 0; r < 4; ++r)
                 fmt::format_to(std::back_inserter(out), "{}{}", c || r ? "," : "", g.transform[c][r]);

@@ -62,6 +62,10 @@ glm::dmat4 frame_matrix(const TurtleState& t, double scale) {
 
 } // namespace
 
+std::string organ_label(const OrganShape& shape) {
+    return shape.kind == OrganKind::Sphere ? std::string(turtle_symbol(TurtleOp::Sphere)->name) : shape.name;
+}
+
 glm::vec3 palette_color(int index) {
     static const glm::vec3 palette[] = {
         {0.45f, 0.32f, 0.20f}, // bark
@@ -281,12 +285,16 @@ void Turtle::apply(TurtleOp op, std::size_t i) {
         break;
     }
     case TurtleOp::Sphere:
-        sink_.organ(TurtleOrgan{"@O", frame_matrix(t_, arg(i, 0, t_.width / 2)), t_.color, i, s_.id(i)});
+        sink_.organ(TurtleOrgan{
+            {OrganKind::Sphere, {}}, frame_matrix(t_, arg(i, 0, t_.width / 2)), t_.color, i, s_.id(i)});
         break;
     case TurtleOp::Surface:
         // "~name": the surface's name follows the '~'
-        sink_.organ(TurtleOrgan{program_.symbols[s_.sym[i]].name.substr(1), frame_matrix(t_, arg(i, 0, 1.0)),
-                                t_.color, i, s_.id(i)});
+        sink_.organ(TurtleOrgan{{OrganKind::Surface, program_.symbols[s_.sym[i]].name.substr(1)},
+                                frame_matrix(t_, arg(i, 0, 1.0)),
+                                t_.color,
+                                i,
+                                s_.id(i)});
         break;
     case TurtleOp::SetHeading:
         if (s_.arity(i) >= 6)

@@ -110,7 +110,8 @@ TEST_CASE("@M moves, SetHead sets the heading, @O places a sphere", "[turtle]") 
     REQUIRE(sk.axes.size() == 1);
     CHECK(sk.axes[0].points.back().radius == Approx(2.0)); // !(4): width 4, radius 2
     REQUIRE(sk.organs.size() == 2);
-    CHECK(sk.organs[0].shape == "@O");
+    CHECK(sk.organs[0].shape.kind == OrganKind::Sphere);
+    CHECK(organ_label(sk.organs[0].shape) == "@O");
     CHECK(sk.organs[0].transform[3][1] == Approx(1.0)); // placed at the turtle's position
     CHECK(glm::length(glm::dvec3(sk.organs[1].transform[1])) == Approx(3.0)); // scaled by 3
 }

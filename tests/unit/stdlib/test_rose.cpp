@@ -247,7 +247,7 @@ void check_rose(const Rose& r, const std::string& what) {
     }
     int leaves = 0;
     for (const auto& o : r.skeleton.organs) {
-        if (o.shape != "petiole") continue;
+        if (o.shape != OrganShape{OrganKind::Surface, "petiole"}) continue;
         ++leaves;
         glm::dvec3 at(o.transform[3]), g(o.transform[1]);
         bool found = false;
