@@ -18,7 +18,7 @@ namespace plant::physics {
 
 namespace {
 
-constexpr double kFixedMass = 1e12; // "effectively infinite" inside group sums (PLANTS.md pitfall)
+constexpr double kFixedMass = 1e12; // "effectively infinite" inside group sums (docs/physics.md, root)
 
 } // namespace
 
@@ -36,7 +36,7 @@ glm::dvec3 surface_adaption(const glm::dvec3& forward, const glm::dvec3& to_surf
 glm::dvec3 phototropism(const glm::dvec3& forward, const glm::dvec3& to_light, double occlusion, double eta,
                         double dt) {
     glm::dvec3 f = glm::normalize(forward), l = glm::normalize(to_light);
-    glm::dvec3 axis = glm::cross(f, l); // toward the light (PLANTS.md pitfall)
+    glm::dvec3 axis = glm::cross(f, l); // toward the light (docs/physics.md: not the printed v_l x v_f)
     double len = glm::length(axis);
     if (len < 1e-12) return f;
     // Eq. 7, and never past the light direction itself
@@ -293,7 +293,7 @@ double World::matching_mass(std::uint32_t j) const {
 }
 
 glm::dmat3 World::rest_moment(std::uint32_t j) const {
-    // Eq. 15's term for one member is 0.2 m R D R̄ᵀ (PLANTS.md pitfall); this is its rest part,
+    // Eq. 15's term for one member is 0.2 m R D R̄ᵀ (docs/physics.md); this is its rest part,
     // 0.2 m D R̄ᵀ, which only growth changes
     const glm::dvec3& r = radii_[j];
     glm::dmat3 D(0.0);

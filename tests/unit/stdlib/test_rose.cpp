@@ -141,7 +141,7 @@ double wrap_degrees(double a) {
     return a;
 }
 
-// Every rule of PLANTS.md that can be read off one grown rose.
+// Every rule of the rose (docs/rose.md, checks) that can be read off one grown rose.
 void check_rose(const Rose& r, const std::string& what) {
     INFO(what);
     const double h_trunk = r.params.at("h_trunk"), r_trunk = r.params.at("r_trunk");
