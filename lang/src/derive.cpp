@@ -4,7 +4,7 @@
 #include "plant/derive.hpp"
 #include "plant/environment.hpp"
 
-#include "plant/random.hpp"
+#include "plant/streams.hpp"
 #include "plant/vm.hpp"
 #include "rewrite/engine.hpp"
 

@@ -7,21 +7,16 @@
 namespace plant {
 
 SymbolTable::SymbolTable() {
-    // Turtle symbols of LANGUAGE.md section 10 and the query modules of section 8.
-    static const char* turtle[] = {"F", "f",  "G",  "+",       "-",  "&",   "^",   "\\",
-                                   "/", "|",  "$",  "[",       "]",  "!",   ";",   "~",
-                                   "%", "@O", "@R", "SetHead", "@M", "@Tp", "@Ts", "SetColor"};
-    for (const char* t : turtle) {
-        SymbolId id = intern(t);
-        infos_[id].turtle = true;
+    // the turtle's symbols and query modules, one row each in plant/turtle_symbols.hpp
+    for (const TurtleSymbol& t : kTurtleSymbols) {
+        SymbolId id = intern(t.name);
+        SymbolInfo& info = infos_[id];
+        if (!t.prefix) info.turtle_op = t.op;
+        info.turtle = t.kind == TurtleKind::Turtle;
+        info.query = t.kind == TurtleKind::Query;
         // multi-letter turtle names are declared so letter runs do not split them
-        infos_[id].declared =
-            std::string_view(t).size() > 1 && std::isalpha(static_cast<unsigned char>(t[0]));
-    }
-    for (const char* q : {"?P", "?H", "?U", "?L", "?E"}) {
-        SymbolId id = intern(q);
-        infos_[id].query = true;
-        infos_[id].declared = true;
+        info.declared =
+            info.query || (t.name.size() > 1 && std::isalpha(static_cast<unsigned char>(t.name[0])));
     }
     open_bracket = *find("[");
     close_bracket = *find("]");
@@ -35,6 +30,7 @@ SymbolId SymbolTable::intern(std::string_view name) {
     auto id = static_cast<SymbolId>(infos_.size());
     SymbolInfo info;
     info.name = std::string(name);
+    info.turtle_op = prefixed_turtle_op(name);
     infos_.push_back(std::move(info));
     index_.emplace(std::string(name), id);
     return id;

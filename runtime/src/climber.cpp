@@ -1,6 +1,7 @@
 // The climber environment: a physics::World driven by the grammar's bound modules.
 #include "plant/climber.hpp"
 
+#include "geometry.hpp"
 #include "obstacle_args.hpp"
 #include "triangle_mesh.hpp"
 
@@ -16,10 +17,6 @@ namespace {
 
 constexpr ValueType N = ValueType::Number;
 constexpr ValueType V = ValueType::Vec3;
-
-glm::dvec3 vec(const double* a) {
-    return {a[0], a[1], a[2]};
-}
 
 // The frame's columns are the particle's axes: x = -left, y = heading, z = up.
 glm::dquat quat_of(const glm::dmat3& frame) {

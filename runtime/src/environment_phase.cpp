@@ -21,12 +21,15 @@ class QuerySink : public TurtleSink {
   public:
     QuerySink(const Program& p, const ModuleString& s) : program_(p), string_(s) {}
     void query(std::size_t module, const TurtleState& t) override {
-        const std::string& name = program_.symbols[string_.sym[module]].name;
-        if (name == "?E") { // communication modules: answered after the environments see the plant
+        const TurtleOp op = program_.symbols[string_.sym[module]].turtle_op;
+        if (op == TurtleOp::Communicate) { // answered after the environments see the plant
             positions[string_.id(module)] = Place{t.position, t.axis};
             return;
         }
-        glm::dvec3 v = name == "?P" ? t.position : name == "?H" ? t.heading : name == "?U" ? t.up : t.left;
+        glm::dvec3 v = op == TurtleOp::QueryPosition  ? t.position
+                       : op == TurtleOp::QueryHeading ? t.heading
+                       : op == TurtleOp::QueryUp      ? t.up
+                                                      : t.left;
         found[string_.id(module)] = v;
     }
     struct Place {
@@ -141,10 +144,9 @@ void TurtleEnvironmentPhase::run(const Derivation& d, RunState& state, ModuleStr
             if (Environment* env = state.environment(e)) env->see(sk);
     }
     // ?E(env, slots...): the named environment answers at the module's position (docs/language.md,
-    // environments; open L-systems' communication modules)
-    const auto e_symbol = p.symbols.find("?E");
-    for (std::size_t i = 0; e_symbol && i < string.size(); ++i) {
-        if (string.sym[i] != *e_symbol || string.arity(i) < 2) continue;
+    // environment objects: open L-systems' communication modules)
+    for (std::size_t i = 0; !sink.positions.empty() && i < string.size(); ++i) {
+        if (p.symbols[string.sym[i]].turtle_op != TurtleOp::Communicate || string.arity(i) < 2) continue;
         auto it = sink.positions.find(string.id(i));
         double* a = string.params.data() + string.poff[i];
         const auto env = static_cast<std::size_t>(a[0]);

@@ -4,6 +4,7 @@
 
 #include "plant/climber.hpp"
 
+#include "geometry.hpp"
 #include "obstacle_args.hpp"
 #include "triangle_mesh.hpp"
 
@@ -25,11 +26,9 @@ constexpr ValueType V = ValueType::Vec3;
 constexpr ValueType B = ValueType::Bool;
 constexpr EnvAccess Pure = EnvAccess::Pure;
 
+using plant::vec; // geometry.hpp
 glm::dvec3 vec(const EnvArg& a) {
-    return {a.v[0], a.v[1], a.v[2]};
-}
-glm::dvec3 vec(const double* a) {
-    return {a[0], a[1], a[2]};
+    return vec(a.v);
 }
 
 // Reads keyword arguments of one kind, checking names and types.

@@ -83,6 +83,23 @@ void check_mesh_part(const MeshPart& part, const std::string& what) {
                               " vertices");
 }
 
+const Scene& exported_scene(const Scene& scene, Scene& storage, const std::string& what) {
+    const Scene* s = &scene;
+    if (scene.nested()) {
+        try {
+            storage = flatten(scene);
+        } catch (const std::out_of_range& e) {
+            throw ExportError(what + ": " + e.what());
+        }
+        s = &storage;
+    }
+    for (const Instance& inst : s->instances)
+        if (inst.prototype >= s->prototypes.size())
+            throw ExportError(what + ": an instance places prototype " + std::to_string(inst.prototype) +
+                              " but the scene has " + std::to_string(s->prototypes.size()));
+    return *s;
+}
+
 void write_file_atomically(const std::string& path, const std::string& bytes) {
     std::FILE* file = nullptr;
     const std::string temp = create_temp_beside(path, file);
@@ -296,10 +313,6 @@ struct GltfBuilder {
         }
 
         for (const Instance& inst : scene.instances) {
-            if (inst.prototype >= scene.prototypes.size())
-                throw ExportError("glTF export: an instance places prototype " +
-                                  std::to_string(inst.prototype) + " but the scene has " +
-                                  std::to_string(scene.prototypes.size()));
             const int mesh = proto_mesh[inst.prototype];
             if (mesh < 0) continue;
             tinygltf::Node node;
@@ -332,7 +345,8 @@ void write_gltf(const Scene& scene, const std::string& path) {
         throw ExportError("cannot write " + quoted(path) + ": a glTF file name must end in .glb or .gltf");
     const bool binary = ext == ".glb";
 
-    GltfBuilder builder(scene);
+    Scene flat;
+    GltfBuilder builder(exported_scene(scene, flat, "glTF export"));
     builder.build();
     if (binary && !builder.model.buffers.empty() &&
         builder.model.buffers[0].data.size() > std::numeric_limits<std::uint32_t>::max() - 1024)

@@ -2,11 +2,7 @@
 // one triangle mesh with vertex normals (and texture coordinates for .obj and .ply).
 #include "plant/export.hpp"
 
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <OpenMesh/Core/IO/MeshIO.hh>
-#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
-#pragma GCC diagnostic pop
+#include "openmesh.hpp"
 
 #include <glm/glm.hpp>
 
@@ -28,18 +24,10 @@ namespace plant {
 namespace {
 
 namespace fs = std::filesystem;
-using Mesh = OpenMesh::TriMesh_ArrayKernelT<>;
+using Mesh = OpenMeshTriangles;
 
 std::string quoted(const std::string& s) {
     return "'" + s + "'";
-}
-
-void quiet_openmesh() {
-    static std::once_flag once;
-    std::call_once(once, [] {
-        omlog().disable(); // the OBJ writer logs to stdout
-        omerr().disable(); // add_face reports complex edges; they are handled below
-    });
 }
 
 glm::vec3 unit_or_up(glm::vec3 n) {
@@ -97,7 +85,7 @@ class Flattener {
 
 } // namespace
 
-void write_mesh_file(const Scene& scene, const std::string& path) {
+void write_mesh_file(const Scene& given, const std::string& path) {
     std::string ext = fs::path(path).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(),
                    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
@@ -105,6 +93,8 @@ void write_mesh_file(const Scene& scene, const std::string& path) {
         throw ExportError("cannot write " + quoted(path) +
                           ": a mesh file name must end in .obj, .ply or .off");
     quiet_openmesh();
+    Scene flattened;
+    const Scene& scene = exported_scene(given, flattened, "mesh export");
 
     Mesh mesh;
     mesh.request_vertex_normals();
@@ -112,10 +102,6 @@ void write_mesh_file(const Scene& scene, const std::string& path) {
     {
         std::size_t nv = scene.tubes.positions.size(), nf = scene.tubes.triangle_count();
         for (const Instance& inst : scene.instances) {
-            if (inst.prototype >= scene.prototypes.size())
-                throw ExportError("mesh export: an instance places prototype " +
-                                  std::to_string(inst.prototype) + " but the scene has " +
-                                  std::to_string(scene.prototypes.size()));
             nv += scene.prototypes[inst.prototype].positions.size();
             nf += scene.prototypes[inst.prototype].triangle_count();
         }

@@ -402,6 +402,9 @@ struct Renderer {
 } // namespace
 
 Image render_scene(const Scene& scene, int width, int height) {
+    // placed scenes are drawn flattened; an instance of a prototype the scene does not have is
+    // skipped rather than failing, as befits a preview
+    if (scene.nested()) return render_scene(flatten(scene), width, height);
     if (width <= 0 || height <= 0)
         throw ExportError("PNG size must be positive, got " + std::to_string(width) + "x" +
                           std::to_string(height));

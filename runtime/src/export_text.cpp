@@ -9,10 +9,8 @@ namespace plant {
 
 namespace {
 
-void vec(std::string& out, const glm::dvec3& v) {
-    fmt::format_to(std::back_inserter(out), "[{},{},{}]", v.x, v.y, v.z);
-}
-void vec(std::string& out, const glm::vec3& v) {
+// A vector as a JSON array, in its own precision (positions double, colors float).
+template <class Vec> void json_vec(std::string& out, const Vec& v) {
     fmt::format_to(std::back_inserter(out), "[{},{},{}]", v.x, v.y, v.z);
 }
 
@@ -41,15 +39,15 @@ std::string skeleton_json(const Skeleton& sk) {
             const SkeletonPoint& p = axis.points[k];
             out += k ? "," : "";
             out += "{\"position\":";
-            vec(out, p.position);
+            json_vec(out, p.position);
             out += ",\"heading\":";
-            vec(out, p.heading);
+            json_vec(out, p.heading);
             out += ",\"left\":";
-            vec(out, p.left);
+            json_vec(out, p.left);
             out += ",\"up\":";
-            vec(out, p.up);
+            json_vec(out, p.up);
             fmt::format_to(std::back_inserter(out), ",\"radius\":{},\"color\":", p.radius);
-            vec(out, p.color);
+            json_vec(out, p.color);
             fmt::format_to(std::back_inserter(out), ",\"module\":{},\"id\":{}}}", json_string(p.module),
                            p.id);
         }
@@ -59,12 +57,13 @@ std::string skeleton_json(const Skeleton& sk) {
     for (std::size_t o = 0; o < sk.organs.size(); ++o) {
         const SkeletonOrgan& g = sk.organs[o];
         out += o ? ",\n" : "\n";
-        fmt::format_to(std::back_inserter(out), "{{\"shape\":{},\"matrix\":[", json_string(g.shape));
+        fmt::format_to(std::back_inserter(out), "{{\"shape\":{},\"matrix\":[",
+                       json_string(organ_label(g.shape)));
         for (int c = 0; c < 4; ++c)
             for (int r = 0; r < 4; ++r)
                 fmt::format_to(std::back_inserter(out), "{}{}", c || r ? "," : "", g.transform[c][r]);
         out += "],\"color\":";
-        vec(out, g.color);
+        json_vec(out, g.color);
         fmt::format_to(std::back_inserter(out), ",\"id\":{}}}", g.id);
     }
     out += "]}\n";

@@ -7,6 +7,8 @@
 // so the tube does not twist.
 #include "plant/mesh.hpp"
 
+#include "geometry.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -32,13 +34,7 @@ glm::dvec3 transport(const glm::dvec3& v, const glm::dvec3& a, const glm::dvec3&
     glm::dvec3 axis = glm::cross(a, b);
     double s = glm::length(axis), c = glm::dot(a, b);
     if (s < 1e-12) return c > 0 ? v : -v;
-    axis /= s;
-    return v * c + glm::cross(axis, v) * s + axis * (glm::dot(axis, v) * (1 - c));
-}
-
-// Rotates v about the unit axis k by phi, right-handed.
-glm::dvec3 transport_about(const glm::dvec3& v, const glm::dvec3& k, double phi) {
-    return v * std::cos(phi) + glm::cross(k, v) * std::sin(phi) + k * glm::dot(k, v) * (1 - std::cos(phi));
+    return rotate(v, axis / s, c, s);
 }
 
 glm::dvec3 any_perpendicular(const glm::dvec3& t) {
@@ -112,8 +108,8 @@ void rings_of(const TubePath& path, const MeshOptions& o, Scratch& s) {
         int n = std::max(2, static_cast<int>(std::ceil(theta / (22.5 * kPi / 180.0))));
         for (int j = 0; j <= n; ++j) {
             double phi = theta * j / n;
-            glm::dvec3 c = center + transport_about(start - center, turn, phi);
-            glm::dvec3 t = transport_about(d0, turn, phi);
+            glm::dvec3 c = center + rotate(start - center, turn, phi);
+            glm::dvec3 t = rotate(d0, turn, phi);
             rings.push_back(Ring{c, glm::normalize(t), r, glm::dvec3(0), 1.0, p.color});
         }
     }

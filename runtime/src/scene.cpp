@@ -4,21 +4,25 @@
 
 #include "plant/export.hpp"
 
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <OpenMesh/Core/IO/MeshIO.hh>
-#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
-#pragma GCC diagnostic pop
+#include "openmesh.hpp"
 
 #include <fmt/format.h>
 
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <optional>
+#include <stdexcept>
 
 namespace plant {
 
 void Scene::update_bounds() {
+    if (nested()) {
+        const Scene flat = flatten(*this); // its bounds are of everything placed
+        bounds_min = flat.bounds_min;
+        bounds_max = flat.bounds_max;
+        return;
+    }
     glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
     for (const auto& p : tubes.positions) {
         lo = glm::min(lo, p);
@@ -35,6 +39,74 @@ void Scene::update_bounds() {
     if (lo.x > hi.x) lo = hi = glm::vec3(0.0f);
     bounds_min = lo;
     bounds_max = hi;
+}
+
+Scene flatten(const Scene& scene) {
+    if (!scene.nested()) return scene;
+    Scene out;
+    out.tubes = scene.tubes;
+    out.prototypes = scene.prototypes;
+    out.prototype_names = scene.prototype_names;
+    out.instances = scene.instances;
+    out.materials = scene.materials;
+    std::map<std::array<float, 3>, std::uint32_t> material_index;
+    for (std::uint32_t m = static_cast<std::uint32_t>(out.materials.size()); m-- > 0;) {
+        const glm::vec3& c = out.materials[m].color;
+        material_index[{c.x, c.y, c.z}] = m; // the first material of each color
+    }
+    auto material_of = [&](const glm::vec3& c) {
+        auto [it, added] = material_index.emplace(std::array<float, 3>{c.x, c.y, c.z},
+                                                  static_cast<std::uint32_t>(out.materials.size()));
+        if (added) out.materials.push_back(Material{c});
+        return it->second;
+    };
+    // per scene prototype, once placed: the result's prototype of its tubes (or none) and of each
+    // of its own prototypes, and its instances in its own frame
+    struct Drawn {
+        int tubes = -1;
+        std::vector<Instance> instances;
+    };
+    std::vector<std::optional<Drawn>> drawn(scene.scene_prototypes.size());
+    for (const Instance& placement : scene.scene_instances) {
+        const std::size_t k = placement.prototype;
+        if (k >= scene.scene_prototypes.size() || !scene.scene_prototypes[k])
+            throw std::out_of_range("a placement of scene prototype " + std::to_string(k) +
+                                    " but the scene has " + std::to_string(scene.scene_prototypes.size()));
+        if (!drawn[k]) {
+            const Scene inner = flatten(*scene.scene_prototypes[k]);
+            const std::string name =
+                k < scene.scene_prototype_names.size() && !scene.scene_prototype_names[k].empty()
+                    ? scene.scene_prototype_names[k]
+                    : "scene" + std::to_string(k);
+            std::vector<std::uint32_t> material(inner.materials.size());
+            for (std::size_t m = 0; m < inner.materials.size(); ++m)
+                material[m] = material_of(inner.materials[m].color);
+            auto add = [&](MeshPart part, const std::string& part_name) {
+                for (auto& p : part.primitives) p.material = material.at(p.material);
+                out.prototypes.push_back(std::move(part));
+                out.prototype_names.push_back(name + "/" + part_name);
+                return static_cast<std::uint32_t>(out.prototypes.size() - 1);
+            };
+            Drawn d;
+            if (!inner.tubes.empty()) d.tubes = static_cast<int>(add(inner.tubes, "tubes"));
+            std::vector<std::uint32_t> proto(inner.prototypes.size());
+            for (std::size_t p = 0; p < inner.prototypes.size(); ++p)
+                proto[p] = add(inner.prototypes[p], p < inner.prototype_names.size()
+                                                        ? inner.prototype_names[p]
+                                                        : "prototype" + std::to_string(p));
+            for (const Instance& i : inner.instances)
+                d.instances.push_back(Instance{proto.at(i.prototype), i.transform});
+            drawn[k] = std::move(d);
+        }
+        const Drawn& d = *drawn[k];
+        if (d.tubes >= 0)
+            out.instances.push_back(Instance{static_cast<std::uint32_t>(d.tubes), placement.transform});
+        for (const Instance& i : d.instances)
+            out.instances.push_back(Instance{i.prototype, placement.transform * i.transform});
+    }
+    if (out.materials.empty()) out.materials.push_back(Material{});
+    out.update_bounds();
+    return out;
 }
 
 namespace {
@@ -100,12 +172,10 @@ MeshPart sphere_prototype() {
 }
 
 MeshPart loaded_prototype(const SurfaceDef& s) {
-    using Mesh = OpenMesh::TriMesh_ArrayKernelT<>;
-    Mesh mesh;
+    OpenMeshTriangles mesh;
     mesh.request_vertex_normals();
     mesh.request_face_normals();
-    omlog().disable();
-    omerr().disable(); // failures are reported as our own diagnostics
+    quiet_openmesh(); // failures are reported as our own diagnostics
     OpenMesh::IO::Options opt;
     if (!OpenMesh::IO::read_mesh(mesh, s.path, opt))
         throw RuntimeError(RuntimeErrorKind::Geometry, s.span,
@@ -128,6 +198,28 @@ MeshPart loaded_prototype(const SurfaceDef& s) {
                            fmt::format("surface '{}' loaded from '{}' has no faces", s.name, s.path));
     m.primitives.push_back(Primitive{0, static_cast<std::uint32_t>(m.indices.size()), 0});
     return m;
+}
+
+// The mesh of an organ's shape, in its own frame.
+MeshPart organ_mesh(const Program& program, const OrganShape& shape) {
+    switch (shape.kind) {
+    case OrganKind::Sphere:
+        return sphere_prototype();
+    case OrganKind::Surface:
+        for (auto it = program.surfaces.rbegin(); it != program.surfaces.rend(); ++it)
+            if (it->name == shape.name)
+                return it->kind == "load" ? loaded_prototype(*it) : polygon_prototype(*it);
+        throw RuntimeError(RuntimeErrorKind::Geometry, Span{},
+                           fmt::format("'~{}' places a surface that is not declared: add "
+                                       "'surface {} = polygon(...);'",
+                                       shape.name, shape.name));
+    case OrganKind::Instance:
+        break;
+    }
+    throw RuntimeError(RuntimeErrorKind::Geometry, Span{},
+                       fmt::format("instance '{}' cannot be meshed as an organ: its prototype is a "
+                                   "scene (Scene::scene_prototypes)",
+                                   shape.name));
 }
 
 } // namespace
@@ -163,36 +255,21 @@ Scene build_scene(const Program& program, const Skeleton& skeleton, const MeshOp
             Primitive{first, static_cast<std::uint32_t>(by_material[m].size()), m});
     }
     // organs: one prototype per (shape, color), meshed once
-    std::map<std::pair<std::string, std::uint32_t>, std::uint32_t> prototype_index;
-    std::map<std::string, MeshPart> shapes;
+    std::map<std::pair<OrganShape, std::uint32_t>, std::uint32_t> prototype_index;
+    std::map<OrganShape, MeshPart> shapes;
     for (const auto& organ : skeleton.organs) {
         std::uint32_t material = material_of(organ.color);
         auto key = std::pair{organ.shape, material};
         auto it = prototype_index.find(key);
         if (it == prototype_index.end()) {
             auto sit = shapes.find(organ.shape);
-            if (sit == shapes.end()) {
-                MeshPart shape;
-                if (organ.shape == "@O") {
-                    shape = sphere_prototype();
-                } else {
-                    const SurfaceDef* def = nullptr;
-                    for (const auto& s : program.surfaces)
-                        if (s.name == organ.shape) def = &s;
-                    if (!def)
-                        throw RuntimeError(RuntimeErrorKind::Geometry, Span{},
-                                           fmt::format("'~{}' places a surface that is not declared: add "
-                                                       "'surface {} = polygon(...);'",
-                                                       organ.shape, organ.shape));
-                    shape = def->kind == "load" ? loaded_prototype(*def) : polygon_prototype(*def);
-                }
-                sit = shapes.emplace(organ.shape, std::move(shape)).first;
-            }
+            if (sit == shapes.end())
+                sit = shapes.emplace(organ.shape, organ_mesh(program, organ.shape)).first;
             MeshPart proto = sit->second;
             for (auto& p : proto.primitives) p.material = material;
             it = prototype_index.emplace(key, static_cast<std::uint32_t>(scene.prototypes.size())).first;
             scene.prototypes.push_back(std::move(proto));
-            scene.prototype_names.push_back(organ.shape);
+            scene.prototype_names.push_back(organ_label(organ.shape));
         }
         scene.instances.push_back(Instance{it->second, glm::mat4(organ.transform)});
     }

@@ -1,10 +1,6 @@
 #include "triangle_mesh.hpp"
 
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <OpenMesh/Core/IO/MeshIO.hh>
-#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
-#pragma GCC diagnostic pop
+#include "openmesh.hpp"
 
 #include <fmt/format.h>
 
@@ -16,10 +12,8 @@ namespace plant {
 
 bool load_triangles(const std::string& path, std::vector<Triangle>& out, const char* who,
                     std::string& error) {
-    using Mesh = OpenMesh::TriMesh_ArrayKernelT<>;
-    Mesh mesh;
-    omlog().disable();
-    omerr().disable();
+    OpenMeshTriangles mesh;
+    quiet_openmesh();
     if (!OpenMesh::IO::read_mesh(mesh, path)) {
         error = fmt::format("{}: cannot load the mesh '{}'", who, path);
         return false;

@@ -5,6 +5,8 @@
 #include "plant/derive.hpp"
 #include "plant/environment.hpp"
 
+#include "geometry.hpp"
+
 #include <fmt/format.h>
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -17,12 +19,6 @@ namespace plant {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
-
-// Rotates a about axis k (unit) by phi, right-handed (Rodrigues).
-glm::dvec3 rotate(const glm::dvec3& a, const glm::dvec3& k, double phi) {
-    double c = std::cos(phi), s = std::sin(phi);
-    return a * c + glm::cross(k, a) * s + k * glm::dot(k, a) * (1 - c);
-}
 
 void rotate_frame(TurtleState& t, const glm::dvec3& axis, double phi) {
     t.heading = rotate(t.heading, axis, phi);
@@ -64,27 +60,11 @@ glm::dmat4 frame_matrix(const TurtleState& t, double scale) {
     return m;
 }
 
-struct Symbols {
-    SymbolId F = kNoSymbol, f = kNoSymbol, G = kNoSymbol, plus = kNoSymbol, minus = kNoSymbol,
-             amp = kNoSymbol, caret = kNoSymbol, back = kNoSymbol, slash = kNoSymbol, pipe = kNoSymbol,
-             dollar = kNoSymbol, open = kNoSymbol, close = kNoSymbol, bang = kNoSymbol, semi = kNoSymbol,
-             sphere = kNoSymbol, set_head = kNoSymbol, set_head2 = kNoSymbol, move_to = kNoSymbol,
-             tropism = kNoSymbol, elasticity = kNoSymbol, set_color = kNoSymbol, qP = kNoSymbol,
-             qH = kNoSymbol, qU = kNoSymbol, qL = kNoSymbol, qE = kNoSymbol;
-    explicit Symbols(const SymbolTable& st) {
-        auto get = [&](const char* n, SymbolId& out) {
-            if (auto id = st.find(n)) out = *id;
-        };
-        get("F", F), get("f", f), get("G", G), get("+", plus), get("-", minus), get("&", amp),
-            get("^", caret);
-        get("\\", back), get("/", slash), get("|", pipe), get("$", dollar), get("[", open), get("]", close);
-        get("!", bang), get(";", semi), get("@O", sphere), get("@R", set_head), get("SetHead", set_head2);
-        get("@M", move_to), get("@Tp", tropism), get("@Ts", elasticity), get("SetColor", set_color);
-        get("?P", qP), get("?H", qH), get("?U", qU), get("?L", qL), get("?E", qE);
-    }
-};
-
 } // namespace
+
+std::string organ_label(const OrganShape& shape) {
+    return shape.kind == OrganKind::Sphere ? std::string(turtle_symbol(TurtleOp::Sphere)->name) : shape.name;
+}
 
 glm::vec3 palette_color(int index) {
     static const glm::vec3 palette[] = {
@@ -101,164 +81,254 @@ glm::vec3 palette_color(int index) {
     return palette[((index % n) + n) % n];
 }
 
-void interpret(const Program& program, const ModuleString& s, const TurtleOptions& options,
-               TurtleSink& sink) {
-    const Symbols y(program.symbols);
-    TurtleState t;
-    t.step = options.step;
-    t.angle = options.angle;
-    t.width = options.width;
-    t.color = palette_color(0);
-    std::vector<TurtleState> stack;
-    int next_axis = 0;
-    int parent_axis = -1; // axis the current branch grows from
-    std::vector<int> parent_stack;
+namespace {
 
-    auto arg = [&](std::size_t i, std::uint32_t k, double fallback) {
-        return s.arity(i) > k ? s.args(i)[k] : fallback;
-    };
-    auto vec_arg = [&](std::size_t i, std::uint32_t k) {
-        const double* a = s.args(i);
-        return glm::dvec3(a[k], a[k + 1], a[k + 2]);
-    };
-    auto check = [&](std::size_t i) {
+// One pass of the turtle over a string: its state, the branch stack and the axes begun so far.
+class Turtle {
+  public:
+    Turtle(const Program& program, const ModuleString& s, const TurtleOptions& options, TurtleSink& sink)
+        : program_(program), s_(s), options_(options), sink_(sink) {
+        t_.step = options.step;
+        t_.angle = options.angle;
+        t_.width = options.width;
+        t_.color = palette_color(0);
+        // what each symbol does: bound to a climber (drawn like F, ending where its particle is),
+        // or its turtle operation (plant/turtle_symbols.hpp)
+        const std::size_t n = program.symbols.size();
+        bound_.assign(n, 0);
+        ops_.assign(n, TurtleOp::None);
+        for (std::size_t k = 0; k < n; ++k) {
+            const SymbolInfo& info = program.symbols.all()[k];
+            bound_[k] = !info.bound_to.empty();
+            ops_[k] = info.turtle_op;
+        }
+    }
+
+    void run() {
+        for (std::size_t i = 0; i < s_.size(); ++i) {
+            const SymbolId sym = s_.sym[i];
+            if (sym >= ops_.size()) continue;
+            if (bound_[sym])
+                bound_segment(i);
+            else if (ops_[sym] != TurtleOp::None)
+                apply(ops_[sym], i);
+        }
+    }
+
+  private:
+    double arg(std::size_t i, std::uint32_t k, double fallback) const {
+        return s_.arity(i) > k ? s_.args(i)[k] : fallback;
+    }
+    glm::dvec3 vec_arg(std::size_t i, std::uint32_t k) const { return vec(s_.args(i) + k); }
+
+    void check(std::size_t i) const {
         auto finite = [](const glm::dvec3& v) {
             return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
         };
-        if (!finite(t.position) || !finite(t.heading) || !finite(t.left) || !finite(t.up))
+        if (!finite(t_.position) || !finite(t_.heading) || !finite(t_.left) || !finite(t_.up))
             throw RuntimeError(RuntimeErrorKind::Turtle, Span{},
                                fmt::format("the turtle left finite space at module {} ('{}') of the string",
-                                           i + 1, program.symbols[s.sym[i]].name));
-    };
-    auto tropism = [&]() {
+                                           i + 1, program_.symbols[s_.sym[i]].name));
+    }
+
+    void tropism() {
         // ABOP p. 58: rotate H toward T by e |H x T| about H x T
-        if (t.elasticity == 0) return;
-        glm::dvec3 axis = glm::cross(t.heading, t.tropism);
+        if (t_.elasticity == 0) return;
+        glm::dvec3 axis = glm::cross(t_.heading, t_.tropism);
         double len = glm::length(axis);
         if (len < 1e-12) return;
-        rotate_frame(t, axis / len, t.elasticity * len);
-        orthonormalize(t);
-    };
+        rotate_frame(t_, axis / len, t_.elasticity * len);
+        orthonormalize(t_);
+    }
 
     // the first segment after '[' or a move starts a new axis
-    auto start_axis = [&]() {
-        if (t.axis >= 0) return;
-        t.axis = next_axis++;
-        sink.axis_begin(t.axis, parent_axis, t);
-    };
-    // modules bound to a climber: drawn like F, ending where their particle is
-    std::vector<char> bound(program.symbols.size(), 0);
-    for (std::size_t k = 0; k < bound.size(); ++k) bound[k] = !program.symbols.all()[k].bound_to.empty();
-
-    for (std::size_t i = 0; i < s.size(); ++i) {
-        const SymbolId sym = s.sym[i];
-        if (sym < bound.size() && bound[sym]) {
-            // Seg(len, r): length and radius; with a particle, the segment ends at its position
-            double len = arg(i, 0, t.step);
-            if (s.arity(i) > 1) t.width = 2 * s.args(i)[1];
-            start_axis();
-            glm::dvec3 from = t.position;
-            glm::dvec3 p;
-            glm::dmat3 frame;
-            bool placed = false;
-            for (const BoundPoses* bp : options.poses)
-                if (bp && bp->pose(s.id(i), p, frame)) {
-                    placed = true;
-                    break;
-                }
-            if (placed) {
-                t.position = p;
-                t.heading = frame[1];
-                t.left = -frame[0];
-                t.up = frame[2];
-            } else {
-                t.position += t.heading * len;
-            }
-            check(i);
-            sink.segment(TurtleSegment{from, t.position, &t, i, s.id(i)});
-            t.bound_parent = s.id(i);
-        } else if (sym == y.F || sym == y.G) {
-            double len = arg(i, 0, t.step);
-            if (s.arity(i) > 1) t.width = s.args(i)[1];
-            start_axis();
-            glm::dvec3 from = t.position;
-            t.position += t.heading * len;
-            tropism();
-            check(i);
-            sink.segment(TurtleSegment{from, t.position, &t, i, s.id(i)});
-        } else if (sym == y.f) {
-            t.position += t.heading * arg(i, 0, t.step);
-            t.axis = -1;
-            check(i);
-        } else if (sym == y.plus || sym == y.minus) {
-            double a = arg(i, 0, t.angle) * kDeg * (sym == y.plus ? 1 : -1);
-            rotate_frame(t, t.up, a);
-        } else if (sym == y.amp || sym == y.caret) {
-            double a = arg(i, 0, t.angle) * kDeg * (sym == y.amp ? 1 : -1);
-            rotate_frame(t, t.left, a);
-        } else if (sym == y.slash || sym == y.back) {
-            double a = arg(i, 0, t.angle) * kDeg * (sym == y.slash ? 1 : -1);
-            rotate_frame(t, t.heading, a);
-        } else if (sym == y.pipe) {
-            rotate_frame(t, t.up, std::numbers::pi);
-        } else if (sym == y.dollar) {
-            // roll so that L is horizontal: L = V x H with V the world's up
-            glm::dvec3 l = glm::cross(glm::dvec3(0, 1, 0), t.heading);
-            if (glm::length(l) > 1e-9) {
-                t.left = glm::normalize(l);
-                t.up = glm::cross(t.heading, t.left);
-            }
-        } else if (sym == y.open) {
-            stack.push_back(t);
-            parent_stack.push_back(parent_axis);
-            if (t.axis >= 0) parent_axis = t.axis;
-            t.axis = -1;
-        } else if (sym == y.close) {
-            if (stack.empty())
-                throw RuntimeError(RuntimeErrorKind::Turtle, Span{},
-                                   fmt::format("']' at module {} of the string closes no '[' (the turtle's "
-                                               "stack is empty)",
-                                               i + 1));
-            t = stack.back();
-            stack.pop_back();
-            parent_axis = parent_stack.back();
-            parent_stack.pop_back();
-        } else if (sym == y.bang) {
-            t.width = arg(i, 0, t.width);
-        } else if (sym == y.semi) {
-            t.color_index = static_cast<int>(std::clamp(arg(i, 0, t.color_index + 1), -1e6, 1e6));
-            t.color = palette_color(t.color_index);
-        } else if (sym == y.set_color) {
-            glm::dvec3 c(arg(i, 0, 0), arg(i, 1, 0), arg(i, 2, 0));
-            if (c.x > 1 || c.y > 1 || c.z > 1) c /= 255.0;
-            t.color = glm::clamp(glm::vec3(c), glm::vec3(0.0f), glm::vec3(1.0f));
-        } else if (sym == y.sphere) {
-            double r = arg(i, 0, t.width / 2);
-            sink.organ(TurtleOrgan{"@O", frame_matrix(t, r), t.color, i, s.id(i)});
-        } else if (sym == y.set_head || sym == y.set_head2) {
-            if (s.arity(i) >= 6)
-                set_heading(t, vec_arg(i, 0), vec_arg(i, 3));
-            else if (s.arity(i) >= 3)
-                set_heading(t, vec_arg(i, 0), t.up);
-            check(i);
-        } else if (sym == y.move_to) {
-            if (s.arity(i) >= 3) t.position = vec_arg(i, 0);
-            t.axis = -1;
-            check(i);
-        } else if (sym == y.tropism) {
-            if (s.arity(i) >= 3) t.tropism = vec_arg(i, 0);
-        } else if (sym == y.elasticity) {
-            t.elasticity = arg(i, 0, 0);
-        } else if (sym == y.qP || sym == y.qH || sym == y.qU || sym == y.qL || sym == y.qE) {
-            sink.query(i, t);
-        } else {
-            const std::string& name = program.symbols[sym].name;
-            if (name.size() > 1 && name[0] == '~') {
-                double scale = arg(i, 0, 1.0);
-                sink.organ(TurtleOrgan{name.substr(1), frame_matrix(t, scale), t.color, i, s.id(i)});
-            }
-        }
+    void start_axis() {
+        if (t_.axis >= 0) return;
+        t_.axis = next_axis_++;
+        sink_.axis_begin(t_.axis, parent_axis_, t_);
     }
+
+    // Seg(len, r) bound to a climber: length and radius; with a particle, the segment ends at
+    // its position and the turtle takes its frame
+    void bound_segment(std::size_t i) {
+        double len = arg(i, 0, t_.step);
+        if (s_.arity(i) > 1) t_.width = 2 * s_.args(i)[1];
+        start_axis();
+        glm::dvec3 from = t_.position;
+        glm::dvec3 p;
+        glm::dmat3 frame;
+        bool placed = false;
+        for (const BoundPoses* bp : options_.poses)
+            if (bp && bp->pose(s_.id(i), p, frame)) {
+                placed = true;
+                break;
+            }
+        if (placed) {
+            t_.position = p;
+            t_.heading = frame[1];
+            t_.left = -frame[0];
+            t_.up = frame[2];
+        } else {
+            t_.position += t_.heading * len;
+        }
+        check(i);
+        sink_.segment(TurtleSegment{from, t_.position, &t_, i, s_.id(i)});
+        t_.bound_parent = s_.id(i);
+    }
+
+    void forward(std::size_t i) {
+        double len = arg(i, 0, t_.step);
+        if (s_.arity(i) > 1) t_.width = s_.args(i)[1];
+        start_axis();
+        glm::dvec3 from = t_.position;
+        t_.position += t_.heading * len;
+        tropism();
+        check(i);
+        sink_.segment(TurtleSegment{from, t_.position, &t_, i, s_.id(i)});
+    }
+
+    // a turn of the parameter's degrees (default the grammar's angle) about one of the
+    // turtle's own axes, `sign` giving the direction
+    void turn(std::size_t i, const glm::dvec3& axis, int sign) {
+        rotate_frame(t_, axis, arg(i, 0, t_.angle) * kDeg * sign);
+    }
+
+    void push() {
+        stack_.push_back(t_);
+        parent_stack_.push_back(parent_axis_);
+        if (t_.axis >= 0) parent_axis_ = t_.axis;
+        t_.axis = -1;
+    }
+
+    void pop(std::size_t i) {
+        if (stack_.empty())
+            throw RuntimeError(RuntimeErrorKind::Turtle, Span{},
+                               fmt::format("']' at module {} of the string closes no '[' (the turtle's "
+                                           "stack is empty)",
+                                           i + 1));
+        t_ = stack_.back();
+        stack_.pop_back();
+        parent_axis_ = parent_stack_.back();
+        parent_stack_.pop_back();
+    }
+
+    void apply(TurtleOp op, std::size_t i);
+
+    const Program& program_;
+    const ModuleString& s_;
+    const TurtleOptions& options_;
+    TurtleSink& sink_;
+    TurtleState t_;
+    std::vector<TurtleState> stack_;
+    int next_axis_ = 0;
+    int parent_axis_ = -1; // axis the current branch grows from
+    std::vector<int> parent_stack_;
+    std::vector<char> bound_;
+    std::vector<TurtleOp> ops_;
+};
+
+// One row of plant/turtle_symbols.hpp each (its doc says what the case does).
+void Turtle::apply(TurtleOp op, std::size_t i) {
+    switch (op) {
+    case TurtleOp::None:
+    case TurtleOp::Cut:
+        break;
+    case TurtleOp::Forward:
+        forward(i);
+        break;
+    case TurtleOp::Move:
+        t_.position += t_.heading * arg(i, 0, t_.step);
+        t_.axis = -1;
+        check(i);
+        break;
+    case TurtleOp::TurnLeft:
+    case TurtleOp::TurnRight:
+        turn(i, t_.up, op == TurtleOp::TurnLeft ? 1 : -1);
+        break;
+    case TurtleOp::PitchDown:
+    case TurtleOp::PitchUp:
+        turn(i, t_.left, op == TurtleOp::PitchDown ? 1 : -1);
+        break;
+    case TurtleOp::RollRight:
+    case TurtleOp::RollLeft:
+        turn(i, t_.heading, op == TurtleOp::RollRight ? 1 : -1);
+        break;
+    case TurtleOp::TurnAround:
+        rotate_frame(t_, t_.up, std::numbers::pi);
+        break;
+    case TurtleOp::RollLevel: {
+        // roll so that L is horizontal: L = V x H with V the world's up
+        glm::dvec3 l = glm::cross(glm::dvec3(0, 1, 0), t_.heading);
+        if (glm::length(l) > 1e-9) {
+            t_.left = glm::normalize(l);
+            t_.up = glm::cross(t_.heading, t_.left);
+        }
+        break;
+    }
+    case TurtleOp::Push:
+        push();
+        break;
+    case TurtleOp::Pop:
+        pop(i);
+        break;
+    case TurtleOp::Width:
+        t_.width = arg(i, 0, t_.width);
+        break;
+    case TurtleOp::PaletteColor:
+        t_.color_index = static_cast<int>(std::clamp(arg(i, 0, t_.color_index + 1), -1e6, 1e6));
+        t_.color = palette_color(t_.color_index);
+        break;
+    case TurtleOp::RgbColor: {
+        glm::dvec3 c(arg(i, 0, 0), arg(i, 1, 0), arg(i, 2, 0));
+        if (c.x > 1 || c.y > 1 || c.z > 1) c /= 255.0;
+        t_.color = glm::clamp(glm::vec3(c), glm::vec3(0.0f), glm::vec3(1.0f));
+        break;
+    }
+    case TurtleOp::Sphere:
+        sink_.organ(TurtleOrgan{
+            {OrganKind::Sphere, {}}, frame_matrix(t_, arg(i, 0, t_.width / 2)), t_.color, i, s_.id(i)});
+        break;
+    case TurtleOp::Surface:
+        // "~name": the surface's name follows the '~'
+        sink_.organ(TurtleOrgan{{OrganKind::Surface, program_.symbols[s_.sym[i]].name.substr(1)},
+                                frame_matrix(t_, arg(i, 0, 1.0)),
+                                t_.color,
+                                i,
+                                s_.id(i)});
+        break;
+    case TurtleOp::SetHeading:
+        if (s_.arity(i) >= 6)
+            set_heading(t_, vec_arg(i, 0), vec_arg(i, 3));
+        else if (s_.arity(i) >= 3)
+            set_heading(t_, vec_arg(i, 0), t_.up);
+        check(i);
+        break;
+    case TurtleOp::MoveTo:
+        if (s_.arity(i) >= 3) t_.position = vec_arg(i, 0);
+        t_.axis = -1;
+        check(i);
+        break;
+    case TurtleOp::Tropism:
+        if (s_.arity(i) >= 3) t_.tropism = vec_arg(i, 0);
+        break;
+    case TurtleOp::Elasticity:
+        t_.elasticity = arg(i, 0, 0);
+        break;
+    case TurtleOp::QueryPosition:
+    case TurtleOp::QueryHeading:
+    case TurtleOp::QueryUp:
+    case TurtleOp::QueryLeft:
+    case TurtleOp::Communicate:
+        sink_.query(i, t_);
+        break;
+    }
+}
+
+} // namespace
+
+void interpret(const Program& program, const ModuleString& s, const TurtleOptions& options,
+               TurtleSink& sink) {
+    Turtle(program, s, options, sink).run();
 }
 
 TurtleOptions turtle_options(const Derivation& d) {

@@ -63,4 +63,5 @@ OPCODE(LoadMulConst, 0, 1, Next, "push frame[a] * consts[b]")
 OPCODE(LoadAddConst, 0, 1, Next, "push frame[a] + consts[b]")
 // ---- shapes and environments ----
 OPCODE(Curve, 1, 1, Next, "replace t on top by curves[a](t)")
-OPCODE(EnvCall, n, 3, Next, "method b of environment a (the run state's), on n numbers; pushes its result (at most a vec3)")
+OPCODE(EnvCall, n, 3, Next,
+       "method b of environment a (the run state's), on n numbers; pushes its result (at most a vec3)")

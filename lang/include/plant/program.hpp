@@ -5,6 +5,7 @@
 #include "plant/ast.hpp"
 #include "plant/diagnostics.hpp"
 #include "plant/module_string.hpp"
+#include "plant/turtle_symbols.hpp"
 
 #include <array>
 #include <cstdint>
@@ -25,10 +26,11 @@ const char* value_type_name(ValueType t);
 
 struct SymbolInfo {
     std::string name;
-    bool declared = false; // by `module`, or a built-in turtle or query symbol
-    bool turtle = false;   // has a meaning for the turtle (docs/language.md, the turtle)
-    bool query = false;    // ?P ?H ?U ?L ?E
-    int arity = -1;        // declared parameter count; -1 when any count is accepted
+    bool declared = false;               // by `module`, or a built-in turtle or query symbol
+    bool turtle = false;                 // a built-in turtle symbol (plant/turtle_symbols.hpp)
+    bool query = false;                  // ?P ?H ?U ?L ?E
+    TurtleOp turtle_op = TurtleOp::None; // what the turtle does for it (also for "~name")
+    int arity = -1;                      // declared parameter count; -1 when any count is accepted
     std::vector<ValueType> param_types;
     std::vector<std::string> param_names;
     std::string bound_to; // the environment that holds its segments (`bound ivy`)

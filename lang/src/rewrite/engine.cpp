@@ -6,7 +6,7 @@
 // identities are numbered in string order, so the result is the same for any number of threads.
 #include "engine.hpp"
 
-#include "plant/random.hpp"
+#include "plant/streams.hpp"
 #include "rewriter.hpp"
 
 #include <fmt/format.h>

@@ -4,7 +4,7 @@
 // hands whole stretches to the faster routes when the plan and the string allow them.
 #include "rewriter.hpp"
 
-#include "plant/random.hpp"
+#include "plant/streams.hpp"
 
 #include <fmt/format.h>
 

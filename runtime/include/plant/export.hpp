@@ -17,6 +17,11 @@ struct ExportError : std::runtime_error {
 // normals or uvs present but not one per position, a partial triangle, an index out of range.
 void check_mesh_part(const MeshPart& part, const std::string& what);
 
+// What a writer draws: `scene` itself, or its flattened copy (plant/scene.hpp), kept in
+// `storage`, when it places whole scenes. Throws ExportError, naming `what` ("glTF export"), when
+// an instance places a prototype the scene does not have.
+const Scene& exported_scene(const Scene& scene, Scene& storage, const std::string& what);
+
 // Writes `bytes` to `path` through a temporary file and a rename.
 void write_file_atomically(const std::string& path, const std::string& bytes);
 

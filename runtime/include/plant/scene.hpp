@@ -1,10 +1,12 @@
 // What the mesher hands to the exporters: flat triangle buffers in world space for the tubes,
-// organ prototypes meshed once, and their placements. y is up (glTF's convention).
+// organ prototypes meshed once, and their placements; and whole scenes placed as prototypes
+// (instanced sub-plants), which the exporters flatten. y is up (glTF's convention).
 #pragma once
 
 #include <glm/glm.hpp>
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -44,9 +46,23 @@ struct Scene {
     std::vector<MeshPart> prototypes; // organ shapes (leaves, flowers, spheres), in their own frame
     std::vector<std::string> prototype_names;
     std::vector<Instance> instances;
+    // Prototypes that are whole scenes, in their own frame with their own materials (an
+    // instanced sub-plant), and their placements (Instance::prototype indexes scene_prototypes).
+    std::vector<std::shared_ptr<const Scene>> scene_prototypes;
+    std::vector<std::string> scene_prototype_names;
+    std::vector<Instance> scene_instances;
     std::vector<Material> materials;              // at least one
-    glm::vec3 bounds_min{0.0f}, bounds_max{0.0f}; // of everything, instances included
+    glm::vec3 bounds_min{0.0f}, bounds_max{0.0f}; // of everything, instances and placed scenes included
     void update_bounds();
+    bool nested() const { return !scene_instances.empty(); }
 };
+
+// The scene with every placed scene drawn into it: each placed scene's tubes become one prototype
+// and its prototypes become prototypes of the result (once per scene prototype, however often it
+// is placed), placed by the composed transforms; its materials join the result's (one per
+// color). Prototypes, instances and materials the scene had keep their indices, and a scene
+// without placed scenes comes back unchanged. Throws std::out_of_range for a placement of a
+// scene prototype that does not exist.
+Scene flatten(const Scene& scene);
 
 } // namespace plant

@@ -28,7 +28,7 @@ struct SkeletonAxis {
 };
 
 struct SkeletonOrgan {
-    std::string shape; // surface name or "@O"
+    OrganShape shape;
     glm::dmat4 transform;
     glm::vec3 color;
     ModuleId id = 0;

@@ -1,6 +1,6 @@
-// The 3D turtle (LANGUAGE.md section 10): state as plain data, one operation per module, output
-// to a sink. y is up; the turtle starts at the origin with heading H = +Y, left L = -X and
-// up U = H x L = +Z, so a 2D grammar draws in the XY plane and '+' turns toward L.
+// The 3D turtle (docs/language.md, the turtle; its symbols are plant/turtle_symbols.hpp): state as plain
+// data, one operation per module, output to a sink. y is up; the turtle starts at the origin with heading H =
+// +Y, left L = -X and up U = H x L = +Z, so a 2D grammar draws in the XY plane and '+' turns toward L.
 #pragma once
 
 #include "plant/diagnostics.hpp"
@@ -10,6 +10,8 @@
 
 #include <glm/glm.hpp>
 
+#include <compare>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -39,9 +41,23 @@ struct TurtleSegment {
     ModuleId id;
 };
 
+// What an organ is. Instance is kept for instanced sub-plants (a prototype that is a whole
+// scene, scene.hpp); no symbol places one yet.
+enum class OrganKind : std::uint8_t { Sphere, Surface, Instance };
+
+struct OrganShape {
+    OrganKind kind = OrganKind::Sphere;
+    std::string name; // Surface: the surface's name; Instance: the prototype's; Sphere: empty
+    auto operator<=>(const OrganShape&) const = default;
+};
+
+// The name outputs show for a shape (skeleton files, mesh and node names): "@O", the symbol that
+// places a sphere, or the surface's or prototype's name.
+std::string organ_label(const OrganShape& shape);
+
 // A surface, sphere or other organ placed in the turtle's frame.
 struct TurtleOrgan {
-    std::string shape; // surface name, or "@O" for a sphere
+    OrganShape shape;
     glm::dmat4 transform;
     glm::vec3 color;
     std::size_t module;

@@ -3,6 +3,7 @@
 
 #include "parallel.hpp"
 #include "plant/physics/light.hpp"
+#include "plant/random.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -17,7 +18,7 @@ namespace plant::physics {
 
 namespace {
 
-constexpr double kFixedMass = 1e12; // "effectively infinite" inside group sums (PLANTS.md pitfall)
+constexpr double kFixedMass = 1e12; // "effectively infinite" inside group sums (docs/physics.md, root)
 
 } // namespace
 
@@ -35,7 +36,7 @@ glm::dvec3 surface_adaption(const glm::dvec3& forward, const glm::dvec3& to_surf
 glm::dvec3 phototropism(const glm::dvec3& forward, const glm::dvec3& to_light, double occlusion, double eta,
                         double dt) {
     glm::dvec3 f = glm::normalize(forward), l = glm::normalize(to_light);
-    glm::dvec3 axis = glm::cross(f, l); // toward the light (PLANTS.md pitfall)
+    glm::dvec3 axis = glm::cross(f, l); // toward the light (docs/physics.md: not the printed v_l x v_f)
     double len = glm::length(axis);
     if (len < 1e-12) return f;
     // Eq. 7, and never past the light direction itself
@@ -292,7 +293,7 @@ double World::matching_mass(std::uint32_t j) const {
 }
 
 glm::dmat3 World::rest_moment(std::uint32_t j) const {
-    // Eq. 15's term for one member is 0.2 m R D R̄ᵀ (PLANTS.md pitfall); this is its rest part,
+    // Eq. 15's term for one member is 0.2 m R D R̄ᵀ (docs/physics.md); this is its rest part,
     // 0.2 m D R̄ᵀ, which only growth changes
     const glm::dvec3& r = radii_[j];
     glm::dmat3 D(0.0);
@@ -718,17 +719,9 @@ void World::step() {
 
 namespace {
 
-// Counter-based random numbers, as the language's: a draw depends on (seed, particle, draw).
+// Counter-based random numbers (plant/random.hpp): a draw depends on (seed, particle, draw).
 double random_unit(std::uint64_t seed, std::uint64_t particle, std::uint64_t draw) {
-    auto mix = [](std::uint64_t z) {
-        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-        z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-        return z ^ (z >> 31);
-    };
-    std::uint64_t h = mix(seed + 0x9e3779b97f4a7c15ULL);
-    h = mix(h ^ (particle * 0xd1b54a32d192ed03ULL));
-    h = mix(h ^ (draw * 0x8cb92ba72f3d8dd7ULL + 0x2545f4914f6cdd1dULL));
-    return static_cast<double>(h >> 11) * 0x1.0p-53;
+    return plant::random_unit(plant::random_bits(seed, particle, draw));
 }
 
 glm::dquat heading_to(const glm::dvec3& forward) {

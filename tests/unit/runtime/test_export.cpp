@@ -6,7 +6,11 @@
 
 #include <catch2/catch.hpp>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include <filesystem>
+#include <fstream>
+#include <memory>
 
 using namespace plant;
 
@@ -81,4 +85,77 @@ TEST_CASE("the skeleton JSON lists axes with points and organs with matrices", "
     CHECK(json.find("\"parent\":0") != std::string::npos); // the branch's parent is the main axis
     CHECK(json.find("\"shape\":\"s\"") != std::string::npos);
     CHECK(json.find("\"module\":\"F\"") != std::string::npos);
+}
+
+namespace {
+
+std::string file_bytes(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+} // namespace
+
+TEST_CASE("a scene placed as a prototype is flattened by its transforms for every writer", "[export][mesh]") {
+    auto inner = std::make_shared<Scene>(scene_of("axiom: ;(2) F @O(0.5);"));
+    REQUIRE(inner->prototypes.size() == 1);
+    Scene outer = scene_of("axiom: F;"); // a tube of its own, in the bark color
+    const std::size_t outer_materials = outer.materials.size();
+    outer.scene_prototypes.push_back(inner);
+    outer.scene_prototype_names.push_back("sprig");
+    const glm::mat4 right = glm::translate(glm::mat4(1.0f), glm::vec3(10, 0, 0));
+    const glm::mat4 up_twice =
+        glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(0, 5, 0)), glm::vec3(2.0f));
+    outer.scene_instances = {Instance{0, right}, Instance{0, up_twice}};
+    outer.update_bounds();
+
+    const Scene flat = flatten(outer);
+    CHECK(!flat.nested());
+    // the inner tubes and sphere become two prototypes, placed twice each
+    REQUIRE(flat.prototypes.size() == 2);
+    CHECK(flat.prototype_names == std::vector<std::string>{"sprig/tubes", "sprig/@O"});
+    REQUIRE(flat.instances.size() == 4);
+    CHECK(flat.instances[0].prototype == 0);
+    CHECK(flat.instances[0].transform == right);
+    CHECK(flat.instances[1].transform == right * inner->instances[0].transform);
+    CHECK(flat.instances[2].transform == up_twice);
+    CHECK(flat.tubes.positions == outer.tubes.positions);
+    // the inner red joins the outer materials, and the primitives point at it
+    CHECK(flat.materials.size() == outer_materials + 1);
+    CHECK(flat.materials[flat.prototypes[0].primitives[0].material].color ==
+          inner->materials[inner->tubes.primitives[0].material].color);
+    // bounds: the first copy reaches x = 10 + inner max, the second y = 5 + 2 * inner max
+    CHECK(flat.bounds_max.x == Approx(10 + inner->bounds_max.x));
+    CHECK(flat.bounds_max.y == Approx(5 + 2 * inner->bounds_max.y));
+    CHECK(outer.bounds_min == flat.bounds_min);
+    CHECK(outer.bounds_max == flat.bounds_max);
+    // a scene that places no scene comes back as it was
+    CHECK(flatten(*inner).instances.size() == inner->instances.size());
+    CHECK(flatten(*inner).prototype_names == inner->prototype_names);
+
+    // every writer draws the flattened scene
+    const std::string dir = (std::filesystem::temp_directory_path() / "plant-nested-test").string();
+    std::filesystem::create_directories(dir);
+    for (const char* ext : {".obj", ".glb"}) {
+        const std::string a = dir + "/nested" + ext, b = dir + "/flat" + ext;
+        if (std::string(ext) == ".obj") {
+            write_mesh_file(outer, a);
+            write_mesh_file(flat, b);
+        } else {
+            write_gltf(outer, a);
+            write_gltf(flat, b);
+        }
+        CHECK(!file_bytes(a).empty());
+        const bool same_bytes = file_bytes(a) == file_bytes(b);
+        CHECK(same_bytes);
+    }
+    const Image nested_image = render_scene(outer, 64, 48), flat_image = render_scene(flat, 64, 48);
+    const bool same_pixels = nested_image.rgb == flat_image.rgb;
+    CHECK(same_pixels);
+    CHECK(nested_image.rgb != render_scene(scene_of("axiom: F;"), 64, 48).rgb); // the placed scenes show
+
+    // a placement of a scene prototype that is not there is an export error
+    outer.scene_instances.push_back(Instance{3, right});
+    CHECK_THROWS_AS(write_gltf(outer, dir + "/broken.glb"), ExportError);
+    std::filesystem::remove_all(dir);
 }

@@ -110,7 +110,8 @@ TEST_CASE("@M moves, SetHead sets the heading, @O places a sphere", "[turtle]") 
     REQUIRE(sk.axes.size() == 1);
     CHECK(sk.axes[0].points.back().radius == Approx(2.0)); // !(4): width 4, radius 2
     REQUIRE(sk.organs.size() == 2);
-    CHECK(sk.organs[0].shape == "@O");
+    CHECK(sk.organs[0].shape.kind == OrganKind::Sphere);
+    CHECK(organ_label(sk.organs[0].shape) == "@O");
     CHECK(sk.organs[0].transform[3][1] == Approx(1.0)); // placed at the turtle's position
     CHECK(glm::length(glm::dvec3(sk.organs[1].transform[1])) == Approx(3.0)); // scaled by 3
 }
@@ -175,4 +176,22 @@ TEST_CASE("G draws like F, and colors come from the color module and SetColor", 
     near(pts[5].position - pts[4].position, {1, 0, 0}); // @R set the heading to +X
     CHECK(pts[5].module == "F");
     CHECK(pts[5].id != 0);
+}
+
+TEST_CASE("every row of the turtle-symbol table is registered with its operation", "[turtle]") {
+    SymbolTable table;
+    for (const TurtleSymbol& row : kTurtleSymbols) {
+        auto id = table.find(row.name);
+        REQUIRE(id);
+        const SymbolInfo& info = table[*id];
+        CHECK(info.turtle == (row.kind == TurtleKind::Turtle));
+        CHECK(info.query == (row.kind == TurtleKind::Query));
+        CHECK(info.turtle_op == (row.prefix ? TurtleOp::None : row.op)); // a bare '~' does nothing
+        CHECK(row.min_params <= row.max_params);
+        CHECK(!row.doc.empty());
+    }
+    // "~name" places a surface; any other new name has no turtle meaning
+    CHECK(table[table.intern("~leaf")].turtle_op == TurtleOp::Surface);
+    CHECK(table[table.intern("Apex")].turtle_op == TurtleOp::None);
+    CHECK(turtle_symbol(TurtleOp::Sphere)->name == "@O");
 }

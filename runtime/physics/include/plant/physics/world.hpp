@@ -65,7 +65,7 @@ struct Settings {
 glm::dvec3 surface_adaption(const glm::dvec3& forward, const glm::dvec3& to_surface, double tau, double dt);
 // Phototropism, Eq. 7: toward the light by (1 - O) eta dt, O the occlusion in [0, 1]. The axis is
 // forward x to_light, so the apex turns toward the light (the printed v_l x v_f turns it away:
-// PLANTS.md lists that pitfall).
+// docs/physics.md notes it).
 glm::dvec3 phototropism(const glm::dvec3& forward, const glm::dvec3& to_light, double occlusion, double eta,
                         double dt);
 
