@@ -5,8 +5,10 @@
 #include "outputs.hpp"
 #include "repl.hpp"
 
+#include "plant/ast.hpp"
 #include "plant/builtins.hpp"
 #include "plant/environments.hpp"
+#include "plant/turtle_symbols.hpp"
 
 #include <fmt/format.h>
 
@@ -94,6 +96,59 @@ int help_env(const HelpArgs& a) {
     return kOk;
 }
 
+int help_turtle(const HelpArgs& a) {
+    std::vector<std::pair<std::string, std::string>> turtle, queries;
+    for (const TurtleSymbol& t : kTurtleSymbols) {
+        std::string name = std::string(t.name) + (t.prefix ? "name" : ""); // "~name": any name after '~'
+        if (a.names) {
+            std::cout << name << "\n";
+            continue;
+        }
+        if (!t.params.empty()) name += "(" + std::string(t.params) + ")";
+        (t.kind == TurtleKind::Query ? queries : turtle).emplace_back(name, std::string(t.doc));
+    }
+    if (a.names) return kOk;
+    std::cout << "Turtle symbols (H heading, L left, U up; angles in degrees; every parameter optional "
+                 "unless the line says otherwise):\n";
+    print_columns(turtle);
+    std::cout << "Query modules (the turtle pass writes their parameters before a step that reads them):\n";
+    print_columns(queries);
+    return kOk;
+}
+
+// A small table of the language's {enum, spelling, doc} (ast.hpp), under a title.
+template <typename Table> int help_spelled(const HelpArgs& a, const char* title, const Table& table) {
+    std::vector<std::pair<std::string, std::string>> rows;
+    for (const auto& entry : table) {
+        if (a.names) std::cout << entry.spelling << "\n";
+        rows.emplace_back(entry.spelling, entry.doc);
+    }
+    if (a.names) return kOk;
+    std::cout << title << "\n";
+    print_columns(rows);
+    return kOk;
+}
+
+int help_hooks(const HelpArgs& a) {
+    return help_spelled(a, "Hooks (on NAME { statements }), in the order they run:", ast::kHooks);
+}
+
+int help_settings(const HelpArgs& a) {
+    return help_spelled(a, "Settings (NAME expression; at the top level):", ast::kSettings);
+}
+
+int help_operators(const HelpArgs& a) {
+    if (a.names) {
+        for (const auto& op : ast::kBinaryOps) std::cout << op.spelling << "\n";
+        for (const auto& op : ast::kUnaryOps) std::cout << op.spelling << "\n";
+        for (const auto& op : ast::kAssignOps) std::cout << op.spelling << "\n";
+        return kOk;
+    }
+    help_spelled(a, "Binary operators, tightest first:", ast::kBinaryOps);
+    help_spelled(a, "Unary operators:", ast::kUnaryOps);
+    return help_spelled(a, "Assignments (in hooks and function bodies):", ast::kAssignOps);
+}
+
 int help_formats(const HelpArgs& a) {
     std::vector<std::pair<std::string, std::string>> rows;
     for (const auto& f : output_formats()) {
@@ -124,6 +179,10 @@ struct HelpTopic {
 
 const HelpTopic kTopics[] = {
     {"builtins", "the built-in functions, their argument types and what they do", help_builtins},
+    {"turtle", "the turtle symbols and query modules, their parameters and defaults", help_turtle},
+    {"hooks", "the hooks a grammar can define, in the order they run", help_hooks},
+    {"settings", "the top-level settings (derive, angle, ...)", help_settings},
+    {"operators", "the operators of expressions and assignments", help_operators},
     {"env", "environment kinds; 'plant help env KIND' lists a kind's methods", help_env},
     {"formats", "the output formats 'plant run' writes, by extension", help_formats},
     {"repl", "the commands of 'plant repl'", help_repl},

@@ -52,6 +52,13 @@ contains "help env lists kinds" "$tmp/stdout" "climber"
 check "help env KIND" 0 "$plant" help env climber
 contains "help env KIND lists methods" "$tmp/stdout" "pull(number, vec3) -> number"
 check "help env unknown kind" 64 "$plant" help env tree
+check "help turtle" 0 "$plant" help turtle
+contains "help turtle shows a symbol's parameters and doc" "$tmp/stdout" "@Tp(x, y, z)"
+contains "help turtle lists query modules" "$tmp/stdout" "?E(env, slots...)"
+check "help hooks" 0 "$plant" help hooks
+contains "help hooks lists before_step" "$tmp/stdout" "before_step"
+check "help operators" 0 "$plant" help operators
+contains "help operators lists &&" "$tmp/stdout" "&&"
 check "help formats" 0 "$plant" help formats
 contains "help formats" "$tmp/stdout" ".skel.json"
 check "help repl" 0 "$plant" help repl

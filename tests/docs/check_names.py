@@ -4,8 +4,8 @@
     tests/docs/check_names.py PLANT SOURCE_DIR
 
 Every name `plant help TOPIC --names` prints must appear as code (between backticks) in the
-document that describes it. A new built-in, environment method, REPL command or output format
-therefore cannot land without a line in the docs. Adding a topic is one row in TOPICS.
+document that describes it. A new built-in, turtle symbol, hook, setting, operator, environment method, REPL command
+or output format therefore cannot land without a line in the docs. Adding a topic is one row in TOPICS.
 """
 import re
 import subprocess
@@ -16,6 +16,10 @@ import sys
 #   prefix: at the start of the span, not followed by a letter or digit (`:step [N]`, `.glb`)
 TOPICS = [
     (["builtins"], "docs/language.md", "word"),
+    (["turtle"], "docs/language.md", "prefix"),
+    (["hooks"], "docs/language.md", "word"),
+    (["settings"], "docs/language.md", "word"),
+    (["operators"], "docs/language.md", "word"),
     (["env"], "docs/language.md", "word"),  # the kinds; their methods below
     (["repl"], "README.md", "prefix"),
     (["formats"], "README.md", "prefix"),
