@@ -147,13 +147,15 @@ void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list) {
                                           info.name, info.arity, info.arity == 1 ? "" : "s", nargs,
                                           where(info.decl_span)));
             }
-            if (sym == P_.symbols.open_bracket || sym == P_.symbols.close_bracket) {
-                if (nargs) diags_->error(m.span, "brackets take no parameters");
+            if (info.turtle_op == TurtleOp::Push || info.turtle_op == TurtleOp::Pop) {
+                // the turtle table's only count it enforces: brackets take none
+                if (nargs > turtle_symbol(info.turtle_op)->max_params)
+                    diags_->error(m.span, "brackets take no parameters");
                 emit(c, Op::Emit, static_cast<std::int32_t>(sym), 0, m.span);
                 continue;
             }
             std::vector<Span> arg_spans;
-            const bool communication = info.query && info.name == "?E";
+            const bool communication = info.turtle_op == TurtleOp::Communicate;
             for (std::size_t i = 0; i < nargs; ++i) {
                 // ?E(env, slots...): the first argument names an environment, which is kept as its index
                 if (communication && i == 0) {

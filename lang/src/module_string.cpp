@@ -1,4 +1,4 @@
-// The module string's helpers and its printed form (LANGUAGE.md section 11).
+// The module string's helpers and its printed form (docs/language.md, printing strings).
 #include "plant/derive.hpp"
 
 #include <fmt/format.h>

@@ -33,7 +33,7 @@ function ol(axiom, productions) {
 }
 
 // lindenmayer.js walks a right context past the ']' that closes the current branch and keeps
-// matching in the parent axis. cpfg, L-Py and LANGUAGE.md section 4 do not: a symbol whose axis
+// matching in the parent axis. cpfg, L-Py and plant (docs/language.md, productions) do not: a symbol whose axis
 // ends (a ']' or the end of the string, after ignored symbols and skipped lateral branches) has
 // no right context at all. This guard, used as the production's condition, rejects exactly those
 // symbols; for every other symbol lindenmayer.js's own match decides.
@@ -197,7 +197,7 @@ function fromLindenmayer(axiom) {
     return axiom.map((m) => ({ name: m.symbol, params: m.params ?? [] }));
 }
 
-// Parses `plant derive` output (LANGUAGE.md section 11): modules back to back, each an
+// Parses `plant derive` output (docs/language.md, printing strings): modules back to back, each an
 // @-, ?- or ~-name, a single symbol, or a letter; `multi` lists multi-letter names to read by
 // longest match (a space separates such a name from a following letter). Parameters in
 // parentheses, separated by commas.

@@ -1,6 +1,6 @@
-// The module string: flat arrays, no per-module heap objects (ARCHITECTURE.md, "Data that
-// matters for speed"). Module i has symbol sym[i], parameters params[poff[i] .. poff[i+1]) and
-// the identity ids[i] (LANGUAGE.md section 6). Vec3 parameters occupy three consecutive doubles.
+// The module string: flat arrays, no per-module heap objects (docs/design.md, the module
+// string). Module i has symbol sym[i], parameters params[poff[i] .. poff[i+1]) and
+// the identity ids[i] (docs/language.md, module identity). Vec3 parameters occupy three consecutive doubles.
 //
 // A string may go without identities (keep_ids false, ids empty): a derivation whose identities
 // nobody can observe (`plant derive` without --ids, a program that never calls id() and has no

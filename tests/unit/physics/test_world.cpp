@@ -1,4 +1,4 @@
-// The particle runtime's checks from PLANTS.md (climber section) that its first part supports.
+// The particle runtime's checks that docs/physics.md lists, from Hädrich et al. 2017.
 #define GLM_ENABLE_EXPERIMENTAL
 #include "plant/physics/world.hpp"
 

@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Fails when a C++ source file passes 800 lines or a function body passes 120 lines.
+"""Fails when a C++ source file passes 800 lines, a function body passes 120 lines, or a tracked
+file cites design notes that are not in the repository (docs/ is the reference).
 
 The house rule (docs/architecture.md, "Files and functions"): a file or function that grows past
 these is split by concept. The VM's dispatch loop is the one function allowed to be longer.
@@ -9,7 +10,7 @@ noexcept, override, a trailing return type or an initializer list) and is not a 
 statement; its length runs to the matching closing brace, counted by brace depth outside string
 and character literals and comments.
 
-usage: check_sizes.py REPO_ROOT
+usage: check_style.py REPO_ROOT
 """
 import re
 import subprocess
@@ -86,6 +87,27 @@ def functions(path):
     return len(lines), found
 
 
+# Notes the project was started from, which are not part of it: cite docs/ or the paper instead.
+OUTSIDE_NOTES = re.compile(r"\b(LANGUAGE|ARCHITECTURE|PLANTS|STYLE)\.md\b|shared/design")
+
+
+def outside_citations(root):
+    tracked = subprocess.run(["git", "-C", root, "ls-files"], capture_output=True, text=True,
+                             check=True).stdout.split()
+    found = []
+    for rel in tracked:
+        if rel == "tests/style/check_style.py" or "node_modules/" in rel:
+            continue
+        try:
+            with open(f"{root}/{rel}", encoding="utf-8") as f:
+                for n, line in enumerate(f, 1):
+                    if OUTSIDE_NOTES.search(line):
+                        found.append(f"{rel}:{n}: cites design notes outside the repository; cite docs/ or the paper")
+        except (UnicodeDecodeError, IsADirectoryError):
+            continue
+    return found
+
+
 def main():
     root = sys.argv[1] if len(sys.argv) > 1 else "."
     files = subprocess.run(["git", "-C", root, "ls-files", "*.cpp", "*.hpp", "*.h"],
@@ -98,9 +120,10 @@ def main():
         for name, line, length in fns:
             if length > MAX_FUNCTION and (rel, name) not in ALLOWED:
                 problems.append(f"{rel}:{line}: function '{name}' is {length} lines (at most {MAX_FUNCTION})")
+    problems += outside_citations(root)
     for p in problems:
         print(p)
-    print(f"check_sizes: {len(files)} files, {len(problems)} problems")
+    print(f"check_style: {len(files)} files, {len(problems)} problems")
     return 1 if problems else 0
 
 
