@@ -48,7 +48,7 @@ std::string Session::session_source(const std::string* extra_fn) const {
     }
     if (!edits_.empty()) {
         // each edit on lines of its own, so that an error points into what the user typed
-        s += "on before_step {\n";
+        s += fmt::format("on {} {{\n", ast::spelling(ast::HookKind::BeforeStep));
         for (const auto& [at, statements] : edits_)
             s += fmt::format("if step() == {} {{\n{}\n}}\n", at, statements);
         s += "}\n";
