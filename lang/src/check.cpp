@@ -27,13 +27,18 @@ void Compiler::check_defines_used() {
     }
 }
 
-// `module Seg(len, r) bound ivy;` needs ivy to be of a kind that holds segments (a climber)
+// `module Seg(len, r) bound ivy;` needs ivy to be of a kind that holds segments (a climber); the
+// module keeps ivy's index, so that nothing looks it up by name while deriving
 void Compiler::check_bound_modules() {
-    for (const auto& info : P_.symbols.all()) {
+    for (std::size_t k = 0; k < P_.symbols.size(); ++k) {
+        SymbolInfo& info = P_.symbols[static_cast<SymbolId>(k)];
         if (info.bound_to.empty()) continue;
         const EnvironmentDecl* decl = nullptr;
-        for (const EnvironmentDecl& d : P_.environments)
-            if (d.name == info.bound_to) decl = &d;
+        for (std::size_t e = 0; e < P_.environments.size(); ++e)
+            if (P_.environments[e].name == info.bound_to) {
+                decl = &P_.environments[e];
+                info.bound_env = static_cast<int>(e);
+            }
         if (!decl)
             diags_->error(info.decl_span,
                           fmt::format("module '{}' is bound to '{}', which is not an environment; "

@@ -206,24 +206,7 @@ void Compiler::compile_settings(const ast::File& f) {
             continue;
         }
         seen[s.key] = s.span;
-        Code* target = &P_.setting_seed;
-        switch (s.key) {
-        case Key::Derive:
-            target = &P_.setting_derive;
-            break;
-        case Key::Angle:
-            target = &P_.setting_angle;
-            break;
-        case Key::Step:
-            target = &P_.setting_step;
-            break;
-        case Key::Width:
-            target = &P_.setting_width;
-            break;
-        case Key::Seed:
-            target = &P_.setting_seed;
-            break;
-        }
+        Code* target = &P_.settings[static_cast<std::size_t>(s.key)];
         *target = Code{};
         Ctx c;
         c.code = target;

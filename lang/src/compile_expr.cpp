@@ -162,9 +162,11 @@ std::vector<std::string> Compiler::visible_names(Ctx& c) const {
     return out;
 }
 
-void Compiler::unknown_name(Ctx& c, const std::string& name, Span span, const char* what) {
+void Compiler::unknown_name(Ctx& c, const std::string& name, Span span, Unknown kind) {
+    static constexpr const char* kWhat[] = {"name", "function", "variable"};
+    const char* what = kWhat[static_cast<int>(kind)];
     std::vector<std::string> names = visible_names(c);
-    if (std::string(what) == "function") {
+    if (kind == Unknown::Function) { // the suggestion comes from the callables
         names.clear();
         for (const auto& f : P_.functions) names.push_back(f.name);
         for (const auto& b : builtin_table()) names.emplace_back(b.name);
@@ -277,7 +279,7 @@ ValueType Compiler::compile_name(Ctx& c, const ast::Expr& e) {
             e.span, fmt::format("environment '{}' can only be queried with a method, as in '{}.contains(p)'",
                                 e.text, e.text));
     } else {
-        unknown_name(c, e.text, e.span, "name");
+        unknown_name(c, e.text, e.span, Unknown::Name);
     }
     emit_const(c, 0, e.span);
     return ValueType::Number;
@@ -467,7 +469,7 @@ ValueType Compiler::compile_call(Ctx& c, const ast::Expr& e) {
         return b.result;
     }
     if (!name_known) {
-        unknown_name(c, name, e.span, "function");
+        unknown_name(c, name, e.span, Unknown::Function);
     } else if (!arity_match) {
         std::string counts;
         for (const auto& b : builtin_table())

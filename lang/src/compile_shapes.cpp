@@ -58,7 +58,6 @@ void Compiler::compile_curve(const ast::ShapeDecl& s) {
 void Compiler::compile_surface(const ast::ShapeDecl& s) {
     SurfaceDef def;
     def.name = s.name;
-    def.kind = s.kind;
     def.span = s.span;
     // a surface in an importing file replaces the library's (libraries are compiled first), so a
     // user swaps a default leaf for load("my_leaf.obj"); twice in one file is an error
@@ -72,6 +71,7 @@ void Compiler::compile_surface(const ast::ShapeDecl& s) {
         replace = i;
     }
     if (s.kind == "polygon") {
+        def.kind = SurfaceKind::Polygon;
         for (const auto& a : s.args) {
             auto v = eval_const(*a, "a polygon corner");
             if (!v) return;
@@ -87,6 +87,7 @@ void Compiler::compile_surface(const ast::ShapeDecl& s) {
             return;
         }
     } else if (s.kind == "load") {
+        def.kind = SurfaceKind::Load;
         if (s.args.size() != 1 || s.args[0]->kind != ast::ExprKind::String) {
             diags_->error(s.span, "load(...) takes one quoted file name, as in load(\"leaf.obj\")");
             return;

@@ -121,7 +121,8 @@ void Compiler::compile_for(Ctx& c, const ast::Stmt& s) {
 void Compiler::compile_use(Ctx& c, const ast::Stmt& s) {
     if (c.kind != CtxKind::Hook) {
         diags_->error(s.span, fmt::format("'use' is allowed only in hooks (on {}, on {}, ...)",
-                                          ast::kHooks[0].spelling, ast::kHooks[1].spelling));
+                                          ast::spelling(ast::HookKind::Start),
+                                          ast::spelling(ast::HookKind::BeforeStep)));
         return;
     }
     int g = s.name == "none" ? -1 : P_.group_index(s.name);
@@ -243,7 +244,7 @@ void Compiler::compile_assign(Ctx& c, const ast::Stmt& s) {
         emit(c, Op::StoreGlobal, static_cast<std::int32_t>(g.slot), value_width(g.type), s.span);
         return;
     }
-    unknown_name(c, s.name, s.span, "variable");
+    unknown_name(c, s.name, s.span, Unknown::Variable);
 }
 
 void Compiler::compile_hooks(const ast::File& f) {

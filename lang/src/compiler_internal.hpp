@@ -135,7 +135,9 @@ class Compiler {
     const LocalVar* find_local(Ctx& c, const std::string& name) const;
     std::uint16_t add_local(Ctx& c, const std::string& name, ValueType t);
     std::vector<std::string> visible_names(Ctx& c) const;
-    void unknown_name(Ctx& c, const std::string& name, Span span, const char* what);
+    // What an unknown name was used as: it words the message and picks the suggestions.
+    enum class Unknown : std::uint8_t { Name, Function, Variable };
+    void unknown_name(Ctx& c, const std::string& name, Span span, Unknown kind);
     void type_error(Span span, const std::string& op, ValueType a, ValueType b);
     void duplicate(const std::string& what, const std::string& name, Span here, Span first);
     std::string where(Span s) const;

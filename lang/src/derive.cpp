@@ -86,25 +86,29 @@ void Derivation::start() {
     env.prog = &prog_;
     env.run = &run_;
     env.globals = globals_.data();
-    auto setting = [&](const Code& c, double fallback) {
+    using Key = ast::SettingKey;
+    auto setting = [&](Key key, double fallback) {
+        const Code& c = prog_.setting(key);
         return c.empty() ? fallback : eval_number(c, nullptr, env);
     };
-    double steps = opt_.steps ? *opt_.steps : setting(prog_.setting_derive, 0);
+    auto where = [&](Key key) {
+        const Code& c = prog_.setting(key);
+        return c.spans.empty() ? Span{} : c.spans.back();
+    };
+    double steps = opt_.steps ? *opt_.steps : setting(Key::Derive, 0);
     if (steps < 0 || steps > 1e6 || steps != std::floor(steps))
         throw RuntimeError{
-            RuntimeErrorKind::Setting,
-            prog_.setting_derive.spans.empty() ? Span{} : prog_.setting_derive.spans.back(),
+            RuntimeErrorKind::Setting, where(Key::Derive),
             fmt::format("the number of steps must be a whole number from 0 to 1000000, found {}", steps)};
     target_ = static_cast<int>(steps);
-    double seed = setting(prog_.setting_seed, 0);
+    double seed = setting(Key::Seed, 0);
     if (!(seed >= 0 && seed < 9.0e18) || seed != std::floor(seed))
-        throw RuntimeError{RuntimeErrorKind::Setting,
-                           prog_.setting_seed.spans.empty() ? Span{} : prog_.setting_seed.spans.back(),
+        throw RuntimeError{RuntimeErrorKind::Setting, where(Key::Seed),
                            fmt::format("the seed must be a whole number from 0 to 9e18, found {}", seed)};
     seed_ = opt_.seed ? *opt_.seed : static_cast<std::uint64_t>(seed);
-    angle_ = setting(prog_.setting_angle, 90);
-    step_length_ = setting(prog_.setting_step, 1);
-    width_ = setting(prog_.setting_width, 0.1); // a tenth of the default step: a slender branch
+    angle_ = setting(Key::Angle, 90);
+    step_length_ = setting(Key::Step, 1);
+    width_ = setting(Key::Width, 0.1); // a tenth of the default step: a slender branch
     step_ = 0;
     stopped_ = false;
     group_ = -1;

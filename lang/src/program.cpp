@@ -18,9 +18,10 @@ SymbolTable::SymbolTable() {
         info.declared =
             info.query || (t.name.size() > 1 && std::isalpha(static_cast<unsigned char>(t.name[0])));
     }
-    open_bracket = *find("[");
-    close_bracket = *find("]");
-    cut = *find("%");
+    auto by_op = [&](TurtleOp op) { return *find(turtle_symbol(op)->name); };
+    open_bracket = by_op(TurtleOp::Push);
+    close_bracket = by_op(TurtleOp::Pop);
+    cut = by_op(TurtleOp::Cut);
 }
 
 SymbolId SymbolTable::intern(std::string_view name) {

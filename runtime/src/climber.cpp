@@ -337,7 +337,7 @@ namespace {
 struct ClimberArgs {
     physics::Settings s;
     Climber::Config c;
-    ObstacleArgs shapes{"climber"};
+    ObstacleArgs shapes{climber_kind().name};
     std::vector<glm::dvec3> attract, emit_at, emit_v;
     std::vector<double> attract_r, attract_s, emit_r;
     double friction = 0.5, elasticity = 0.0, break_threshold = 0;
@@ -532,7 +532,7 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
     for (const physics::Obstacle& o : obstacles) add(o);
     for (const auto& path : p.meshes) {
         std::vector<Triangle> mesh;
-        if (!load_triangles(path, mesh, "climber", error)) return nullptr;
+        if (!load_triangles(path, mesh, climber_kind().name, error)) return nullptr;
         physics::Obstacle o;
         o.kind = physics::Obstacle::Grid;
         o.grid = distance_grid(mesh, p.mesh_cell, 4 * p.mesh_cell + p.c.adaption_range);

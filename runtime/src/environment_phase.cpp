@@ -74,12 +74,10 @@ void advance_bound(const Derivation& d, RunState& state, ModuleString& string) {
     std::vector<Environment*> by_symbol(p.symbols.size(), nullptr);
     std::vector<Environment*> holders;
     for (std::size_t k = 0; k < p.symbols.size(); ++k) {
-        const std::string& env = p.symbols.all()[k].bound_to;
-        if (env.empty()) continue;
-        for (std::size_t e = 0; e < state.size(); ++e)
-            if (p.environments[e].name == env && state.environment(e) &&
-                state.environment(e)->kind().holds_segments)
-                by_symbol[k] = state.environment(e);
+        const int e = p.symbols.all()[k].bound_env;
+        if (e < 0 || static_cast<std::size_t>(e) >= state.size()) continue;
+        Environment* env = state.environment(static_cast<std::size_t>(e));
+        if (env && env->kind().holds_segments) by_symbol[k] = env;
     }
     for (std::size_t e = 0; e < state.size(); ++e)
         if (state.environment(e) && state.environment(e)->kind().holds_segments)

@@ -501,7 +501,7 @@ class Light : public Environment {
 using Made = std::unique_ptr<Environment>;
 
 Made make_ellipsoid(const std::vector<EnvArg>& args, std::string& error) {
-    Args a("ellipsoid", args, error);
+    Args a(kEllipsoid.name, args, error);
     if (!a.only({"center", "radii"})) return nullptr;
     const EnvArg* c = a.find("center", V);
     const EnvArg* r = a.find("radii", V);
@@ -515,7 +515,7 @@ Made make_ellipsoid(const std::vector<EnvArg>& args, std::string& error) {
 }
 
 Made make_proximity(const std::vector<EnvArg>& args, std::string& error) {
-    Args a("proximity", args, error);
+    Args a(kProximity.name, args, error);
     if (!a.only({"radius"})) return nullptr;
     const EnvArg* r = a.find("radius", N);
     if (!a.ok()) return nullptr;
@@ -528,15 +528,15 @@ Made make_proximity(const std::vector<EnvArg>& args, std::string& error) {
 }
 
 Made make_obstacles(const std::vector<EnvArg>& args, std::string& error) {
-    Args a("obstacles", args, error);
+    Args a(kObstacles.name, args, error);
     if (!a.only({"sphere", "sphere_radius", "box_min", "box_max", "plane_point", "plane_normal", "mesh"}))
         return nullptr;
     auto o = std::make_unique<Obstacles>();
-    ObstacleArgs shapes("obstacles");
+    ObstacleArgs shapes(kObstacles.name);
     for (const auto& arg : args) {
         if (arg.key == "mesh") {
             if (!shapes.mesh(arg, error)) return nullptr;
-            if (!load_triangles(arg.text, o->triangles, "obstacles", error)) return nullptr;
+            if (!load_triangles(arg.text, o->triangles, kObstacles.name, error)) return nullptr;
             continue;
         }
         if (!shapes.read(arg, error)) return nullptr;
@@ -546,7 +546,7 @@ Made make_obstacles(const std::vector<EnvArg>& args, std::string& error) {
 }
 
 Made make_envelope(const std::vector<EnvArg>& args, std::string& error) {
-    Args a("envelope", args, error);
+    Args a(kEnvelope.name, args, error);
     if (!a.only({"top", "bottom", "px", "pz", "nx", "nz", "top_shape", "bottom_shape"})) return nullptr;
     auto e = std::make_unique<Envelope>();
     const EnvArg *t = a.find("top", V), *b = a.find("bottom", V);
@@ -581,7 +581,7 @@ Made make_envelope(const std::vector<EnvArg>& args, std::string& error) {
 }
 
 Made make_light(const std::vector<EnvArg>& args, std::string& error) {
-    Args a("light", args, error);
+    Args a(kLight.name, args, error);
     if (!a.only({"direction", "resolution", "opacity"})) return nullptr;
     const EnvArg *d = a.find("direction", V), *res = a.find("resolution", N), *op = a.find("opacity", N);
     if (!a.ok()) return nullptr;

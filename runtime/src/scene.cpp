@@ -208,7 +208,7 @@ MeshPart organ_mesh(const Program& program, const OrganShape& shape) {
     case OrganKind::Surface:
         for (auto it = program.surfaces.rbegin(); it != program.surfaces.rend(); ++it)
             if (it->name == shape.name)
-                return it->kind == "load" ? loaded_prototype(*it) : polygon_prototype(*it);
+                return it->kind == SurfaceKind::Load ? loaded_prototype(*it) : polygon_prototype(*it);
         throw RuntimeError(RuntimeErrorKind::Geometry, Span{},
                            fmt::format("'~{}' places a surface that is not declared: add "
                                        "'surface {} = polygon(...);'",

@@ -289,8 +289,9 @@ void Turtle::apply(TurtleOp op, std::size_t i) {
             {OrganKind::Sphere, {}}, frame_matrix(t_, arg(i, 0, t_.width / 2)), t_.color, i, s_.id(i)});
         break;
     case TurtleOp::Surface:
-        // "~name": the surface's name follows the '~'
-        sink_.organ(TurtleOrgan{{OrganKind::Surface, program_.symbols[s_.sym[i]].name.substr(1)},
+        // "~name": the surface's name follows the prefix row's name
+        sink_.organ(TurtleOrgan{{OrganKind::Surface, program_.symbols[s_.sym[i]].name.substr(
+                                                         turtle_symbol(TurtleOp::Surface)->name.size())},
                                 frame_matrix(t_, arg(i, 0, 1.0)),
                                 t_.color,
                                 i,

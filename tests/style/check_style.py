@@ -88,7 +88,7 @@ def functions(path):
 
 
 # Notes the project was started from, which are not part of it: cite docs/ or the paper instead.
-OUTSIDE_NOTES = re.compile(r"\b(LANGUAGE|ARCHITECTURE|PLANTS|STYLE)\.md\b|shared/design")
+OUTSIDE_NOTES = re.compile(r"\b(LANGUAGE|ARCHITECTURE|PLANTS|STYLE)\.md\b|shared/(design|papers)")
 
 
 def outside_citations(root):

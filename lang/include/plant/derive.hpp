@@ -92,7 +92,6 @@ class Derivation {
     void run();
 
     const ModuleString& string() const { return current_; }
-    ModuleString& mutable_string() { return current_; }
     int steps_done() const { return step_; }
     int target_steps() const { return target_; }
     bool stopped() const { return stopped_; }
@@ -101,9 +100,9 @@ class Derivation {
     double default_step() const { return step_length_; }
     double default_width() const { return width_; }
     std::vector<double>& globals() { return globals_; }
+    const std::vector<double>& globals() const { return globals_; }
     int active_group() const { return group_; }
     void use_group(int group) { group_ = group; } // -1: none (the REPL's :use)
-    void set_seed(std::uint64_t seed) { seed_ = seed; }
     ModuleId next_id() const;
     const Program& program() const { return prog_; }
     // The live environments, made from the program's declarations by start().

@@ -33,7 +33,8 @@ struct SymbolInfo {
     int arity = -1;                      // declared parameter count; -1 when any count is accepted
     std::vector<ValueType> param_types;
     std::vector<std::string> param_names;
-    std::string bound_to; // the environment that holds its segments (`bound ivy`)
+    std::string bound_to; // the environment that holds its segments (`bound ivy`), as written
+    int bound_env = -1;   // its index in Program::environments, resolved by the compiler
     Span decl_span;
 };
 
@@ -237,9 +238,10 @@ struct CurveDef {
 };
 
 // `surface name = polygon(p0, p1, ...)` or `= load("file.obj")`, evaluated at compile time.
+enum class SurfaceKind : std::uint8_t { Polygon, Load };
 struct SurfaceDef {
     std::string name;
-    std::string kind;                          // polygon | load
+    SurfaceKind kind = SurfaceKind::Polygon;
     std::vector<std::array<double, 3>> points; // polygon corners
     std::string path;                          // load: resolved against the grammar's directory
     Span span;
@@ -277,8 +279,9 @@ struct Program {
     std::vector<Function> functions;
     std::vector<std::string> print_formats;
 
-    Code axiom; // emits the axiom's modules
-    Code setting_derive, setting_angle, setting_step, setting_width, setting_seed;
+    Code axiom;                                       // emits the axiom's modules
+    std::array<Code, ast::kSettings.size()> settings; // by ast::SettingKey; empty: not set
+    const Code& setting(ast::SettingKey key) const { return settings[static_cast<std::size_t>(key)]; }
     double default_angle = 90, default_step = 1, default_width = 1;
     std::vector<std::uint8_t> ignored; // per symbol: skipped when matching context
     bool uses_cut = false;             // some successor or the axiom produces '%'

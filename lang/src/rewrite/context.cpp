@@ -154,7 +154,8 @@ std::vector<std::size_t> find_matches(const Derivation& d, const Program& progra
     w.env.prog = &program;
     // another program (the REPL's :find compiles one) sees its environments as declared
     w.env.run = &program == &d.program() ? &d.run_state() : nullptr;
-    std::vector<double> globals = const_cast<Derivation&>(d).globals();
+    std::vector<double> globals =
+        d.globals(); // a copy: conditions may not write it, but the VM takes it writable
     w.env.globals = globals.data();
     w.env.seed = d.seed();
     w.env.step = d.steps_done();

@@ -17,9 +17,7 @@ namespace {
 std::vector<std::pair<std::string, const Code*>> all_code(const Program& p) {
     std::vector<std::pair<std::string, const Code*>> out;
     out.emplace_back("axiom", &p.axiom);
-    for (const Code* s :
-         {&p.setting_derive, &p.setting_angle, &p.setting_step, &p.setting_width, &p.setting_seed})
-        out.emplace_back("setting", s);
+    for (const Code& s : p.settings) out.emplace_back("setting", &s);
     for (const auto& f : p.functions) out.emplace_back("fn " + f.name, &f.code);
     for (std::size_t k = 0; k < p.hooks.size(); ++k)
         out.emplace_back(std::string("on ") + ast::spelling(static_cast<HookKind>(k)), &p.hooks[k]);
