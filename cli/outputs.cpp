@@ -32,11 +32,20 @@ std::string mesh_summary(const Scene& s) {
         s.bounds_min.z, s.bounds_max.x, s.bounds_max.y, s.bounds_max.z);
 }
 
-void write_scene_gltf(const OutputSources& from, const std::string& path) {
-    write_gltf(from.scene, path);
+void write_glb(const OutputSources& from, const std::string& path) {
+    write_gltf(from.scene, path, GltfContainer::Binary);
 }
-void write_scene_mesh(const OutputSources& from, const std::string& path) {
-    write_mesh_file(from.scene, path); // OBJ, PLY or OFF by the path's extension
+void write_gltf_json(const OutputSources& from, const std::string& path) {
+    write_gltf(from.scene, path, GltfContainer::Json);
+}
+void write_obj(const OutputSources& from, const std::string& path) {
+    write_mesh_file(from.scene, path, MeshFileFormat::Obj);
+}
+void write_ply(const OutputSources& from, const std::string& path) {
+    write_mesh_file(from.scene, path, MeshFileFormat::Ply);
+}
+void write_off(const OutputSources& from, const std::string& path) {
+    write_mesh_file(from.scene, path, MeshFileFormat::Off);
 }
 void write_scene_png(const OutputSources& from, const std::string& path) {
     write_png(from.scene, path, from.options.width, from.options.height);
@@ -56,12 +65,12 @@ void write_mesh_summary(const OutputSources& from, const std::string& path) {
 
 // Adding a format: one row here and its writer above (docs: README.md lists the extensions).
 constexpr OutputFormat kFormats[] = {
-    {".glb", OutputNeeds::Scene, write_scene_gltf,
+    {".glb", OutputNeeds::Scene, write_glb,
      "glTF 2.0, binary; each organ is one mesh shared by every node that places it"},
-    {".gltf", OutputNeeds::Scene, write_scene_gltf, "glTF 2.0 as JSON, the buffer embedded as a data URI"},
-    {".obj", OutputNeeds::Scene, write_scene_mesh, "Wavefront OBJ, everything in one triangle mesh"},
-    {".ply", OutputNeeds::Scene, write_scene_mesh, "PLY, everything in one triangle mesh"},
-    {".off", OutputNeeds::Scene, write_scene_mesh, "OFF, everything in one triangle mesh"},
+    {".gltf", OutputNeeds::Scene, write_gltf_json, "glTF 2.0 as JSON, the buffer embedded as a data URI"},
+    {".obj", OutputNeeds::Scene, write_obj, "Wavefront OBJ, everything in one triangle mesh"},
+    {".ply", OutputNeeds::Scene, write_ply, "PLY, everything in one triangle mesh"},
+    {".off", OutputNeeds::Scene, write_off, "OFF, everything in one triangle mesh"},
     {".png", OutputNeeds::Scene, write_scene_png, "a shaded preview from a 3/4 view, --size pixels"},
     {".svg", OutputNeeds::Skeleton, write_skeleton_svg, "a line drawing of the XY plane, for 2D grammars"},
     {".txt", OutputNeeds::String, write_string_text, "the derived string, as plant derive prints it"},

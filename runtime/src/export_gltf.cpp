@@ -128,13 +128,6 @@ namespace {
 constexpr int array_buffer = 34962;         // ARRAY_BUFFER
 constexpr int element_array_buffer = 34963; // ELEMENT_ARRAY_BUFFER
 
-std::string lower_extension(const std::string& path) {
-    std::string ext = fs::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    return ext;
-}
-
 // The double nearest to the shortest decimal that reads back as `f`: JSON then shows 0.1 for
 // 0.1f instead of 0.10000000149011612. Not for accessor min and max, which must match the data.
 double tidy(float f) {
@@ -339,11 +332,8 @@ struct GltfBuilder {
 
 } // namespace
 
-void write_gltf(const Scene& scene, const std::string& path) {
-    const std::string ext = lower_extension(path);
-    if (ext != ".glb" && ext != ".gltf")
-        throw ExportError("cannot write " + quoted(path) + ": a glTF file name must end in .glb or .gltf");
-    const bool binary = ext == ".glb";
+void write_gltf(const Scene& scene, const std::string& path, GltfContainer container) {
+    const bool binary = container == GltfContainer::Binary;
 
     Scene flat;
     GltfBuilder builder(exported_scene(scene, flat, "glTF export"));

@@ -85,13 +85,10 @@ class Flattener {
 
 } // namespace
 
-void write_mesh_file(const Scene& given, const std::string& path) {
-    std::string ext = fs::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    if (ext != ".obj" && ext != ".ply" && ext != ".off")
-        throw ExportError("cannot write " + quoted(path) +
-                          ": a mesh file name must end in .obj, .ply or .off");
+void write_mesh_file(const Scene& given, const std::string& path, MeshFileFormat format) {
+    // OpenMesh picks its writer by an extension, whatever the file is called
+    static constexpr const char* kOpenMeshExtension[] = {".obj", ".ply", ".off"};
+    const std::string ext = kOpenMeshExtension[static_cast<int>(format)];
     quiet_openmesh();
     Scene flattened;
     const Scene& scene = exported_scene(given, flattened, "mesh export");
@@ -120,7 +117,7 @@ void write_mesh_file(const Scene& given, const std::string& path) {
 
     OpenMesh::IO::Options options(OpenMesh::IO::Options::VertexNormal);
     // OFF stays plain NOFF: few readers understand texture coordinates in OFF files.
-    if (ext != ".off") options += OpenMesh::IO::Options::VertexTexCoord;
+    if (format != MeshFileFormat::Off) options += OpenMesh::IO::Options::VertexTexCoord;
 
     std::ostringstream out(std::ios::out | std::ios::binary);
     if (!OpenMesh::IO::write_mesh(mesh, out, ext, options, 7))

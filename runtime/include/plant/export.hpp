@@ -25,15 +25,20 @@ const Scene& exported_scene(const Scene& scene, Scene& storage, const std::strin
 // Writes `bytes` to `path` through a temporary file and a rename.
 void write_file_atomically(const std::string& path, const std::string& bytes);
 
-// .glb (binary) or .gltf (JSON with the buffer embedded as a data URI): one buffer, the tubes as
-// one mesh, each prototype as a mesh shared by all nodes that place it, one material per color.
-void write_gltf(const Scene& scene, const std::string& path);
+// glTF's two containers: binary (.glb), or JSON with the buffer embedded as a data URI (.gltf).
+enum class GltfContainer : std::uint8_t { Binary, Json };
+// One buffer, the tubes as one mesh, each prototype as a mesh shared by all nodes that place it,
+// one material per color. The caller names the container; the path's extension is not read.
+void write_gltf(const Scene& scene, const std::string& path, GltfContainer container);
 
 // A PNG preview: software rasterizer with a z-buffer and Lambert shading, a 3/4 view framed on
 // the scene's bounding box, white background.
 void write_png(const Scene& scene, const std::string& path, int width, int height);
 
-// .obj, .ply or .off through OpenMesh, everything flattened into one triangle mesh.
-void write_mesh_file(const Scene& scene, const std::string& path);
+// The mesh files OpenMesh writes for us.
+enum class MeshFileFormat : std::uint8_t { Obj, Ply, Off };
+// Everything flattened into one triangle mesh with vertex normals (and texture coordinates, but
+// for OFF), written through OpenMesh in `format`; the path's extension is not read.
+void write_mesh_file(const Scene& scene, const std::string& path, MeshFileFormat format);
 
 } // namespace plant

@@ -68,9 +68,9 @@ TEST_CASE("an empty scene renders a blank image", "[export][png]") {
 
 TEST_CASE("writers leave no partial file when they fail", "[export]") {
     Scene s = scene_of("axiom: F;");
-    CHECK_THROWS_AS(write_gltf(s, "/nonexistent-dir/x.glb"), ExportError);
-    CHECK_THROWS_AS(write_mesh_file(s, "/tmp/plant-test.xyz"), ExportError);
-    CHECK(!std::filesystem::exists("/tmp/plant-test.xyz"));
+    CHECK_THROWS_AS(write_gltf(s, "/nonexistent-dir/x.glb", GltfContainer::Binary), ExportError);
+    CHECK_THROWS_AS(write_mesh_file(s, "/nonexistent-dir/x.obj", MeshFileFormat::Obj), ExportError);
+    CHECK(!std::filesystem::exists("/nonexistent-dir"));
 }
 
 TEST_CASE("the skeleton JSON lists axes with points and organs with matrices", "[export]") {
@@ -139,11 +139,11 @@ TEST_CASE("a scene placed as a prototype is flattened by its transforms for ever
     for (const char* ext : {".obj", ".glb"}) {
         const std::string a = dir + "/nested" + ext, b = dir + "/flat" + ext;
         if (std::string(ext) == ".obj") {
-            write_mesh_file(outer, a);
-            write_mesh_file(flat, b);
+            write_mesh_file(outer, a, MeshFileFormat::Obj);
+            write_mesh_file(flat, b, MeshFileFormat::Obj);
         } else {
-            write_gltf(outer, a);
-            write_gltf(flat, b);
+            write_gltf(outer, a, GltfContainer::Binary);
+            write_gltf(flat, b, GltfContainer::Binary);
         }
         CHECK(!file_bytes(a).empty());
         const bool same_bytes = file_bytes(a) == file_bytes(b);
@@ -156,6 +156,6 @@ TEST_CASE("a scene placed as a prototype is flattened by its transforms for ever
 
     // a placement of a scene prototype that is not there is an export error
     outer.scene_instances.push_back(Instance{3, right});
-    CHECK_THROWS_AS(write_gltf(outer, dir + "/broken.glb"), ExportError);
+    CHECK_THROWS_AS(write_gltf(outer, dir + "/broken.glb", GltfContainer::Binary), ExportError);
     std::filesystem::remove_all(dir);
 }
