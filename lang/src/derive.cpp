@@ -1,6 +1,7 @@
 // The derivation's lifecycle: settings and the axiom (start), steps, hooks, the end. One step:
-// hooks, then (if some production reads query modules) a turtle pass, then the rewrite,
-// decomposition and cut (the engine, rewrite/engine.cpp), then hooks again.
+// hooks, then the environment phase (when some production reads query modules or the program
+// declares environments), then the rewrite, decomposition and cut (the engine,
+// rewrite/engine.cpp), then hooks again.
 #include "plant/derive.hpp"
 #include "plant/environment.hpp"
 

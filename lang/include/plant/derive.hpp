@@ -29,6 +29,9 @@ class EngineHandle {
     EngineHandle(const EngineHandle& other);
     EngineHandle& operator=(const EngineHandle&) = delete;
     ~EngineHandle();
+    // Non-const from a const derivation: the engine's caches (rule plans built on first use,
+    // scratch buffers) fill as a const Derivation is read, as in interpreted(). They change no
+    // result, but one derivation must not be read from two threads at once.
     Engine* operator->() const { return engine_.get(); }
     Engine& operator*() const { return *engine_; }
 
