@@ -269,7 +269,15 @@ class World {
     // Particle j's goal from the groups' frames (Eq. 3-4).
     glm::dvec3 goal_of(std::uint32_t j, const std::vector<Frame>& frames, const Groups& groups) const;
     double stiffness(std::uint32_t i) const;
-    void separate_particles();
+
+    // The phases of step(), in order (world.cpp, shape_matching.cpp, collisions.cpp).
+    void predict();             // Eq. 1: predicted positions; the old ones go to scratch_.old
+    void pull_to_anchors();     // Eq. 5, letting go of anchors too far away
+    void refresh_groups();      // rebuilds the groups and rest moments when they are stale
+    void match_shapes_passes(); // the shape-matching passes: positions toward their goals, then orientations
+    void separate_particles();  // contacts between particles (section 5.2)
+    void integrate();           // Eq. 17-18 with damping, and contacts with obstacles
+    void break_overstretched(); // connections stretched past the break threshold let go
 
     Settings settings_;
     std::vector<glm::dvec3> x_, v_, rest_x_, radii_;
