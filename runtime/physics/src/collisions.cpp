@@ -9,20 +9,32 @@
 
 namespace plant::physics {
 
-double Obstacle::distance(const glm::dvec3& p) const {
-    switch (kind) {
-    case Sphere:
+namespace {
+
+// Obstacle::distance, declared inline: GCC allows a function declared inline a larger inlining
+// budget, and the integration's loop over the obstacles (integrate()) wants it inlined, as it was
+// when the whole step was one file
+inline double signed_distance(const Obstacle& o, const glm::dvec3& p) {
+    const glm::dvec3 &a = o.a, &b = o.b;
+    switch (o.kind) {
+    case Obstacle::Sphere:
         return glm::length(p - a) - b.x;
-    case Box: {
+    case Obstacle::Box: {
         glm::dvec3 c = (a + b) * 0.5, h = (b - a) * 0.5, q = glm::abs(p - c) - h;
         return glm::length(glm::max(q, glm::dvec3(0.0))) + std::min(std::max(q.x, std::max(q.y, q.z)), 0.0);
     }
-    case Plane:
+    case Obstacle::Plane:
         return glm::dot(p - a, glm::normalize(b));
-    case Grid:
-        return grid ? grid->sample(p - a) : 1e300;
+    case Obstacle::Grid:
+        return o.grid ? o.grid->sample(p - a) : 1e300;
     }
     return 1e300;
+}
+
+} // namespace
+
+double Obstacle::distance(const glm::dvec3& p) const {
+    return signed_distance(*this, p);
 }
 
 double DistanceGrid::sample(const glm::dvec3& p) const {
