@@ -45,7 +45,7 @@ void World::group_moments(const Groups& g, std::vector<glm::dmat3>& each,
     each.resize(n);
     sums.resize(n);
     // Eq. 15's moment R D R̄ᵀ: the rest part D R̄ᵀ (with the mass) changes only with growth and
-    // is kept with the groups (step()); here only the current rotation enters
+    // is kept with the groups (refresh_groups()); here only the current rotation enters
     const bool cached = !groups_stale_ && scratch_.rest_moment.size() == n;
     auto one = [&](std::size_t j) {
         if (alive_[j])

@@ -1,7 +1,9 @@
 // Oriented-particle plant dynamics after Hädrich et al. 2017 (climbing-plants-particles.txt,
-// section 4.1 and the appendix), usable from C++ without the language. This is the first part of
-// the climber runtime: particles, shape matching with ellipsoid moments, goals, age-dependent
-// stiffness, a fixed root and damping. Growth, anchors, obstacles, breaking and wind come next.
+// section 4.1 and the appendix), usable from C++ without the language: particles, shape matching
+// with ellipsoid moments, goals, age-dependent stiffness, roots, anchors, growth, obstacles,
+// collisions, breaking and wind. The sources go by concept: world.cpp (particles, edits and the
+// step's phases in order), shape_matching.cpp (groups, moments, goals, the passes), frames.cpp
+// (group rotations), collisions.cpp (obstacles and contacts), growth.cpp (growth and branching).
 //
 // Particles are stored one array per field (PositionBasedDynamics' habit); a particle is named by
 // a {index, generation} handle (Box2D's), and a parent's index is always below its children's.
