@@ -1,7 +1,9 @@
 // Oriented-particle plant dynamics after Hädrich et al. 2017 (climbing-plants-particles.txt,
-// section 4.1 and the appendix), usable from C++ without the language. This is the first part of
-// the climber runtime: particles, shape matching with ellipsoid moments, goals, age-dependent
-// stiffness, a fixed root and damping. Growth, anchors, obstacles, breaking and wind come next.
+// section 4.1 and the appendix), usable from C++ without the language: particles, shape matching
+// with ellipsoid moments, goals, age-dependent stiffness, roots, anchors, growth, obstacles,
+// collisions, breaking and wind. The sources go by concept: world.cpp (particles, edits and the
+// step's phases in order), shape_matching.cpp (groups, moments, goals, the passes), frames.cpp
+// (group rotations), collisions.cpp (obstacles and contacts), growth.cpp (growth and branching).
 //
 // Particles are stored one array per field (PositionBasedDynamics' habit); a particle is named by
 // a {index, generation} handle (Box2D's), and a parent's index is always below its children's.
@@ -269,7 +271,15 @@ class World {
     // Particle j's goal from the groups' frames (Eq. 3-4).
     glm::dvec3 goal_of(std::uint32_t j, const std::vector<Frame>& frames, const Groups& groups) const;
     double stiffness(std::uint32_t i) const;
-    void separate_particles();
+
+    // The phases of step(), in order (world.cpp, shape_matching.cpp, collisions.cpp).
+    void predict();             // Eq. 1: predicted positions; the old ones go to scratch_.old
+    void pull_to_anchors();     // Eq. 5, letting go of anchors too far away
+    void refresh_groups();      // rebuilds the groups and rest moments when they are stale
+    void match_shapes_passes(); // the shape-matching passes: positions toward their goals, then orientations
+    void separate_particles();  // contacts between particles (section 5.2)
+    void integrate();           // Eq. 17-18 with damping, and contacts with obstacles
+    void break_overstretched(); // connections stretched past the break threshold let go
 
     Settings settings_;
     std::vector<glm::dvec3> x_, v_, rest_x_, radii_;

@@ -1,0 +1,202 @@
+// Collisions (Hädrich et al., section 5.2): obstacles as signed distance fields, the integration
+// that keeps particles out of them, and the contacts between particles.
+#include "plant/physics/world.hpp"
+
+#include "parallel.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace plant::physics {
+
+namespace {
+
+// Obstacle::distance, declared inline: GCC allows a function declared inline a larger inlining
+// budget, and the integration's loop over the obstacles (integrate()) wants it inlined, as it was
+// when the whole step was one file
+inline double signed_distance(const Obstacle& o, const glm::dvec3& p) {
+    const glm::dvec3 &a = o.a, &b = o.b;
+    switch (o.kind) {
+    case Obstacle::Sphere:
+        return glm::length(p - a) - b.x;
+    case Obstacle::Box: {
+        glm::dvec3 c = (a + b) * 0.5, h = (b - a) * 0.5, q = glm::abs(p - c) - h;
+        return glm::length(glm::max(q, glm::dvec3(0.0))) + std::min(std::max(q.x, std::max(q.y, q.z)), 0.0);
+    }
+    case Obstacle::Plane:
+        return glm::dot(p - a, glm::normalize(b));
+    case Obstacle::Grid:
+        return o.grid ? o.grid->sample(p - a) : 1e300;
+    }
+    return 1e300;
+}
+
+} // namespace
+
+double Obstacle::distance(const glm::dvec3& p) const {
+    return signed_distance(*this, p);
+}
+
+double DistanceGrid::sample(const glm::dvec3& p) const {
+    if (d.empty()) return 1e300;
+    const glm::dvec3 hi = lo + glm::dvec3(n - 1) * cell;
+    const glm::dvec3 q = glm::clamp(p, lo, hi);
+    const double outside = glm::length(p - q);
+    const glm::dvec3 u = (q - lo) / cell;
+    const glm::ivec3 c = glm::clamp(glm::ivec3(glm::floor(u)), glm::ivec3(0), glm::max(n - 2, glm::ivec3(0)));
+    const glm::dvec3 f = glm::clamp(u - glm::dvec3(c), 0.0, 1.0);
+    auto at = [&](int x, int y, int z) {
+        x = std::min(x, n.x - 1), y = std::min(y, n.y - 1), z = std::min(z, n.z - 1);
+        return d[(static_cast<std::size_t>(z) * n.y + y) * n.x + x];
+    };
+    auto lerp = [](double a0, double a1, double t) { return a0 + (a1 - a0) * t; };
+    const double x00 = lerp(at(c.x, c.y, c.z), at(c.x + 1, c.y, c.z), f.x);
+    const double x10 = lerp(at(c.x, c.y + 1, c.z), at(c.x + 1, c.y + 1, c.z), f.x);
+    const double x01 = lerp(at(c.x, c.y, c.z + 1), at(c.x + 1, c.y, c.z + 1), f.x);
+    const double x11 = lerp(at(c.x, c.y + 1, c.z + 1), at(c.x + 1, c.y + 1, c.z + 1), f.x);
+    return lerp(lerp(x00, x10, f.y), lerp(x01, x11, f.y), f.z) + outside;
+}
+
+glm::dvec3 Obstacle::normal(const glm::dvec3& p) const {
+    if (kind == Plane) return glm::normalize(b);
+    // central differences of the distance (over half a cell for a sampled grid)
+    const double e = kind == Grid && grid ? grid->cell / 2 : 1e-6;
+    glm::dvec3 g(distance(p + glm::dvec3(e, 0, 0)) - distance(p - glm::dvec3(e, 0, 0)),
+                 distance(p + glm::dvec3(0, e, 0)) - distance(p - glm::dvec3(0, e, 0)),
+                 distance(p + glm::dvec3(0, 0, e)) - distance(p - glm::dvec3(0, 0, e)));
+    double l = glm::length(g);
+    return l > 0 ? g / l : glm::dvec3(0, 1, 0);
+}
+
+void World::integrate() {
+    // Eq. 17-18, with damping; then obstacles: a particle inside one is put back on its surface
+    // (its radius off it), its velocity losing the normal part (or bouncing by the elasticity)
+    // and some of the tangential part (friction)
+    const double dt = settings_.dt;
+    const std::size_t n = x_.size();
+    const std::vector<glm::dvec3>& old = scratch_.old;
+    parallel_ranges(n, settings_.threads, 2048, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) {
+            if (!alive_[i]) continue;
+            v_[i] = fixed_[i] ? glm::dvec3(0.0) : (x_[i] - old[i]) / dt * (1.0 - settings_.damping);
+            age_[i] += dt;
+            if (fixed_[i]) continue;
+            const double r = std::min({radii_[i].x, radii_[i].y, radii_[i].z});
+            for (const auto& o : obstacles_) {
+                double d = o.distance(x_[i]) - r;
+                if (d >= 0) continue;
+                glm::dvec3 nrm = o.normal(x_[i]);
+                x_[i] -= nrm * d;
+                double vn = glm::dot(v_[i], nrm);
+                glm::dvec3 tangential = v_[i] - nrm * vn;
+                v_[i] = tangential * (1 - o.friction) + (vn < 0 ? -vn * o.elasticity : vn) * nrm;
+            }
+        }
+    });
+}
+
+// Section 5.2: plants collide with each other and with themselves. Particles are spheres of
+// their thinnest radius; two that overlap and are not joined (parent and child, or children of
+// one parent) move apart along the line between them, half each (all of it when the other is a
+// fixed root), as Müller and Chentanez 2011 resolve contacts. The pushes are gathered per
+// particle from the positions before any moves, so the result does not depend on the order or
+// the thread count.
+void World::separate_particles() {
+    const std::size_t n = x_.size();
+    auto& thin = scratch_.thin;
+    thin.assign(n, 0.0);
+    double reach = 0;
+    for (std::size_t i = 0; i < n; ++i)
+        if (alive_[i]) {
+            thin[i] = std::min({radii_[i].x, radii_[i].y, radii_[i].z});
+            reach = std::max(reach, 2 * thin[i]);
+        }
+    if (reach <= 0 || n < 2) return;
+    const double cell = 2 * reach; // twice the widest contact: a 2 x 2 x 2 block of cells holds every partner
+    // a cell's key: one term per axis, xor-ed
+    auto term_x = [](std::int64_t x) { return static_cast<std::uint64_t>(x * 73856093); };
+    auto term_y = [](std::int64_t y) { return static_cast<std::uint64_t>(y * 19349663); };
+    auto term_z = [](std::int64_t z) { return static_cast<std::uint64_t>(z * 83492791); };
+    auto hash = [&](const glm::i64vec3& c) { return term_x(c.x) ^ term_y(c.y) ^ term_z(c.z); };
+    // each particle's cell, once: floor by truncation and correction (the baseline x86-64 has
+    // no rounding instruction, and std::floor is a call)
+    auto floor_of = [](double u) {
+        const auto t = static_cast<std::int64_t>(u);
+        return t - static_cast<std::int64_t>(static_cast<double>(t) > u);
+    };
+    // an open-addressing table from a cell's key to its run of particles in `members` (in index
+    // order), built by counting: no sort. A slot holds the key and the run's bounds together, so
+    // a lookup touches one cache line.
+    std::size_t size = 16;
+    while (size < 4 * n) size *= 2; // a quarter full at most: short probes
+    auto& table = scratch_.table;   // begin == end: an empty slot
+    table.assign(size, Cell{});
+    auto& slot_of = scratch_.slot_of;
+    slot_of.assign(n, ~0u);
+    auto& cell_of = scratch_.cell_of;
+    cell_of.resize(n);
+    for (std::uint32_t i = 0; i < n; ++i) {
+        if (!alive_[i]) continue;
+        const glm::dvec3 u = x_[i] / cell;
+        cell_of[i] = glm::i64vec3(floor_of(u.x), floor_of(u.y), floor_of(u.z));
+        const std::uint64_t k = hash(cell_of[i]);
+        std::size_t slot = k & (size - 1);
+        while (table[slot].end != 0 && table[slot].key != k) slot = (slot + 1) & (size - 1);
+        table[slot].key = k;
+        ++table[slot].end; // counts, for now
+        slot_of[i] = static_cast<std::uint32_t>(slot);
+    }
+    std::uint32_t running = 0;
+    for (Cell& c : table) { // counts to runs; `end` is the fill cursor below
+        const std::uint32_t count = c.end;
+        c.begin = c.end = running;
+        running += count;
+    }
+    auto& members = scratch_.members;
+    members.resize(running);
+    for (std::uint32_t i = 0; i < n; ++i)
+        if (slot_of[i] != ~0u) members[table[slot_of[i]].end++] = i;
+    auto& push = scratch_.push;
+    push.assign(n, glm::dvec3(0.0));
+    parallel_ranges(n, settings_.threads, 2048, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) {
+            if (!alive_[i] || fixed_[i]) continue;
+            const double ri = thin[i];
+            const glm::dvec3 xi = x_[i];
+            // only the 2 x 2 x 2 block of cells on the side of each axis the particle is nearer
+            // to can hold a partner
+            const glm::i64vec3 c = cell_of[i];
+            const glm::dvec3 frac = xi / cell - glm::dvec3(c);
+            const glm::i64vec3 side(frac.x < 0.5 ? -1 : 1, frac.y < 0.5 ? -1 : 1, frac.z < 0.5 ? -1 : 1);
+            // the hash's three terms for the two cells along each axis
+            const std::uint64_t hx[2] = {term_x(c.x), term_x(c.x + side.x)};
+            const std::uint64_t hy[2] = {term_y(c.y), term_y(c.y + side.y)};
+            const std::uint64_t hz[2] = {term_z(c.z), term_z(c.z + side.z)};
+            // the block's eight keys, z slowest (the order the pushes are summed in)
+            std::uint64_t keys[8];
+            for (int q = 0; q < 8; ++q) keys[q] = hx[q & 1] ^ hy[(q >> 1) & 1] ^ hz[q >> 2];
+            glm::dvec3 pushed(0.0);
+            for (const std::uint64_t k : keys) {
+                std::size_t slot = k & (size - 1);
+                while (table[slot].end != table[slot].begin && table[slot].key != k)
+                    slot = (slot + 1) & (size - 1);
+                const Cell& run = table[slot];
+                for (std::uint32_t at = run.begin; at < run.end; ++at) {
+                    const std::uint32_t j = members[at];
+                    const glm::dvec3 d = xi - x_[j];
+                    const double dist2 = glm::dot(d, d), want = ri + thin[j];
+                    if (dist2 >= want * want || dist2 < 1e-24) continue; // apart, or itself
+                    // joined particles (parent and child, children of one parent) do not collide
+                    const std::uint32_t pi = parent_[i], pj = parent_[j];
+                    if (pi == j || pj == i || (pi != kNone && pi == pj)) continue;
+                    const double dist = std::sqrt(dist2);
+                    pushed += d / dist * ((want - dist) * (fixed_[j] ? 1.0 : 0.5));
+                }
+            }
+            push[i] = pushed;
+        }
+    });
+    for (std::size_t i = 0; i < n; ++i) x_[i] += push[i];
+}
+
+} // namespace plant::physics
