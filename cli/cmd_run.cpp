@@ -82,7 +82,7 @@ int run_main(RunCmd& c) {
                                      summary.triangles, summary.organs, ms_since(t0));
     } catch (const RuntimeError& e) {
         std::cerr << render(Diagnostic{Severity::Error, e.span, e.message, {}}, sources, c.g.color);
-        return kRuntime;
+        return e.kind == RuntimeErrorKind::Input ? kNoInput : kRuntime; // a mesh file it cannot read
     } catch (const ExportError& e) {
         std::cerr << "plant: " << e.what() << "\n";
         return kCantCreate;

@@ -202,12 +202,14 @@ bool write_atomically(const fs::path& path, const std::string& text) {
 }
 
 // Returns an empty string when the test passed, else what went wrong.
-std::string run_one(const fs::path& file, bool bless, bool& blessed) {
+std::string run_one(const fs::path& file, bool bless, bool& blessed,
+                    const std::vector<std::string>& allow_read) {
     std::string text;
     if (!read_file(file.string(), text)) return "  cannot read the file\n";
     Expectations e = read_expectations(text);
     std::vector<std::string> args{e.command, file.filename().string()};
     args.insert(args.end(), e.args.begin(), e.args.end());
+    for (const auto& d : allow_read) args.insert(args.end(), {"--allow-read", fs::absolute(d).string()});
     Outcome o = run_self(args, file.parent_path());
     if (e.script) {
         std::vector<std::string> errors, warnings;
@@ -274,6 +276,7 @@ std::string run_one(const fs::path& file, bool bless, bool& blessed) {
 
 struct TestCmd {
     std::vector<std::string> paths;
+    std::vector<std::string> allow_read; // passed on to each grammar's command
     bool bless = false;
     bool verbose = false;
 };
@@ -301,7 +304,7 @@ int test_main(const TestCmd& c) {
     int passed = 0, failed = 0, blessed_count = 0;
     for (const auto& f : files) {
         bool blessed = false;
-        std::string msg = run_one(f, c.bless, blessed);
+        std::string msg = run_one(f, c.bless, blessed, c.allow_read);
         if (msg.empty()) {
             ++passed;
             if (blessed) {
@@ -330,6 +333,7 @@ void setup_test(CLI::App& app, int& exit_code) {
     cmd->add_flag("--bless", c->bless,
                   "Rewrite the golden sidecars from the current output (review the diff!)");
     cmd->add_flag("-v,--verbose", c->verbose, "List passing tests too");
+    add_allow_read(*cmd, c->allow_read);
     cmd->callback([c, &exit_code] { exit_code = test_main(*c); });
 }
 

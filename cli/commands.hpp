@@ -28,6 +28,7 @@ struct GrammarOptions {
     std::string file;
     std::vector<std::string> defines; // name=value
     std::vector<std::string> include_dirs;
+    std::vector<std::string> allow_read; // --allow-read DIR
     std::optional<int> steps;
     std::optional<std::uint64_t> seed;
     int threads = 0; // 0: one per core
@@ -36,6 +37,9 @@ struct GrammarOptions {
 };
 
 void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation);
+
+// --allow-read DIR (repeatable), on every command that compiles a grammar.
+void add_allow_read(CLI::App& cmd, std::vector<std::string>& dirs);
 
 // Compiles the grammar, printing diagnostics to stderr. On failure sets `exit_code`.
 std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& sources, int& exit_code);

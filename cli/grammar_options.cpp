@@ -17,6 +17,7 @@ void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation) {
         ->type_name("NAME=VALUE");
     cmd.add_option("-I,--include", o.include_dirs, "Add a directory to the library search path")
         ->type_name("DIR");
+    add_allow_read(cmd, o.allow_read);
     if (derivation) {
         cmd.add_option("-n,--steps", o.steps,
                        "Number of derivation steps (default: the grammar's 'derive N;')")
@@ -34,19 +35,28 @@ void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation) {
     o.color = isatty(2) != 0 && std::getenv("NO_COLOR") == nullptr;
 }
 
+void add_allow_read(CLI::App& cmd, std::vector<std::string>& dirs) {
+    cmd.add_option("--allow-read", dirs,
+                   "Let the grammar read files under DIR too (imports, load(...), meshes); by default "
+                   "only its own folder, -I and PLANT_PATH folders and the standard library")
+        ->type_name("DIR")
+        ->allow_extra_args(false);
+}
+
 std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& sources, int& exit_code) {
     std::string text;
-    if (!read_file(o.file, text)) {
+    if (ReadFailure f = read_input_file(o.file, text, kMaxSourceBytes, false); f != ReadFailure::None) {
         std::error_code ec;
         std::cerr << fmt::format("plant: cannot read '{}': {}\n", o.file,
                                  std::filesystem::is_directory(o.file, ec) ? "it is a directory"
-                                 : std::filesystem::exists(o.file, ec)     ? "permission denied"
-                                                                           : "no such file");
+                                                                           : describe(f));
         exit_code = kNoInput;
         return nullptr;
     }
     CompileOptions co;
     co.include_dirs = o.include_dirs;
+    co.confine_reads = true;
+    co.allow_read = o.allow_read;
     co.environments = runtime_environments();
     for (const auto& d : o.defines) {
         auto eq = d.find('=');
@@ -64,7 +74,7 @@ std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& so
     if (diags.error_count() > diags.all().size())
         std::cerr << fmt::format("plant: {} more errors not shown\n",
                                  diags.error_count() - diags.all().size());
-    if (!program) exit_code = kGrammar;
+    if (!program) exit_code = diags.has_input_errors() ? kNoInput : kGrammar;
     return program;
 }
 

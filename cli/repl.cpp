@@ -61,6 +61,10 @@ CompileOptions Session::compile_options() const {
     CompileOptions co;
     for (const auto& [name, value] : params_) co.defines.emplace_back(name, value);
     if (!file_.empty()) co.file_texts[file_] = file_text_; // the file as :load or :reload read it
+    // the session's source is "<session>": the loaded grammar's folder is its own
+    co.confine_reads = true;
+    co.allow_read = allow_read_;
+    if (!file_.empty()) co.allow_read.push_back(fs::path(file_).parent_path().string());
     co.environments = runtime_environments();
     return co;
 }

@@ -58,6 +58,8 @@ class Session {
     // The lines :help (and `plant help repl`) prints.
     static std::string command_list();
     void set_interrupt(const std::atomic<bool>* flag) { interrupt_ = flag; }
+    // --allow-read: folders the grammar may read besides its own (file_access.hpp)
+    void allow_read(std::vector<std::string> dirs) { allow_read_ = std::move(dirs); }
     int load(const std::string& path); // :load; 0, or the exit code of the failure (65, 66, 70)
     // Whether some line since the last call reported an error (scripts exit 1 when one did).
     bool take_failed() {
@@ -112,6 +114,7 @@ class Session {
     bool color_;
     const std::atomic<bool>* interrupt_ = nullptr;
 
+    std::vector<std::string> allow_read_;       // --allow-read
     std::string file_;                          // the loaded grammar's path, as given
     std::string file_text_;                     // its text as :load or :reload read it
     std::optional<std::string> axiom_;          // typed `axiom: ...`
@@ -134,6 +137,6 @@ class Session {
     double last_step_ms_ = 0;
 };
 
-int repl_main(const std::string& file, bool color);
+int repl_main(const std::string& file, bool color, const std::vector<std::string>& allow_read = {});
 
 } // namespace plant::cli

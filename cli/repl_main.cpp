@@ -57,9 +57,10 @@ std::string history_path() {
 
 } // namespace
 
-int repl_main(const std::string& file, bool color) {
+int repl_main(const std::string& file, bool color, const std::vector<std::string>& allow_read) {
     const bool interactive = isatty(0) != 0;
     Session session(std::cout, std::cerr, color && interactive);
+    session.allow_read(allow_read);
     g_session = &session;
     if (!file.empty()) {
         int code = session.load(file);
@@ -118,10 +119,13 @@ void setup_repl(CLI::App& app, int& exit_code) {
         app.add_subcommand("repl", "An interactive session: step a derivation, inspect the string, change "
                                    "rules and params, look at the plant");
     cmd->add_option("FILE", *file, "A grammar to load");
+    auto allow = std::make_shared<std::vector<std::string>>();
+    add_allow_read(*cmd, *allow);
     cmd->footer("Reads commands from standard input without a prompt when it is not a terminal:\n"
                 "  plant repl grammar.plant < script");
-    cmd->callback(
-        [file, &exit_code] { exit_code = repl_main(*file, isatty(2) != 0 && !std::getenv("NO_COLOR")); });
+    cmd->callback([file, allow, &exit_code] {
+        exit_code = repl_main(*file, isatty(2) != 0 && !std::getenv("NO_COLOR"), *allow);
+    });
 }
 
 } // namespace plant::cli

@@ -7,12 +7,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <cstdlib>
 #include <filesystem>
-
-#ifndef PLANT_STDLIB_DIR
-#define PLANT_STDLIB_DIR ""
-#endif
 
 namespace plant {
 
@@ -28,23 +23,21 @@ std::string Compiler::resolve_import(const ast::Import& im, std::uint32_t from_f
         searched.push_back(p.string());
         return fs::exists(p, ec) ? p.lexically_normal().string() : std::string();
     }
-    std::vector<std::string> dirs = opts_.include_dirs;
-    if (const char* pp = std::getenv("PLANT_PATH")) {
-        std::string s = pp;
-        std::size_t b = 0;
-        while (b <= s.size()) {
-            std::size_t e = s.find(':', b);
-            if (e == std::string::npos) e = s.size();
-            if (e > b) dirs.push_back(s.substr(b, e - b));
-            b = e + 1;
-        }
-    }
-    if (std::string(PLANT_STDLIB_DIR).size()) dirs.emplace_back(PLANT_STDLIB_DIR);
+    std::vector<std::string> dirs = library_dirs(opts_);
     for (const auto& d : dirs) {
         fs::path p = fs::path(d) / (im.target + ".plant");
         searched.push_back(p.string());
         if (fs::exists(p, ec)) return p.lexically_normal().string();
     }
+    return {};
+}
+
+std::string Compiler::readable(const std::string& written, const std::string& path, Span span) {
+    if (!access_) access_ = std::make_unique<FileAccess>(sm_.file(main_file_).name(), opts_);
+    std::string id = FileAccess::identity(path);
+    if (id.empty()) return path; // missing: whoever reads it says so
+    if (!opts_.confine_reads || access_->allowed(id)) return id;
+    diags_->input_error(span, FileAccess::refusal(written));
     return {};
 }
 
@@ -61,7 +54,11 @@ void Compiler::load(std::uint32_t file_id, std::map<std::string, std::pair<const
         for (const auto& p : rb.productions) block.productions.push_back(p.span);
     }
     files_.push_back(std::move(file));
-    std::string self = fs::path(sm_.file(file_id).name()).lexically_normal().string();
+    // files are told apart by identity (symbolic links and `..` resolved), shown as named
+    const std::string self_shown = fs::path(sm_.file(file_id).name()).lexically_normal().string();
+    std::string self = FileAccess::identity(self_shown);
+    if (self.empty()) self = self_shown;
+    shown_[self] = self_shown;
     stack.push_back(self);
     loaded_paths_.insert(self);
     for (const auto& im : f->imports) {
@@ -74,22 +71,33 @@ void Compiler::load(std::uint32_t file_id, std::map<std::string, std::pair<const
                                                             im.target, fmt::join(searched, ", ")));
             continue;
         }
-        if (std::find(stack.begin(), stack.end(), path) != stack.end()) {
+        const auto given = opts_.file_texts.find(path);
+        std::string id = path;
+        if (given == opts_.file_texts.end()) {
+            id = readable(im.target, path, im.span);
+            if (id.empty()) continue;
+        } else if (std::string c = FileAccess::identity(path); !c.empty()) {
+            id = c;
+        }
+        if (std::find(stack.begin(), stack.end(), id) != stack.end()) {
+            std::vector<std::string> chain;
+            for (const auto& s : stack) chain.push_back(shown_[s]);
             diags_->error(im.span,
                           fmt::format("import cycle: '{}' imports '{}', which is already being imported "
                                       "(chain: {})",
-                                      self, path, fmt::join(stack, " -> ")));
+                                      self_shown, path, fmt::join(chain, " -> ")));
             continue;
         }
-        if (loaded_paths_.count(path)) continue; // imported already through another path
+        if (loaded_paths_.count(id)) continue; // imported already through another path
         std::string text;
-        if (auto it = opts_.file_texts.find(path); it != opts_.file_texts.end()) {
-            text = it->second;
-        } else if (!read_file(path, text)) {
-            diags_->error(im.span, fmt::format("cannot read imported file '{}'", path));
+        if (given != opts_.file_texts.end()) {
+            text = given->second;
+        } else if (ReadFailure why = read_input_file(id, text); why != ReadFailure::None) {
+            diags_->input_error(im.span,
+                                fmt::format("cannot read imported file '{}': {}", im.target, describe(why)));
             continue;
         }
-        std::uint32_t id = sm_.add(path, std::move(text));
+        std::uint32_t source = sm_.add(path, std::move(text));
         std::map<std::string, std::pair<const ast::Expr*, Span>> ov;
         for (std::size_t k = 0; k < im.overrides.size(); ++k) {
             const std::string& name = im.overrides[k].first;
@@ -99,7 +107,7 @@ void Compiler::load(std::uint32_t file_id, std::map<std::string, std::pair<const
             }
             ov[name] = {im.overrides[k].second.get(), im.override_spans[k]};
         }
-        load(id, std::move(ov), stack);
+        load(source, std::move(ov), stack);
     }
     stack.pop_back();
     order_.push_back({f, std::move(overrides)});

@@ -95,6 +95,7 @@ void Compiler::compile_surface(const ast::ShapeDecl& s) {
         fs::path p(s.args[0]->text);
         if (p.is_relative()) p = fs::path(sm_.file(s.span.file).name()).parent_path() / p;
         def.path = p.lexically_normal().string();
+        if (readable(s.args[0]->text, def.path, s.args[0]->span).empty()) return;
     } else {
         diags_->error(
             s.kind_span,
@@ -131,6 +132,7 @@ void Compiler::compile_environment(const ast::ShapeDecl& s) {
             if (path.is_relative()) path = fs::path(sm_.file(s.span.file).name()).parent_path() / path;
             a.text = path.lexically_normal().string();
             a.span = s.args[i]->span;
+            if (readable(s.args[i]->text, a.text, a.span).empty()) return;
             args.push_back(a);
             continue;
         }
@@ -144,7 +146,13 @@ void Compiler::compile_environment(const ast::ShapeDecl& s) {
         args.push_back(a);
     }
     std::string error;
-    auto env = opts_.environments(s.kind, args, error);
+    std::unique_ptr<Environment> env;
+    try {
+        env = opts_.environments(s.kind, args, error);
+    } catch (const InputError& e) { // a file it reads (a mesh) is unreadable or malformed
+        diags_->input_error(s.kind_span, e.message);
+        return;
+    }
     if (!env) {
         diags_->error(s.kind_span,
                       error.empty() ? fmt::format("unknown environment kind '{}'", s.kind) : error);

@@ -11,23 +11,13 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 namespace plant {
 
 namespace fs = std::filesystem;
 
 bool read_file(const std::string& path, std::string& out) {
-    std::error_code ec;
-    if (fs::is_directory(path, ec)) return false;
-    std::ifstream f(path, std::ios::binary);
-    if (!f) return false;
-    std::ostringstream ss;
-    ss << f.rdbuf();
-    if (f.bad()) return false;
-    out = ss.str();
-    return true;
+    return read_input_file(path, out, kMaxSourceBytes, false) == ReadFailure::None;
 }
 
 // Optimal string alignment distance: insertions, deletions, substitutions and swaps of two
@@ -86,6 +76,7 @@ std::unique_ptr<Program> Compiler::compile(std::uint32_t main_file) {
         if (e) defines_[name] = {std::move(e), id};
     }
     std::vector<std::string> stack;
+    main_file_ = main_file;
     load(main_file, {}, stack);
     if (diags_->has_errors()) return nullptr; // do not pile checks on a broken parse
 

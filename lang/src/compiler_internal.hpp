@@ -3,6 +3,7 @@
 // compile_stmt.cpp, compile_rules.cpp and check.cpp.
 #pragma once
 
+#include "file_access.hpp"
 #include "plant/ast.hpp"
 #include "plant/compiler.hpp"
 #include "plant/program.hpp"
@@ -103,6 +104,10 @@ class Compiler {
               std::vector<std::string>& stack);
     std::string resolve_import(const ast::Import& im, std::uint32_t from_file,
                                std::vector<std::string>& searched);
+    // A file the grammar names (an import, load(...), a mesh): its identity when it may be read
+    // (a missing file keeps `path`, for the reader to report); empty, with an input error
+    // naming it as `written`, when it lies outside the allowed folders (file_access.hpp).
+    std::string readable(const std::string& written, const std::string& path, Span span);
     void declare();
     void declare_modules(const ast::File& f);
     void declare_values(const LoadedFile& lf);
@@ -153,7 +158,10 @@ class Compiler {
     std::vector<std::unique_ptr<ast::File>> files_; // the syntax trees, in the order they were read
     std::vector<LoadedFile> order_;                 // files after the files they import
     std::vector<const ast::ShapeDecl*> curve_decls_, surface_decls_, env_decls_; // in load order
-    std::set<std::string> loaded_paths_;
+    std::set<std::string> loaded_paths_; // by identity: each file is imported once
+    std::unique_ptr<FileAccess> access_; // made on first use, from the main file's folder
+    std::uint32_t main_file_ = 0;
+    std::map<std::string, std::string> shown_; // a loaded file's identity -> its name as shown
     std::unordered_map<std::string, ConstVal> consts_;
     std::unordered_map<std::string, Span> value_spans_;
     std::unordered_map<std::string, std::uint32_t> fn_index_;

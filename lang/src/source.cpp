@@ -1,6 +1,12 @@
 #include "plant/source.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 namespace plant {
 
@@ -39,6 +45,66 @@ SourceManager::SourceManager() {
 std::uint32_t SourceManager::add(std::string name, std::string text) {
     files_.push_back(std::make_unique<SourceFile>(std::move(name), std::move(text)));
     return static_cast<std::uint32_t>(files_.size() - 1);
+}
+
+ReadFailure read_input_file(const std::string& path, std::string& out, std::size_t max_bytes,
+                            bool regular_only) {
+    // stat first so a FIFO or a device is never opened; then open without blocking (a FIFO
+    // swapped in meanwhile opens at once) and check the open file again
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0)
+        return errno == EACCES                       ? ReadFailure::Denied
+               : errno == ENOENT || errno == ENOTDIR ? ReadFailure::Missing
+                                                     : ReadFailure::Failed;
+    if (S_ISDIR(st.st_mode) || (regular_only && !S_ISREG(st.st_mode))) return ReadFailure::NotRegular;
+    if (S_ISREG(st.st_mode) && static_cast<std::uint64_t>(st.st_size) > max_bytes)
+        return ReadFailure::TooLarge;
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOCTTY | (regular_only ? O_NONBLOCK : 0));
+    if (fd < 0) return errno == EACCES ? ReadFailure::Denied : ReadFailure::Failed;
+    ReadFailure result = ReadFailure::None;
+    if (::fstat(fd, &st) != 0) {
+        result = ReadFailure::Failed;
+    } else if (S_ISDIR(st.st_mode) || (regular_only && !S_ISREG(st.st_mode))) {
+        result = ReadFailure::NotRegular;
+    } else {
+        std::string text;
+        char buf[1 << 16];
+        while (true) {
+            const ssize_t n = ::read(fd, buf, sizeof buf);
+            if (n < 0 && errno == EINTR) continue;
+            if (n < 0) {
+                result = ReadFailure::Failed;
+                break;
+            }
+            if (n == 0) break;
+            if (text.size() + static_cast<std::size_t>(n) > max_bytes) { // grew, or not a regular file
+                result = ReadFailure::TooLarge;
+                break;
+            }
+            text.append(buf, static_cast<std::size_t>(n));
+        }
+        if (result == ReadFailure::None) out = std::move(text);
+    }
+    ::close(fd);
+    return result;
+}
+
+std::string describe(ReadFailure f, std::size_t max_bytes) {
+    switch (f) {
+    case ReadFailure::None:
+        return "read";
+    case ReadFailure::Missing:
+        return "no such file";
+    case ReadFailure::Denied:
+        return "permission denied";
+    case ReadFailure::NotRegular:
+        return "it is not a regular file (a folder, a device or a pipe)";
+    case ReadFailure::TooLarge:
+        return fmt::format("it is larger than {} MB, the most plant reads", max_bytes >> 20);
+    case ReadFailure::Failed:
+        break;
+    }
+    return "it cannot be read";
 }
 
 } // namespace plant

@@ -351,6 +351,9 @@ struct ClimberArgs {
     bool check(std::string& error);
 };
 
+// The largest adaption_range and mesh_cell (docs/language.md, "Limits").
+constexpr double kMaxMeshReach = 1000;
+
 bool ClimberArgs::read(const EnvArg& a, std::string& error) {
     // besides the obstacle shapes (ObstacleArgs) and meshes
     static const char* numbers[] = {
@@ -383,6 +386,15 @@ bool ClimberArgs::read(const EnvArg& a, std::string& error) {
     }
     const double x = a.v[0];
     const glm::dvec3 v(a.v[0], a.v[1], a.v[2]);
+    if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) {
+        error = fmt::format("climber: '{}' must be finite", a.key);
+        return false;
+    }
+    // the distance grid of a mesh spans the mesh grown by 4 mesh_cell + adaption_range
+    if ((a.key == "adaption_range" || a.key == "mesh_cell") && x > kMaxMeshReach) {
+        error = fmt::format("climber: '{}' must be at most {}, found {}", a.key, kMaxMeshReach, x);
+        return false;
+    }
     if (a.key == "substeps")
         c.substeps = static_cast<int>(std::clamp(x, 0.0, 1000.0));
     else if (a.key == "iterations")
@@ -536,6 +548,12 @@ std::unique_ptr<Environment> make_climber(const std::vector<EnvArg>& args, std::
         physics::Obstacle o;
         o.kind = physics::Obstacle::Grid;
         o.grid = distance_grid(mesh, p.mesh_cell, 4 * p.mesh_cell + p.c.adaption_range);
+        if (!o.grid) {
+            error = fmt::format("climber: the mesh '{}' reaches too far for a distance grid (its corners, "
+                                "grown by 4 mesh_cell + adaption_range, must stay finite)",
+                                path);
+            return nullptr;
+        }
         std::vector<glm::dvec3> shown;
         for (const auto& t : mesh) shown.insert(shown.end(), {t.a, t.b, t.c});
         climber->show_mesh(w.obstacles().size(), std::move(shown));

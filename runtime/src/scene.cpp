@@ -4,6 +4,7 @@
 
 #include "plant/export.hpp"
 
+#include "mesh_file.hpp"
 #include "openmesh.hpp"
 
 #include <fmt/format.h>
@@ -175,11 +176,18 @@ MeshPart loaded_prototype(const SurfaceDef& s) {
     OpenMeshTriangles mesh;
     mesh.request_vertex_normals();
     mesh.request_face_normals();
-    quiet_openmesh(); // failures are reported as our own diagnostics
     OpenMesh::IO::Options opt;
-    if (!OpenMesh::IO::read_mesh(mesh, s.path, opt))
+    std::string why;
+    switch (read_mesh_file(s.path, mesh, opt, why)) { // failures are reported as our own diagnostics
+    case MeshRead::Ok:
+        break;
+    case MeshRead::Failed:
         throw RuntimeError(RuntimeErrorKind::Geometry, s.span,
                            fmt::format("cannot load surface '{}' from '{}'", s.name, s.path));
+    case MeshRead::Refused:
+        throw RuntimeError(RuntimeErrorKind::Input, s.span,
+                           fmt::format("surface '{}': cannot read mesh file '{}': {}", s.name, s.path, why));
+    }
     mesh.triangulate();
     mesh.update_normals();
     MeshPart m;

@@ -1,6 +1,8 @@
 #include "triangle_mesh.hpp"
 
+#include "mesh_file.hpp"
 #include "openmesh.hpp"
+#include "plant/diagnostics.hpp"
 
 #include <fmt/format.h>
 
@@ -13,10 +15,16 @@ namespace plant {
 bool load_triangles(const std::string& path, std::vector<Triangle>& out, const char* who,
                     std::string& error) {
     OpenMeshTriangles mesh;
-    quiet_openmesh();
-    if (!OpenMesh::IO::read_mesh(mesh, path)) {
+    OpenMesh::IO::Options options;
+    std::string why;
+    switch (read_mesh_file(path, mesh, options, why)) {
+    case MeshRead::Ok:
+        break;
+    case MeshRead::Failed:
         error = fmt::format("{}: cannot load the mesh '{}'", who, path);
         return false;
+    case MeshRead::Refused:
+        throw InputError(fmt::format("{}: cannot read mesh file '{}': {}", who, path, why));
     }
     mesh.triangulate();
     for (auto f : mesh.faces()) {
@@ -71,32 +79,6 @@ double signed_distance(const std::vector<Triangle>& mesh, const glm::dvec3& p) {
         }
     }
     return sign * best;
-}
-
-std::shared_ptr<const physics::DistanceGrid> distance_grid(const std::vector<Triangle>& mesh, double cell,
-                                                           double margin, std::size_t max_points) {
-    glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
-    for (const auto& t : mesh)
-        for (const glm::dvec3& v : {t.a, t.b, t.c}) lo = glm::min(lo, v), hi = glm::max(hi, v);
-    lo -= glm::dvec3(margin);
-    hi += glm::dvec3(margin);
-    auto points = [&](double c) { return glm::ceil((hi - lo) / c) + 1.0; }; // in double: no overflow
-    while (true) {
-        glm::dvec3 n = points(cell);
-        if (n.x * n.y * n.z <= static_cast<double>(max_points)) break;
-        cell *= 1.25;
-    }
-    auto g = std::make_shared<physics::DistanceGrid>();
-    g->lo = lo;
-    g->cell = cell;
-    g->n = glm::ivec3(points(cell));
-    g->d.resize(static_cast<std::size_t>(g->n.x) * g->n.y * g->n.z);
-    for (int z = 0; z < g->n.z; ++z)
-        for (int y = 0; y < g->n.y; ++y)
-            for (int x = 0; x < g->n.x; ++x)
-                g->d[(static_cast<std::size_t>(z) * g->n.y + y) * g->n.x + x] =
-                    signed_distance(mesh, lo + glm::dvec3(x, y, z) * cell);
-    return g;
 }
 
 void obstacle_triangles(const physics::Obstacle& o, const glm::dvec3& lo, const glm::dvec3& hi,

@@ -16,7 +16,12 @@ struct CompileOptions {
     std::vector<std::pair<std::string, std::string>> defines; // -D name=value
     std::vector<std::string> include_dirs;                    // -I dir, then PLANT_PATH, then stdlib
     std::map<std::string, std::string> file_texts;            // imported files' text, instead of reading them
-    EnvironmentFactory environments; // the runtime's kinds; none: `env` cannot be used
+    // Confine the files a grammar reads (imports, load(...), mesh files) to its own folder, the
+    // library folders, the standard library and `allow_read` (file_access.hpp). The plant command
+    // always does; a program embedding the compiler decides for its own grammars.
+    bool confine_reads = false;
+    std::vector<std::string> allow_read; // --allow-read DIR
+    EnvironmentFactory environments;     // the runtime's kinds; none: `env` cannot be used
 };
 
 // Reads, parses and compiles `path` and everything it imports. Returns null when there were

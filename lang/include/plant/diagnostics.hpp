@@ -25,6 +25,13 @@ class Diagnostics {
     explicit Diagnostics(std::size_t cap = 50) : cap_(cap) {}
     void error(Span span, std::string message) { add({Severity::Error, span, std::move(message), {}}); }
     void warning(Span span, std::string message) { add({Severity::Warning, span, std::move(message), {}}); }
+    // An error about a file the program names that cannot or may not be read (an import, a
+    // mesh): the command line exits 66 (unreadable input) rather than 65.
+    void input_error(Span span, std::string message) {
+        ++input_errors_;
+        error(span, std::move(message));
+    }
+    bool has_input_errors() const { return input_errors_ > 0; }
     void add(Diagnostic d);
     bool has_errors() const { return errors_ > 0; }
     std::size_t error_count() const { return errors_; }
@@ -32,11 +39,13 @@ class Diagnostics {
     void clear() {
         items_.clear();
         errors_ = 0;
+        input_errors_ = 0;
     }
 
   private:
     std::size_t cap_;
     std::size_t errors_ = 0;
+    std::size_t input_errors_ = 0;
     std::vector<Diagnostic> items_;
 };
 
@@ -53,6 +62,7 @@ enum class RuntimeErrorKind {
     Setting,     // a setting (derive, seed) out of its range
     Turtle,      // the turtle cannot interpret the string (unbalanced ']', leaving finite space)
     Geometry,    // the plant cannot be meshed (a surface that cannot be loaded, out-of-range points)
+    Input,       // a file the program names cannot be read (a surface's mesh file): exit 66
 };
 
 // Thrown by the runtime for errors that end a derivation (runtime errors exit 70).
@@ -73,6 +83,14 @@ struct RuntimeError : std::exception {
     Span span;
     std::string message; // as shown to the user, with the step's prefix once `step` is set
     int step = -1;       // the derivation step it happened in; -1: none named
+};
+
+// Thrown while making an environment when a file it reads (a mesh) cannot be read or is
+// malformed; the compiler reports it as an input error (exit 66).
+struct InputError : std::exception {
+    explicit InputError(std::string m) : message(std::move(m)) {}
+    const char* what() const noexcept override { return message.c_str(); }
+    std::string message;
 };
 
 } // namespace plant

@@ -2,6 +2,7 @@
 // computed on demand so that every AST node can carry its span cheaply.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -48,5 +49,20 @@ class SourceManager {
   private:
     std::vector<std::unique_ptr<SourceFile>> files_;
 };
+
+// Reading a file a grammar names (a source, an import, a mesh): only a regular file is read, and
+// only up to a size cap checked before reading, so a FIFO, a device (/dev/zero) or a huge file is
+// refused instead of blocking or filling memory.
+enum class ReadFailure { None, Missing, Denied, NotRegular, TooLarge, Failed };
+
+inline constexpr std::size_t kMaxSourceBytes = std::size_t{64} << 20; // sources and mesh files
+
+// Reads `path` whole into `out`. With `regular_only` false (the grammar the user names on the
+// command line, which may be a pipe) other kinds of file are read too, still up to `max_bytes`.
+ReadFailure read_input_file(const std::string& path, std::string& out,
+                            std::size_t max_bytes = kMaxSourceBytes, bool regular_only = true);
+
+// Why it failed, for a message: "no such file", "it is not a regular file", ...
+std::string describe(ReadFailure f, std::size_t max_bytes = kMaxSourceBytes);
 
 } // namespace plant
