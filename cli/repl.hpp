@@ -58,6 +58,7 @@ class Session {
     // The lines :help (and `plant help repl`) prints.
     static std::string command_list();
     void set_interrupt(const std::atomic<bool>* flag) { interrupt_ = flag; }
+    void set_max_steps(std::uint64_t n) { max_steps_ = n; } // --max-steps
     int load(const std::string& path); // :load; 0, or the exit code of the failure (65, 66, 70)
     // Whether some line since the last call reported an error (scripts exit 1 when one did).
     bool take_failed() {
@@ -111,6 +112,7 @@ class Session {
     std::ostream& err_;
     bool color_;
     const std::atomic<bool>* interrupt_ = nullptr;
+    std::uint64_t max_steps_ = kDefaultMaxSteps;
 
     std::string file_;                          // the loaded grammar's path, as given
     std::string file_text_;                     // its text as :load or :reload read it
@@ -134,6 +136,6 @@ class Session {
     double last_step_ms_ = 0;
 };
 
-int repl_main(const std::string& file, bool color);
+int repl_main(const std::string& file, bool color, std::uint64_t max_steps = kDefaultMaxSteps);
 
 } // namespace plant::cli

@@ -57,9 +57,10 @@ std::string history_path() {
 
 } // namespace
 
-int repl_main(const std::string& file, bool color) {
+int repl_main(const std::string& file, bool color, std::uint64_t max_steps) {
     const bool interactive = isatty(0) != 0;
     Session session(std::cout, std::cerr, color && interactive);
+    session.set_max_steps(max_steps);
     g_session = &session;
     if (!file.empty()) {
         int code = session.load(file);
@@ -114,14 +115,23 @@ int repl_main(const std::string& file, bool color) {
 
 void setup_repl(CLI::App& app, int& exit_code) {
     auto file = std::make_shared<std::string>();
+    auto max_steps = std::make_shared<std::uint64_t>(kDefaultMaxSteps);
     CLI::App* cmd =
         app.add_subcommand("repl", "An interactive session: step a derivation, inspect the string, change "
                                    "rules and params, look at the plant");
     cmd->add_option("FILE", *file, "A grammar to load");
+    cmd->add_option_function<std::string>(
+           "--max-steps",
+           [max_steps](const std::string& v) { *max_steps = parse_count("--max-steps", v, 1); },
+           fmt::format("Stop an evaluation (a hook call, a production for one module, an expression) "
+                       "after this many instructions (default {})",
+                       kDefaultMaxSteps))
+        ->type_name("N");
     cmd->footer("Reads commands from standard input without a prompt when it is not a terminal:\n"
                 "  plant repl grammar.plant < script");
-    cmd->callback(
-        [file, &exit_code] { exit_code = repl_main(*file, isatty(2) != 0 && !std::getenv("NO_COLOR")); });
+    cmd->callback([file, max_steps, &exit_code] {
+        exit_code = repl_main(*file, isatty(2) != 0 && !std::getenv("NO_COLOR"), *max_steps);
+    });
 }
 
 } // namespace plant::cli

@@ -76,7 +76,8 @@ class Lowering {
             e->kind = ast::ExprKind::Number;
             std::string s = n.string();
             auto r = std::from_chars(s.data(), s.data() + s.size(), e->number);
-            if (r.ec != std::errc()) diags_.error(e->span, fmt::format("number '{}' is out of range", s));
+            if (r.ec != std::errc())
+                diags_.error(e->span, fmt::format("number '{}' is out of range", excerpt(s)));
         } else if (n.is_type<g::string_lit>()) {
             e->kind = ast::ExprKind::String;
             e->text = unescape(n.string_view());

@@ -4,6 +4,7 @@
 #include "plant/diagnostics.hpp"
 #include "plant/environment.hpp"
 #include "plant/program.hpp"
+#include "plant/vm.hpp"
 
 #include <map>
 #include <memory>
@@ -16,7 +17,8 @@ struct CompileOptions {
     std::vector<std::pair<std::string, std::string>> defines; // -D name=value
     std::vector<std::string> include_dirs;                    // -I dir, then PLANT_PATH, then stdlib
     std::map<std::string, std::string> file_texts;            // imported files' text, instead of reading them
-    EnvironmentFactory environments; // the runtime's kinds; none: `env` cannot be used
+    EnvironmentFactory environments;            // the runtime's kinds; none: `env` cannot be used
+    std::uint64_t max_steps = kDefaultMaxSteps; // the VM's budget for constants evaluated now
 };
 
 // Reads, parses and compiles `path` and everything it imports. Returns null when there were
