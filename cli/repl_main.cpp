@@ -61,6 +61,8 @@ int repl_main(const std::string& file, bool color, std::uint64_t max_steps) {
     const bool interactive = isatty(0) != 0;
     Session session(std::cout, std::cerr, color && interactive);
     session.set_max_steps(max_steps);
+    // (before the grammar is loaded: the derivation made then keeps the flag for its steps)
+    if (interactive) session.set_interrupt(&g_interrupt);
     g_session = &session;
     if (!file.empty()) {
         int code = session.load(file);
@@ -81,7 +83,6 @@ int repl_main(const std::string& file, bool color, std::uint64_t max_steps) {
         return failed ? kFailed : kOk;
     }
     // interactive: Ctrl-C interrupts a long step and returns to the prompt
-    session.set_interrupt(&g_interrupt);
     struct sigaction sa {};
     sa.sa_handler = on_sigint;
     sigemptyset(&sa.sa_mask);
