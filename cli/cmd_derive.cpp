@@ -5,8 +5,10 @@
 
 #include <fmt/format.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <sys/resource.h>
@@ -27,6 +29,17 @@ long peak_rss_kb() {
     rusage ru{};
     getrusage(RUSAGE_SELF, &ru);
     return ru.ru_maxrss;
+}
+
+// Writes `text` to standard output; exit 73 with a message when it cannot (a full disk, a closed pipe).
+int write_stdout(const std::string& text) {
+    errno = 0;
+    bool ok = std::fwrite(text.data(), 1, text.size(), stdout) == text.size();
+    ok = std::fflush(stdout) == 0 && ok;
+    if (ok) return kOk;
+    std::cerr << fmt::format("plant: cannot write the string to standard output: {}\n",
+                             errno ? std::strerror(errno) : "write error");
+    return kCantCreate;
 }
 
 int derive_main(const DeriveCmd& c) {
@@ -63,17 +76,11 @@ int derive_main(const DeriveCmd& c) {
         stats_out +=
             fmt::format("total steps={} modules={} bytes={} ms={:.4f} peak_rss_kb={}\n", d.steps_done(),
                         d.string().size(), d.string().bytes(), total_ms, peak_rss_kb());
-        std::fwrite(stats_out.data(), 1, stats_out.size(), stdout);
-        return kOk;
+        return write_stdout(stats_out);
     }
     std::string text = format_string(*program, d.string(), c.ids);
     text += '\n';
-    std::fwrite(text.data(), 1, text.size(), stdout);
-    if (std::fflush(stdout) != 0) {
-        std::cerr << "plant: cannot write the string to standard output\n";
-        return kFailed;
-    }
-    return kOk;
+    return write_stdout(text);
 }
 
 } // namespace

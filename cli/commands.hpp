@@ -33,8 +33,13 @@ struct GrammarOptions {
     std::optional<std::uint64_t> seed;
     int threads = 0; // 0: one per core
     std::size_t max_modules = 50'000'000;
+    std::uint64_t max_steps = kDefaultMaxSteps; // instructions one evaluation may run
     bool color = false;
 };
+
+// Reads a whole number from 0 (`lowest`) to 2^64 - 1 written in decimal digits; throws
+// CLI::ValidationError naming `option` and the range otherwise (a usage error, exit 64).
+std::uint64_t parse_count(const std::string& option, const std::string& text, std::uint64_t lowest);
 
 void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation);
 

@@ -4,8 +4,10 @@
 
 #include <fmt/format.h>
 
+#include <charconv>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <thread>
 #include <unistd.h>
 
@@ -22,7 +24,11 @@ void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation) {
         cmd.add_option("-n,--steps", o.steps,
                        "Number of derivation steps (default: the grammar's 'derive N;')")
             ->check(CLI::Range(0, 1000000));
-        cmd.add_option("--seed", o.seed, "Random seed (default: the grammar's 'seed S;', else 0)");
+        cmd.add_option_function<std::string>(
+               "--seed", [&o](const std::string& v) { o.seed = parse_count("--seed", v, 0); },
+               "Random seed, a whole number from 0 to 2^64 - 1 (default: the grammar's 'seed S;', "
+               "else 0)")
+            ->type_name("UINT");
         cmd.add_option("--threads", o.threads,
                        "Rewriting threads; 0 means one per core. The result never depends "
                        "on it")
@@ -32,6 +38,13 @@ void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation) {
                        "modules")
             ->check(CLI::PositiveNumber);
     }
+    cmd.add_option_function<std::string>(
+           "--max-steps", [&o](const std::string& v) { o.max_steps = parse_count("--max-steps", v, 1); },
+           fmt::format("Stop with an error when one evaluation (a hook call; a production's condition, "
+                       "weight or body for one module; a constant) runs more than this many "
+                       "instructions, the functions it calls included (default {})",
+                       kDefaultMaxSteps))
+        ->type_name("N");
     o.color = isatty(2) != 0 && std::getenv("NO_COLOR") == nullptr;
 }
 
@@ -41,6 +54,17 @@ void add_allow_read(CLI::App& cmd, std::vector<std::string>& dirs) {
                    "only its own folder, -I and PLANT_PATH folders and the standard library")
         ->type_name("DIR")
         ->allow_extra_args(false);
+}
+
+std::uint64_t parse_count(const std::string& option, const std::string& text, std::uint64_t lowest) {
+    std::uint64_t v = 0;
+    const char* end = text.data() + text.size();
+    auto r = std::from_chars(text.data(), end, v);
+    if (text.empty() || r.ec != std::errc() || r.ptr != end || v < lowest)
+        throw CLI::ValidationError(fmt::format("{} must be a whole number from {} to {}, found '{}'", option,
+                                               lowest, std::numeric_limits<std::uint64_t>::max(),
+                                               text.size() > 40 ? text.substr(0, 40) + "..." : text));
+    return v;
 }
 
 std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& sources, int& exit_code) {
@@ -58,6 +82,7 @@ std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& so
     co.confine_reads = true;
     co.allow_read = o.allow_read;
     co.environments = runtime_environments();
+    co.max_steps = o.max_steps;
     for (const auto& d : o.defines) {
         auto eq = d.find('=');
         if (eq == std::string::npos || eq == 0) {
@@ -85,6 +110,7 @@ DeriveOptions derive_options(const GrammarOptions& o) {
     d.threads =
         o.threads > 0 ? o.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     d.max_modules = o.max_modules;
+    d.max_steps = o.max_steps;
     return d;
 }
 

@@ -30,6 +30,7 @@ DeriveOptions Session::options() const {
     o.seed = seed_;
     o.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     o.interrupt = interrupt_;
+    o.max_steps = max_steps_;
     static TurtleEnvironmentPhase phase;
     o.environment_phase = &phase;
     std::ostream* out = &out_;
@@ -59,6 +60,7 @@ std::string Session::session_source(const std::string* extra_fn) const {
 
 CompileOptions Session::compile_options() const {
     CompileOptions co;
+    co.max_steps = max_steps_;
     for (const auto& [name, value] : params_) co.defines.emplace_back(name, value);
     if (!file_.empty()) co.file_texts[file_] = file_text_; // the file as :load or :reload read it
     // the session's source is "<session>": the loaded grammar's folder is its own
@@ -364,6 +366,8 @@ void Session::evaluate(const std::string& expr) {
     env.prog = program.get();
     env.globals = globals.data();
     env.seed = seed_.value_or(0);
+    env.interrupt = interrupt_; // Ctrl-C stops a long evaluation too
+    env.max_steps = max_steps_;
     if (!history_.empty()) env.step = current().steps_done();
     std::vector<double> frame(std::max<std::size_t>(f->frame_size, 1));
     double r[3] = {0, 0, 0};

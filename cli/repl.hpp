@@ -60,6 +60,7 @@ class Session {
     void set_interrupt(const std::atomic<bool>* flag) { interrupt_ = flag; }
     // --allow-read: folders the grammar may read besides its own (file_access.hpp)
     void allow_read(std::vector<std::string> dirs) { allow_read_ = std::move(dirs); }
+    void set_max_steps(std::uint64_t n) { max_steps_ = n; } // --max-steps
     int load(const std::string& path); // :load; 0, or the exit code of the failure (65, 66, 70)
     // Whether some line since the last call reported an error (scripts exit 1 when one did).
     bool take_failed() {
@@ -113,6 +114,7 @@ class Session {
     std::ostream& err_;
     bool color_;
     const std::atomic<bool>* interrupt_ = nullptr;
+    std::uint64_t max_steps_ = kDefaultMaxSteps;
 
     std::vector<std::string> allow_read_;       // --allow-read
     std::string file_;                          // the loaded grammar's path, as given
@@ -137,6 +139,7 @@ class Session {
     double last_step_ms_ = 0;
 };
 
-int repl_main(const std::string& file, bool color, const std::vector<std::string>& allow_read = {});
+int repl_main(const std::string& file, bool color, const std::vector<std::string>& allow_read = {},
+              std::uint64_t max_steps = kDefaultMaxSteps);
 
 } // namespace plant::cli

@@ -57,10 +57,14 @@ std::string history_path() {
 
 } // namespace
 
-int repl_main(const std::string& file, bool color, const std::vector<std::string>& allow_read) {
+int repl_main(const std::string& file, bool color, const std::vector<std::string>& allow_read,
+              std::uint64_t max_steps) {
     const bool interactive = isatty(0) != 0;
     Session session(std::cout, std::cerr, color && interactive);
     session.allow_read(allow_read);
+    session.set_max_steps(max_steps);
+    // (before the grammar is loaded: the derivation made then keeps the flag for its steps)
+    if (interactive) session.set_interrupt(&g_interrupt);
     g_session = &session;
     if (!file.empty()) {
         int code = session.load(file);
@@ -81,7 +85,6 @@ int repl_main(const std::string& file, bool color, const std::vector<std::string
         return failed ? kFailed : kOk;
     }
     // interactive: Ctrl-C interrupts a long step and returns to the prompt
-    session.set_interrupt(&g_interrupt);
     struct sigaction sa {};
     sa.sa_handler = on_sigint;
     sigemptyset(&sa.sa_mask);
@@ -115,16 +118,24 @@ int repl_main(const std::string& file, bool color, const std::vector<std::string
 
 void setup_repl(CLI::App& app, int& exit_code) {
     auto file = std::make_shared<std::string>();
+    auto max_steps = std::make_shared<std::uint64_t>(kDefaultMaxSteps);
     CLI::App* cmd =
         app.add_subcommand("repl", "An interactive session: step a derivation, inspect the string, change "
                                    "rules and params, look at the plant");
     cmd->add_option("FILE", *file, "A grammar to load");
     auto allow = std::make_shared<std::vector<std::string>>();
     add_allow_read(*cmd, *allow);
+    cmd->add_option_function<std::string>(
+           "--max-steps",
+           [max_steps](const std::string& v) { *max_steps = parse_count("--max-steps", v, 1); },
+           fmt::format("Stop an evaluation (a hook call, a production for one module, an expression) "
+                       "after this many instructions (default {})",
+                       kDefaultMaxSteps))
+        ->type_name("N");
     cmd->footer("Reads commands from standard input without a prompt when it is not a terminal:\n"
                 "  plant repl grammar.plant < script");
-    cmd->callback([file, allow, &exit_code] {
-        exit_code = repl_main(*file, isatty(2) != 0 && !std::getenv("NO_COLOR"), *allow);
+    cmd->callback([file, allow, max_steps, &exit_code] {
+        exit_code = repl_main(*file, isatty(2) != 0 && !std::getenv("NO_COLOR"), *allow, *max_steps);
     });
 }
 

@@ -61,6 +61,7 @@ std::optional<ConstVal> Compiler::eval_const(const ast::Expr& e, const char* wha
     env.prog = &P_;
     env.globals = P_.global_values.data();
     env.seed = 0;
+    env.max_steps = opts_.max_steps;
     ConstVal v;
     v.type = t;
     v.span = e.span;

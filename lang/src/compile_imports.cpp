@@ -13,6 +13,10 @@ namespace plant {
 
 namespace fs = std::filesystem;
 
+namespace {
+constexpr std::size_t kMaxImportDepth = 64; // files open at once in a chain of imports
+} // namespace
+
 std::string Compiler::resolve_import(const ast::Import& im, std::uint32_t from_file,
                                      std::vector<std::string>& searched) {
     fs::path from_dir = fs::path(sm_.file(from_file).name()).parent_path();
@@ -89,6 +93,13 @@ void Compiler::load(std::uint32_t file_id, std::map<std::string, std::pair<const
             continue;
         }
         if (loaded_paths_.count(id)) continue; // imported already through another path
+        if (stack.size() >= kMaxImportDepth) { // load() recurses once per file of the chain
+            diags_->error(im.span,
+                          fmt::format("imports nested deeper than {} files (the chain starts at '{}'); "
+                                      "import the libraries side by side instead",
+                                      kMaxImportDepth, shown_[stack.front()]));
+            continue;
+        }
         std::string text;
         if (given != opts_.file_texts.end()) {
             text = given->second;

@@ -68,6 +68,9 @@ void Derivation::run_hook(HookKind kind) {
     env.position = stream::kNoPosition;
     env.step = step_;
     env.effects = &effects;
+    env.max_steps = opt_.max_steps;
+    env.interrupt = opt_.interrupt;
+    if (opt_.on_print) effects.on_print = &opt_.on_print; // each line as it is printed
     std::vector<double> frame(std::max<std::size_t>(prog_.hook_frame[k], 1));
     try {
         plant::run(prog_.hooks[k], frame.data(), env);
@@ -87,6 +90,8 @@ void Derivation::start() {
     env.prog = &prog_;
     env.run = &run_;
     env.globals = globals_.data();
+    env.max_steps = opt_.max_steps;
+    env.interrupt = opt_.interrupt;
     using Key = ast::SettingKey;
     auto setting = [&](Key key, double fallback) {
         const Code& c = prog_.setting(key);

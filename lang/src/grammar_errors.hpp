@@ -113,7 +113,8 @@ PLANT_CONSTRUCT(expr_stmt);
 #undef PLANT_CONSTRUCT
 
 // Rules that nest; their depth is bounded so that a pathological input (ten thousand '(')
-// is an error rather than a stack overflow.
+// is an error rather than a stack overflow. Each must also be selected in parser.cpp's
+// selector: the parse-tree builder calls this control's start() for selected rules only.
 template <typename Rule> inline constexpr bool is_nesting = false;
 template <> inline constexpr bool is_nesting<paren_expr> = true;
 template <> inline constexpr bool is_nesting<unary_expr> = true;

@@ -34,7 +34,11 @@ using selector = pt::selector<
         g::symbol_set_kind, g::rules_item, g::group_name, g::rules_body, g::decompose_item, g::interpret_item,
         g::max_depth_clause, g::hook_item, g::hook_name, g::import_item, g::import_target, g::with_clause,
         g::override_block, g::override_item>,
-    pt::fold_one::on<g::postfix, g::mul, g::add, g::rel, g::eqx, g::and_x, g::or_x, g::ternary>>;
+    // (ternary_then and ternary_else are selected only so that their nesting is counted: the tree
+    // builder calls the grammar's control for selected rules alone; each has one child, which
+    // fold_one puts in its place)
+    pt::fold_one::on<g::postfix, g::mul, g::add, g::rel, g::eqx, g::and_x, g::or_x, g::ternary,
+                     g::ternary_then, g::ternary_else>>;
 
 namespace {
 
@@ -72,7 +76,8 @@ class Lowering {
             e->kind = ast::ExprKind::Number;
             std::string s = n.string();
             auto r = std::from_chars(s.data(), s.data() + s.size(), e->number);
-            if (r.ec != std::errc()) diags_.error(e->span, fmt::format("number '{}' is out of range", s));
+            if (r.ec != std::errc())
+                diags_.error(e->span, fmt::format("number '{}' is out of range", excerpt(s)));
         } else if (n.is_type<g::string_lit>()) {
             e->kind = ast::ExprKind::String;
             e->text = unescape(n.string_view());

@@ -20,6 +20,8 @@ namespace {
 
 constexpr int kMaxCallDepth = 256;
 constexpr std::size_t kStackSize = 1024;
+// Instructions between two looks at the interrupt flag (Ctrl-C): a few milliseconds' work.
+constexpr std::int64_t kStepSlice = std::int64_t{1} << 16;
 constexpr double kPi = std::numbers::pi;
 
 [[noreturn]] void fail(const Code& code, std::size_t pc, std::string msg,
@@ -202,6 +204,26 @@ std::string format_number(double v) {
     return fmt::format("{}", v);
 }
 
+// A slice of the evaluation's budget is used up: looks at the interrupt, then hands out the
+// next slice, or stops the evaluation at the instruction it reached.
+[[gnu::noinline]] std::int64_t next_slice(const Code& code, std::size_t pc, EvalEnv& env) {
+    if (env.interrupt && env.interrupt->load(std::memory_order_relaxed))
+        fail(code, pc, "interrupted", RuntimeErrorKind::Interrupted);
+    if (env.steps_left == 0) {
+        std::string where = env.function >= 0
+                                ? fmt::format(" (in function '{}')", env.prog->functions[env.function].name)
+                                : "";
+        fail(code, pc,
+             fmt::format("ran out of steps: more than {} instructions in one evaluation{}; a larger "
+                         "--max-steps allows more",
+                         env.max_steps, where),
+             RuntimeErrorKind::StepLimit);
+    }
+    auto n = static_cast<std::int64_t>(std::min<std::uint64_t>(env.steps_left, kStepSlice));
+    env.steps_left -= static_cast<std::uint64_t>(n);
+    return n;
+}
+
 struct ArenaScope {
     EvalEnv& env;
     std::size_t saved;
@@ -212,9 +234,22 @@ struct ArenaScope {
     ~ArenaScope() { env.arena_top = saved; }
 };
 
+RunStatus execute(const Code& code, double* frame, EvalEnv& env, double* result);
+
 } // namespace
 
+// An evaluation: a fresh budget of env.max_steps instructions for `code` and every function it
+// calls (execute, below, runs them).
 RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
+    env.slice = static_cast<std::int64_t>(std::min<std::uint64_t>(env.max_steps, kStepSlice));
+    env.steps_left = env.max_steps - static_cast<std::uint64_t>(env.slice);
+    env.function = -1;
+    return execute(code, frame, env, result);
+}
+
+namespace {
+
+RunStatus execute(const Code& code, double* frame, EvalEnv& env, double* result) {
     ArenaScope scope(env, kStackSize);
     // The arena may grow (and move) inside nested calls, so address the stack by offset.
     const std::size_t base = scope.saved;
@@ -223,7 +258,10 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
     int sp = 0;
     const Instr* ins = code.instrs.data();
     const std::size_t n = code.instrs.size();
+    std::int64_t slice = env.slice; // kept in env.slice while a function runs, and on return
     for (std::size_t pc = 0; pc < n; ++pc) {
+        if (--slice < 0) [[unlikely]]
+            slice = next_slice(code, pc, env) - 1;
         const Instr& I = ins[pc];
         switch (I.op) {
         case Op::Const:
@@ -380,8 +418,13 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
             double r[3] = {0, 0, 0};
             ++env.call_depth;
             ModuleString* saved_out = env.out;
+            const int saved_function = env.function;
             env.out = nullptr;
-            run(fn.code, callee.data(), env, r);
+            env.function = static_cast<int>(I.a);
+            env.slice = slice;
+            execute(fn.code, callee.data(), env, r);
+            slice = env.slice;
+            env.function = saved_function;
             env.out = saved_out;
             --env.call_depth;
             st = S();
@@ -392,6 +435,7 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
         case Op::Return:
             if (result)
                 for (int k = 0; k < I.n; ++k) result[k] = st[sp - I.n + k];
+            env.slice = slice;
             return RunStatus::Finished;
         case Op::Emit: {
             sp -= I.n;
@@ -426,6 +470,7 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
         }
         case Op::ProduceEnd:
             env.produced = true;
+            env.slice = slice;
             return RunStatus::Produced;
         case Op::NProduceMark:
             env.produced = true;
@@ -459,7 +504,13 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
                     c = e;
                 }
             }
-            if (env.effects) env.effects->printed += line + "\n";
+            if (env.effects) {
+                line += '\n';
+                if (env.effects->on_print)
+                    (*env.effects->on_print)(line);
+                else
+                    env.effects->printed += line;
+            }
             break;
         }
         case Op::ForCheck:
@@ -468,6 +519,7 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
         case Op::Halt:
             if (result)
                 for (int k = 0; k < I.n; ++k) result[k] = st[sp - I.n + k];
+            env.slice = slice;
             return RunStatus::Finished;
         case Op::LoadMulConst:
             st[sp++] = frame[I.a] * code.consts[I.b];
@@ -499,8 +551,11 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
     }
     if (result && sp > 0)
         for (int k = 0; k < std::min(sp, 3); ++k) result[k] = st[sp - std::min(sp, 3) + k];
+    env.slice = slice;
     return RunStatus::Finished;
 }
+
+} // namespace
 
 double CurveDef::operator()(double t) const {
     if (!(t >= 0)) t = 0; // NaN too

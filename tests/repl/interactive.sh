@@ -147,5 +147,29 @@ expect_text "the recalled command runs in the new session" "20.5"
 keys C-d
 expect_line "Ctrl-D on an empty line ends the session" 'shell$'
 
+# --- third session: Ctrl-C stops a runaway evaluation (a budget that would last for hours) ---
+cat >"$work/h.plant" <<'EOF'
+fn f(n) = n > 0 ? f(n - 1) + f(n - 1) : 1;
+var k = 0;
+on before_step { for i in 0..1e7 { for j in 0..1e7 { k += 1; } } }
+axiom: F;
+EOF
+type_text "$plant repl --max-steps 100000000000000 h.plant"
+keys Enter
+expect_text "the REPL starts with a runaway grammar" "loaded h.plant"
+type_text "f(100)"
+keys Enter
+sleep 0.3
+keys C-c
+expect_text "Ctrl-C stops a runaway expression" "interrupted"
+type_text ":step"
+keys Enter
+sleep 0.3
+keys C-c
+expect_text "Ctrl-C stops a runaway hook" "interrupted; still at step 0"
+type_text ":quit"
+keys Enter
+expect_line "the session goes on after both and quits" 'shell$'
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

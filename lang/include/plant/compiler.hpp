@@ -4,6 +4,7 @@
 #include "plant/diagnostics.hpp"
 #include "plant/environment.hpp"
 #include "plant/program.hpp"
+#include "plant/vm.hpp"
 
 #include <map>
 #include <memory>
@@ -20,8 +21,9 @@ struct CompileOptions {
     // library folders, the standard library and `allow_read` (file_access.hpp). The plant command
     // always does; a program embedding the compiler decides for its own grammars.
     bool confine_reads = false;
-    std::vector<std::string> allow_read; // --allow-read DIR
-    EnvironmentFactory environments;     // the runtime's kinds; none: `env` cannot be used
+    std::vector<std::string> allow_read;        // --allow-read DIR
+    EnvironmentFactory environments;            // the runtime's kinds; none: `env` cannot be used
+    std::uint64_t max_steps = kDefaultMaxSteps; // the VM's budget for constants evaluated now
 };
 
 // Reads, parses and compiles `path` and everything it imports. Returns null when there were

@@ -7,6 +7,7 @@
 #include "plant/module_string.hpp"
 #include "plant/program.hpp"
 #include "plant/run_state.hpp"
+#include "plant/vm.hpp"
 
 #include <atomic>
 #include <functional>
@@ -70,6 +71,9 @@ struct DeriveOptions {
     std::function<void(const StepStats&)> on_step;
     std::function<void(const std::string&)> on_print; // output of print(...) in hooks
     const std::atomic<bool>* interrupt = nullptr;     // set asynchronously to abandon a step
+    // Instructions one evaluation may run (a hook call; a production's condition, weight or
+    // body for one module; a setting): the VM's budget (vm.hpp, EvalEnv::max_steps).
+    std::uint64_t max_steps = kDefaultMaxSteps;
     // Whether the string keeps module identities (docs/language.md, module identity). Without them a
     // derivation writes 8 bytes less per module; they are kept anyway when the program can
     // observe them (it calls id(), or has query modules or environments).

@@ -7,6 +7,7 @@
 
 #include <exception>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace plant {
@@ -49,6 +50,12 @@ class Diagnostics {
     std::vector<Diagnostic> items_;
 };
 
+// Source text quoted in a message: at most `max` characters, then "..." (a megabyte-long number
+// is named by its start).
+inline std::string excerpt(std::string_view text, std::size_t max = 40) {
+    return text.size() <= max ? std::string(text) : std::string(text.substr(0, max)) + "...";
+}
+
 // `file:line:col: error: message`, the source line, and a caret under the span.
 std::string render(const Diagnostic& d, const SourceManager& sources, bool color = false);
 std::string render_all(const Diagnostics& ds, const SourceManager& sources, bool color = false);
@@ -59,6 +66,7 @@ enum class RuntimeErrorKind {
     Arithmetic,  // division by zero, or NaN or infinity reaching a module parameter
     ModuleLimit, // the string outgrew --max-modules or --max-bytes
     Interrupted, // the derivation was asked to stop (Ctrl-C in the REPL)
+    StepLimit,   // one evaluation ran more instructions than --max-steps allows
     Setting,     // a setting (derive, seed) out of its range
     Turtle,      // the turtle cannot interpret the string (unbalanced ']', leaving finite space)
     Geometry,    // the plant cannot be meshed (a surface that cannot be loaded, out-of-range points)

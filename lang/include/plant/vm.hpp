@@ -4,6 +4,8 @@
 #include "plant/program.hpp"
 
 #include <atomic>
+#include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -13,8 +15,16 @@ namespace plant {
 struct HookEffects {
     int use_group = -2; // -2: unchanged, -1: none, else group index
     bool stop = false;
+    // Each print() line is handed to `on_print` as it is made when that is set (so a hook that
+    // prints in a long loop shows its output and holds none); otherwise it is kept in `printed`.
+    const std::function<void(const std::string&)>* on_print = nullptr;
     std::string printed;
 };
+
+// The default of EvalEnv::max_steps (--max-steps): 500 times what the busiest shipped grammar or
+// test uses in one evaluation (about 390,000), above a loop stopped at 10 million turns (about
+// 10 instructions a turn), and a runaway evaluation stops within a second.
+inline constexpr std::uint64_t kDefaultMaxSteps = 200'000'000;
 
 // Marks an identity as "new in this step"; the engine replaces it with a real identity after
 // the step so identities do not depend on how the string was split between threads.
@@ -39,6 +49,15 @@ struct EvalEnv {
     std::size_t max_output = ~std::size_t{0}; // module limit of the output
     std::size_t max_params = ~std::size_t{0}; // parameter limit of the output
     const std::atomic<bool>* interrupt = nullptr;
+
+    // The evaluation budget ("fuel"): run() called from outside the VM (a hook, a production's
+    // condition, weight, successor values or body, a setting, a constant) may execute at most
+    // max_steps instructions, the functions it calls included; the interrupt is looked at every
+    // kStepSlice instructions of it. steps_left and slice belong to run().
+    std::uint64_t max_steps = kDefaultMaxSteps;
+    std::uint64_t steps_left = 0; // of the running evaluation, beyond the current slice
+    std::int64_t slice = 0;       // instructions left in the current slice
+    int function = -1;            // the function being run, -1: none (for messages)
 
     // Output of production bodies.
     ModuleString* out = nullptr;

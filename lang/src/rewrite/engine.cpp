@@ -94,6 +94,7 @@ void Engine::rewrite(const Derivation& d, const ModuleString& in, ModuleString& 
         w.env.max_output = d.opt_.max_modules;
         w.env.max_params = d.opt_.max_bytes / sizeof(double);
         w.env.interrupt = d.opt_.interrupt;
+        w.env.max_steps = d.opt_.max_steps;
         w.out.keep_ids = in.keep_ids;
     };
     out.clear();

@@ -224,14 +224,25 @@ std::size_t Rewriter::choose(Worker& w, std::size_t i, std::size_t set0, std::si
         }
     }
     if (count == 0) return 0;
+    // Weights near the largest double can sum to infinity: then they are all divided by the
+    // largest first (a scale of 1 changes no weight, so ordinary weights draw as they always did).
+    double scale = 1;
+    if (!std::isfinite(total)) {
+        double largest = 0;
+        for (std::size_t k = 0; k < count; ++k) largest = std::max(largest, options[k].weight);
+        scale = 1 / largest;
+        total = 0;
+        for (std::size_t k = 0; k < count; ++k) total += options[k].weight * scale;
+    }
     double u = random_unit(random_bits(w.env.seed, w.env.phase, i, stream::kChoiceDraw)) * total;
     std::size_t pick = count - 1;
     for (std::size_t k = 0; k < count; ++k) {
-        if (u < options[k].weight) {
+        const double weight = options[k].weight * scale;
+        if (u < weight) {
             pick = k;
             break;
         }
-        u -= options[k].weight;
+        u -= weight;
     }
     const Production& pr = *options[pick].pr;
     w.env.draw = 0;

@@ -3,6 +3,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <chrono>
+#include <thread>
+
 #include <algorithm>
 #include <filesystem>
 
@@ -161,6 +164,63 @@ TEST_CASE("recursion in functions is bounded", "[derive][limits]") {
     auto c = test::compile("fn f(x) = f(x + 1); axiom: A(1); derive 1; rules { A(x) -> A(f(x)); }");
     Derivation d(*c->program, {});
     CHECK_THROWS_WITH(d.run(), "step 1: recursion deeper than 256 calls in 'f'");
+}
+
+TEST_CASE("one evaluation has one budget of instructions, calls and loops included", "[derive][limits]") {
+    auto c = test::compile("fn f(n) = n > 0 ? f(n - 1) + f(n - 1) : 1;\n"
+                           "axiom: A(30); derive 1; rules { A(n) -> B(f(n)); }");
+    DeriveOptions o;
+    o.max_steps = 100000;
+    Derivation d(*c->program, o);
+    try {
+        d.run();
+        FAIL("expected an error");
+    } catch (const RuntimeError& e) {
+        CHECK(e.kind == RuntimeErrorKind::StepLimit);
+        CHECK(e.message.find("more than 100000 instructions in one evaluation (in function 'f')") !=
+              std::string::npos);
+    }
+    // each module's evaluation starts afresh: a budget one evaluation fits runs any number of them
+    auto many =
+        test::compile("axiom: A A A A A A A A; derive 3; rules { A { for i in 0..100 { } produce A; } }");
+    DeriveOptions small;
+    small.max_steps = 5000;
+    Derivation fits(*many->program, small);
+    CHECK_NOTHROW(fits.run());
+}
+
+TEST_CASE("the interrupt stops a runaway hook inside its budget", "[derive][limits]") {
+    auto c =
+        test::compile("var n = 0; on start { for i in 0..1e7 { for j in 0..1e7 { n += 1; } } }\naxiom: F;");
+    std::atomic<bool> stop{false};
+    DeriveOptions o;
+    o.interrupt = &stop;
+    o.max_steps = std::uint64_t{1} << 60; // the budget alone would run for years
+    Derivation d(*c->program, o);
+    std::thread ctrl_c([&stop] {
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        stop.store(true);
+    });
+    auto t0 = std::chrono::steady_clock::now();
+    try {
+        d.run();
+        FAIL("expected an error");
+    } catch (const RuntimeError& e) {
+        CHECK(e.kind == RuntimeErrorKind::Interrupted);
+    }
+    ctrl_c.join();
+    CHECK(std::chrono::steady_clock::now() - t0 < std::chrono::seconds(5));
+}
+
+TEST_CASE("print() hands each line over as it is printed", "[derive][limits]") {
+    auto c =
+        test::compile("on start { for i in 0..3 { print(\"line\", i); } n = 1 / 0; }\nvar n = 0; axiom: F;");
+    std::vector<std::string> lines;
+    DeriveOptions o;
+    o.on_print = [&lines](const std::string& text) { lines.push_back(text); };
+    Derivation d(*c->program, o);
+    CHECK_THROWS(d.run());
+    CHECK(lines == std::vector<std::string>{"line 0\n", "line 1\n", "line 2\n"});
 }
 
 TEST_CASE("numbers print in the shortest form that reads back", "[derive]") {

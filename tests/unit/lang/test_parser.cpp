@@ -154,6 +154,34 @@ TEST_CASE("deep nesting is an error, not a stack overflow", "[parser]") {
     CHECK(p->file->axioms[0].successor.size() == 20000);
 }
 
+TEST_CASE("every recursive construct counts toward the nesting limit", "[parser][limits]") {
+    auto repeat = [](const std::string& s, int n) {
+        std::string out;
+        for (int k = 0; k < n; ++k) out += s;
+        return out;
+    };
+    const int n = 20000; // deep enough to overflow the stack if a level went uncounted
+    const std::string deep[] = {
+        "x ? 1 : " + repeat("x ? 1 : ", n) + "1",       // conditional chain (else)
+        repeat("x ? ", n) + "1" + repeat(" : 1", n),    // conditional chain (then)
+        repeat("-", n) + "1",                           // unary minus
+        repeat("!", n) + "x",                           // negation
+        repeat("(", n) + "1" + repeat(")", n),          // parentheses
+        repeat("f(", n) + "1" + repeat(")", n),         // calls
+        repeat("x.f(", n) + "1" + repeat(")", n),       // method calls
+        repeat("-(x ? ", n) + "1" + repeat(" : 1)", n), // a mixture
+    };
+    for (const auto& e : deep) {
+        auto p = parse("param x = 1;\naxiom: F(" + e + ");");
+        REQUIRE(!p->diags.all().empty());
+        CHECK(p->diags.all()[0].message.rfind("nesting deeper than 200 levels", 0) == 0);
+    }
+    std::string hook = "on start { " + repeat("if (1) { ", n) + repeat("}", n) + " }\naxiom: F;";
+    CHECK(first_error(hook).find("nesting deeper than 200 levels") != std::string::npos);
+    std::string chain = "on start { if (1) {} " + repeat("else if (1) {} ", n) + "}\naxiom: F;";
+    CHECK(first_error(chain).find("nesting deeper than 200 levels") != std::string::npos);
+}
+
 TEST_CASE("binary garbage gives a positioned error", "[parser]") {
     std::string junk("\x7f\x45\x4c\x46\x02\x01\x00\x00\xff\xfe", 10);
     auto p = parse(junk);
