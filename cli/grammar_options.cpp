@@ -38,7 +38,7 @@ std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& so
     std::string text;
     if (!read_file(o.file, text)) {
         std::error_code ec;
-        std::cerr << fmt::format("plant: cannot read '{}': {}\n", o.file,
+        std::cerr << fmt::format("plant: cannot read '{}': {}\n", escape_controls(o.file),
                                  std::filesystem::is_directory(o.file, ec) ? "it is a directory"
                                  : std::filesystem::exists(o.file, ec)     ? "permission denied"
                                                                            : "no such file");
@@ -51,7 +51,7 @@ std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& so
     for (const auto& d : o.defines) {
         auto eq = d.find('=');
         if (eq == std::string::npos || eq == 0) {
-            std::cerr << fmt::format("plant: -D expects name=value, found '{}'\n", d);
+            std::cerr << fmt::format("plant: -D expects name=value, found '{}'\n", escape_controls(d));
             exit_code = kUsage;
             return nullptr;
         }

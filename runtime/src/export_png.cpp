@@ -492,13 +492,17 @@ void png_sink_write(void* context, void* data, int size) {
 
 } // namespace
 
-void write_png(const Scene& scene, const std::string& path, int width, int height) {
+std::string png_bytes(const Scene& scene, int width, int height, const std::string& path) {
     const Image img = render_scene(scene, width, height);
     PngSink sink;
     const int ok = stbi_write_png_to_func(png_sink_write, &sink, img.width, img.height, 3, img.rgb.data(),
                                           img.width * 3);
     if (!ok || sink.failed || sink.bytes.empty()) throw ExportError("cannot encode PNG for " + path);
-    write_file_atomically(path, sink.bytes);
+    return std::move(sink.bytes);
+}
+
+void write_png(const Scene& scene, const std::string& path, int width, int height) {
+    write_file_atomically(path, png_bytes(scene, width, height, path));
 }
 
 } // namespace plant

@@ -41,6 +41,12 @@ class Diagnostics {
 };
 
 // `file:line:col: error: message`, the source line, and a caret under the span.
+// Text from a grammar, a file or a file name made safe to print to a terminal: the C0 control
+// characters (but newline and tab when `keep_lines`), DEL, the C1 controls (U+0080 to U+009F)
+// and bytes that are not UTF-8 become visible escapes (`\x1b`, `\u009b`, `\xff`), so no escape
+// sequence reaches the terminal; all other text is kept as it is.
+std::string escape_controls(std::string_view text, bool keep_lines = false);
+
 std::string render(const Diagnostic& d, const SourceManager& sources, bool color = false);
 std::string render_all(const Diagnostics& ds, const SourceManager& sources, bool color = false);
 
