@@ -59,6 +59,7 @@ enum class RuntimeErrorKind {
     Setting,     // a setting (derive, seed) out of its range
     Turtle,      // the turtle cannot interpret the string (unbalanced ']', leaving finite space)
     Geometry,    // the plant cannot be meshed (a surface that cannot be loaded, out-of-range points)
+    Physics,     // an environment's simulation broke down (a particle's position is no longer finite)
 };
 
 // Thrown by the runtime for errors that end a derivation (runtime errors exit 70).

@@ -1,5 +1,6 @@
 #include "plant/physics/fluid.hpp"
 
+#include "cells.hpp"
 #include "parallel.hpp"
 
 #include <glm/gtc/quaternion.hpp>
@@ -82,7 +83,7 @@ void Fluid::build_grid() {
     cell_start_.assign(cells + 1, 0);
     std::vector<std::uint32_t> cell_of(x_.size());
     for (std::size_t i = 0; i < x_.size(); ++i) {
-        glm::ivec3 c = glm::clamp(glm::ivec3(glm::floor((x_[i] - lo_) / cell)), glm::ivec3(0), n_ - 1);
+        glm::ivec3 c = cell_index((x_[i] - lo_) / cell, glm::ivec3(0), n_ - 1);
         cell_of[i] = static_cast<std::uint32_t>((static_cast<std::size_t>(c.z) * n_.y + c.y) * n_.x + c.x);
         ++cell_start_[cell_of[i] + 1];
     }
@@ -111,7 +112,8 @@ template <class F> void Fluid::for_neighbours(const glm::dvec3& p, double radius
     // cell-sorted arrays. (Trimming each row to the ball costs more than the candidates it saves.)
     const double cell = s_.support / 2;
     const int reach = static_cast<int>(std::ceil(radius / cell));
-    glm::ivec3 c = glm::ivec3(glm::floor((p - lo_) / cell));
+    // a cell beyond the grid by more than `reach` sees the same (no) cells as one just past it
+    glm::ivec3 c = cell_index((p - lo_) / cell, glm::ivec3(-reach - 1), n_ + reach);
     const int x0 = std::max(c.x - reach, 0), x1 = std::min(c.x + reach, n_.x - 1);
     if (x0 > x1) return;
     for (int z = std::max(c.z - reach, 0); z <= std::min(c.z + reach, n_.z - 1); ++z)
@@ -192,7 +194,7 @@ void Fluid::compute_densities(const World* plant) {
     for (std::uint32_t i = 0; i < n; ++i) {
         const glm::dvec3 xi = x_[i];
         const glm::vec3 xif = xf_[i];
-        const glm::ivec3 c = glm::clamp(glm::ivec3(glm::floor((xi - lo_) / cell)), glm::ivec3(0), n_ - 1);
+        const glm::ivec3 c = cell_index((xi - lo_) / cell, glm::ivec3(0), n_ - 1);
         const int x0 = std::max(c.x - 2, 0), x1 = std::min(c.x + 2, n_.x - 1);
         for (int z = c.z; z <= std::min(c.z + 2, n_.z - 1); ++z)
             for (int y = z == c.z ? c.y : std::max(c.y - 2, 0); y <= std::min(c.y + 2, n_.y - 1); ++y) {
