@@ -253,7 +253,13 @@ void Climber::advance(std::set<ModuleId>& left) {
             physics::Handle h = particle(id);
             if (h.valid() && world_.alive(h)) world_.pull(h, target);
         }
-        for (int a = 0; a < air_steps; ++a) fluid_.step(&world_);
+        try {
+            for (int a = 0; a < air_steps; ++a) fluid_.step(&world_);
+        } catch (const physics::AirCrowded& e) {
+            throw RuntimeError(RuntimeErrorKind::Physics, Span{},
+                               std::string(e.what()) +
+                                   ": lower the emitters' velocities or the wind, or raise air_stiffness");
+        }
         world_.step();
     }
     pulls_.clear();

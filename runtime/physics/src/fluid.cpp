@@ -15,6 +15,9 @@ namespace plant::physics {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
+// The most particles a grid cell may hold on average, seen from a particle (the sum of the
+// cells' squared counts over the particle count) before a step gives up: see build_grid.
+constexpr int kMaxCrowding = 8;
 
 } // namespace
 
@@ -87,6 +90,15 @@ void Fluid::build_grid() {
         cell_of[i] = static_cast<std::uint32_t>((static_cast<std::size_t>(c.z) * n_.y + c.y) * n_.x + c.x);
         ++cell_start_[cell_of[i] + 1];
     }
+    // a particle's neighbour search visits the cells around its own, so the work of a pass is
+    // about the sum of the cells' squared counts: about one particle a cell at rest, a few where
+    // the air is compressed; far more and the search would be quadratic in the particles
+    double crowding = 0;
+    for (std::size_t c = 1; c <= cells; ++c) crowding += double(cell_start_[c]) * double(cell_start_[c]);
+    if (crowding > kMaxCrowding * double(x_.size()) + 1e4)
+        throw AirCrowded("the air crowded into few cells (" +
+                         std::to_string(std::llround(crowding / double(x_.size()))) +
+                         " particles a cell on average, at most " + std::to_string(kMaxCrowding) + ")");
     for (std::size_t c = 0; c < cells; ++c) cell_start_[c + 1] += cell_start_[c];
     order_.assign(x_.size(), 0);
     sorted_x_.resize(x_.size());
