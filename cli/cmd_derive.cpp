@@ -58,7 +58,7 @@ int derive_main(const DeriveCmd& c) {
         if (c.stats) steps.push_back(s);
         if (progress) std::cerr << fmt::format("\rstep {}: {} modules   ", s.step, s.modules) << std::flush;
     };
-    opt.on_print = [](const std::string& text) { std::cerr << text; };
+    opt.on_print = [](const std::string& text) { std::cerr << escape_controls(text, true); };
     TurtleEnvironmentPhase phase;
     opt.environment_phase = &phase;
     Derivation d(*program, opt);

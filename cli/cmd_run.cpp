@@ -40,7 +40,7 @@ int run_main(RunCmd& c) {
         std::cerr << fmt::format(
             "plant: --size expects WIDTHxHEIGHT, each from 16 to 16384 and at most 64 million "
             "pixels, found '{}'\n",
-            c.size);
+            escape_controls(c.size));
         return kUsage;
     }
     if (c.outputs.empty()) {
@@ -49,7 +49,7 @@ int run_main(RunCmd& c) {
     }
     for (const auto& o : c.outputs) {
         if (!format_of(o)) {
-            std::cerr << fmt::format("plant: cannot tell the format of '{}': use {}\n", o,
+            std::cerr << fmt::format("plant: cannot tell the format of '{}': use {}\n", escape_controls(o),
                                      known_extensions());
             return kUsage;
         }
@@ -63,7 +63,7 @@ int run_main(RunCmd& c) {
     DeriveOptions opt = derive_options(c.g);
     TurtleEnvironmentPhase phase;
     opt.environment_phase = &phase;
-    opt.on_print = [](const std::string& text) { std::cerr << text; };
+    opt.on_print = [](const std::string& text) { std::cerr << escape_controls(text, true); };
     opt.on_step = [&](const StepStats& s) {
         if (progress) std::cerr << fmt::format("\rstep {}: {} modules   ", s.step, s.modules) << std::flush;
     };
@@ -84,7 +84,7 @@ int run_main(RunCmd& c) {
         std::cerr << render(Diagnostic{Severity::Error, e.span, e.message, {}}, sources, c.g.color);
         return e.kind == RuntimeErrorKind::Input ? kNoInput : kRuntime; // a mesh file it cannot read
     } catch (const ExportError& e) {
-        std::cerr << "plant: " << e.what() << "\n";
+        std::cerr << "plant: " << escape_controls(e.what(), true) << "\n";
         return kCantCreate;
     }
     return kOk;

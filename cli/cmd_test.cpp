@@ -91,14 +91,6 @@ Outcome run_self(const std::vector<std::string>& args, const fs::path& dir) {
     return o;
 }
 
-std::vector<std::string> split_words(const std::string& s) {
-    std::vector<std::string> out;
-    std::istringstream in(s);
-    std::string w;
-    while (in >> w) out.push_back(w);
-    return out;
-}
-
 std::vector<std::string> lines_of(const std::string& s) {
     std::vector<std::string> out;
     std::string line;
@@ -112,27 +104,60 @@ struct Expectations {
     std::string command = "derive";
     std::vector<std::string> args, out, errors, warnings;
     std::optional<int> exit_code;
+    int command_line = 0, command_col = 0; // where `# command:` names the command
+    int args_line = 0;                     // the line of `# args:`, and where each word begins
+    std::vector<int> arg_cols;
 };
+
+// The words of `rest` with the 1-based column each begins at, `rest` starting at column `col`.
+std::vector<std::string> split_words_at(const std::string& rest, int col, std::vector<int>& cols) {
+    std::vector<std::string> out;
+    for (std::size_t i = 0; i < rest.size();) {
+        if (std::isspace(static_cast<unsigned char>(rest[i]))) {
+            ++i;
+            continue;
+        }
+        std::size_t e = i;
+        while (e < rest.size() && !std::isspace(static_cast<unsigned char>(rest[e]))) ++e;
+        out.push_back(rest.substr(i, e - i));
+        cols.push_back(col + static_cast<int>(i));
+        i = e;
+    }
+    return out;
+}
 
 Expectations read_expectations(const std::string& text) {
     Expectations e;
+    int line_no = 0;
     for (auto raw : lines_of(text)) {
+        ++line_no;
         if (!raw.empty() && raw.back() == '\r') raw.pop_back(); // files with CRLF line ends
         auto hash = raw.find('#');
         if (hash == std::string::npos) continue;
         std::string c = raw.substr(hash + 1);
+        int rest_col = 0; // the 1-based column `rest` begins at
         auto take = [&](const char* key, std::string& rest) {
             std::string k = std::string(" ") + key;
             if (c.rfind(k, 0) != 0) return false;
             rest = c.substr(k.size());
-            if (!rest.empty() && rest[0] == ' ') rest.erase(0, 1);
+            rest_col = static_cast<int>(hash + 1 + k.size()) + 1;
+            if (!rest.empty() && rest[0] == ' ') {
+                rest.erase(0, 1);
+                ++rest_col;
+            }
             return true;
         };
         std::string rest;
         if (take("args:", rest)) {
-            e.args = split_words(rest);
+            e.arg_cols.clear();
+            e.args = split_words_at(rest, rest_col, e.arg_cols);
+            e.args_line = line_no;
         } else if (take("command:", rest)) {
-            e.command = split_words(rest).empty() ? "derive" : split_words(rest)[0];
+            std::vector<int> cols;
+            const std::vector<std::string> words = split_words_at(rest, rest_col, cols);
+            e.command = words.empty() ? "derive" : words[0];
+            e.command_line = line_no;
+            e.command_col = words.empty() ? rest_col : cols[0];
             e.script = true;
         } else if (take("expect error:", rest)) {
             e.errors.push_back(rest);
@@ -201,12 +226,80 @@ bool write_atomically(const fs::path& path, const std::string& text) {
     }
 }
 
+// A folder of plant test's own for one test's outputs, removed with everything in it.
+struct OutputFolder {
+    fs::path path;
+    OutputFolder() {
+        char name[] = "/tmp/plant-test-XXXXXX";
+        if (mkdtemp(name)) path = name;
+    }
+    ~OutputFolder() {
+        std::error_code ignored;
+        if (!path.empty()) fs::remove_all(path, ignored);
+    }
+    OutputFolder(const OutputFolder&) = delete;
+    OutputFolder& operator=(const OutputFolder&) = delete;
+};
+
+// What a test may ask for in its comments: `plant derive`, `check` or `run`, never `test` or
+// `repl` (a test that runs tests spawns processes without end), and outputs only as plain file
+// names, which land in `outdir` (a test file from a stranger must not overwrite the user's files).
+// Rewrites the outputs into `outdir`; a `run` without outputs gets the default pair there.
+// Returns an error placed on the comment, or an empty string.
+std::string confine(const fs::path& file, Expectations& e, const fs::path& outdir) {
+    auto at = [&](int line, int col, const std::string& msg) {
+        return fmt::format("  {}:{}:{}: error: {}\n", escape_controls(file.string()), line, col,
+                           escape_controls(msg));
+    };
+    static const std::string kAllowed[] = {"derive", "check", "run"};
+    if (std::find(std::begin(kAllowed), std::end(kAllowed), e.command) == std::end(kAllowed))
+        return at(e.command_line, e.command_col,
+                  fmt::format("plant test runs only 'derive', 'check' and 'run' from a test's comments, "
+                              "not '{}'",
+                              e.command));
+    bool outputs = false;
+    for (std::size_t k = 0; k < e.args.size(); ++k) {
+        const std::string a = e.args[k];
+        std::string prefix, value;
+        std::size_t at_k = k;
+        if (a == "-o" || a == "--output") {
+            if (k + 1 >= e.args.size()) break; // plant itself reports the missing value
+            at_k = ++k;
+            value = e.args[at_k];
+        } else if (a.rfind("--output=", 0) == 0) {
+            prefix = "--output=";
+        } else if (a.rfind("-o", 0) == 0) {
+            prefix = "-o";
+        } else {
+            continue;
+        }
+        if (!prefix.empty()) value = a.substr(prefix.size());
+        outputs = true;
+        if (outdir.empty())
+            return at(e.args_line, e.arg_cols[at_k], "cannot create a folder for the outputs");
+        if (value.empty() || value.find('/') != std::string::npos || value == "." || value == "..")
+            return at(e.args_line, e.arg_cols[at_k],
+                      fmt::format("an output of a test must be a plain file name (no folder, no '..'), "
+                                  "found '{}': plant test writes outputs into a folder of its own",
+                                  value));
+        e.args[at_k] = prefix + (outdir / value).string();
+    }
+    if (e.command == "run" && !outputs) {
+        const std::string stem = file.stem().string();
+        for (const char* ext : {".glb", ".png"})
+            e.args.insert(e.args.end(), {"-o", (outdir / (stem + ext)).string()});
+    }
+    return {};
+}
+
 // Returns an empty string when the test passed, else what went wrong.
 std::string run_one(const fs::path& file, bool bless, bool& blessed,
                     const std::vector<std::string>& allow_read) {
     std::string text;
     if (!read_file(file.string(), text)) return "  cannot read the file\n";
     Expectations e = read_expectations(text);
+    OutputFolder outdir;
+    if (std::string refused = confine(file, e, outdir.path); !refused.empty()) return refused;
     std::vector<std::string> args{e.command, file.filename().string()};
     args.insert(args.end(), e.args.begin(), e.args.end());
     for (const auto& d : allow_read) args.insert(args.end(), {"--allow-read", fs::absolute(d).string()});
@@ -296,7 +389,8 @@ int test_main(const TestCmd& c) {
         } else if (fs::exists(p, ec)) {
             files.emplace_back(p);
         } else {
-            std::cerr << fmt::format("plant: cannot read '{}': no such file or directory\n", p);
+            std::cerr << fmt::format("plant: cannot read '{}': no such file or directory\n",
+                                     escape_controls(p));
             return kNoInput;
         }
     }

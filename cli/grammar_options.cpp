@@ -71,7 +71,7 @@ std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& so
     std::string text;
     if (ReadFailure f = read_input_file(o.file, text, kMaxSourceBytes, false); f != ReadFailure::None) {
         std::error_code ec;
-        std::cerr << fmt::format("plant: cannot read '{}': {}\n", o.file,
+        std::cerr << fmt::format("plant: cannot read '{}': {}\n", escape_controls(o.file),
                                  std::filesystem::is_directory(o.file, ec) ? "it is a directory"
                                                                            : describe(f));
         exit_code = kNoInput;
@@ -86,7 +86,7 @@ std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& so
     for (const auto& d : o.defines) {
         auto eq = d.find('=');
         if (eq == std::string::npos || eq == 0) {
-            std::cerr << fmt::format("plant: -D expects name=value, found '{}'\n", d);
+            std::cerr << fmt::format("plant: -D expects name=value, found '{}'\n", escape_controls(d));
             exit_code = kUsage;
             return nullptr;
         }

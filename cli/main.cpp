@@ -34,14 +34,14 @@ int main(int argc, char** argv) {
         // is a usage error.
         std::string which;
         for (const CLI::App* sub : app.get_subcommands()) which = sub->get_name();
-        std::cerr << "plant: " << e.what() << "\n"
+        std::cerr << "plant: " << plant::escape_controls(e.what(), true) << "\n"
                   << "Run 'plant " << (which.empty() ? "" : which + " ") << "--help' for usage.\n";
         return kUsage;
     } catch (const std::bad_alloc&) {
         std::cerr << "plant: out of memory (lower --max-modules or the derivation length)\n";
         return kRuntime;
     } catch (const std::exception& e) {
-        std::cerr << "plant: internal error: " << e.what() << "\n";
+        std::cerr << "plant: internal error: " << plant::escape_controls(e.what(), true) << "\n";
         return kRuntime;
     }
     return exit_code;

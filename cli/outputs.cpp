@@ -1,4 +1,5 @@
 #include "outputs.hpp"
+#include "pending_files.hpp"
 
 #include "plant/environment.hpp"
 
@@ -9,12 +10,8 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <filesystem>
-#include <unistd.h>
 
 namespace plant::cli {
-
-namespace fs = std::filesystem;
 
 namespace {
 
@@ -32,51 +29,51 @@ std::string mesh_summary(const Scene& s) {
         s.bounds_min.z, s.bounds_max.x, s.bounds_max.y, s.bounds_max.z);
 }
 
-void write_glb(const OutputSources& from, const std::string& path) {
-    write_gltf(from.scene, path, GltfContainer::Binary);
+std::string glb_bytes(const OutputSources& from, const std::string& target) {
+    return gltf_bytes(from.scene, GltfContainer::Binary, target);
 }
-void write_gltf_json(const OutputSources& from, const std::string& path) {
-    write_gltf(from.scene, path, GltfContainer::Json);
+std::string gltf_json_bytes(const OutputSources& from, const std::string& target) {
+    return gltf_bytes(from.scene, GltfContainer::Json, target);
 }
-void write_obj(const OutputSources& from, const std::string& path) {
-    write_mesh_file(from.scene, path, MeshFileFormat::Obj);
+std::string obj_bytes(const OutputSources& from, const std::string& target) {
+    return mesh_file_bytes(from.scene, MeshFileFormat::Obj, target);
 }
-void write_ply(const OutputSources& from, const std::string& path) {
-    write_mesh_file(from.scene, path, MeshFileFormat::Ply);
+std::string ply_bytes(const OutputSources& from, const std::string& target) {
+    return mesh_file_bytes(from.scene, MeshFileFormat::Ply, target);
 }
-void write_off(const OutputSources& from, const std::string& path) {
-    write_mesh_file(from.scene, path, MeshFileFormat::Off);
+std::string off_bytes(const OutputSources& from, const std::string& target) {
+    return mesh_file_bytes(from.scene, MeshFileFormat::Off, target);
 }
-void write_scene_png(const OutputSources& from, const std::string& path) {
-    write_png(from.scene, path, from.options.width, from.options.height);
+std::string scene_png_bytes(const OutputSources& from, const std::string& target) {
+    return png_bytes(from.scene, from.options.width, from.options.height, target);
 }
-void write_skeleton_svg(const OutputSources& from, const std::string& path) {
-    write_svg(from.skeleton, path);
+std::string skeleton_svg_bytes(const OutputSources& from, const std::string&) {
+    return skeleton_svg(from.skeleton);
 }
-void write_skeleton_file(const OutputSources& from, const std::string& path) {
-    write_skeleton_json(from.skeleton, path);
+std::string skeleton_json_bytes(const OutputSources& from, const std::string&) {
+    return skeleton_json(from.skeleton);
 }
-void write_string_text(const OutputSources& from, const std::string& path) {
-    write_file_atomically(path, format_string(from.program, from.derivation.string()) + "\n");
+std::string string_text_bytes(const OutputSources& from, const std::string&) {
+    return format_string(from.program, from.derivation.string()) + "\n";
 }
-void write_mesh_summary(const OutputSources& from, const std::string& path) {
-    write_file_atomically(path, mesh_summary(from.scene));
+std::string mesh_summary_bytes(const OutputSources& from, const std::string&) {
+    return mesh_summary(from.scene);
 }
 
 // Adding a format: one row here and its writer above (docs: README.md lists the extensions).
 constexpr OutputFormat kFormats[] = {
-    {".glb", OutputNeeds::Scene, write_glb,
+    {".glb", OutputNeeds::Scene, glb_bytes,
      "glTF 2.0, binary; each organ is one mesh shared by every node that places it"},
-    {".gltf", OutputNeeds::Scene, write_gltf_json, "glTF 2.0 as JSON, the buffer embedded as a data URI"},
-    {".obj", OutputNeeds::Scene, write_obj, "Wavefront OBJ, everything in one triangle mesh"},
-    {".ply", OutputNeeds::Scene, write_ply, "PLY, everything in one triangle mesh"},
-    {".off", OutputNeeds::Scene, write_off, "OFF, everything in one triangle mesh"},
-    {".png", OutputNeeds::Scene, write_scene_png, "a shaded preview from a 3/4 view, --size pixels"},
-    {".svg", OutputNeeds::Skeleton, write_skeleton_svg, "a line drawing of the XY plane, for 2D grammars"},
-    {".txt", OutputNeeds::String, write_string_text, "the derived string, as plant derive prints it"},
-    {".skel.json", OutputNeeds::Skeleton, write_skeleton_file,
+    {".gltf", OutputNeeds::Scene, gltf_json_bytes, "glTF 2.0 as JSON, the buffer embedded as a data URI"},
+    {".obj", OutputNeeds::Scene, obj_bytes, "Wavefront OBJ, everything in one triangle mesh"},
+    {".ply", OutputNeeds::Scene, ply_bytes, "PLY, everything in one triangle mesh"},
+    {".off", OutputNeeds::Scene, off_bytes, "OFF, everything in one triangle mesh"},
+    {".png", OutputNeeds::Scene, scene_png_bytes, "a shaded preview from a 3/4 view, --size pixels"},
+    {".svg", OutputNeeds::Skeleton, skeleton_svg_bytes, "a line drawing of the XY plane, for 2D grammars"},
+    {".txt", OutputNeeds::String, string_text_bytes, "the derived string, as plant derive prints it"},
+    {".skel.json", OutputNeeds::Skeleton, skeleton_json_bytes,
      "the skeleton, what the turtle drew before meshing (docs/skeleton.md)"},
-    {".mesh.txt", OutputNeeds::Scene, write_mesh_summary,
+    {".mesh.txt", OutputNeeds::Scene, mesh_summary_bytes,
      "counts and bounds of the meshed scene, for golden files"},
 };
 
@@ -149,7 +146,8 @@ OutputSummary write_outputs(const Program& program, const Derivation& d,
     for (const auto& p : paths) {
         const OutputFormat* f = format_of(p);
         if (!f)
-            throw ExportError(fmt::format("cannot tell the format of '{}': use {}", p, known_extensions()));
+            throw ExportError(fmt::format("cannot tell the format of '{}': use {}", escape_controls(p),
+                                          known_extensions()));
         formats.push_back(f);
     }
     bool need_skeleton = false, need_scene = false;
@@ -166,38 +164,13 @@ OutputSummary write_outputs(const Program& program, const Derivation& d,
         scene = build_scene(program, skeleton, mo);
         if (options.obstacles) add_environments(d.run_state(), scene);
     }
-    // All or nothing: every file is first written under a temporary name beside its target
-    // (same extension, which the writers go by); only when all succeeded are they renamed.
-    std::vector<std::string> temps;
-    auto discard = [&] {
-        for (const auto& t : temps) {
-            std::error_code ignored;
-            fs::remove(t, ignored);
-        }
-    };
-    try {
-        for (std::size_t k = 0; k < formats.size(); ++k) {
-            const fs::path target(paths[k]);
-            fs::path parent = target.parent_path();
-            std::error_code ec;
-            if (!parent.empty()) fs::create_directories(parent, ec);
-            std::string name = target.filename().string();
-            std::string path =
-                (parent / ("." + name + ".plant-tmp" + std::to_string(::getpid()) + "-" + std::to_string(k) +
-                           name.substr(name.find('.') == std::string::npos ? name.size() : name.find('.'))))
-                    .string();
-            temps.push_back(path);
-            formats[k]->write(OutputSources{program, d, skeleton, scene, options}, path);
-        }
-        for (std::size_t k = 0; k < temps.size(); ++k) {
-            std::error_code ec;
-            fs::rename(temps[k], paths[k], ec);
-            if (ec) throw ExportError(fmt::format("cannot write '{}': {}", paths[k], ec.message()));
-        }
-    } catch (...) {
-        discard();
-        throw;
-    }
+    // All or nothing across the run: every file is written under a temporary name beside its
+    // target, and only when all are written are they renamed (PendingFiles removes them on an
+    // error and on SIGINT or SIGTERM).
+    PendingFiles pending(paths);
+    for (std::size_t k = 0; k < formats.size(); ++k)
+        pending.write(k, formats[k]->bytes(OutputSources{program, d, skeleton, scene, options}, paths[k]));
+    pending.commit();
     return OutputSummary{scene.tubes.triangle_count(), scene.instances.size()};
 }
 

@@ -38,7 +38,8 @@ struct OutputSources {
 struct OutputFormat {
     const char* extension; // with its dot; matched case-insensitively, the longest match wins
     OutputNeeds needs;
-    void (*write)(const OutputSources& from, const std::string& path);
+    // the file's bytes; `target` names the file in messages only
+    std::string (*bytes)(const OutputSources& from, const std::string& target);
     const char* doc; // one line for `plant run --help` and `plant help formats`
 };
 

@@ -34,7 +34,7 @@ DeriveOptions Session::options() const {
     static TurtleEnvironmentPhase phase;
     o.environment_phase = &phase;
     std::ostream* out = &out_;
-    o.on_print = [out](const std::string& text) { *out << text; };
+    o.on_print = [out](const std::string& text) { *out << escape_controls(text, true); };
     return o;
 }
 
@@ -134,7 +134,7 @@ bool Session::rebuild(int steps, const std::string* extra_fn) {
 int Session::load(const std::string& path) {
     std::error_code ec;
     if (!fs::is_regular_file(path, ec)) {
-        error() << fmt::format("plant: cannot read '{}': {}\n", path,
+        error() << fmt::format("plant: cannot read '{}': {}\n", escape_controls(path),
                                fs::is_directory(path, ec) ? "it is a directory" : "no such file");
         return 66;
     }
@@ -152,7 +152,8 @@ int Session::load(const std::string& path) {
         std::tie(file_, file_text_, axiom_, extra_rules_, params_, seed_, uses_, edits_) = saved;
         return last_error_runtime_ ? 70 : 65;
     }
-    out_ << fmt::format("loaded {}: {} at step 0\n", path, modules(current().string().size()));
+    out_ << fmt::format("loaded {}: {} at step 0\n", escape_controls(path),
+                        modules(current().string().size()));
     return 0;
 }
 
@@ -439,12 +440,12 @@ void Session::export_files(const std::vector<std::string>& paths) {
     if (!need_derivation()) return;
     try {
         OutputSummary s = write_outputs(*program_, current(), paths, OutputOptions{});
-        for (const auto& p : paths) out_ << "wrote " << p << "\n";
+        for (const auto& p : paths) out_ << "wrote " << escape_controls(p) << "\n";
         out_ << fmt::format("{} triangles, {} organs\n", s.triangles, s.organs);
     } catch (const RuntimeError& e) {
         error() << render(Diagnostic{Severity::Error, e.span, e.message, {}}, *sources_, color_);
     } catch (const ExportError& e) {
-        error() << "plant: " << e.what() << "\n";
+        error() << "plant: " << escape_controls(e.what(), true) << "\n";
     }
 }
 

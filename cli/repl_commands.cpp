@@ -137,7 +137,7 @@ void Session::reload() {
         int steps = history_.empty() ? 0 : current().steps_done();
         std::string saved = file_text_;
         if (!read_file(file_, file_text_)) {
-            error() << fmt::format("plant: cannot read '{}'\n", file_);
+            error() << fmt::format("plant: cannot read '{}'\n", escape_controls(file_));
         } else if (rebuild(steps)) {
             out_ << fmt::format("reloaded; step {}: {}\n", current().steps_done(),
                                 modules(current().string().size()));

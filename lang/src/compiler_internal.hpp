@@ -124,6 +124,15 @@ class Compiler {
     void check_bound_modules();
     void check_group_directions();
     void check_shadowed(const ast::Production& p, const Production& cp, const RuleSet& set);
+    // check_shadowed's index of the rule set being compiled: the first production that always
+    // applies, by predecessor; rebuilt when another set (or a set that moved) comes
+    struct ShadowIndex {
+        const RuleSet* set = nullptr;
+        std::size_t indexed = 0; // productions looked at
+        Span first;              // the first production's span, to know the set again
+        std::unordered_map<std::string, std::size_t> first_always;
+    };
+    ShadowIndex shadow_;
     void check_never_applying();
     void check_raw_runs();
     void build_template(Production& p);

@@ -35,6 +35,31 @@ std::string printable(std::string_view s) {
     return out;
 }
 
+// The length of the UTF-8 sequence at s[i], or 0 when it is not one (RFC 3629: no overlong
+// forms, no surrogates, nothing past U+10FFFF).
+std::size_t utf8_length(std::string_view s, std::size_t i) {
+    const auto at = [&](std::size_t k) { return static_cast<unsigned char>(s[k]); };
+    const unsigned char c = at(i);
+    std::size_t n = 0;
+    unsigned char lo = 0x80, hi = 0xbf; // the second byte's range
+    if (c >= 0xc2 && c <= 0xdf)
+        n = 2;
+    else if (c >= 0xe0 && c <= 0xef) {
+        n = 3;
+        if (c == 0xe0) lo = 0xa0;
+        if (c == 0xed) hi = 0x9f;
+    } else if (c >= 0xf0 && c <= 0xf4) {
+        n = 4;
+        if (c == 0xf0) lo = 0x90;
+        if (c == 0xf4) hi = 0x8f;
+    } else
+        return 0;
+    if (i + n > s.size() || at(i + 1) < lo || at(i + 1) > hi) return 0;
+    for (std::size_t k = 2; k < n; ++k)
+        if (at(i + k) < 0x80 || at(i + k) > 0xbf) return 0;
+    return n;
+}
+
 void render_one(std::string& out, Severity sev, Span span, const std::string& message,
                 const SourceManager& sources, bool color) {
     const char* on = "";
@@ -42,13 +67,14 @@ void render_one(std::string& out, Severity sev, Span span, const std::string& me
     if (color)
         on = sev == Severity::Error ? "\x1b[1;31m" : sev == Severity::Warning ? "\x1b[1;35m" : "\x1b[1;36m";
     if (!span.valid()) {
-        out += fmt::format("plant: {}{}:{} {}\n", on, severity_name(sev), off, message);
+        out +=
+            fmt::format("plant: {}{}:{} {}\n", on, severity_name(sev), off, escape_controls(message, true));
         return;
     }
     const SourceFile& f = sources.file(span.file);
     LineCol lc = f.line_col(span.begin);
-    out += fmt::format("{}:{}:{}: {}{}:{} {}\n", f.name(), lc.line, lc.col, on, severity_name(sev), off,
-                       message);
+    out += fmt::format("{}:{}:{}: {}{}:{} {}\n", escape_controls(f.name()), lc.line, lc.col, on,
+                       severity_name(sev), off, escape_controls(message, true));
     std::string line = printable(f.line_text(lc.line));
     if (line.size() > 200) line = line.substr(0, 200);
     out += fmt::format("{:5} | {}\n", lc.line, line);
@@ -63,6 +89,41 @@ void render_one(std::string& out, Severity sev, Span span, const std::string& me
 }
 
 } // namespace
+
+std::string escape_controls(std::string_view text, bool keep_lines) {
+    bool plain = true;
+    for (unsigned char c : text)
+        if ((c < 0x20 && !(keep_lines && (c == '\n' || c == '\t'))) || c >= 0x7f) {
+            plain = false;
+            break;
+        }
+    if (plain) return std::string(text);
+    std::string out;
+    out.reserve(text.size() + 16);
+    for (std::size_t i = 0; i < text.size();) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        if (c < 0x80) {
+            if ((c < 0x20 && !(keep_lines && (c == '\n' || c == '\t'))) || c == 0x7f)
+                out += fmt::format("\\x{:02x}", c);
+            else
+                out += static_cast<char>(c);
+            ++i;
+            continue;
+        }
+        const std::size_t n = utf8_length(text, i);
+        if (n == 0) {
+            out += fmt::format("\\x{:02x}", c);
+            ++i;
+        } else if (n == 2 && c == 0xc2 && static_cast<unsigned char>(text[i + 1]) < 0xa0) {
+            out += fmt::format("\\u{:04x}", static_cast<unsigned char>(text[i + 1])); // a C1 control
+            i += 2;
+        } else {
+            out.append(text.substr(i, n));
+            i += n;
+        }
+    }
+    return out;
+}
 
 std::string render(const Diagnostic& d, const SourceManager& sources, bool color) {
     std::string out;

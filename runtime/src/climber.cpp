@@ -1,5 +1,6 @@
 // The climber environment: a physics::World driven by the grammar's bound modules.
 #include "plant/climber.hpp"
+#include "plant/diagnostics.hpp"
 
 #include "geometry.hpp"
 #include "obstacle_args.hpp"
@@ -252,10 +253,30 @@ void Climber::advance(std::set<ModuleId>& left) {
             physics::Handle h = particle(id);
             if (h.valid() && world_.alive(h)) world_.pull(h, target);
         }
-        for (int a = 0; a < air_steps; ++a) fluid_.step(&world_);
+        try {
+            for (int a = 0; a < air_steps; ++a) fluid_.step(&world_);
+        } catch (const physics::AirCrowded& e) {
+            throw RuntimeError(RuntimeErrorKind::Physics, Span{},
+                               std::string(e.what()) +
+                                   ": lower the emitters' velocities or the wind, or raise air_stiffness");
+        }
         world_.step();
     }
     pulls_.clear();
+    // a wind, pull or segment far beyond any scene can push particles out of finite space; the
+    // plant cannot be drawn from there, so the derivation ends (the caller names the climber)
+    for (const auto& [id, h] : particle_of_)
+        if (!finite(world_.position(h)))
+            throw RuntimeError(RuntimeErrorKind::Physics, Span{},
+                               fmt::format("the segment of module #{} left finite space (its position is "
+                                           "infinite or not a number): lower the wind, pulls, segment "
+                                           "lengths or box sizes that drove it there",
+                                           id));
+    for (const glm::dvec3& x : fluid_.positions())
+        if (!finite(x))
+            throw RuntimeError(RuntimeErrorKind::Physics, Span{},
+                               "the air left finite space (a particle's position is infinite or not a "
+                               "number): lower the wind or the emitters' velocities");
     // broken-off and cut parts leave the string (and the world)
     for (auto it = particle_of_.begin(); it != particle_of_.end();) {
         if (world_.attached(it->second)) {

@@ -3,9 +3,12 @@
 #include "plant/environment_phase.hpp"
 
 #include "plant/environment.hpp"
+#include "plant/program.hpp"
 #include "plant/run_state.hpp"
 #include "plant/skeleton.hpp"
 #include "plant/turtle.hpp"
+
+#include <fmt/format.h>
 
 #include <optional>
 #include <set>
@@ -79,9 +82,12 @@ void advance_bound(const Derivation& d, RunState& state, ModuleString& string) {
         Environment* env = state.environment(static_cast<std::size_t>(e));
         if (env && env->kind().holds_segments) by_symbol[k] = env;
     }
+    std::vector<std::size_t> holder_envs; // each holder's index in p.environments
     for (std::size_t e = 0; e < state.size(); ++e)
-        if (state.environment(e) && state.environment(e)->kind().holds_segments)
+        if (state.environment(e) && state.environment(e)->kind().holds_segments) {
             holders.push_back(state.environment(e));
+            holder_envs.push_back(e);
+        }
     if (holders.empty()) return;
     ModuleString interpreted = d.interpreted(string);
     for (Environment* h : holders) h->begin_segments();
@@ -93,7 +99,18 @@ void advance_bound(const Derivation& d, RunState& state, ModuleString& string) {
     BoundSink sink(interpreted, by_symbol, own);
     interpret(p, interpreted, turtle_options(d), sink);
     std::set<ModuleId> gone;
-    for (Environment* h : holders) h->advance(gone);
+    for (std::size_t k = 0; k < holders.size(); ++k) {
+        try {
+            holders[k]->advance(gone);
+        } catch (RuntimeError& e) {
+            if (e.kind != RuntimeErrorKind::Physics || e.span.valid()) throw;
+            // name the environment and point at its declaration
+            const EnvironmentDecl& decl = p.environments[holder_envs[k]];
+            e.span = decl.span;
+            e.message = fmt::format("{} '{}': {}", decl.kind_name, decl.name, e.message);
+            throw;
+        }
+    }
     if (!gone.empty())
         cut_branches(string, p.symbols.open_bracket, p.symbols.close_bracket,
                      [&](std::size_t i) { return gone.count(string.id(i)) > 0; });

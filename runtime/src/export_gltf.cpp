@@ -332,7 +332,7 @@ struct GltfBuilder {
 
 } // namespace
 
-void write_gltf(const Scene& scene, const std::string& path, GltfContainer container) {
+std::string gltf_bytes(const Scene& scene, GltfContainer container, const std::string& path) {
     const bool binary = container == GltfContainer::Binary;
 
     Scene flat;
@@ -351,7 +351,11 @@ void write_gltf(const Scene& scene, const std::string& path, GltfContainer conta
         throw ExportError("cannot write " + quoted(path) + ": glTF serialization failed");
     // Free the model's copy of the buffer before the file copy is made.
     builder.model = tinygltf::Model{};
-    write_file_atomically(path, std::move(out).str());
+    return std::move(out).str();
+}
+
+void write_gltf(const Scene& scene, const std::string& path, GltfContainer container) {
+    write_file_atomically(path, gltf_bytes(scene, container, path));
 }
 
 } // namespace plant

@@ -85,7 +85,7 @@ class Flattener {
 
 } // namespace
 
-void write_mesh_file(const Scene& given, const std::string& path, MeshFileFormat format) {
+std::string mesh_file_bytes(const Scene& given, MeshFileFormat format, const std::string& path) {
     // OpenMesh picks its writer by an extension, whatever the file is called
     static constexpr const char* kOpenMeshExtension[] = {".obj", ".ply", ".off"};
     const std::string ext = kOpenMeshExtension[static_cast<int>(format)];
@@ -123,7 +123,11 @@ void write_mesh_file(const Scene& given, const std::string& path, MeshFileFormat
     if (!OpenMesh::IO::write_mesh(mesh, out, ext, options, 7))
         throw ExportError("cannot write " + quoted(path) + ": OpenMesh failed to write the " + ext.substr(1) +
                           " file");
-    write_file_atomically(path, out.str());
+    return std::move(out).str();
+}
+
+void write_mesh_file(const Scene& scene, const std::string& path, MeshFileFormat format) {
+    write_file_atomically(path, mesh_file_bytes(scene, format, path));
 }
 
 } // namespace plant

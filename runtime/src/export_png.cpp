@@ -10,6 +10,7 @@
 #include "plant/export.hpp"
 #include "plant/raster.hpp"
 
+#include <fmt/format.h>
 #include <glm/glm.hpp>
 #include <stb/stb_image_write.h>
 
@@ -37,6 +38,9 @@ constexpr int kSub = 1 << kSubBits;
 constexpr double kGuard = double(1 << 20); // screen coordinates are clamped to +-this (samples)
 constexpr std::int64_t kMaxPixels = std::int64_t(64) << 20;
 constexpr std::int64_t kMaxSupersampledPixels = std::int64_t(4) << 20; // 2048 x 2048 output
+// How many times over the triangles may cover the image (rows and samples visited per sample)
+// before the preview is given up: a few seconds of drawing. Shipped grammars stay far below.
+constexpr std::int64_t kMaxOverdraw = 400;
 constexpr int kLutSize = 4096;
 
 bool finite3(const glm::dvec3& v) {
@@ -141,6 +145,10 @@ struct Raster {
     std::vector<float> depth;
     std::vector<std::uint8_t> rgb; // sRGB samples
     std::array<std::uint8_t, kLutSize> encode{};
+    // Rows and samples the rasterizer may still visit. Each triangle is clipped to the image, but
+    // many large triangles on top of each other (262,144 leaves, each the size of the view) would
+    // still take minutes; past the budget the preview is given up (kMaxOverdraw).
+    std::int64_t budget = 0;
 };
 
 std::uint8_t linear_to_srgb8(double v) {
@@ -245,9 +253,11 @@ void fill_triangle(Raster& r, ShadedVertex a, ShadedVertex b, ShadedVertex c,
         // The samples k = 0..last of this row where every edge function is >= 0, solved exactly
         // rather than tested one by one (long slivers have huge, nearly empty bounding boxes).
         std::int64_t kmin = 0, kmax = last;
+        --r.budget;
         if (!clip_span(w0, a0, kmin, kmax) || !clip_span(w1, a1, kmin, kmax) ||
             !clip_span(w2, a2, kmin, kmax))
             continue;
+        r.budget -= kmax - kmin;
         const double dx = double(kmin), dy = double(y - y0);
         float z = float(zrow0 + dzdx * dx + dzdy * dy);
         float t = float(trow0 + dtdx * dx + dtdy * dy);
@@ -385,6 +395,11 @@ struct Renderer {
             const std::uint32_t ia = part.indices[i], ib = part.indices[i + 1], ic = part.indices[i + 2];
             if (ia >= nv || ib >= nv || ic >= nv) continue;
             draw_triangle(verts[ia], verts[ib], verts[ic], color);
+            if (raster.budget < 0)
+                throw ExportError(fmt::format(
+                    "the PNG preview is given up: its triangles cover the image more than {} times over "
+                    "(large organs on top of each other); leave the .png out and view a .glb instead",
+                    kMaxOverdraw));
         }
     }
 
@@ -426,6 +441,7 @@ Image render_scene(const Scene& scene, int width, int height) {
                           std::to_string(height) + " PNG");
     }
     for (int i = 0; i < kLutSize; ++i) r.encode[i] = linear_to_srgb8(double(i) / (kLutSize - 1));
+    r.budget = kMaxOverdraw * std::int64_t(samples);
 
     const Camera cam = make_camera(scene, r.width, r.height);
     Renderer ren{scene,
@@ -492,13 +508,17 @@ void png_sink_write(void* context, void* data, int size) {
 
 } // namespace
 
-void write_png(const Scene& scene, const std::string& path, int width, int height) {
+std::string png_bytes(const Scene& scene, int width, int height, const std::string& path) {
     const Image img = render_scene(scene, width, height);
     PngSink sink;
     const int ok = stbi_write_png_to_func(png_sink_write, &sink, img.width, img.height, 3, img.rgb.data(),
                                           img.width * 3);
     if (!ok || sink.failed || sink.bytes.empty()) throw ExportError("cannot encode PNG for " + path);
-    write_file_atomically(path, sink.bytes);
+    return std::move(sink.bytes);
+}
+
+void write_png(const Scene& scene, const std::string& path, int width, int height) {
+    write_file_atomically(path, png_bytes(scene, width, height, path));
 }
 
 } // namespace plant

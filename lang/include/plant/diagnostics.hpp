@@ -57,6 +57,12 @@ inline std::string excerpt(std::string_view text, std::size_t max = 40) {
 }
 
 // `file:line:col: error: message`, the source line, and a caret under the span.
+// Text from a grammar, a file or a file name made safe to print to a terminal: the C0 control
+// characters (but newline and tab when `keep_lines`), DEL, the C1 controls (U+0080 to U+009F)
+// and bytes that are not UTF-8 become visible escapes (`\x1b`, `\u009b`, `\xff`), so no escape
+// sequence reaches the terminal; all other text is kept as it is.
+std::string escape_controls(std::string_view text, bool keep_lines = false);
+
 std::string render(const Diagnostic& d, const SourceManager& sources, bool color = false);
 std::string render_all(const Diagnostics& ds, const SourceManager& sources, bool color = false);
 
@@ -71,6 +77,7 @@ enum class RuntimeErrorKind {
     Turtle,      // the turtle cannot interpret the string (unbalanced ']', leaving finite space)
     Geometry,    // the plant cannot be meshed (a surface that cannot be loaded, out-of-range points)
     Input,       // a file the program names cannot be read (a surface's mesh file): exit 66
+    Physics,     // an environment's simulation broke down (a particle's position is no longer finite)
 };
 
 // Thrown by the runtime for errors that end a derivation (runtime errors exit 70).

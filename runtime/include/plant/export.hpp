@@ -30,15 +30,21 @@ enum class GltfContainer : std::uint8_t { Binary, Json };
 // One buffer, the tubes as one mesh, each prototype as a mesh shared by all nodes that place it,
 // one material per color. The caller names the container; the path's extension is not read.
 void write_gltf(const Scene& scene, const std::string& path, GltfContainer container);
+// The bytes write_gltf writes; `path` names the file in messages only.
+std::string gltf_bytes(const Scene& scene, GltfContainer container, const std::string& path);
 
 // A PNG preview: software rasterizer with a z-buffer and Lambert shading, a 3/4 view framed on
 // the scene's bounding box, white background.
 void write_png(const Scene& scene, const std::string& path, int width, int height);
+// The bytes write_png writes; `path` names the file in messages only.
+std::string png_bytes(const Scene& scene, int width, int height, const std::string& path);
 
 // The mesh files OpenMesh writes for us.
 enum class MeshFileFormat : std::uint8_t { Obj, Ply, Off };
 // Everything flattened into one triangle mesh with vertex normals (and texture coordinates, but
 // for OFF), written through OpenMesh in `format`; the path's extension is not read.
 void write_mesh_file(const Scene& scene, const std::string& path, MeshFileFormat format);
+// The bytes write_mesh_file writes; `path` names the file in messages only.
+std::string mesh_file_bytes(const Scene& scene, MeshFileFormat format, const std::string& path);
 
 } // namespace plant

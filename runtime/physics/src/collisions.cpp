@@ -113,14 +113,19 @@ void World::separate_particles() {
         }
     if (reach <= 0 || n < 2) return;
     const double cell = 2 * reach; // twice the widest contact: a 2 x 2 x 2 block of cells holds every partner
-    // a cell's key: one term per axis, xor-ed
-    auto term_x = [](std::int64_t x) { return static_cast<std::uint64_t>(x * 73856093); };
-    auto term_y = [](std::int64_t y) { return static_cast<std::uint64_t>(y * 19349663); };
-    auto term_z = [](std::int64_t z) { return static_cast<std::uint64_t>(z * 83492791); };
+    // a cell's key: one term per axis, xor-ed; multiplied as unsigned numbers, which wrap where
+    // a signed product would overflow and give the same bits where it does not
+    auto term_x = [](std::int64_t x) { return static_cast<std::uint64_t>(x) * 73856093u; };
+    auto term_y = [](std::int64_t y) { return static_cast<std::uint64_t>(y) * 19349663u; };
+    auto term_z = [](std::int64_t z) { return static_cast<std::uint64_t>(z) * 83492791u; };
     auto hash = [&](const glm::i64vec3& c) { return term_x(c.x) ^ term_y(c.y) ^ term_z(c.z); };
     // each particle's cell, once: floor by truncation and correction (the baseline x86-64 has
-    // no rounding instruction, and std::floor is a call)
+    // no rounding instruction, and std::floor is a call). A coordinate is first clamped to
+    // 2^52 cells either way (NaN to the top), so the conversion and the neighbours' c + 1 stay
+    // in range for a particle blown far away; nearer ones are not changed.
     auto floor_of = [](double u) {
+        constexpr double far = 0x1p52;
+        u = u < far ? (u > -far ? u : -far) : far;
         const auto t = static_cast<std::int64_t>(u);
         return t - static_cast<std::int64_t>(static_cast<double>(t) > u);
     };

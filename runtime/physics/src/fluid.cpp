@@ -1,5 +1,6 @@
 #include "plant/physics/fluid.hpp"
 
+#include "cells.hpp"
 #include "parallel.hpp"
 
 #include <glm/gtc/quaternion.hpp>
@@ -14,6 +15,9 @@ namespace plant::physics {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
+// The most particles a grid cell may hold on average, seen from a particle (the sum of the
+// cells' squared counts over the particle count) before a step gives up: see build_grid.
+constexpr int kMaxCrowding = 8;
 
 } // namespace
 
@@ -82,10 +86,19 @@ void Fluid::build_grid() {
     cell_start_.assign(cells + 1, 0);
     std::vector<std::uint32_t> cell_of(x_.size());
     for (std::size_t i = 0; i < x_.size(); ++i) {
-        glm::ivec3 c = glm::clamp(glm::ivec3(glm::floor((x_[i] - lo_) / cell)), glm::ivec3(0), n_ - 1);
+        glm::ivec3 c = cell_index((x_[i] - lo_) / cell, glm::ivec3(0), n_ - 1);
         cell_of[i] = static_cast<std::uint32_t>((static_cast<std::size_t>(c.z) * n_.y + c.y) * n_.x + c.x);
         ++cell_start_[cell_of[i] + 1];
     }
+    // a particle's neighbour search visits the cells around its own, so the work of a pass is
+    // about the sum of the cells' squared counts: about one particle a cell at rest, a few where
+    // the air is compressed; far more and the search would be quadratic in the particles
+    double crowding = 0;
+    for (std::size_t c = 1; c <= cells; ++c) crowding += double(cell_start_[c]) * double(cell_start_[c]);
+    if (crowding > kMaxCrowding * double(x_.size()) + 1e4)
+        throw AirCrowded("the air crowded into few cells (" +
+                         std::to_string(std::llround(crowding / double(x_.size()))) +
+                         " particles a cell on average, at most " + std::to_string(kMaxCrowding) + ")");
     for (std::size_t c = 0; c < cells; ++c) cell_start_[c + 1] += cell_start_[c];
     order_.assign(x_.size(), 0);
     sorted_x_.resize(x_.size());
@@ -111,7 +124,8 @@ template <class F> void Fluid::for_neighbours(const glm::dvec3& p, double radius
     // cell-sorted arrays. (Trimming each row to the ball costs more than the candidates it saves.)
     const double cell = s_.support / 2;
     const int reach = static_cast<int>(std::ceil(radius / cell));
-    glm::ivec3 c = glm::ivec3(glm::floor((p - lo_) / cell));
+    // a cell beyond the grid by more than `reach` sees the same (no) cells as one just past it
+    glm::ivec3 c = cell_index((p - lo_) / cell, glm::ivec3(-reach - 1), n_ + reach);
     const int x0 = std::max(c.x - reach, 0), x1 = std::min(c.x + reach, n_.x - 1);
     if (x0 > x1) return;
     for (int z = std::max(c.z - reach, 0); z <= std::min(c.z + reach, n_.z - 1); ++z)
@@ -192,7 +206,7 @@ void Fluid::compute_densities(const World* plant) {
     for (std::uint32_t i = 0; i < n; ++i) {
         const glm::dvec3 xi = x_[i];
         const glm::vec3 xif = xf_[i];
-        const glm::ivec3 c = glm::clamp(glm::ivec3(glm::floor((xi - lo_) / cell)), glm::ivec3(0), n_ - 1);
+        const glm::ivec3 c = cell_index((xi - lo_) / cell, glm::ivec3(0), n_ - 1);
         const int x0 = std::max(c.x - 2, 0), x1 = std::min(c.x + 2, n_.x - 1);
         for (int z = c.z; z <= std::min(c.z + 2, n_.z - 1); ++z)
             for (int y = z == c.z ? c.y : std::max(c.y - 2, 0); y <= std::min(c.y + 2, n_.y - 1); ++y) {

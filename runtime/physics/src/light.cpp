@@ -1,5 +1,7 @@
 #include "plant/physics/light.hpp"
 
+#include "cells.hpp"
+
 #include <cmath>
 
 namespace plant::physics {
@@ -36,7 +38,7 @@ void LightGrid::build(const std::vector<glm::dvec3>& points, double cell) {
     count_.assign(static_cast<std::size_t>(n_.x) * n_.y * n_.z, 0);
     for (const auto& p : points) {
         if (!finite(p)) continue;
-        glm::ivec3 c = glm::clamp(glm::ivec3(glm::floor((p - lo) / cell)), glm::ivec3(0), n_ - 1);
+        glm::ivec3 c = cell_index((p - lo) / cell, glm::ivec3(0), n_ - 1);
         ++count_[(static_cast<std::size_t>(c.z) * n_.y + c.y) * n_.x + c.x];
     }
 }
@@ -45,7 +47,8 @@ double LightGrid::count_toward(const glm::dvec3& p, const glm::dvec3& dir) const
     if (count_.empty() || !finite(p) || !finite(dir)) return 0;
     const double cell = cell_;
     glm::dvec3 q = p;
-    const glm::ivec3 own = glm::ivec3(glm::floor((p - lo_) / cell));
+    // outside the grid, own matches no cell of it whether clamped to just past it or not
+    const glm::ivec3 own = cell_index((p - lo_) / cell, glm::ivec3(-1), n_);
     double count = 0;
     glm::ivec3 last = own;
     const glm::dvec3 extent = glm::dvec3(n_) * cell;
@@ -62,7 +65,7 @@ double LightGrid::count_toward(const glm::dvec3& p, const glm::dvec3& dir) const
             if (leaving) break;
             continue;
         }
-        const glm::ivec3 c = glm::clamp(glm::ivec3(glm::floor(rel / cell)), glm::ivec3(0), n_ - 1);
+        const glm::ivec3 c = cell_index(rel / cell, glm::ivec3(0), n_ - 1);
         if (c == own || c == last) continue;
         last = c;
         count += count_[(static_cast<std::size_t>(c.z) * n_.y + c.y) * n_.x + c.x];

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 using namespace plant::physics;
@@ -439,4 +440,23 @@ TEST_CASE("growth: phototropism turns an apex toward the light less in the plant
     INFO("forward.y of the tip: in the open " << open << ", in the shade " << shaded);
     CHECK(open > 0.1);          // turned toward the light
     CHECK(shaded < 0.5 * open); // much less under the layer
+}
+
+TEST_CASE("collisions: particles far beyond int64 cells (or not finite) keep the step defined", "[physics]") {
+    // a plant 1e19 and one 1e300 away, and one at infinity: their cells' coordinates are clamped
+    // before the conversion (an ASan/UBSan build fails here without it); near ones are not moved
+    Settings s;
+    s.gravity = glm::dvec3(0.0);
+    s.collisions = true;
+    World w(s);
+    const glm::dvec3 r(0.02);
+    std::vector<Handle> near;
+    near.push_back(w.add_root({0, 0, 0}, glm::dquat(1, 0, 0, 0), r));
+    near.push_back(w.add_particle(near.back(), {0, 0.05, 0}, glm::dquat(1, 0, 0, 0), r));
+    for (double far : {1e19, -1e19, 1e300, -1e300, std::numeric_limits<double>::infinity()}) {
+        Handle root = w.add_root({far, far, -far}, glm::dquat(1, 0, 0, 0), r);
+        w.add_particle(root, {far, far, -far}, glm::dquat(1, 0, 0, 0), r);
+    }
+    for (int k = 0; k < 3; ++k) w.step();
+    CHECK(w.position(near[1]).y == Approx(0.05).margin(1e-6));
 }

@@ -14,6 +14,7 @@
 #include <glm/glm.hpp>
 
 #include <cstdint>
+#include <stdexcept>
 #include <vector>
 
 namespace plant::physics {
@@ -42,6 +43,13 @@ struct FluidSettings {
     double emitter_drive = 40.0; // 1/s: how fast an emitter brings the air at its centre to its velocity
     double coupling = 1.0;       // scales the forces between air and plant
     int threads = 1;
+};
+
+// Thrown by Fluid::step when the air has crowded into few grid cells (an emitter or a wind far
+// faster than the air can carry, or next to no stiffness): its neighbour search would take time
+// quadratic in the particles. Nothing was moved.
+struct AirCrowded : std::runtime_error {
+    using std::runtime_error::runtime_error;
 };
 
 class Fluid {

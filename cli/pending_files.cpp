@@ -1,0 +1,144 @@
+#include "pending_files.hpp"
+
+#include "plant/export.hpp"
+
+#include <fmt/format.h>
+
+#include <cerrno>
+#include <csignal>
+#include <cstring>
+#include <fcntl.h>
+#include <filesystem>
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace plant::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// What the signal handler reads: published before the handlers are installed, withdrawn after
+// they are put back, never changed in between but for the `live` flags. The handler only calls
+// unlink, sigaction and raise, which are async-signal-safe (signal-safety(7)).
+struct Registry {
+    const std::string* temps = nullptr;
+    const std::atomic<bool>* live = nullptr;
+    std::size_t count = 0;
+    struct sigaction old_int {
+    }, old_term{};
+};
+std::atomic<Registry*> g_registry{nullptr};
+
+void on_signal(int sig, siginfo_t* info, void* context) {
+    Registry* r = g_registry.load();
+    if (!r) return;
+    const struct sigaction& old = sig == SIGINT ? r->old_int : r->old_term;
+    if (!(old.sa_flags & SA_SIGINFO) && old.sa_handler == SIG_IGN) return;
+    if ((old.sa_flags & SA_SIGINFO) && old.sa_sigaction) {
+        old.sa_sigaction(sig, info, context);
+        return;
+    }
+    if (!(old.sa_flags & SA_SIGINFO) && old.sa_handler != SIG_DFL) {
+        old.sa_handler(sig);
+        return;
+    }
+    for (std::size_t k = 0; k < r->count; ++k)
+        if (r->live[k].load()) ::unlink(r->temps[k].c_str());
+    // end the process by the signal, as it would have ended without this handler
+    struct sigaction dfl {};
+    dfl.sa_handler = SIG_DFL;
+    sigemptyset(&dfl.sa_mask);
+    sigaction(sig, &dfl, nullptr);
+    raise(sig); // delivered when this handler returns (the signal is blocked while it runs)
+}
+
+std::string in_quotes(const std::string& s) {
+    return "'" + s + "'";
+}
+
+} // namespace
+
+PendingFiles::PendingFiles(const std::vector<std::string>& targets)
+    : targets_(targets), live_(std::make_unique<std::atomic<bool>[]>(targets.size())) {
+    static std::atomic<unsigned> counter{0};
+    for (const auto& t : targets_) {
+        const fs::path target(t);
+        temps_.push_back(
+            (target.parent_path() / ("." + target.filename().string() + ".plant-tmp-" +
+                                     std::to_string(::getpid()) + "-" + std::to_string(counter++)))
+                .string());
+    }
+    auto* r = new Registry{temps_.data(), live_.get(), temps_.size(), {}, {}};
+    struct sigaction sa {};
+    sa.sa_sigaction = on_signal;
+    sa.sa_flags = SA_SIGINFO;
+    sigemptyset(&sa.sa_mask);
+    sigaddset(&sa.sa_mask, SIGINT);
+    sigaddset(&sa.sa_mask, SIGTERM);
+    // the old actions are read before the registry is published, so the handler always has them
+    sigaction(SIGINT, nullptr, &r->old_int);
+    sigaction(SIGTERM, nullptr, &r->old_term);
+    g_registry.store(r);
+    sigaction(SIGINT, &sa, nullptr);
+    sigaction(SIGTERM, &sa, nullptr);
+}
+
+PendingFiles::~PendingFiles() {
+    Registry* r = g_registry.load();
+    if (r) {
+        sigaction(SIGINT, &r->old_int, nullptr);
+        sigaction(SIGTERM, &r->old_term, nullptr);
+        g_registry.store(nullptr);
+        delete r;
+    }
+    for (std::size_t k = 0; k < temps_.size(); ++k)
+        if (live_[k].load()) ::unlink(temps_[k].c_str());
+}
+
+void PendingFiles::write(std::size_t k, const std::string& bytes) {
+    const std::string& target = targets_[k];
+    const fs::path parent = fs::path(target).parent_path();
+    if (fs::path(target).filename().empty())
+        throw ExportError("cannot write " + in_quotes(target) + ": not a file name");
+    std::error_code ec;
+    if (!parent.empty()) fs::create_directories(parent, ec);
+    live_[k].store(true); // before the file exists: a signal from here on removes it
+    const int fd = ::open(temps_[k].c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd < 0) {
+        const int err = errno;
+        live_[k].store(false);
+        throw ExportError(fmt::format("cannot write {}: cannot create a file in {}: {}", in_quotes(target),
+                                      in_quotes(parent.empty() ? std::string(".") : parent.string()),
+                                      std::strerror(err)));
+    }
+    std::size_t done = 0;
+    int err = 0;
+    while (done < bytes.size()) {
+        const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) {
+            err = n < 0 ? errno : EIO;
+            break;
+        }
+        done += static_cast<std::size_t>(n);
+    }
+    if (::close(fd) != 0 && err == 0) err = errno;
+    if (err != 0) throw ExportError("cannot write " + in_quotes(target) + ": " + std::strerror(err));
+}
+
+void PendingFiles::commit() {
+    // a rename onto a folder fails: find it before any file is renamed
+    for (const auto& t : targets_) {
+        struct stat st {};
+        if (::stat(t.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
+            throw ExportError("cannot write " + in_quotes(t) + ": it is a folder");
+    }
+    for (std::size_t k = 0; k < temps_.size(); ++k) {
+        if (::rename(temps_[k].c_str(), targets_[k].c_str()) != 0)
+            throw ExportError("cannot write " + in_quotes(targets_[k]) + ": " + std::strerror(errno));
+        live_[k].store(false);
+    }
+}
+
+} // namespace plant::cli

@@ -1,0 +1,36 @@
+// Output files of one command, written under temporary names beside their targets and renamed
+// into place only when every one of them has been written: a run that fails, or is stopped by
+// SIGINT or SIGTERM, leaves the earlier files as they were and no temporary file behind.
+#pragma once
+
+#include <atomic>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace plant::cli {
+
+class PendingFiles {
+  public:
+    // Picks a temporary name beside each target and installs SIGINT and SIGTERM handlers that
+    // remove the temporary files. When the handler found in place was a function (the REPL's
+    // Ctrl-C flag), it is called instead and the files stay: the process goes on and this object
+    // removes or renames them. Otherwise the handler removes them and ends the process by the
+    // signal, as it would have ended without us.
+    explicit PendingFiles(const std::vector<std::string>& targets);
+    ~PendingFiles(); // removes what was not committed and puts the old handlers back
+    PendingFiles(const PendingFiles&) = delete;
+    PendingFiles& operator=(const PendingFiles&) = delete;
+
+    // Writes the k-th file's bytes to its temporary name. Throws ExportError naming the target.
+    void write(std::size_t k, const std::string& bytes);
+    // Renames every temporary file onto its target. Throws ExportError naming the target when a
+    // rename fails (after checking beforehand what can be checked: a target that is a folder).
+    void commit();
+
+  private:
+    std::vector<std::string> targets_, temps_;
+    std::unique_ptr<std::atomic<bool>[]> live_; // the temporary file may exist: remove it
+};
+
+} // namespace plant::cli
