@@ -3,7 +3,7 @@ BUILD ?= build
 JOBS ?= 2
 CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
 
-.PHONY: all deps configure build demo test bench format format-check clean
+.PHONY: all deps configure build demo test test-sanitize fuzz bench format format-check clean
 
 all: build
 
@@ -25,6 +25,17 @@ demo: build
 test: build format-check
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
+# The sanitizer job (docs/testing.md): plant and the unit tests built with ASan and UBSan into
+# build-asan/, the tests, the hostile inputs and the mutation fuzzer run on them; under 30 minutes.
+test-sanitize: | deps
+	bash scripts/test-sanitize
+
+# The libFuzzer targets (docs/testing.md), built with clang into build-fuzz/, each run for
+# FUZZ_SECONDS seconds; a finding fails it and is saved in build-fuzz/findings/.
+FUZZ_SECONDS ?= 60
+fuzz: | deps
+	FUZZ_SECONDS=$(FUZZ_SECONDS) bash scripts/fuzz
+
 bench: build
 	bash bench/run
 
@@ -39,4 +50,4 @@ format-check: | deps
 	  || { echo "format-check: run 'make format' and commit the result" >&2; exit 1; }
 
 clean:
-	rm -rf $(BUILD) out
+	rm -rf $(BUILD) build-asan build-fuzz out

@@ -7,9 +7,11 @@ on the result. Any exit by signal, exit status of 128 or more, sanitizer report 
 time limit is a failure; the offending input is kept in the output directory. Diagnostics and
 ordinary error statuses are the expected outcome for most mutants.
 
-  mutate.py PLANT [--seed N] [--count N] [--out DIR]
+  mutate.py PLANT [--seed N] [--count N] [--seconds S] [--timeout S] [--out DIR]
 
-The seed fixes the mutants, so a failure reproduces. Built with -fsanitize=address,undefined,
+The seed fixes the mutants, so a failure reproduces. With --seconds, it stops starting new
+mutants once that much time has passed (the count is then an upper bound): the sanitizer job
+gives it a time budget this way (docs/testing.md). Built with -fsanitize=address,undefined,
 plant also reports memory errors that do not crash.
 """
 import argparse
@@ -20,6 +22,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import time
 
 TOKENS = list("()[]{}<>;:,.+-*/^=!?&|@#'\"\\$%~`\n\t 0123456789") + [
     "->", "=>", "<<", ">>", "if", "module", "axiom", "param", "use", "env", "group", "end",
@@ -48,6 +51,8 @@ def main() -> int:
     ap.add_argument("plant")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--count", type=int, default=150)
+    ap.add_argument("--seconds", type=float, default=None, help="time budget: start no mutant after this many seconds")
+    ap.add_argument("--timeout", type=float, default=30, help="seconds one command may run (default 30)")
     ap.add_argument("--out", default=None, help="where failing inputs are kept (default: a temporary directory)")
     args = ap.parse_args()
     plant = os.path.realpath(args.plant)
@@ -63,7 +68,12 @@ def main() -> int:
     work = pathlib.Path(tempfile.mkdtemp(prefix="plant-fuzz-work-"))
     case = work / "case.plant"
     bad = 0
+    done = 0
+    start = time.monotonic()
     for k in range(args.count):
+        if args.seconds is not None and time.monotonic() - start > args.seconds:
+            break
+        done += 1
         text = mutate(rng, rng.choice(sources))
         case.write_text(text, encoding="utf-8", errors="replace")
         commands = [
@@ -73,9 +83,9 @@ def main() -> int:
         ]
         for cmd in commands:
             try:
-                r = subprocess.run(cmd, capture_output=True, timeout=30, cwd=work)
+                r = subprocess.run(cmd, capture_output=True, timeout=args.timeout, cwd=work)
             except subprocess.TimeoutExpired:
-                reason = "ran past 30 s"
+                reason = f"ran past {args.timeout:g} s"
             else:
                 err = r.stderr.decode("utf-8", "replace")
                 if r.returncode < 0 or r.returncode >= 128:
@@ -88,7 +98,7 @@ def main() -> int:
             kept = out / f"mutant_{args.seed}_{k}.plant"
             kept.write_text(text, encoding="utf-8", errors="replace")
             print(f"FAIL plant {cmd[1]} on {kept}: {reason}")
-    print(f"{args.count} mutants, 3 commands each: {bad} failed")
+    print(f"{done} mutants, 3 commands each, in {time.monotonic() - start:.0f} s: {bad} failed")
     shutil.rmtree(work, ignore_errors=True)
     if not bad and args.out is None:
         shutil.rmtree(out, ignore_errors=True)

@@ -155,7 +155,13 @@ void World::frame_pair(const std::uint32_t (&group)[2], const std::vector<glm::d
         v2 cw, sw;
         small_turn(w2, cw, sw);
         for (int l = 0; l < 2; ++l)
-            if (turn[l] && !(w2[l] < 1e-4)) large_turn(w2[l], cw[l], sw[l]); // as rotation_of
+            if (turn[l] && !(w2[l] < 1e-4)) { // as rotation_of
+                // through scalars: binding a reference to a vector lane is a GCC extension
+                double c = 0, s = 0;
+                large_turn(w2[l], c, s);
+                cw[l] = c;
+                sw[l] = s;
+            }
         const Quat2 p{cw, omega[0] * sw, omega[1] * sw, omega[2] * sw};
         // p * q as glm multiplies quaternions, then glm::normalize
         n = {p.w * q.w - p.x * q.x - p.y * q.y - p.z * q.z, p.w * q.x + p.x * q.w + p.y * q.z - p.z * q.y,
