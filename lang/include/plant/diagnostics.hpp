@@ -60,6 +60,7 @@ enum class RuntimeErrorKind {
     Turtle,      // the turtle cannot interpret the string (unbalanced ']', leaving finite space)
     Geometry,    // the plant cannot be meshed (a surface that cannot be loaded, out-of-range points)
     Physics,     // an environment's simulation broke down (a particle's position is no longer finite)
+    Memory,      // a stage would need more memory than --max-memory allows
 };
 
 // Thrown by the runtime for errors that end a derivation (runtime errors exit 70).
