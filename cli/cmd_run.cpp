@@ -26,6 +26,7 @@ struct RunCmd {
     int sides = 8;
     bool no_obstacles = false;
     std::string size = "800x800";
+    std::string max_memory;
 };
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
@@ -54,6 +55,12 @@ int run_main(RunCmd& c) {
             return kUsage;
         }
     }
+    std::uint64_t max_memory = 0;
+    if (!c.max_memory.empty() && (max_memory = parse_memory(c.max_memory)) == 0) {
+        std::cerr << fmt::format("plant: --max-memory expects a size such as 512M or 4G, found '{}'\n",
+                                 escape_controls(c.max_memory));
+        return kUsage;
+    }
     int exit_code = kOk;
     SourceManager sources;
     auto program = load_program(c.g, sources, exit_code);
@@ -76,6 +83,7 @@ int run_main(RunCmd& c) {
         oo.obstacles = !c.no_obstacles;
         oo.width = width;
         oo.height = height;
+        oo.max_memory = max_memory;
         OutputSummary summary = write_outputs(*program, d, c.outputs, oo);
         if (progress)
             std::cerr << fmt::format("{} modules, {} triangles, {} organs in {:.0f} ms\n", d.string().size(),
@@ -103,6 +111,10 @@ void setup_run(CLI::App& app, int& exit_code) {
         ->type_name("FILE");
     cmd->add_option("--sides", c->sides, "Vertices around each ring of a branch")->check(CLI::Range(3, 64));
     cmd->add_option("--size", c->size, "Size of PNG previews")->type_name("WxH");
+    cmd->add_option("--max-memory", c->max_memory,
+                    "Memory meshing and export may take, as 512M or 4G; a run that would need more "
+                    "stops before meshing (default: half the physical memory)")
+        ->type_name("SIZE");
     cmd->add_flag("--no-obstacles", c->no_obstacles,
                   "Leave the environments' obstacles (a climber's walls, say) out of meshes and images");
     std::string formats = "Output formats:\n";

@@ -10,6 +10,8 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cstdlib>
+#include <unistd.h>
 
 namespace plant::cli {
 
@@ -107,6 +109,49 @@ std::string known_extensions() {
     return out;
 }
 
+std::uint64_t default_max_memory() {
+    const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGESIZE);
+    if (pages <= 0 || page <= 0) return std::uint64_t(4) << 30;
+    return std::uint64_t(pages) * std::uint64_t(page) / 2;
+}
+
+std::uint64_t parse_memory(const std::string& text) {
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str(), &end);
+    if (end == text.c_str() || !(v > 0)) return 0;
+    const std::string unit(end);
+    double scale = 1;
+    if (unit == "K" || unit == "k")
+        scale = 1024.0;
+    else if (unit == "M" || unit == "m")
+        scale = 1024.0 * 1024;
+    else if (unit == "G" || unit == "g")
+        scale = 1024.0 * 1024 * 1024;
+    else if (!unit.empty())
+        return 0;
+    const double bytes = v * scale;
+    return bytes >= 1 && bytes < 1.8e19 ? static_cast<std::uint64_t>(bytes) : 0;
+}
+
+// Before meshing: every skeleton point becomes a ring of sides + 1 vertices (position, normal,
+// texture coordinate: 32 bytes) and 2 * sides triangles (12 bytes each); the scene, its export
+// copy and the exporter's own buffers hold it about three times over. Stops with a Memory error
+// naming --max-memory when that passes the budget.
+static void check_mesh_memory(const Skeleton& skeleton, const OutputOptions& options) {
+    std::uint64_t points = 0;
+    for (const auto& a : skeleton.axes) points += a.points.size();
+    const std::uint64_t sides = static_cast<std::uint64_t>(std::max(options.sides, 3));
+    const double bytes = 3.0 * double(points) * double((sides + 1) * 32 + 2 * sides * 12) +
+                         256.0 * double(skeleton.organs.size());
+    const std::uint64_t budget = options.max_memory ? options.max_memory : default_max_memory();
+    if (bytes > double(budget))
+        throw RuntimeError(RuntimeErrorKind::Memory, Span{},
+                           fmt::format("meshing would take about {:.1f} GB ({} skeleton points, {} sides a "
+                                       "ring) but --max-memory allows {:.1f} GB: lower --sides or the "
+                                       "derivation length, or raise --max-memory",
+                                       bytes / 1e9, points, sides, double(budget) / 1e9));
+}
+
 // The environments' obstacles as one more prototype, placed once where it is: flat-shaded
 // triangles in a stone grey.
 static void add_environments(const RunState& environments, Scene& scene) {
@@ -159,6 +204,7 @@ OutputSummary write_outputs(const Program& program, const Derivation& d,
     Scene scene;
     if (need_skeleton) skeleton = build_skeleton(program, d.interpreted(d.string()), turtle_options(d));
     if (need_scene) {
+        check_mesh_memory(skeleton, options);
         MeshOptions mo;
         mo.sides = options.sides;
         scene = build_scene(program, skeleton, mo);

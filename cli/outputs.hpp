@@ -15,8 +15,14 @@ namespace plant::cli {
 struct OutputOptions {
     int sides = 8;
     int width = 800, height = 800;
-    bool obstacles = true; // the environments' geometry (walls, boxes) goes into meshes and images
+    bool obstacles = true;        // the environments' geometry (walls, boxes) goes into meshes and images
+    std::uint64_t max_memory = 0; // bytes meshing and export may take; 0: default_max_memory()
 };
+
+// Half the machine's physical memory: the default of --max-memory.
+std::uint64_t default_max_memory();
+// "512M", "4G", "1.5G" or a number of bytes; 0 when it cannot be read.
+std::uint64_t parse_memory(const std::string& text);
 
 // What a format is made from; each stage needs the ones before it.
 enum class OutputNeeds {

@@ -78,6 +78,7 @@ enum class RuntimeErrorKind {
     Geometry,    // the plant cannot be meshed (a surface that cannot be loaded, out-of-range points)
     Input,       // a file the program names cannot be read (a surface's mesh file): exit 66
     Physics,     // an environment's simulation broke down (a particle's position is no longer finite)
+    Memory,      // a stage would need more memory than --max-memory allows
 };
 
 // Thrown by the runtime for errors that end a derivation (runtime errors exit 70).
