@@ -15,6 +15,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     plant::Diagnostics diags;
     plant::CompileOptions options;
     options.environments = plant::runtime_environments();
+    options.confine_reads = true;  // as the plant command does: a fuzzed import reads nothing outside
+    options.max_steps = 1'000'000; // a fuzzed loop ends quickly
     std::uint32_t id = sources.add("fuzz.plant", std::string(reinterpret_cast<const char*>(data), size));
     auto program = plant::compile_source(sources, id, options, diags);
     std::string rendered = plant::render_all(diags, sources);

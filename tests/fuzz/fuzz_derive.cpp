@@ -18,6 +18,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     plant::Diagnostics diags;
     plant::CompileOptions options;
     options.environments = plant::runtime_environments();
+    options.confine_reads = true;  // as the plant command does: a fuzzed import reads nothing outside
+    options.max_steps = 1'000'000; // a fuzzed loop ends quickly
     std::uint32_t id = sources.add("fuzz.plant", std::string(reinterpret_cast<const char*>(data), size));
     auto program = plant::compile_source(sources, id, options, diags);
     if (!program) return 0;
@@ -26,6 +28,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     derive.max_modules = 10'000;
     derive.max_bytes = std::size_t{16} << 20;
     derive.threads = 1;
+    derive.max_steps = 1'000'000;
     derive.on_print = [](const std::string&) {};
     plant::TurtleEnvironmentPhase phase;
     derive.environment_phase = &phase;
