@@ -4,10 +4,9 @@
 // expected outcome; a crash, a sanitizer report, any other exception escaping (which the command
 // line would report as an internal error), a leak or a run past libFuzzer's -timeout is a
 // finding. docs/testing.md says how to run it.
-#include "plant/compiler.hpp"
+#include "fuzz_compile.hpp"
 #include "plant/derive.hpp"
 #include "plant/environment_phase.hpp"
-#include "plant/environments.hpp"
 
 #include <cstddef>
 #include <cstdint>
@@ -16,19 +15,14 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     plant::SourceManager sources;
     plant::Diagnostics diags;
-    plant::CompileOptions options;
-    options.environments = plant::runtime_environments();
-    options.confine_reads = true;  // as the plant command does: a fuzzed import reads nothing outside
-    options.max_steps = 1'000'000; // a fuzzed loop ends quickly
-    std::uint32_t id = sources.add("fuzz.plant", std::string(reinterpret_cast<const char*>(data), size));
-    auto program = plant::compile_source(sources, id, options, diags);
+    auto program = plant::fuzz::compile_bytes(data, size, sources, diags);
     if (!program) return 0;
     plant::DeriveOptions derive;
     derive.steps = 3;
     derive.max_modules = 10'000;
     derive.max_bytes = std::size_t{16} << 20;
     derive.threads = 1;
-    derive.max_steps = 1'000'000;
+    derive.max_steps = plant::fuzz::kMaxSteps;
     derive.on_print = [](const std::string&) {};
     plant::TurtleEnvironmentPhase phase;
     derive.environment_phase = &phase;
