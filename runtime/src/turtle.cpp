@@ -285,17 +285,23 @@ void Turtle::apply(TurtleOp op, std::size_t i) {
         break;
     }
     case TurtleOp::Sphere:
-        sink_.organ(TurtleOrgan{
-            {OrganKind::Sphere, {}}, frame_matrix(t_, arg(i, 0, t_.width / 2)), t_.color, i, s_.id(i)});
-        break;
-    case TurtleOp::Surface:
-        // "~name": the surface's name follows the prefix row's name
-        sink_.organ(TurtleOrgan{{OrganKind::Surface, program_.symbols[s_.sym[i]].name.substr(
-                                                         turtle_symbol(TurtleOp::Surface)->name.size())},
-                                frame_matrix(t_, arg(i, 0, 1.0)),
+        sink_.organ(TurtleOrgan{{OrganKind::Sphere, {}, -1, {}},
+                                frame_matrix(t_, arg(i, 0, t_.width / 2)),
                                 t_.color,
                                 i,
                                 s_.id(i)});
+        break;
+    case TurtleOp::Surface:
+        // "~name": the surface's name follows the prefix row's name
+        sink_.organ(TurtleOrgan{
+            {OrganKind::Surface,
+             program_.symbols[s_.sym[i]].name.substr(turtle_symbol(TurtleOp::Surface)->name.size()),
+             -1,
+             {}},
+            frame_matrix(t_, arg(i, 0, 1.0)),
+            t_.color,
+            i,
+            s_.id(i)});
         break;
     case TurtleOp::SetHeading:
         if (s_.arity(i) >= 6)

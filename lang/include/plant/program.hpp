@@ -35,6 +35,7 @@ struct SymbolInfo {
     std::vector<std::string> param_names;
     std::string bound_to; // the environment that holds its segments (`bound ivy`), as written
     int bound_env = -1;   // its index in Program::environments, resolved by the compiler
+    int instance = -1;    // the instance it places: an index in *Program::instances (-1: none)
     Span decl_span;
 };
 
@@ -271,6 +272,22 @@ struct EnvironmentDecl {
     std::shared_ptr<const Environment> initial; // null without a runtime or on error
 };
 
+struct Program;
+
+// `instance Name(params) { items }` compiled (docs/language.md, instances): a sub-L-system with
+// its own axiom, rules, settings, interpretation rules and surfaces, compiled once. The turtle
+// places it wherever it meets the module `Name(args)`; it is derived and meshed once per distinct
+// argument tuple (and view depth).
+struct InstanceDef {
+    std::string name;
+    Span span; // the declaration
+    std::vector<ValueType> param_types;
+    std::vector<std::string> param_names;
+    std::vector<std::uint32_t> param_slots; // the global slot of each parameter in `program`
+    std::shared_ptr<const Program> program; // the body; its `instances` is the root's table
+    int depth = 1;                          // 1 + the deepest instance it places (1: none)
+};
+
 struct Program {
     SymbolTable symbols;
     std::vector<Global> globals;
@@ -299,6 +316,16 @@ struct Program {
     std::vector<CurveDef> curves;
     std::vector<EnvironmentDecl> environments; // `env` declarations, in file order
     std::vector<ProgramFile> files;            // in the order they were read: the main file first
+
+    // Every instance declaration of the grammar (top level, imported and nested), in one table
+    // owned by the root program; an instance's program reads the same table through `instances`
+    // (SymbolInfo::instance indexes it). Empty when the grammar declares none.
+    std::shared_ptr<std::vector<InstanceDef>> instance_table; // set in the root program only
+    const std::vector<InstanceDef>* instances = nullptr;      // the root's table, in every program
+    const InstanceDef* instance(SymbolId s) const {
+        const int k = s < symbols.size() ? symbols[s].instance : -1;
+        return k >= 0 && instances ? &(*instances)[static_cast<std::size_t>(k)] : nullptr;
+    }
 
     int group_index(std::string_view name) const;
 };

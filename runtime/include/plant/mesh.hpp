@@ -5,6 +5,7 @@
 #include "plant/skeleton.hpp"
 
 #include <functional>
+#include <optional>
 
 namespace plant {
 
@@ -13,6 +14,10 @@ struct MeshOptions {
     double sharp_bend_deg = 45.0; // past this a joint is rounded with extra rings
     double tip_taper = 0.35;      // radius of the last ring, as a fraction of the axis radius there
     bool continue_axes = true;    // an axis's tube goes on into a child axis (see tube_paths)
+    // Where the viewer stands (plant run --camera): with the grammar's `param depth_unit`, each
+    // instance placement's view depth comes from its distance to it (docs/language.md, level of
+    // detail). None: every placement has the program's own view_depth.
+    std::optional<glm::dvec3> camera;
 };
 
 // The points one tube runs through, in order.

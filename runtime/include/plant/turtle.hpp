@@ -41,13 +41,15 @@ struct TurtleSegment {
     ModuleId id;
 };
 
-// What an organ is. Instance is kept for instanced sub-plants (a prototype that is a whole
-// scene, scene.hpp); no symbol places one yet.
+// What an organ is. Instance: an instanced sub-L-system (plant/program.hpp InstanceDef), meshed
+// as a prototype that is a whole scene (scene.hpp).
 enum class OrganKind : std::uint8_t { Sphere, Surface, Instance };
 
 struct OrganShape {
     OrganKind kind = OrganKind::Sphere;
-    std::string name; // Surface: the surface's name; Instance: the prototype's; Sphere: empty
+    std::string name;         // Surface: the surface's name; Instance: the instance's; Sphere: empty
+    int instance = -1;        // Instance: its index in *Program::instances
+    std::vector<double> args; // Instance: the argument tuple (the placement scale not included)
     auto operator<=>(const OrganShape&) const = default;
 };
 

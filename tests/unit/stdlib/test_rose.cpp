@@ -251,7 +251,7 @@ void check_phyllotaxis(const Rose& r) {
     }
     int leaves = 0;
     for (const auto& o : r.skeleton.organs) {
-        if (o.shape != OrganShape{OrganKind::Surface, "petiole"}) continue;
+        if (o.shape != OrganShape{OrganKind::Surface, "petiole", -1, {}}) continue;
         ++leaves;
         glm::dvec3 at(o.transform[3]), g(o.transform[1]);
         bool found = false;
