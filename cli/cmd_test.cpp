@@ -337,6 +337,8 @@ std::string run_one(const fs::path& file, bool bless, bool& blessed,
         std::vector<std::string> run_args{"run", file.filename().string()};
         run_args.insert(run_args.end(), e.args.begin(), e.args.end());
         run_args.insert(run_args.end(), {"-o", tmp_name});
+        for (const auto& d : allow_read)
+            run_args.insert(run_args.end(), {"--allow-read", fs::absolute(d).string()});
         Outcome m = run_self(run_args, file.parent_path());
         read_file(tmp_name, mesh);
         unlink(tmp_name);

@@ -93,8 +93,10 @@ bool Session::rebuild(int steps, const std::string* extra_fn) {
     std::uint32_t id = sources->add("<session>", session_source(extra_fn));
     auto program = compile_source(*sources, id, co, diags);
     err_ << render_all(news(diags, *sources), *sources, color_);
+    last_error_input_ = diags.has_input_errors();
     if (!program) {
         failed_ = true;
+        last_error_runtime_ = false;
         return false;
     }
     std::vector<std::unique_ptr<Derivation>> history;
@@ -150,7 +152,7 @@ int Session::load(const std::string& path) {
     edits_.clear();
     if (!rebuild(0)) {
         std::tie(file_, file_text_, axiom_, extra_rules_, params_, seed_, uses_, edits_) = saved;
-        return last_error_runtime_ ? 70 : 65;
+        return last_error_runtime_ ? 70 : last_error_input_ ? 66 : 65;
     }
     out_ << fmt::format("loaded {}: {} at step 0\n", escape_controls(path),
                         modules(current().string().size()));

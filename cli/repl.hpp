@@ -131,7 +131,8 @@ class Session {
     bool failed_ = false;
     bool quit_ = false; // :quit was typed
     bool last_error_runtime_ = false;
-    std::ostream& error(); // err_, marking the line as failed
+    bool last_error_input_ = false; // the last compile failed on a file it could not read
+    std::ostream& error();          // err_, marking the line as failed
 
     std::unique_ptr<SourceManager> sources_;
     std::unique_ptr<Program> program_;
