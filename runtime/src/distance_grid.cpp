@@ -14,7 +14,10 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <exception>
 #include <limits>
+#include <mutex>
+#include <system_error>
 #include <thread>
 
 namespace plant {
@@ -161,18 +164,31 @@ std::shared_ptr<const physics::DistanceGrid> distance_grid(const std::vector<Tri
     // each sample is independent of the others: layers are shared among threads, the values do
     // not depend on how
     std::atomic<int> next{0};
+    std::mutex failure_lock;
+    std::exception_ptr failure; // the first exception of any thread (running out of memory)
     auto work = [&] {
-        for (int z = next++; z < g->n.z; z = next++)
-            for (int y = 0; y < g->n.y; ++y)
-                for (int x = 0; x < g->n.x; ++x)
-                    g->d[(static_cast<std::size_t>(z) * g->n.y + y) * g->n.x + x] =
-                        tree.signed_distance(lo + glm::dvec3(x, y, z) * cell);
+        try {
+            for (int z = next++; z < g->n.z; z = next++)
+                for (int y = 0; y < g->n.y; ++y)
+                    for (int x = 0; x < g->n.x; ++x)
+                        g->d[(static_cast<std::size_t>(z) * g->n.y + y) * g->n.x + x] =
+                            tree.signed_distance(lo + glm::dvec3(x, y, z) * cell);
+        } catch (...) {
+            next = g->n.z; // the others stop after their layer
+            const std::lock_guard<std::mutex> hold(failure_lock);
+            if (!failure) failure = std::current_exception();
+        }
     };
     const unsigned threads = std::clamp(std::thread::hardware_concurrency(), 1u, 8u);
     std::vector<std::thread> pool;
-    for (unsigned i = 1; i < threads && mesh.size() > 64; ++i) pool.emplace_back(work);
+    try {
+        for (unsigned i = 1; i < threads && mesh.size() > 64; ++i) pool.emplace_back(work);
+    } catch (const std::system_error&) {
+        // no more threads: the ones started (and this one) do the work
+    }
     work();
     for (auto& t : pool) t.join();
+    if (failure) std::rethrow_exception(failure); // on the caller's thread, where it is reported
     return g;
 }
 
