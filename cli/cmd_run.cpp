@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <iostream>
@@ -68,6 +69,8 @@ int run_main(RunCmd& c) {
     const bool progress = isatty(2) != 0;
     auto t0 = std::chrono::steady_clock::now();
     DeriveOptions opt = derive_options(c.g);
+    // the string's share of --max-memory: a step holds the string it reads and the one it writes
+    if (max_memory) opt.max_bytes = std::min<std::uint64_t>(opt.max_bytes, max_memory / 2);
     TurtleEnvironmentPhase phase;
     opt.environment_phase = &phase;
     opt.on_print = [](const std::string& text) { std::cerr << escape_controls(text, true); };
@@ -112,8 +115,9 @@ void setup_run(CLI::App& app, int& exit_code) {
     cmd->add_option("--sides", c->sides, "Vertices around each ring of a branch")->check(CLI::Range(3, 64));
     cmd->add_option("--size", c->size, "Size of PNG previews")->type_name("WxH");
     cmd->add_option("--max-memory", c->max_memory,
-                    "Memory meshing and export may take, as 512M or 4G; a run that would need more "
-                    "stops before meshing (default: half the physical memory)")
+                    "Memory the run may take, as 512M or 4G: the derivation's string may take half of it, "
+                    "and a run whose meshing and export would need more stops before meshing "
+                    "(default: 8G for the string, half the physical memory for meshing)")
         ->type_name("SIZE");
     cmd->add_flag("--no-obstacles", c->no_obstacles,
                   "Leave the environments' obstacles (a climber's walls, say) out of meshes and images");

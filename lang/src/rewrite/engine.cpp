@@ -53,8 +53,10 @@ void Engine::check_limits(const Derivation& d, std::size_t modules, std::size_t 
         modules * (sizeof(SymbolId) + sizeof(std::uint32_t) + (d.current_.keep_ids ? sizeof(ModuleId) : 0)) +
         params * sizeof(double);
     if (estimate > d.opt_.max_bytes)
-        throw limit(fmt::format("the string needs about {:.1f} GiB, more than the limit of {:.1f} GiB",
-                                estimate / double(1 << 30), d.opt_.max_bytes / double(1 << 30)));
+        throw limit(
+            fmt::format("the string needs about {:.1f} GiB, more than the limit of {:.1f} GiB (plant run: "
+                        "raise --max-memory, which gives the string half of it)",
+                        estimate / double(1 << 30), d.opt_.max_bytes / double(1 << 30)));
 }
 
 const RulePlan& Engine::plan_for(const Program& prog, const std::vector<const RuleSet*>& sets) {
