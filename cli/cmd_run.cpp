@@ -30,7 +30,7 @@ struct RunCmd {
     std::string size = "800x800";
     std::string max_memory;
     bool no_gpu_instancing = false, flatten = false;
-    std::string camera, look_at;
+    std::optional<std::string> camera, look_at; // as given, even empty
 };
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
@@ -42,12 +42,12 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 bool read_view(const RunCmd& c, std::optional<glm::dvec3>& camera, std::optional<glm::dvec3>& look_at) {
     for (auto [name, text, point] :
          {std::tuple{"--camera", &c.camera, &camera}, {"--look-at", &c.look_at, &look_at}}) {
-        if (text->empty()) continue;
-        *point = parse_point(*text);
+        if (!*text) continue;
+        *point = parse_point(**text);
         if (!*point) {
             std::cerr << fmt::format(
                 "plant: {} expects three finite numbers x,y,z (as 0,2.5,-10), found '{}'\n", name,
-                escape_controls(*text));
+                escape_controls(**text));
             return false;
         }
     }
@@ -58,7 +58,7 @@ bool read_view(const RunCmd& c, std::optional<glm::dvec3>& camera, std::optional
     if (camera && look_at && *camera == *look_at) {
         std::cerr << fmt::format("plant: --camera and --look-at are the same point ({}): the camera must "
                                  "look at a point away from itself\n",
-                                 escape_controls(c.camera));
+                                 escape_controls(*c.camera));
         return false;
     }
     return true;
