@@ -13,6 +13,8 @@
 #include <chrono>
 #include <filesystem>
 #include <iostream>
+#include <optional>
+#include <tuple>
 #include <unistd.h>
 
 namespace plant::cli {
@@ -28,10 +30,39 @@ struct RunCmd {
     bool no_obstacles = false;
     std::string size = "800x800";
     std::string max_memory;
+    bool no_gpu_instancing = false, flatten = false;
+    std::optional<std::string> camera, look_at; // as given, even empty
 };
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// --camera and --look-at: each three finite numbers, --look-at only with --camera, and not the
+// same point. Prints a usage error and returns false otherwise.
+bool read_view(const RunCmd& c, std::optional<glm::dvec3>& camera, std::optional<glm::dvec3>& look_at) {
+    for (auto [name, text, point] :
+         {std::tuple{"--camera", &c.camera, &camera}, {"--look-at", &c.look_at, &look_at}}) {
+        if (!*text) continue;
+        *point = parse_point(**text);
+        if (!*point) {
+            std::cerr << fmt::format(
+                "plant: {} expects three finite numbers x,y,z (as 0,2.5,-10), found '{}'\n", name,
+                escape_controls(**text));
+            return false;
+        }
+    }
+    if (look_at && !camera) {
+        std::cerr << "plant: --look-at needs --camera x,y,z, the point the preview is seen from\n";
+        return false;
+    }
+    if (camera && look_at && *camera == *look_at) {
+        std::cerr << fmt::format("plant: --camera and --look-at are the same point ({}): the camera must "
+                                 "look at a point away from itself\n",
+                                 escape_controls(*c.camera));
+        return false;
+    }
+    return true;
 }
 
 int run_main(RunCmd& c) {
@@ -62,6 +93,8 @@ int run_main(RunCmd& c) {
                                  escape_controls(c.max_memory));
         return kUsage;
     }
+    std::optional<glm::dvec3> camera, look_at;
+    if (!read_view(c, camera, look_at)) return kUsage;
     int exit_code = kOk;
     SourceManager sources;
     auto program = load_program(c.g, sources, exit_code);
@@ -87,6 +120,11 @@ int run_main(RunCmd& c) {
         oo.width = width;
         oo.height = height;
         oo.max_memory = max_memory;
+        oo.gltf_layout = c.flatten             ? GltfLayout::Baked
+                         : c.no_gpu_instancing ? GltfLayout::Nodes
+                                               : GltfLayout::GpuInstancing;
+        oo.camera = camera;
+        oo.look_at = look_at;
         OutputSummary summary = write_outputs(*program, d, c.outputs, oo);
         if (progress)
             std::cerr << fmt::format("{} modules, {} triangles, {} organs in {:.0f} ms\n", d.string().size(),
@@ -119,6 +157,19 @@ void setup_run(CLI::App& app, int& exit_code) {
                     "and a run whose meshing and export would need more stops before meshing "
                     "(default: 8G for the string, half the physical memory for meshing)")
         ->type_name("SIZE");
+    auto* nodes = cmd->add_flag("--no-gpu-instancing", c->no_gpu_instancing,
+                                "glTF: place each organ and instance by a plain node sharing its mesh, for "
+                                "viewers without EXT_mesh_gpu_instancing");
+    cmd->add_flag("--flatten", c->flatten,
+                  "glTF: bake every placement into one world-space mesh (nothing shared; larger files)")
+        ->excludes(nodes);
+    cmd->add_option("--camera", c->camera,
+                    "Perspective view of PNG previews from this point; with a grammar's `param "
+                    "depth_unit`, also the point each placement's view depth is measured from")
+        ->type_name("X,Y,Z");
+    cmd->add_option("--look-at", c->look_at,
+                    "The point the --camera looks at (default: the centre of the plant's bounds)")
+        ->type_name("X,Y,Z");
     cmd->add_flag("--no-obstacles", c->no_obstacles,
                   "Leave the environments' obstacles (a climber's walls, say) out of meshes and images");
     std::string formats = "Output formats:\n";

@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <unistd.h>
 
@@ -32,10 +33,10 @@ std::string mesh_summary(const Scene& s) {
 }
 
 std::string glb_bytes(const OutputSources& from, const std::string& target) {
-    return gltf_bytes(from.scene, GltfContainer::Binary, target);
+    return gltf_bytes(from.scene, GltfContainer::Binary, target, from.options.gltf_layout);
 }
 std::string gltf_json_bytes(const OutputSources& from, const std::string& target) {
-    return gltf_bytes(from.scene, GltfContainer::Json, target);
+    return gltf_bytes(from.scene, GltfContainer::Json, target, from.options.gltf_layout);
 }
 std::string obj_bytes(const OutputSources& from, const std::string& target) {
     return mesh_file_bytes(from.scene, MeshFileFormat::Obj, target);
@@ -47,7 +48,9 @@ std::string off_bytes(const OutputSources& from, const std::string& target) {
     return mesh_file_bytes(from.scene, MeshFileFormat::Off, target);
 }
 std::string scene_png_bytes(const OutputSources& from, const std::string& target) {
-    return png_bytes(from.scene, from.options.width, from.options.height, target);
+    std::optional<PngView> view;
+    if (from.options.camera) view = PngView{*from.options.camera, from.options.look_at};
+    return png_bytes(from.scene, from.options.width, from.options.height, target, view);
 }
 std::string skeleton_svg_bytes(const OutputSources& from, const std::string&) {
     return skeleton_svg(from.skeleton);
@@ -65,12 +68,13 @@ std::string mesh_summary_bytes(const OutputSources& from, const std::string&) {
 // Adding a format: one row here and its writer above (docs: README.md lists the extensions).
 constexpr OutputFormat kFormats[] = {
     {".glb", OutputNeeds::Scene, glb_bytes,
-     "glTF 2.0, binary; each organ is one mesh shared by every node that places it"},
+     "glTF 2.0, binary; each organ or instance is one mesh, placed by EXT_mesh_gpu_instancing"},
     {".gltf", OutputNeeds::Scene, gltf_json_bytes, "glTF 2.0 as JSON, the buffer embedded as a data URI"},
     {".obj", OutputNeeds::Scene, obj_bytes, "Wavefront OBJ, everything in one triangle mesh"},
     {".ply", OutputNeeds::Scene, ply_bytes, "PLY, everything in one triangle mesh"},
     {".off", OutputNeeds::Scene, off_bytes, "OFF, everything in one triangle mesh"},
-    {".png", OutputNeeds::Scene, scene_png_bytes, "a shaded preview from a 3/4 view, --size pixels"},
+    {".png", OutputNeeds::Scene, scene_png_bytes,
+     "a shaded preview from a 3/4 view (or from --camera), --size pixels"},
     {".svg", OutputNeeds::Skeleton, skeleton_svg_bytes, "a line drawing of the XY plane, for 2D grammars"},
     {".txt", OutputNeeds::String, string_text_bytes, "the derived string, as plant derive prints it"},
     {".skel.json", OutputNeeds::Skeleton, skeleton_json_bytes,
@@ -113,6 +117,21 @@ std::uint64_t default_max_memory() {
     const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGESIZE);
     if (pages <= 0 || page <= 0) return std::uint64_t(4) << 30;
     return std::uint64_t(pages) * std::uint64_t(page) / 2;
+}
+
+std::optional<glm::dvec3> parse_point(const std::string& text) {
+    glm::dvec3 p(0.0);
+    const char* s = text.c_str();
+    for (int k = 0; k < 3; ++k) {
+        char* end = nullptr;
+        p[k] = std::strtod(s, &end);
+        if (end == s || !std::isfinite(p[k])) return std::nullopt;
+        while (*end == ' ') ++end;
+        if (k < 2 && *end++ != ',') return std::nullopt;
+        s = end;
+    }
+    if (*s != '\0') return std::nullopt;
+    return p;
 }
 
 std::uint64_t parse_memory(const std::string& text) {
@@ -207,6 +226,7 @@ OutputSummary write_outputs(const Program& program, const Derivation& d,
         check_mesh_memory(skeleton, options);
         MeshOptions mo;
         mo.sides = options.sides;
+        mo.camera = options.camera;
         scene = build_scene(program, skeleton, mo);
         if (options.obstacles) add_environments(d.run_state(), scene);
     }

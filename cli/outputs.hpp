@@ -3,9 +3,11 @@
 #pragma once
 
 #include "plant/derive.hpp"
+#include "plant/export.hpp"
 #include "plant/scene.hpp"
 #include "plant/skeleton.hpp"
 
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -17,7 +19,16 @@ struct OutputOptions {
     int width = 800, height = 800;
     bool obstacles = true;        // the environments' geometry (walls, boxes) goes into meshes and images
     std::uint64_t max_memory = 0; // bytes meshing and export may take; 0: default_max_memory()
+    // how .glb and .gltf write placements: GPU instancing, plain nodes (--no-gpu-instancing) or
+    // everything baked (--flatten)
+    GltfLayout gltf_layout = GltfLayout::GpuInstancing;
+    // --camera: where the PNG preview is seen from, and where placements measure their view
+    // depth from (MeshOptions::camera); --look-at: the point it looks at
+    std::optional<glm::dvec3> camera, look_at;
 };
+
+// "x,y,z": three finite numbers separated by commas; none when the text is not that.
+std::optional<glm::dvec3> parse_point(const std::string& text);
 
 // Half the machine's physical memory: the default of --max-memory.
 std::uint64_t default_max_memory();

@@ -1,36 +1,29 @@
-// glTF 2.0 export through tinygltf, and the atomic file writer every exporter shares.
+// glTF 2.0 export through tinygltf.
 //
-// Layout of the single buffer: for each non-empty mesh part (the tubes, then each prototype) four
-// tightly packed buffer views, in this order: POSITION (vec3 float), NORMAL (vec3 float),
-// TEXCOORD_0 (vec2 float), indices (uint32). Every primitive of a part shares the part's vertex
-// accessors and has its own index accessor, a window into the part's index view. All components
-// are 4 bytes, so every view and accessor is 4-byte aligned.
+// Layout of the single buffer: for each non-empty mesh part (the tubes, then each distinct placed
+// prototype) four tightly packed buffer views, in this order: POSITION (vec3 float), NORMAL (vec3
+// float), TEXCOORD_0 (vec2 float), indices (uint32). Every primitive of a part shares the part's
+// vertex accessors and has its own index accessor, a window into the part's index view. With GPU
+// instancing, each instanced node's TRANSLATION (vec3), ROTATION (vec4) and SCALE (vec3) views
+// follow the meshes. All components are 4 bytes, so every view and accessor is 4-byte aligned.
 #include "plant/export.hpp"
+
+#include "export_placement.hpp"
 
 #include <tiny_gltf.h>
 
 #include <glm/glm.hpp>
 
 #include <algorithm>
-#include <atomic>
-#include <cctype>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
-#include <cstdio>
-#include <cstring>
-#include <filesystem>
 #include <limits>
 #include <sstream>
-#include <system_error>
-#include <unistd.h>
 
 namespace plant {
 
-namespace fs = std::filesystem;
-
 // ---------------------------------------------------------------------------------------------
-// Atomic writes
+// glTF
 
 namespace {
 
@@ -38,93 +31,7 @@ std::string quoted(const std::string& s) {
     return "'" + s + "'";
 }
 
-// Creates a new, empty file beside `path` (same directory, hidden, unique name) and returns its
-// path with `file` open for writing. Throws ExportError when the directory is not writable.
-std::string create_temp_beside(const std::string& path, std::FILE*& file) {
-    static std::atomic<unsigned> counter{0};
-    const fs::path target(path);
-    if (target.filename().empty()) throw ExportError("cannot write " + quoted(path) + ": not a file name");
-    const fs::path dir = target.parent_path();
-    for (int attempt = 0;; ++attempt) {
-        const std::string name = "." + target.filename().string() + ".tmp-" + std::to_string(::getpid()) +
-                                 "-" + std::to_string(counter++);
-        const std::string temp = (dir / name).string();
-        // "x": fail if the file exists, so two writers never share a temporary file.
-        file = std::fopen(temp.c_str(), "wbx");
-        if (file) return temp;
-        const int err = errno;
-        if (err == EEXIST && attempt < 100) continue;
-        throw ExportError("cannot write " + quoted(path) + ": cannot create a file in " +
-                          quoted(dir.empty() ? std::string(".") : dir.string()) + ": " + std::strerror(err));
-    }
-}
-
-void remove_quietly(const std::string& temp) {
-    std::error_code ignored;
-    fs::remove(temp, ignored);
-}
-
-} // namespace
-
-void check_mesh_part(const MeshPart& part, const std::string& what) {
-    const std::size_t nv = part.positions.size();
-    if (!part.normals.empty() && part.normals.size() != nv)
-        throw ExportError(what + " has " + std::to_string(nv) + " positions but " +
-                          std::to_string(part.normals.size()) + " normals");
-    if (!part.uvs.empty() && part.uvs.size() != nv)
-        throw ExportError(what + " has " + std::to_string(nv) + " positions but " +
-                          std::to_string(part.uvs.size()) + " texture coordinates");
-    if (part.indices.size() % 3 != 0)
-        throw ExportError(what + " has an index count (" + std::to_string(part.indices.size()) +
-                          ") that is not a multiple of 3");
-    for (std::uint32_t i : part.indices)
-        if (i >= nv)
-            throw ExportError(what + " has index " + std::to_string(i) + " but only " + std::to_string(nv) +
-                              " vertices");
-}
-
-const Scene& exported_scene(const Scene& scene, Scene& storage, const std::string& what) {
-    const Scene* s = &scene;
-    if (scene.nested()) {
-        try {
-            storage = flatten(scene);
-        } catch (const std::out_of_range& e) {
-            throw ExportError(what + ": " + e.what());
-        }
-        s = &storage;
-    }
-    for (const Instance& inst : s->instances)
-        if (inst.prototype >= s->prototypes.size())
-            throw ExportError(what + ": an instance places prototype " + std::to_string(inst.prototype) +
-                              " but the scene has " + std::to_string(s->prototypes.size()));
-    return *s;
-}
-
-void write_file_atomically(const std::string& path, const std::string& bytes) {
-    std::FILE* file = nullptr;
-    const std::string temp = create_temp_beside(path, file);
-    const std::size_t written = bytes.empty() ? 0 : std::fwrite(bytes.data(), 1, bytes.size(), file);
-    int err = written == bytes.size() ? 0 : errno;
-    if (std::fflush(file) != 0 && err == 0) err = errno;
-    if (std::fclose(file) != 0 && err == 0) err = errno;
-    if (written != bytes.size() && err == 0) err = EIO;
-    if (err != 0) {
-        remove_quietly(temp);
-        throw ExportError("cannot write " + quoted(path) + ": " + std::strerror(err));
-    }
-    std::error_code ec;
-    fs::rename(temp, path, ec);
-    if (ec) {
-        remove_quietly(temp);
-        throw ExportError("cannot write " + quoted(path) + ": " + ec.message());
-    }
-}
-
-// ---------------------------------------------------------------------------------------------
-// glTF
-
-namespace {
-
+constexpr const char* kGpuInstancing = "EXT_mesh_gpu_instancing";
 constexpr int array_buffer = 34962;         // ARRAY_BUFFER
 constexpr int element_array_buffer = 34963; // ELEMENT_ARRAY_BUFFER
 
@@ -207,20 +114,7 @@ struct GltfBuilder {
         if (nv > std::numeric_limits<std::uint32_t>::max())
             throw ExportError("glTF export: " + name + " has too many vertices");
 
-        // A part without primitives is drawn whole with material 0.
-        std::vector<Primitive> prims = part.primitives;
-        if (prims.empty()) prims.push_back({0, static_cast<std::uint32_t>(part.indices.size()), 0});
-        for (const Primitive& p : prims) {
-            if (std::uint64_t(p.first) + p.count > part.indices.size() || p.first % 3 != 0 ||
-                p.count % 3 != 0)
-                throw ExportError(
-                    "glTF export: " + name + " has a primitive with indices [" + std::to_string(p.first) +
-                    ", " + std::to_string(std::uint64_t(p.first) + p.count) + ") that does not fit its " +
-                    std::to_string(part.indices.size()) + " indices in whole triangles");
-        }
-        prims.erase(
-            std::remove_if(prims.begin(), prims.end(), [](const Primitive& p) { return p.count == 0; }),
-            prims.end());
+        const std::vector<Primitive> prims = detail::drawn_primitives(part, "glTF export: " + name);
         if (prims.empty() || nv == 0) return -1;
 
         tinygltf::Mesh mesh;
@@ -284,43 +178,88 @@ struct GltfBuilder {
         return index;
     }
 
-    void build() {
+    // A plain node placing `mesh` by the instance's matrix.
+    void add_matrix_node(int mesh, const glm::mat4& transform) {
+        tinygltf::Node node;
+        node.mesh = mesh;
+        node.matrix.resize(16);
+        for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 4; ++r) {
+                const float x = transform[c][r];
+                if (!std::isfinite(x))
+                    throw ExportError("glTF export: an instance of " + model.meshes[std::size_t(mesh)].name +
+                                      " has a transform that is not finite");
+                node.matrix[std::size_t(c * 4 + r)] = tidy(x);
+            }
+        add_node(std::move(node));
+    }
+
+    template <class T> int add_instance_accessor(const std::vector<T>& values, int type) {
+        const int view = add_view(values.data(), values.size() * sizeof(T), 0);
+        return add_accessor(view, 0, values.size(), type, TINYGLTF_COMPONENT_TYPE_FLOAT);
+    }
+
+    // One node drawing `mesh` at every placement (EXT_mesh_gpu_instancing); a placement that is not
+    // a rotation times a positive scale gets a plain node instead.
+    void add_instanced(int mesh, const std::vector<const Instance*>& placements) {
+        std::vector<glm::vec3> translation, scale;
+        std::vector<glm::vec4> rotation;
+        std::vector<const Instance*> plain;
+        for (const Instance* inst : placements) {
+            if (const auto trs = detail::decompose(inst->transform)) {
+                translation.push_back(trs->translation);
+                rotation.push_back(trs->rotation);
+                scale.push_back(trs->scale);
+            } else {
+                plain.push_back(inst);
+            }
+        }
+        if (!translation.empty()) {
+            tinygltf::Value::Object attributes;
+            attributes["TRANSLATION"] =
+                tinygltf::Value(add_instance_accessor(translation, TINYGLTF_TYPE_VEC3));
+            attributes["ROTATION"] = tinygltf::Value(add_instance_accessor(rotation, TINYGLTF_TYPE_VEC4));
+            attributes["SCALE"] = tinygltf::Value(add_instance_accessor(scale, TINYGLTF_TYPE_VEC3));
+            tinygltf::Value::Object extension;
+            extension["attributes"] = tinygltf::Value(std::move(attributes));
+            tinygltf::Node node;
+            node.name = model.meshes[std::size_t(mesh)].name;
+            node.mesh = mesh;
+            node.extensions[kGpuInstancing] = tinygltf::Value(std::move(extension));
+            add_node(std::move(node));
+            if (model.extensionsUsed.empty()) model.extensionsUsed.push_back(kGpuInstancing);
+        }
+        for (const Instance* inst : plain) add_matrix_node(mesh, inst->transform);
+    }
+
+    std::string prototype_name(std::size_t i) const {
+        return i < scene.prototype_names.size() && !scene.prototype_names[i].empty()
+                   ? scene.prototype_names[i]
+                   : "prototype" + std::to_string(i);
+    }
+
+    void build(GltfLayout layout) {
         model.scenes.emplace_back();
         model.scenes[0].name = "plant";
         model.defaultScene = 0;
 
-        const int tubes = add_mesh(scene.tubes, "tubes");
-        if (tubes >= 0) {
-            tinygltf::Node node;
-            node.name = "tubes";
-            node.mesh = tubes;
-            add_node(std::move(node));
-        }
-
-        std::vector<int> proto_mesh(scene.prototypes.size(), -1);
-        for (std::size_t i = 0; i < scene.prototypes.size(); ++i) {
-            const std::string name = i < scene.prototype_names.size() && !scene.prototype_names[i].empty()
-                                         ? scene.prototype_names[i]
-                                         : "prototype" + std::to_string(i);
-            proto_mesh[i] = add_mesh(scene.prototypes[i], name);
-        }
-
-        for (const Instance& inst : scene.instances) {
-            const int mesh = proto_mesh[inst.prototype];
-            if (mesh < 0) continue;
-            tinygltf::Node node;
-            node.mesh = mesh;
-            node.matrix.resize(16);
-            for (int c = 0; c < 4; ++c)
-                for (int r = 0; r < 4; ++r) {
-                    const float x = inst.transform[c][r];
-                    if (!std::isfinite(x))
-                        throw ExportError("glTF export: an instance of " +
-                                          model.meshes[std::size_t(mesh)].name +
-                                          " has a transform that is not finite");
-                    node.matrix[std::size_t(c * 4 + r)] = tidy(x);
-                }
-            add_node(std::move(node));
+        if (layout == GltfLayout::Baked) {
+            const int mesh = add_mesh(detail::bake(scene, "glTF export"), "plant");
+            if (mesh >= 0) {
+                tinygltf::Node node;
+                node.name = "plant";
+                node.mesh = mesh;
+                add_node(std::move(node));
+            }
+        } else {
+            const int tubes = add_mesh(scene.tubes, "tubes");
+            if (tubes >= 0) {
+                tinygltf::Node node;
+                node.name = "tubes";
+                node.mesh = tubes;
+                add_node(std::move(node));
+            }
+            add_placements(layout);
         }
 
         if (!model.buffers.empty()) {
@@ -328,16 +267,42 @@ struct GltfBuilder {
             while (buf.size() % 4 != 0) buf.push_back(0);
         }
     }
+
+    // The placed prototypes, each distinct one meshed once, and their placements.
+    void add_placements(GltfLayout layout) {
+        const std::vector<std::uint32_t> shared = detail::shared_prototypes(scene);
+        std::vector<int> proto_mesh(scene.prototypes.size(), -1);
+        std::vector<bool> meshed(scene.prototypes.size(), false);
+        // placements by mesh, in the order meshes are first placed
+        std::vector<std::vector<const Instance*>> placements;
+        for (const Instance& inst : scene.instances) {
+            const std::uint32_t k = shared[inst.prototype];
+            if (!meshed[k]) {
+                meshed[k] = true;
+                proto_mesh[k] = add_mesh(scene.prototypes[k], prototype_name(k));
+                if (proto_mesh[k] >= 0) placements.resize(std::size_t(proto_mesh[k]) + 1);
+            }
+            const int mesh = proto_mesh[k];
+            if (mesh < 0) continue;
+            if (layout == GltfLayout::Nodes)
+                add_matrix_node(mesh, inst.transform);
+            else
+                placements[std::size_t(mesh)].push_back(&inst);
+        }
+        for (std::size_t mesh = 0; mesh < placements.size(); ++mesh)
+            if (!placements[mesh].empty()) add_instanced(static_cast<int>(mesh), placements[mesh]);
+    }
 };
 
 } // namespace
 
-std::string gltf_bytes(const Scene& scene, GltfContainer container, const std::string& path) {
+std::string gltf_bytes(const Scene& scene, GltfContainer container, const std::string& path,
+                       GltfLayout layout) {
     const bool binary = container == GltfContainer::Binary;
 
     Scene flat;
     GltfBuilder builder(exported_scene(scene, flat, "glTF export"));
-    builder.build();
+    builder.build(layout);
     if (binary && !builder.model.buffers.empty() &&
         builder.model.buffers[0].data.size() > std::numeric_limits<std::uint32_t>::max() - 1024)
         throw ExportError("cannot write " + quoted(path) +
@@ -354,8 +319,8 @@ std::string gltf_bytes(const Scene& scene, GltfContainer container, const std::s
     return std::move(out).str();
 }
 
-void write_gltf(const Scene& scene, const std::string& path, GltfContainer container) {
-    write_file_atomically(path, gltf_bytes(scene, container, path));
+void write_gltf(const Scene& scene, const std::string& path, GltfContainer container, GltfLayout layout) {
+    write_file_atomically(path, gltf_bytes(scene, container, path, layout));
 }
 
 } // namespace plant

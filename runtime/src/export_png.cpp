@@ -1,5 +1,6 @@
-// PNG preview: a small software rasterizer (orthographic 3/4 view, z-buffer, Gouraud-shaded
-// two-sided Lambert lighting, 2x2 supersampling) and the PNG writer on top of it.
+// PNG preview: a small software rasterizer (orthographic 3/4 view, or a perspective camera the
+// user places; z-buffer, Gouraud-shaded two-sided Lambert lighting, 2x2 supersampling) and the PNG
+// writer on top of it.
 //
 // Triangles are set up in 28.4 fixed point with exact 64-bit edge functions and a consistent
 // tie-breaking rule, so meshes are watertight (no background speckles along shared edges) and
@@ -102,16 +103,29 @@ struct Camera {
     glm::dvec3 light{0, 1, 0};                               // unit, toward the light
     double scale = 1.0;                                      // samples per world unit
     double cx = 0.0, cy = 0.0;                               // screen position of `center`
+    // A perspective camera (plant run --camera) sees from `eye` along -toward: a point at view
+    // coordinates (x, y, d) = (right, up, -toward) . (p - eye) lands at (cx + focal x / d,
+    // cy - focal y / d), with depth 1 / d; only d >= near is drawn.
+    bool perspective = false;
+    glm::dvec3 eye{0.0};
+    double focal = 1.0; // samples per unit of x / d
+    double near = 0.0;
 };
+
+void aim(Camera& cam, const glm::dvec3& toward) {
+    cam.toward = toward;
+    const glm::dvec3 forward = -cam.toward;
+    // looking straight up or down, -z is up on the image (the back of the scene at the top)
+    const glm::dvec3 up_hint = std::abs(forward.y) > 0.999 ? glm::dvec3(0, 0, -1) : glm::dvec3(0, 1, 0);
+    cam.right = glm::normalize(glm::cross(forward, up_hint));
+    cam.up = glm::cross(cam.right, forward);
+    cam.light = glm::normalize(0.55 * cam.toward + 0.75 * glm::dvec3(0, 1, 0) - 0.4 * cam.right);
+}
 
 Camera make_camera(const Scene& scene, int width, int height) {
     Camera cam;
     const double az = kAzimuthDeg * kPi / 180.0, el = kElevationDeg * kPi / 180.0;
-    cam.toward = glm::dvec3(std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az));
-    const glm::dvec3 forward = -cam.toward;
-    cam.right = glm::normalize(glm::cross(forward, glm::dvec3(0, 1, 0)));
-    cam.up = glm::cross(cam.right, forward);
-    cam.light = glm::normalize(0.55 * cam.toward + 0.75 * glm::dvec3(0, 1, 0) - 0.4 * cam.right);
+    aim(cam, glm::dvec3(std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az)));
 
     const Box box = framing_box(scene);
     cam.center = 0.5 * (box.lo + box.hi);
@@ -128,6 +142,49 @@ Camera make_camera(const Scene& scene, int width, int height) {
     if (hh > 0.0) scale = std::min(scale, avail_h / hh);
     if (!std::isfinite(scale) || scale <= 0.0) scale = 1.0; // a point: nothing has any area
     cam.scale = scale;
+    cam.cx = 0.5 * width;
+    cam.cy = 0.5 * height;
+    return cam;
+}
+
+// A perspective camera at view.eye looking at view.target (default: the centre of the scene's
+// bounds), its view angle the narrowest that shows every corner of the bounds in front of it,
+// kept between kMinViewDeg and kMaxViewDeg across the image's shorter side.
+Camera make_perspective_camera(const Scene& scene, int width, int height, const PngView& view) {
+    constexpr double kMinViewDeg = 10.0, kMaxViewDeg = 100.0, kFallbackViewDeg = 60.0;
+    Camera cam;
+    cam.perspective = true;
+    cam.eye = view.eye;
+    const Box box = framing_box(scene);
+    const glm::dvec3 target = view.target.value_or(0.5 * (box.lo + box.hi));
+    glm::dvec3 toward = cam.eye - target;
+    const double distance = glm::length(toward);
+    if (distance > 0.0 && std::isfinite(distance)) {
+        aim(cam, toward / distance);
+    } else { // the camera at the point it looks at: look the default 3/4 way
+        const double az = kAzimuthDeg * kPi / 180.0, el = kElevationDeg * kPi / 180.0;
+        aim(cam, glm::dvec3(std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az)));
+    }
+    const double size = glm::length(box.hi - box.lo);
+    cam.near = std::isfinite(size) && size > 0.0 ? 1e-4 * size : 1e-6;
+
+    double need_x = 0.0, need_y = 0.0; // the largest |x / d| and |y / d| of the corners in front
+    for (int corner = 0; corner < 8; ++corner) {
+        const glm::dvec3 p((corner & 1) ? box.hi.x : box.lo.x, (corner & 2) ? box.hi.y : box.lo.y,
+                           (corner & 4) ? box.hi.z : box.lo.z);
+        const glm::dvec3 v = p - cam.eye;
+        const double d = -glm::dot(v, cam.toward);
+        if (!(d > cam.near)) continue;
+        need_x = std::max(need_x, std::abs(glm::dot(v, cam.right)) / d);
+        need_y = std::max(need_y, std::abs(glm::dot(v, cam.up)) / d);
+    }
+    double focal = std::numeric_limits<double>::infinity();
+    if (need_x > 0.0) focal = std::min(focal, 0.5 * width * (1.0 - 2.0 * kMargin) / need_x);
+    if (need_y > 0.0) focal = std::min(focal, 0.5 * height * (1.0 - 2.0 * kMargin) / need_y);
+    const double half = 0.5 * std::min(width, height);
+    auto focal_for = [&](double view_deg) { return half / std::tan(0.5 * view_deg * kPi / 180.0); };
+    if (!std::isfinite(focal)) focal = focal_for(kFallbackViewDeg);
+    cam.focal = std::clamp(focal, focal_for(kMaxViewDeg), focal_for(kMinViewDeg));
     cam.cx = 0.5 * width;
     cam.cy = 0.5 * height;
     return cam;
@@ -292,15 +349,53 @@ std::array<float, 3> lut_scale_for(const Scene& scene, std::uint32_t material) {
     return {clamp01(m.color.r) * s, clamp01(m.color.g) * s, clamp01(m.color.b) * s};
 }
 
+// A vertex in a perspective camera's view coordinates (right, up, depth), with its lighting terms.
+struct ViewVertex {
+    glm::dvec3 p{0.0};
+    float nl = 0.0f, nv = 0.0f; // as ScreenVertex
+    bool ok = false;
+};
+
 struct Renderer {
     const Scene& scene;
     Raster& raster;
     const Camera& cam;
     glm::dvec3 light_view; // the light in (right, up, toward) coordinates
     std::vector<ScreenVertex> verts;
+    std::vector<ViewVertex> view_verts; // for a perspective camera
+
+    // Transforms the part's vertices (by `model` first, if given) to a perspective camera's view.
+    void transform_perspective(const MeshPart& part, const glm::dmat4* model) {
+        const glm::dmat4 m = model ? *model : glm::dmat4(1.0);
+        glm::dmat3 normal_mat = glm::transpose(glm::inverse(glm::dmat3(m)));
+        bool normals_ok = part.normals.size() == part.positions.size();
+        for (int i = 0; i < 3; ++i)
+            if (!finite3(normal_mat[i])) normals_ok = false;
+        const float nan = std::numeric_limits<float>::quiet_NaN();
+        view_verts.resize(part.positions.size());
+        for (std::size_t i = 0; i < part.positions.size(); ++i) {
+            ViewVertex& v = view_verts[i];
+            const glm::dvec3 world = glm::dvec3(m * glm::dvec4(glm::dvec3(part.positions[i]), 1.0));
+            const glm::dvec3 rel = world - cam.eye;
+            v.p = glm::dvec3(glm::dot(rel, cam.right), glm::dot(rel, cam.up), -glm::dot(rel, cam.toward));
+            v.ok = finite3(v.p);
+            v.nl = v.nv = nan;
+            if (!v.ok || !normals_ok) continue;
+            const glm::dvec3 n = normal_mat * glm::dvec3(part.normals[i]);
+            const double len = glm::length(n), dist = glm::length(rel);
+            if (std::isfinite(len) && len > 1e-10 && dist > 0.0) {
+                v.nl = float(glm::dot(n, cam.light) / len);
+                v.nv = float(-glm::dot(n, rel) / (len * dist)); // toward the eye
+            }
+        }
+    }
 
     // Transforms the part's vertices (by `model` first, if given) to screen space.
     void transform(const MeshPart& part, const glm::dmat4* model) {
+        if (cam.perspective) {
+            transform_perspective(part, model);
+            return;
+        }
         // screen = R * (M p) + o, with R's rows scale * right, -scale * up, toward.
         glm::dmat3 view_rows(cam.scale * cam.right, -cam.scale * cam.up, cam.toward);
         const glm::dmat3 view = glm::transpose(view_rows); // columns -> rows
@@ -385,16 +480,90 @@ struct Renderer {
         fill_triangle(raster, {a.x, a.y, a.z, t[0]}, {b.x, b.y, b.z, t[1]}, {c.x, c.y, c.z, t[2]}, color);
     }
 
+    // A perspective triangle: clipped in view coordinates to the near plane and a guard band
+    // around the image, projected, then filled as a fan.
+    void draw_perspective(const ViewVertex& a, const ViewVertex& b, const ViewVertex& c,
+                          const std::array<float, 3>& color) {
+        if (!a.ok || !b.ok || !c.ok) return;
+        float nl[3] = {a.nl, b.nl, c.nl}, nv[3] = {a.nv, b.nv, c.nv};
+        if (std::isnan(nl[0]) || std::isnan(nl[1]) || std::isnan(nl[2])) {
+            // the face normal, turned toward the eye (the origin of view coordinates)
+            glm::dvec3 n = glm::cross(b.p - a.p, c.p - a.p);
+            const double len = glm::length(n), dist = glm::length(a.p);
+            float fl = 1.0f, fv = 1.0f;
+            if (len > 0.0 && std::isfinite(len) && dist > 0.0) {
+                n /= len;
+                if (glm::dot(n, a.p) > 0.0) n = -n;
+                fl = float(glm::dot(n, glm::dvec3(light_view.x, light_view.y, -light_view.z)));
+                fv = float(-glm::dot(n, a.p) / dist);
+            }
+            nl[0] = nl[1] = nl[2] = fl;
+            nv[0] = nv[1] = nv[2] = fv;
+        } else if (nv[0] + nv[1] + nv[2] < 0.0f) {
+            for (int k = 0; k < 3; ++k) {
+                nl[k] = -nl[k];
+                nv[k] = -nv[k];
+            }
+        }
+        struct Clip {
+            glm::dvec3 p;
+            double t; // light intensity
+        };
+        std::array<Clip, 9> poly{}, next{};
+        const ViewVertex* v[3] = {&a, &b, &c};
+        for (int k = 0; k < 3; ++k)
+            poly[std::size_t(k)] = {v[k]->p,
+                                    kAmbient + kKey * std::max(0.0f, nl[k]) + kFill * std::max(0.0f, nv[k])};
+        std::size_t n = 3;
+        const double g = 0.5 * kGuard, f = cam.focal;
+        // inside where plane . (x, y, d, 1) >= 0
+        const glm::dvec4 planes[5] = {{0, 0, 1, -cam.near},
+                                      {f, 0, cam.cx + g, 0},
+                                      {-f, 0, g - cam.cx, 0},
+                                      {0, -f, cam.cy + g, 0},
+                                      {0, f, g - cam.cy, 0}};
+        for (const glm::dvec4& plane : planes) {
+            std::size_t m = 0;
+            for (std::size_t i = 0; i < n; ++i) {
+                const Clip& p = poly[i];
+                const Clip& q = poly[(i + 1) % n];
+                const double dp = glm::dot(plane, glm::dvec4(p.p, 1.0)),
+                             dq = glm::dot(plane, glm::dvec4(q.p, 1.0));
+                if (dp >= 0.0) next[m++] = p;
+                if ((dp >= 0.0) != (dq >= 0.0)) {
+                    const double s = dp / (dp - dq);
+                    next[m++] = {p.p + s * (q.p - p.p), p.t + s * (q.t - p.t)};
+                }
+            }
+            poly = next;
+            n = m;
+            if (n < 3) return;
+        }
+        std::array<ShadedVertex, 9> screen{};
+        for (std::size_t i = 0; i < n; ++i) {
+            const glm::dvec3& p = poly[i].p;
+            const double sx = cam.cx + f * p.x / p.z, sy = cam.cy - f * p.y / p.z;
+            screen[i] = {std::int64_t(std::lround(std::clamp(sx, -kGuard, kGuard) * kSub)),
+                         std::int64_t(std::lround(std::clamp(sy, -kGuard, kGuard) * kSub)), float(1.0 / p.z),
+                         float(poly[i].t)};
+        }
+        for (std::size_t i = 1; i + 1 < n; ++i)
+            fill_triangle(raster, screen[0], screen[i], screen[i + 1], color);
+    }
+
     void draw_range(const MeshPart& part, std::size_t first, std::size_t count, std::uint32_t material) {
         const std::size_t n = part.indices.size();
         if (first >= n) return;
         const std::size_t end = first + std::min(count, n - first);
         const std::array<float, 3> color = lut_scale_for(scene, material);
-        const std::size_t nv = verts.size();
+        const std::size_t nv = cam.perspective ? view_verts.size() : verts.size();
         for (std::size_t i = first; i + 3 <= end; i += 3) {
             const std::uint32_t ia = part.indices[i], ib = part.indices[i + 1], ic = part.indices[i + 2];
             if (ia >= nv || ib >= nv || ic >= nv) continue;
-            draw_triangle(verts[ia], verts[ib], verts[ic], color);
+            if (cam.perspective)
+                draw_perspective(view_verts[ia], view_verts[ib], view_verts[ic], color);
+            else
+                draw_triangle(verts[ia], verts[ib], verts[ic], color);
             if (raster.budget < 0)
                 throw ExportError(fmt::format(
                     "the PNG preview is given up: its triangles cover the image more than {} times over "
@@ -416,10 +585,10 @@ struct Renderer {
 
 } // namespace
 
-Image render_scene(const Scene& scene, int width, int height) {
+Image render_scene(const Scene& scene, int width, int height, const std::optional<PngView>& view) {
     // placed scenes are drawn flattened; an instance of a prototype the scene does not have is
     // skipped rather than failing, as befits a preview
-    if (scene.nested()) return render_scene(flatten(scene), width, height);
+    if (scene.nested()) return render_scene(flatten(scene), width, height, view);
     if (width <= 0 || height <= 0)
         throw ExportError("PNG size must be positive, got " + std::to_string(width) + "x" +
                           std::to_string(height));
@@ -443,12 +612,14 @@ Image render_scene(const Scene& scene, int width, int height) {
     for (int i = 0; i < kLutSize; ++i) r.encode[i] = linear_to_srgb8(double(i) / (kLutSize - 1));
     r.budget = kMaxOverdraw * std::int64_t(samples);
 
-    const Camera cam = make_camera(scene, r.width, r.height);
+    const Camera cam = view ? make_perspective_camera(scene, r.width, r.height, *view)
+                            : make_camera(scene, r.width, r.height);
     Renderer ren{scene,
                  r,
                  cam,
                  glm::dvec3(glm::dot(cam.light, cam.right), glm::dot(cam.light, cam.up),
                             glm::dot(cam.light, cam.toward)),
+                 {},
                  {}};
     ren.draw_part(scene.tubes, nullptr);
     for (const Instance& inst : scene.instances) {
@@ -508,8 +679,9 @@ void png_sink_write(void* context, void* data, int size) {
 
 } // namespace
 
-std::string png_bytes(const Scene& scene, int width, int height, const std::string& path) {
-    const Image img = render_scene(scene, width, height);
+std::string png_bytes(const Scene& scene, int width, int height, const std::string& path,
+                      const std::optional<PngView>& view) {
+    const Image img = render_scene(scene, width, height, view);
     PngSink sink;
     const int ok = stbi_write_png_to_func(png_sink_write, &sink, img.width, img.height, 3, img.rgb.data(),
                                           img.width * 3);
@@ -517,8 +689,9 @@ std::string png_bytes(const Scene& scene, int width, int height, const std::stri
     return std::move(sink.bytes);
 }
 
-void write_png(const Scene& scene, const std::string& path, int width, int height) {
-    write_file_atomically(path, png_bytes(scene, width, height, path));
+void write_png(const Scene& scene, const std::string& path, int width, int height,
+               const std::optional<PngView>& view) {
+    write_file_atomically(path, png_bytes(scene, width, height, path, view));
 }
 
 } // namespace plant

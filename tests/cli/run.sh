@@ -19,6 +19,18 @@ check() { # check NAME EXPECTED_EXIT COMMAND... ; output saved in $tmp/stdout an
     sed 's/^/  /' "$tmp/stderr" | head -5
   fi
 }
+lacks() { # lacks NAME FILE TEXT
+  if ! grep -qF -- "$3" "$2"; then pass=$((pass + 1)); else
+    fail=$((fail + 1))
+    echo "FAIL $1: '$3' in output"
+  fi
+}
+differ() { # differ NAME FILE1 FILE2
+  if ! cmp -s "$2" "$3"; then pass=$((pass + 1)); else
+    fail=$((fail + 1))
+    echo "FAIL $1: $2 and $3 are the same"
+  fi
+}
 contains() { # contains NAME FILE TEXT
   if grep -qF -- "$3" "$2"; then pass=$((pass + 1)); else
     fail=$((fail + 1))
@@ -110,6 +122,42 @@ done
 contains "PNG signature" "$tmp/a.png" "PNG"
 contains "string output" "$tmp/a.txt" "F[+F~leaf(1)]F"
 contains "mesh summary" "$tmp/a.mesh.txt" "instances 1"
+
+# glTF placements: GPU instancing by default, plain nodes, or everything baked
+printf 'surface leaf = polygon(vec3(0,0,0), vec3(1,1,0), vec3(0,2,0));\naxiom: F [ + F ~leaf(1) ] F [ - F ~leaf(1) ] F ~leaf(1);\n' >"$tmp/leaves.plant"
+check "run instanced" 0 "$plant" run "$tmp/leaves.plant" -o "$tmp/i.gltf"
+contains "instanced by default" "$tmp/i.gltf" '"EXT_mesh_gpu_instancing"'
+contains "one instanced node for the leaves" "$tmp/i.gltf" '"name": "leaf"'
+check "run --no-gpu-instancing" 0 "$plant" run "$tmp/leaves.plant" --no-gpu-instancing -o "$tmp/p.gltf"
+lacks "--no-gpu-instancing writes plain nodes" "$tmp/p.gltf" "EXT_mesh_gpu_instancing"
+contains "--no-gpu-instancing keeps matrices" "$tmp/p.gltf" '"matrix"'
+check "run --flatten" 0 "$plant" run "$tmp/leaves.plant" --flatten -o "$tmp/f.gltf"
+lacks "--flatten writes no instancing" "$tmp/f.gltf" "EXT_mesh_gpu_instancing"
+lacks "--flatten writes no matrices" "$tmp/f.gltf" '"matrix"'
+lacks "--flatten shares no leaf mesh" "$tmp/f.gltf" '"name": "leaf"'
+check "--flatten with --no-gpu-instancing" 64 "$plant" run "$tmp/leaves.plant" --flatten --no-gpu-instancing -o "$tmp/x.glb"
+check "run --help lists --flatten" 0 "$plant" run --help
+contains "--help explains --no-gpu-instancing" "$tmp/stdout" "--no-gpu-instancing"
+contains "--help explains --camera" "$tmp/stdout" "--camera"
+contains "--help explains --look-at" "$tmp/stdout" "--look-at"
+
+# the PNG preview from a camera
+check "run --camera" 0 "$plant" run "$tmp/leaves.plant" --camera 0,2,10 --size 64x64 -o "$tmp/cam.png"
+check "run default view" 0 "$plant" run "$tmp/leaves.plant" --size 64x64 -o "$tmp/default.png"
+differ "--camera changes the PNG" "$tmp/cam.png" "$tmp/default.png"
+check "run --camera --look-at" 0 "$plant" run "$tmp/leaves.plant" --camera=-4,1,-6 --look-at 0,3,0 --size 64x64 -o "$tmp/at.png"
+differ "--look-at changes the PNG" "$tmp/cam.png" "$tmp/at.png"
+check "--look-at alone" 64 "$plant" run "$tmp/leaves.plant" --look-at 0,1,0 -o "$tmp/x.png"
+contains "--look-at alone message" "$tmp/stderr" "--look-at needs --camera"
+for bad in "1,2" "1,2,3,4" "a,b,c" "1,2,nan" "1,2,inf" "" "1;2;3"; do
+  check "bad --camera '$bad'" 64 "$plant" run "$tmp/leaves.plant" --camera "$bad" -o "$tmp/x.png"
+done
+contains "bad --camera message" "$tmp/stderr" "--camera expects three finite numbers x,y,z"
+check "bad --look-at" 64 "$plant" run "$tmp/leaves.plant" --camera 1,2,3 --look-at 1,2 -o "$tmp/x.png"
+contains "bad --look-at message" "$tmp/stderr" "--look-at expects three finite numbers"
+check "--camera at --look-at" 64 "$plant" run "$tmp/leaves.plant" --camera 1,2,3 --look-at 1,2,3 -o "$tmp/x.png"
+contains "--camera at --look-at message" "$tmp/stderr" "are the same point"
+if [ -e "$tmp/x.png" ] || [ -e "$tmp/x.glb" ]; then fail=$((fail + 1)); echo "FAIL output after a usage error"; else pass=$((pass + 1)); fi
 
 # an environment's obstacles go into meshes and images as one more prototype, unless left out
 printf 'env wall = obstacles(box_min: vec3(-1, 0, -1), box_max: vec3(1, 1, -0.5));\naxiom: F;\n' >"$tmp/wall.plant"

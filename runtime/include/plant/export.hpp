@@ -4,6 +4,7 @@
 
 #include "plant/scene.hpp"
 
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -27,17 +28,36 @@ void write_file_atomically(const std::string& path, const std::string& bytes);
 
 // glTF's two containers: binary (.glb), or JSON with the buffer embedded as a data URI (.gltf).
 enum class GltfContainer : std::uint8_t { Binary, Json };
-// One buffer, the tubes as one mesh, each prototype as a mesh shared by all nodes that place it,
-// one material per color. The caller names the container; the path's extension is not read.
-void write_gltf(const Scene& scene, const std::string& path, GltfContainer container);
+// How placements are written (prototype scenes are always flattened first, plant/scene.hpp):
+//   GpuInstancing: one mesh per distinct prototype and one node per prototype carrying
+//     EXT_mesh_gpu_instancing (TRANSLATION, ROTATION, SCALE accessors); a placement whose matrix
+//     is not a rotation times a positive scale gets a plain node of its own instead.
+//   Nodes: one plain node per placement, referencing the shared meshes (--no-gpu-instancing).
+//   Baked: everything transformed into one world-space mesh, nothing shared (--flatten).
+enum class GltfLayout : std::uint8_t { GpuInstancing, Nodes, Baked };
+// One buffer, the tubes as one mesh and node, prototypes with the same triangles, attributes and
+// materials as one mesh, placements as `layout` says, one material per color. The caller names
+// the container; the path's extension is not read.
+void write_gltf(const Scene& scene, const std::string& path, GltfContainer container,
+                GltfLayout layout = GltfLayout::GpuInstancing);
 // The bytes write_gltf writes; `path` names the file in messages only.
-std::string gltf_bytes(const Scene& scene, GltfContainer container, const std::string& path);
+std::string gltf_bytes(const Scene& scene, GltfContainer container, const std::string& path,
+                       GltfLayout layout = GltfLayout::GpuInstancing);
 
-// A PNG preview: software rasterizer with a z-buffer and Lambert shading, a 3/4 view framed on
-// the scene's bounding box, white background.
-void write_png(const Scene& scene, const std::string& path, int width, int height);
+// Where a PNG preview is seen from (plant run --camera, --look-at): a perspective camera at `eye`
+// looking at `target` (default: the centre of the scene's bounds), y up.
+struct PngView {
+    glm::dvec3 eye{0.0};
+    std::optional<glm::dvec3> target;
+};
+
+// A PNG preview: software rasterizer with a z-buffer and Lambert shading, white background;
+// without a view, an orthographic 3/4 view framed on the scene's bounding box.
+void write_png(const Scene& scene, const std::string& path, int width, int height,
+               const std::optional<PngView>& view = std::nullopt);
 // The bytes write_png writes; `path` names the file in messages only.
-std::string png_bytes(const Scene& scene, int width, int height, const std::string& path);
+std::string png_bytes(const Scene& scene, int width, int height, const std::string& path,
+                      const std::optional<PngView>& view = std::nullopt);
 
 // The mesh files OpenMesh writes for us.
 enum class MeshFileFormat : std::uint8_t { Obj, Ply, Off };

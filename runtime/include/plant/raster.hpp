@@ -1,9 +1,12 @@
 // The software rasterizer behind write_png, exposed so tests can check pixels without decoding
 // a PNG. Orthographic 3/4 view (from the front-right, somewhat above; y is up) framed on the
-// scene's bounding box with a 5% margin, z-buffer, two-sided Lambert shading plus ambient,
+// scene's bounding box with a 5% margin, or a perspective view from a point (PngView: at the
+// camera, looking at the target, its view angle the narrowest from 10 to 100 degrees that frames
+// the bounding box's corners in front of it); z-buffer, two-sided Lambert shading plus ambient,
 // 2x2 supersampling, white background. Output is sRGB.
 #pragma once
 
+#include "plant/export.hpp"
 #include "plant/scene.hpp"
 
 #include <cstdint>
@@ -20,6 +23,7 @@ struct Image {
 // input (no geometry, zero-size bounds, invalid indices) gives a blank or sparse image, never
 // a crash. Throws ExportError (plant/export.hpp) if width or height is not positive or the
 // image is too large (more than 64 million pixels).
-Image render_scene(const Scene& scene, int width, int height);
+Image render_scene(const Scene& scene, int width, int height,
+                   const std::optional<PngView>& view = std::nullopt);
 
 } // namespace plant

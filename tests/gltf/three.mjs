@@ -1,0 +1,149 @@
+// Loads glTF files with three.js's GLTFLoader (npm `three`, pinned in package-lock.json) under
+// node, as a real consumer of EXT_mesh_gpu_instancing, and checks what it builds: each instanced
+// node becomes one InstancedMesh per primitive with the node's instance count, and instance i's
+// matrix is the matrix the same scene's --no-gpu-instancing file gives that placement.
+//   node tests/gltf/three.mjs [--expect NAME=COUNT]... INSTANCED NODES [INSTANCED NODES]...
+// INSTANCED is a file written with GPU instancing, NODES the same scene with plain nodes.
+// --expect: three.js built an InstancedMesh of COUNT instances for the node named NAME (in every
+// INSTANCED file). Exits 1 when a check fails, 2 on bad usage.
+import { readGltf, gpuInstancing } from './gltf.mjs';
+import { Matrix4 } from 'three';
+import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
+
+// The one browser global three.js needs under node: FileLoader reports progress while it reads
+// a .gltf file's data URI buffer.
+globalThis.ProgressEvent ??= class ProgressEvent extends Event {
+    constructor(type, init = {}) {
+        super(type);
+        Object.assign(this, init);
+    }
+};
+
+function usage() {
+    console.error('usage: node tests/gltf/three.mjs [--expect NAME=COUNT]... INSTANCED NODES [INSTANCED NODES]...');
+    process.exit(2);
+}
+const args = process.argv.slice(2);
+const expect = new Map(), files = [];
+for (let i = 0; i < args.length; ++i) {
+    if (args[i] === '--expect' && /^.+=\d+$/.test(args[i + 1] ?? '')) {
+        const [name, count] = args[++i].split(/=(?=\d+$)/);
+        expect.set(name, Number(count));
+    } else if (args[i].startsWith('-')) usage();
+    else files.push(args[i]);
+}
+if (files.length === 0 || files.length % 2 !== 0) usage();
+
+async function load(gltf) {
+    const bytes = gltf.bytes;
+    const data = bytes.buffer.slice(bytes.byteOffset, bytes.byteOffset + bytes.byteLength);
+    return new GLTFLoader().parseAsync(data, '');
+}
+
+// The glTF node an object was built for: the nearest one up its parents.
+function nodeOf(parser, object) {
+    for (let o = object; o; o = o.parent) {
+        const nodes = parser.associations.get(o)?.nodes;
+        if (nodes !== undefined) return nodes;
+    }
+    return undefined;
+}
+
+const identity = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
+// Matrices (column-major arrays) of the plain nodes of each mesh, in node order.
+function plainMatrices(json) {
+    const byMesh = new Map();
+    for (const node of json.nodes ?? []) {
+        if (node.mesh === undefined || node.extensions?.[gpuInstancing]) continue;
+        if (!byMesh.has(node.mesh)) byMesh.set(node.mesh, []);
+        byMesh.get(node.mesh).push(node.matrix ?? identity);
+    }
+    return byMesh;
+}
+
+function close(a, b) {
+    const size = Math.max(1, ...b.map(Math.abs));
+    return a.every((x, k) => Math.abs(x - b[k]) <= 1e-4 * size);
+}
+
+async function check(instancedFile, nodesFile) {
+    const problems = [];
+    const instanced = await readGltf(instancedFile), nodes = await readGltf(nodesFile);
+    const loaded = await load(instanced);
+    loaded.scene.updateMatrixWorld(true);
+    const parser = loaded.parser, json = instanced.json;
+
+    // what three.js built, by node
+    const built = new Map();
+    loaded.scene.traverse((o) => {
+        if (!o.isInstancedMesh) return;
+        const n = nodeOf(parser, o);
+        if (!built.has(n)) built.set(n, []);
+        built.get(n).push(o);
+    });
+
+    // the placements of each mesh: every plain node of the nodes file, less the plain nodes the
+    // instanced file kept (placements that are not a rotation times a scale)
+    const expected = plainMatrices(nodes.json);
+    for (const [mesh, kept] of plainMatrices(json))
+        for (const m of kept) {
+            const list = expected.get(mesh) ?? [];
+            const at = list.findIndex((e) => close(m, e));
+            if (at < 0) problems.push(`a plain node of mesh ${mesh} is not in ${nodesFile}`);
+            else list.splice(at, 1);
+        }
+
+    let instancedNodes = 0;
+    const counts = new Map();
+    for (const [n, node] of (json.nodes ?? []).entries()) {
+        const ext = node.extensions?.[gpuInstancing];
+        if (!ext) continue;
+        ++instancedNodes;
+        const where = `node ${n} (${node.name})`;
+        const count = json.accessors[ext.attributes.TRANSLATION].count;
+        const meshes = built.get(n) ?? [];
+        const primitives = json.meshes[node.mesh].primitives.length;
+        if (meshes.length !== primitives)
+            problems.push(`${where}: three.js built ${meshes.length} InstancedMeshes for ${primitives} primitives`);
+        const want = expected.get(node.mesh) ?? [];
+        if (want.length !== count)
+            problems.push(`${where}: ${count} instances but ${want.length} placements in ${nodesFile}`);
+        counts.set(node.name, meshes[0]?.count);
+        for (const mesh of meshes) {
+            if (mesh.count !== count) problems.push(`${where}: InstancedMesh of ${mesh.count}, not ${count}`);
+            const m = new Matrix4();
+            for (let i = 0; i < Math.min(mesh.count, want.length); ++i) {
+                mesh.getMatrixAt(i, m);
+                m.premultiply(mesh.matrixWorld);
+                if (!close(m.elements, want[i])) {
+                    problems.push(`${where}: instance ${i} has matrix ${m.elements.map((x) => x.toFixed(4))}, ` +
+                                  `expected ${want[i].map((x) => x.toFixed(4))}`);
+                    break;
+                }
+            }
+        }
+    }
+    for (const n of built.keys())
+        if (!json.nodes?.[n]?.extensions?.[gpuInstancing]) problems.push(`an InstancedMesh for node ${n}, which is not instanced`);
+    for (const [name, count] of expect)
+        if (counts.get(name) !== count)
+            problems.push(`node '${name}': three.js built ${counts.get(name) ?? 'no'} instances, expected ${count}`);
+    const total = [...built.values()].reduce((a, list) => a + list.length, 0);
+    console.log(`${instancedFile}: three.js built ${total} InstancedMeshes for ${instancedNodes} instanced nodes, ` +
+                `${problems.length} problems`);
+    return problems;
+}
+
+let failed = false;
+for (let k = 0; k < files.length; k += 2) {
+    let problems;
+    try {
+        problems = await check(files[k], files[k + 1]);
+    } catch (e) {
+        problems = [`cannot load: ${e?.stack ?? e}`];
+        console.log(`${files[k]}: failed`);
+    }
+    for (const p of problems.slice(0, 20)) console.log(`  ${p}`);
+    if (problems.length > 0) failed = true;
+}
+process.exit(failed ? 1 : 0);
