@@ -18,6 +18,8 @@
 #include <charconv>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <optional>
 #include <sstream>
 
 namespace plant {
@@ -47,10 +49,14 @@ double tidy(float f) {
 
 struct GltfBuilder {
     const Scene& scene;
+    const std::vector<detail::NestedGroup>& groups; // scene prototypes kept as nodes
     tinygltf::Model model;
-    std::vector<int> material_index; // scene material -> glTF material, -1 while unused
+    std::vector<int> material_index;   // scene material -> glTF material, -1 while unused
+    std::vector<std::uint32_t> shared; // prototype -> the first prototype with the same mesh
+    std::vector<int> proto_mesh;       // prototype -> its mesh, -1 while none (or empty)
+    std::vector<bool> meshed;          // prototype -> add_mesh was called for it
 
-    explicit GltfBuilder(const Scene& s) : scene(s) {
+    GltfBuilder(const Scene& s, const std::vector<detail::NestedGroup>& g) : scene(s), groups(g) {
         model.asset.version = "2.0";
         model.asset.generator = "plant";
         material_index.assign(std::max<std::size_t>(scene.materials.size(), 1), -1);
@@ -171,15 +177,38 @@ struct GltfBuilder {
         return static_cast<int>(model.meshes.size() - 1);
     }
 
-    int add_node(tinygltf::Node node) {
+    // Adds `node` at the scene's top level, or as a child of node `parent`.
+    int add_node(tinygltf::Node node, int parent = -1) {
         model.nodes.push_back(std::move(node));
         const int index = static_cast<int>(model.nodes.size() - 1);
-        model.scenes[0].nodes.push_back(index);
+        if (parent < 0)
+            model.scenes[0].nodes.push_back(index);
+        else
+            model.nodes[std::size_t(parent)].children.push_back(index);
         return index;
     }
 
+    // Sets the node's transform: translation, rotation and scale when it is one, else the matrix.
+    void place(tinygltf::Node& node, const glm::mat4& transform, const std::string& what) {
+        if (const auto trs = detail::decompose(transform)) {
+            node.translation = {tidy(trs->translation.x), tidy(trs->translation.y), tidy(trs->translation.z)};
+            node.rotation = {trs->rotation.x, trs->rotation.y, trs->rotation.z, trs->rotation.w};
+            node.scale = {tidy(trs->scale.x), tidy(trs->scale.y), tidy(trs->scale.z)};
+            return;
+        }
+        node.matrix.resize(16);
+        for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 4; ++r) {
+                const float x = transform[c][r];
+                if (!std::isfinite(x))
+                    throw ExportError("glTF export: a placement of " + what +
+                                      " has a transform that is not finite");
+                node.matrix[std::size_t(c * 4 + r)] = tidy(x);
+            }
+    }
+
     // A plain node placing `mesh` by the instance's matrix.
-    void add_matrix_node(int mesh, const glm::mat4& transform) {
+    void add_matrix_node(int mesh, const glm::mat4& transform, int parent = -1) {
         tinygltf::Node node;
         node.mesh = mesh;
         node.matrix.resize(16);
@@ -191,7 +220,7 @@ struct GltfBuilder {
                                       " has a transform that is not finite");
                 node.matrix[std::size_t(c * 4 + r)] = tidy(x);
             }
-        add_node(std::move(node));
+        add_node(std::move(node), parent);
     }
 
     template <class T> int add_instance_accessor(const std::vector<T>& values, int type) {
@@ -199,37 +228,97 @@ struct GltfBuilder {
         return add_accessor(view, 0, values.size(), type, TINYGLTF_COMPONENT_TYPE_FLOAT);
     }
 
-    // One node drawing `mesh` at every placement (EXT_mesh_gpu_instancing); a placement that is not
-    // a rotation times a positive scale gets a plain node instead.
-    void add_instanced(int mesh, const std::vector<const Instance*>& placements) {
+    // Instance accessors for `placements` (EXT_mesh_gpu_instancing's attributes), or none when
+    // no placement is a rotation times a positive scale; those that are not go to `plain`.
+    std::optional<tinygltf::Value> instance_attributes(const std::vector<const glm::mat4*>& placements,
+                                                       std::vector<const glm::mat4*>& plain) {
         std::vector<glm::vec3> translation, scale;
         std::vector<glm::vec4> rotation;
-        std::vector<const Instance*> plain;
-        for (const Instance* inst : placements) {
-            if (const auto trs = detail::decompose(inst->transform)) {
+        for (const glm::mat4* m : placements) {
+            if (const auto trs = detail::decompose(*m)) {
                 translation.push_back(trs->translation);
                 rotation.push_back(trs->rotation);
                 scale.push_back(trs->scale);
             } else {
-                plain.push_back(inst);
+                plain.push_back(m);
             }
         }
-        if (!translation.empty()) {
-            tinygltf::Value::Object attributes;
-            attributes["TRANSLATION"] =
-                tinygltf::Value(add_instance_accessor(translation, TINYGLTF_TYPE_VEC3));
-            attributes["ROTATION"] = tinygltf::Value(add_instance_accessor(rotation, TINYGLTF_TYPE_VEC4));
-            attributes["SCALE"] = tinygltf::Value(add_instance_accessor(scale, TINYGLTF_TYPE_VEC3));
-            tinygltf::Value::Object extension;
-            extension["attributes"] = tinygltf::Value(std::move(attributes));
-            tinygltf::Node node;
-            node.name = model.meshes[std::size_t(mesh)].name;
-            node.mesh = mesh;
-            node.extensions[kGpuInstancing] = tinygltf::Value(std::move(extension));
-            add_node(std::move(node));
-            if (model.extensionsUsed.empty()) model.extensionsUsed.push_back(kGpuInstancing);
+        if (translation.empty()) return std::nullopt;
+        tinygltf::Value::Object attributes;
+        attributes["TRANSLATION"] = tinygltf::Value(add_instance_accessor(translation, TINYGLTF_TYPE_VEC3));
+        attributes["ROTATION"] = tinygltf::Value(add_instance_accessor(rotation, TINYGLTF_TYPE_VEC4));
+        attributes["SCALE"] = tinygltf::Value(add_instance_accessor(scale, TINYGLTF_TYPE_VEC3));
+        tinygltf::Value::Object extension;
+        extension["attributes"] = tinygltf::Value(std::move(attributes));
+        if (model.extensionsUsed.empty()) model.extensionsUsed.push_back(kGpuInstancing);
+        return tinygltf::Value(std::move(extension));
+    }
+
+    void add_instanced_node(int mesh, const tinygltf::Value& extension, int parent = -1) {
+        tinygltf::Node node;
+        node.name = model.meshes[std::size_t(mesh)].name;
+        node.mesh = mesh;
+        node.extensions[kGpuInstancing] = extension;
+        add_node(std::move(node), parent);
+    }
+
+    // One node drawing `mesh` at every placement (EXT_mesh_gpu_instancing); a placement that is not
+    // a rotation times a positive scale gets a plain node instead.
+    void add_instanced(int mesh, const std::vector<const glm::mat4*>& placements) {
+        std::vector<const glm::mat4*> plain;
+        if (const auto extension = instance_attributes(placements, plain))
+            add_instanced_node(mesh, *extension);
+        for (const glm::mat4* m : plain) add_matrix_node(mesh, *m);
+    }
+
+    // The mesh of prototype k (the first prototype with the same mesh, meshed once), or -1.
+    int mesh_of(std::uint32_t k) {
+        k = shared[k];
+        if (!meshed[k]) {
+            meshed[k] = true;
+            proto_mesh[k] = add_mesh(scene.prototypes[k], prototype_name(k));
         }
-        for (const Instance* inst : plain) add_matrix_node(mesh, inst->transform);
+        return proto_mesh[k];
+    }
+
+    // A nested scene prototype: its parts' meshes and instance accessors written once, then a
+    // node per placement whose children draw them.
+    void add_group(const detail::NestedGroup& group) {
+        std::vector<int> meshes;                              // in the order first drawn
+        std::map<int, std::vector<const glm::mat4*>> by_mesh; // mesh -> its transforms in the group
+        for (const auto& [proto, transform] : group.parts) {
+            const int mesh = mesh_of(proto);
+            if (mesh < 0) continue;
+            auto [it, added] = by_mesh.try_emplace(mesh);
+            if (added) meshes.push_back(mesh);
+            it->second.push_back(&transform);
+        }
+        std::vector<std::pair<int, tinygltf::Value>> instanced;
+        std::vector<std::pair<int, const glm::mat4*>> plain;
+        for (int mesh : meshes) {
+            std::vector<const glm::mat4*> rest;
+            if (by_mesh[mesh].size() == 1) { // drawn once (the tubes): a plain child node
+                plain.emplace_back(mesh, by_mesh[mesh][0]);
+                continue;
+            }
+            if (auto extension = instance_attributes(by_mesh[mesh], rest))
+                instanced.emplace_back(mesh, std::move(*extension));
+            for (const glm::mat4* m : rest) plain.emplace_back(mesh, m);
+        }
+        for (const glm::mat4& placement : group.placements) {
+            tinygltf::Node node;
+            node.name = group.name;
+            place(node, placement, group.name);
+            const int parent = add_node(std::move(node));
+            for (const auto& [mesh, extension] : instanced) add_instanced_node(mesh, extension, parent);
+            for (const auto& [mesh, m] : plain) {
+                tinygltf::Node child;
+                child.name = model.meshes[std::size_t(mesh)].name;
+                child.mesh = mesh;
+                if (*m != glm::mat4(1.0f)) place(child, *m, child.name);
+                add_node(std::move(child), parent);
+            }
+        }
     }
 
     std::string prototype_name(std::size_t i) const {
@@ -270,27 +359,24 @@ struct GltfBuilder {
 
     // The placed prototypes, each distinct one meshed once, and their placements.
     void add_placements(GltfLayout layout) {
-        const std::vector<std::uint32_t> shared = detail::shared_prototypes(scene);
-        std::vector<int> proto_mesh(scene.prototypes.size(), -1);
-        std::vector<bool> meshed(scene.prototypes.size(), false);
+        shared = detail::shared_prototypes(scene);
+        proto_mesh.assign(scene.prototypes.size(), -1);
+        meshed.assign(scene.prototypes.size(), false);
         // placements by mesh, in the order meshes are first placed
-        std::vector<std::vector<const Instance*>> placements;
+        std::vector<std::vector<const glm::mat4*>> placements;
         for (const Instance& inst : scene.instances) {
-            const std::uint32_t k = shared[inst.prototype];
-            if (!meshed[k]) {
-                meshed[k] = true;
-                proto_mesh[k] = add_mesh(scene.prototypes[k], prototype_name(k));
-                if (proto_mesh[k] >= 0) placements.resize(std::size_t(proto_mesh[k]) + 1);
-            }
-            const int mesh = proto_mesh[k];
+            const int mesh = mesh_of(inst.prototype);
             if (mesh < 0) continue;
-            if (layout == GltfLayout::Nodes)
+            if (layout == GltfLayout::Nodes) {
                 add_matrix_node(mesh, inst.transform);
-            else
-                placements[std::size_t(mesh)].push_back(&inst);
+                continue;
+            }
+            if (placements.size() <= std::size_t(mesh)) placements.resize(std::size_t(mesh) + 1);
+            placements[std::size_t(mesh)].push_back(&inst.transform);
         }
         for (std::size_t mesh = 0; mesh < placements.size(); ++mesh)
             if (!placements[mesh].empty()) add_instanced(static_cast<int>(mesh), placements[mesh]);
+        for (const detail::NestedGroup& group : groups) add_group(group);
     }
 };
 
@@ -300,8 +386,16 @@ std::string gltf_bytes(const Scene& scene, GltfContainer container, const std::s
                        GltfLayout layout) {
     const bool binary = container == GltfContainer::Binary;
 
-    Scene flat;
-    GltfBuilder builder(exported_scene(scene, flat, "glTF export"));
+    // With GPU instancing, scene prototypes holding many parts stay nodes (export_placement.hpp);
+    // the other layouts draw everything into one level.
+    Scene flat, storage;
+    std::vector<detail::NestedGroup> groups;
+    const Scene* drawn = &scene;
+    if (layout == GltfLayout::GpuInstancing && scene.nested()) {
+        flat = detail::split_nested(scene, groups, "glTF export");
+        drawn = &flat;
+    }
+    GltfBuilder builder(exported_scene(*drawn, storage, "glTF export"), groups);
     builder.build(layout);
     if (binary && !builder.model.buffers.empty() &&
         builder.model.buffers[0].data.size() > std::numeric_limits<std::uint32_t>::max() - 1024)

@@ -7,6 +7,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -123,6 +124,124 @@ std::vector<std::uint32_t> shared_prototypes(const Scene& scene) {
         if (first[i] == i) candidates.push_back(i);
     }
     return first;
+}
+
+namespace {
+
+std::uint64_t saturating_add(std::uint64_t a, std::uint64_t b) {
+    return a > std::numeric_limits<std::uint64_t>::max() - b ? std::numeric_limits<std::uint64_t>::max()
+                                                             : a + b;
+}
+
+// How many parts the scene draws: its tubes, its organ placements and, through every scene
+// prototype it places, theirs (saturating; once per scene prototype however often it is placed).
+std::uint64_t part_count(const Scene& s, std::map<const Scene*, std::uint64_t>& memo) {
+    if (auto it = memo.find(&s); it != memo.end()) return it->second;
+    memo[&s] = 0; // a scene that places itself (never built by plant) counts nothing more
+    std::uint64_t n = (s.tubes.empty() ? 0 : 1) + s.instances.size();
+    for (const Instance& i : s.scene_instances)
+        if (i.prototype < s.scene_prototypes.size() && s.scene_prototypes[i.prototype])
+            n = saturating_add(n, part_count(*s.scene_prototypes[i.prototype], memo));
+    memo[&s] = n;
+    return n;
+}
+
+} // namespace
+
+Scene split_nested(const Scene& scene, std::vector<NestedGroup>& groups, const std::string& what) {
+    groups.clear();
+    const std::size_t n = scene.scene_prototypes.size();
+    std::vector<std::uint64_t> placed(n, 0);
+    for (const Instance& i : scene.scene_instances) {
+        if (i.prototype >= n || !scene.scene_prototypes[i.prototype])
+            throw ExportError(what + ": a placement of scene prototype " + std::to_string(i.prototype) +
+                              " but the scene has " + std::to_string(n));
+        ++placed[i.prototype];
+    }
+    std::map<const Scene*, std::uint64_t> memo;
+    std::vector<int> group_of(n, -1);
+    Scene rest;
+    rest.tubes = scene.tubes;
+    rest.prototypes = scene.prototypes;
+    rest.prototype_names = scene.prototype_names;
+    rest.instances = scene.instances;
+    rest.materials = scene.materials;
+    rest.scene_prototypes = scene.scene_prototypes;
+    rest.scene_prototype_names = scene.scene_prototype_names;
+    for (const Instance& i : scene.scene_instances) {
+        const std::uint32_t k = i.prototype;
+        const std::uint64_t parts = part_count(*scene.scene_prototypes[k], memo);
+        const bool nested =
+            parts > placed[k] && (parts > kNestedFrom / placed[k] || parts * placed[k] > kNestedFrom);
+        if (!nested) {
+            rest.scene_instances.push_back(i);
+            continue;
+        }
+        if (group_of[k] < 0) {
+            group_of[k] = static_cast<int>(groups.size());
+            NestedGroup g;
+            g.name = k < scene.scene_prototype_names.size() && !scene.scene_prototype_names[k].empty()
+                         ? scene.scene_prototype_names[k]
+                         : "scene" + std::to_string(k);
+            groups.push_back(std::move(g));
+        }
+        groups[std::size_t(group_of[k])].placements.push_back(i.transform);
+    }
+    Scene out;
+    try {
+        out = flatten(rest);
+    } catch (const std::out_of_range& e) {
+        throw ExportError(what + ": " + e.what());
+    }
+    // each nested prototype's parts join the result's prototypes, their materials by colour
+    std::map<std::array<float, 3>, std::uint32_t> material_index;
+    for (std::uint32_t m = static_cast<std::uint32_t>(out.materials.size()); m-- > 0;) {
+        const glm::vec3& c = out.materials[m].color;
+        material_index[{c.x, c.y, c.z}] = m;
+    }
+    for (std::size_t k = 0; k < n; ++k) {
+        if (group_of[k] < 0) continue;
+        NestedGroup& g = groups[std::size_t(group_of[k])];
+        Scene inner;
+        try {
+            inner = flatten(*scene.scene_prototypes[k]);
+        } catch (const std::out_of_range& e) {
+            throw ExportError(what + ": " + e.what());
+        }
+        std::vector<std::uint32_t> material(inner.materials.size());
+        for (std::size_t m = 0; m < inner.materials.size(); ++m) {
+            const glm::vec3& c = inner.materials[m].color;
+            auto [it, added] = material_index.emplace(std::array<float, 3>{c.x, c.y, c.z},
+                                                      static_cast<std::uint32_t>(out.materials.size()));
+            if (added) out.materials.push_back(inner.materials[m]);
+            material[m] = it->second;
+        }
+        auto add = [&](MeshPart part, const std::string& name) {
+            for (auto& p : part.primitives) {
+                if (p.material >= material.size())
+                    throw ExportError(what + ": " + g.name + " uses material " + std::to_string(p.material) +
+                                      " but has " + std::to_string(material.size()));
+                p.material = material[p.material];
+            }
+            out.prototypes.push_back(std::move(part));
+            out.prototype_names.push_back(g.name + "/" + name);
+            return static_cast<std::uint32_t>(out.prototypes.size() - 1);
+        };
+        if (!inner.tubes.empty()) g.parts.emplace_back(add(inner.tubes, "tubes"), glm::mat4(1.0f));
+        std::vector<std::uint32_t> proto(inner.prototypes.size());
+        for (std::size_t p = 0; p < inner.prototypes.size(); ++p)
+            proto[p] =
+                add(inner.prototypes[p], p < inner.prototype_names.size() ? inner.prototype_names[p]
+                                                                          : "prototype" + std::to_string(p));
+        for (const Instance& i : inner.instances) {
+            if (i.prototype >= proto.size())
+                throw ExportError(what + ": " + g.name + " places prototype " + std::to_string(i.prototype) +
+                                  " but has " + std::to_string(proto.size()));
+            g.parts.emplace_back(proto[i.prototype], i.transform);
+        }
+    }
+    if (out.materials.empty()) out.materials.push_back(Material{});
+    return out;
 }
 
 std::vector<Primitive> drawn_primitives(const MeshPart& part, const std::string& name) {

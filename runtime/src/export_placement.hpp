@@ -33,6 +33,29 @@ std::optional<Trs> decompose(const glm::mat4& m);
 // branches of several levels of detail); this brings them back to one.
 std::vector<std::uint32_t> shared_prototypes(const Scene& scene);
 
+// A scene prototype whose placements stay nodes in the glTF file: one parent node per placement,
+// whose children draw the prototype's parts with instance accessors shared by every placement
+// (a forest of 100 willows writes one willow's leaf placements, not 100).
+struct NestedGroup {
+    std::string name;
+    std::vector<glm::mat4> placements; // of the scene prototype, in the scene's frame
+    // the prototype's parts: an index in the split scene's prototypes (which places none of
+    // them itself) and the part's transform in the prototype's frame
+    std::vector<std::pair<std::uint32_t, glm::mat4>> parts;
+};
+
+// A scene prototype stays nested when it places more parts (its tubes and organs, and theirs
+// through the scene prototypes it places) than it is placed itself, and drawing every part at
+// every placement would take more than kNestedFrom placements. Any other is drawn into its
+// parent's placements, as flatten() does: a weeping branch placed 960 times with its 12 leaves
+// becomes one instanced node of 11,520 leaves.
+constexpr std::uint64_t kNestedFrom = 65536;
+
+// The scene flattened except for the scene prototypes placed at its top level that stay nested
+// (above): their parts become prototypes of the result, placed by `groups`. Throws ExportError
+// (naming `what`) for a placement of a scene prototype that does not exist.
+Scene split_nested(const Scene& scene, std::vector<NestedGroup>& groups, const std::string& what);
+
 // The part's primitives as they are drawn: the whole part in material 0 when it has none, empty
 // ones left out. Throws ExportError (naming `name`) for a primitive that does not fit the indices
 // in whole triangles.

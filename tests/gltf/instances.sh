@@ -37,4 +37,8 @@ node "$here/instances.mjs" --require "${expect[@]}" "$tmp/nested.glb" "$tmp/nest
 node "$here/validate.mjs" "$tmp/nested.glb" "$tmp/nested.nodes.glb" "$tmp/nested.flat.glb" "$tmp/nested.gltf"
 node "$here/three.mjs" "${pairs[@]}"
 node "$here/three.mjs" "${expect[@]}" "$tmp/nested.glb" "$tmp/nested.nodes.glb" "$tmp/nested.gltf" "$tmp/nested.nodes.glb"
+# the forest: a node per tree, each with the one leaf accessor set of 1,000 placements
+node "$here/instances.mjs" --require --expect tree/leaf=1000 "$tmp/forest.glb"
+node "$here/validate.mjs" "$tmp/forest.glb"
+node "$here/three.mjs" --expect tree/leaf=1000 "$tmp/forest.glb" "$tmp/forest.nodes.glb"
 echo "instances: ${#instanced[@]} grammars and the nested scene passed"

@@ -1,13 +1,14 @@
 // Loads glTF files with three.js's GLTFLoader (npm `three`, pinned in package-lock.json) under
 // node, as a real consumer of EXT_mesh_gpu_instancing, and checks what it builds: each instanced
 // node becomes one InstancedMesh per primitive with the node's instance count, and instance i's
-// matrix is the matrix the same scene's --no-gpu-instancing file gives that placement.
+// world matrix is the matrix the same scene's --no-gpu-instancing file gives that placement (each
+// mesh's placements in node order, instanced or plain, children placed by their parents).
 //   node tests/gltf/three.mjs [--expect NAME=COUNT]... INSTANCED NODES [INSTANCED NODES]...
 // INSTANCED is a file written with GPU instancing, NODES the same scene with plain nodes.
 // --expect: three.js built an InstancedMesh of COUNT instances for the node named NAME (in every
 // INSTANCED file). Exits 1 when a check fails, 2 on bad usage.
 import { readGltf, gpuInstancing } from './gltf.mjs';
-import { Matrix4 } from 'three';
+import { Matrix4, Quaternion, Vector3 } from 'three';
 import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
 
 // The one browser global three.js needs under node: FileLoader reports progress while it reads
@@ -49,14 +50,33 @@ function nodeOf(parser, object) {
     return undefined;
 }
 
-const identity = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
-// Matrices (column-major arrays) of the plain nodes of each mesh, in node order.
+// Each node's world matrix (column-major array), composed from the scene's roots down.
+function worldMatrices(json) {
+    const world = new Map();
+    const local = (node) => {
+        if (node.matrix) return new Matrix4().fromArray(node.matrix);
+        const [tx, ty, tz] = node.translation ?? [0, 0, 0];
+        const [qx, qy, qz, qw] = node.rotation ?? [0, 0, 0, 1];
+        const [sx, sy, sz] = node.scale ?? [1, 1, 1];
+        return new Matrix4().compose(new Vector3(tx, ty, tz), new Quaternion(qx, qy, qz, qw), new Vector3(sx, sy, sz));
+    };
+    const visit = (n, parent) => {
+        const m = local(json.nodes[n]).premultiply(parent);
+        world.set(n, m);
+        for (const c of json.nodes[n].children ?? []) visit(c, m);
+    };
+    for (const scene of json.scenes ?? []) for (const n of scene.nodes ?? []) visit(n, new Matrix4());
+    return world;
+}
+
+// The world matrices of the plain nodes of each mesh, in node order.
 function plainMatrices(json) {
+    const world = worldMatrices(json);
     const byMesh = new Map();
-    for (const node of json.nodes ?? []) {
+    for (const [n, node] of (json.nodes ?? []).entries()) {
         if (node.mesh === undefined || node.extensions?.[gpuInstancing]) continue;
         if (!byMesh.has(node.mesh)) byMesh.set(node.mesh, []);
-        byMesh.get(node.mesh).push(node.matrix ?? identity);
+        byMesh.get(node.mesh).push(world.get(n)?.elements ?? new Matrix4().elements);
     }
     return byMesh;
 }
@@ -82,22 +102,27 @@ async function check(instancedFile, nodesFile) {
         built.get(n).push(o);
     });
 
-    // the placements of each mesh: every plain node of the nodes file, less the plain nodes the
-    // instanced file kept (placements that are not a rotation times a scale)
+    // Every placement of each mesh in the instanced file, in node order: an instanced node's
+    // instances as three.js places them, a plain node where its parents put it. They must be the
+    // plain nodes of the nodes file, in the same order.
     const expected = plainMatrices(nodes.json);
-    for (const [mesh, kept] of plainMatrices(json))
-        for (const m of kept) {
-            const list = expected.get(mesh) ?? [];
-            const at = list.findIndex((e) => close(m, e));
-            if (at < 0) problems.push(`a plain node of mesh ${mesh} is not in ${nodesFile}`);
-            else list.splice(at, 1);
-        }
-
+    const plain = plainMatrices(json);
+    const placed = new Map(), plainSeen = new Map();
+    const place = (mesh, m) => {
+        if (!placed.has(mesh)) placed.set(mesh, []);
+        placed.get(mesh).push(m);
+    };
     let instancedNodes = 0;
     const counts = new Map();
     for (const [n, node] of (json.nodes ?? []).entries()) {
+        if (node.mesh === undefined) continue;
         const ext = node.extensions?.[gpuInstancing];
-        if (!ext) continue;
+        if (!ext) {
+            const k = plainSeen.get(node.mesh) ?? 0;
+            plainSeen.set(node.mesh, k + 1);
+            place(node.mesh, plain.get(node.mesh)[k]);
+            continue;
+        }
         ++instancedNodes;
         const where = `node ${n} (${node.name})`;
         const count = json.accessors[ext.attributes.TRANSLATION].count;
@@ -105,23 +130,27 @@ async function check(instancedFile, nodesFile) {
         const primitives = json.meshes[node.mesh].primitives.length;
         if (meshes.length !== primitives)
             problems.push(`${where}: three.js built ${meshes.length} InstancedMeshes for ${primitives} primitives`);
-        const want = expected.get(node.mesh) ?? [];
-        if (want.length !== count)
-            problems.push(`${where}: ${count} instances but ${want.length} placements in ${nodesFile}`);
         counts.set(node.name, meshes[0]?.count);
-        for (const mesh of meshes) {
+        for (const mesh of meshes)
             if (mesh.count !== count) problems.push(`${where}: InstancedMesh of ${mesh.count}, not ${count}`);
-            const m = new Matrix4();
-            for (let i = 0; i < Math.min(mesh.count, want.length); ++i) {
-                mesh.getMatrixAt(i, m);
-                m.premultiply(mesh.matrixWorld);
-                if (!close(m.elements, want[i])) {
-                    problems.push(`${where}: instance ${i} has matrix ${m.elements.map((x) => x.toFixed(4))}, ` +
-                                  `expected ${want[i].map((x) => x.toFixed(4))}`);
-                    break;
-                }
-            }
+        const m = new Matrix4();
+        for (let i = 0; meshes.length > 0 && i < meshes[0].count; ++i) {
+            meshes[0].getMatrixAt(i, m);
+            place(node.mesh, m.clone().premultiply(meshes[0].matrixWorld).elements);
         }
+    }
+    for (const [mesh, want] of expected) {
+        const got = placed.get(mesh) ?? [];
+        if (got.length !== want.length) {
+            problems.push(`mesh ${mesh}: ${got.length} placements but ${want.length} plain nodes in ${nodesFile}`);
+            continue;
+        }
+        for (let i = 0; i < want.length; ++i)
+            if (!close(got[i], want[i])) {
+                problems.push(`mesh ${mesh}: placement ${i} has matrix ${got[i].map((x) => x.toFixed(4))}, ` +
+                              `expected ${want[i].map((x) => x.toFixed(4))}`);
+                break;
+            }
     }
     for (const n of built.keys())
         if (!json.nodes?.[n]?.extensions?.[gpuInstancing]) problems.push(`an InstancedMesh for node ${n}, which is not instanced`);

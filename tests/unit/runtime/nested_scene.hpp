@@ -125,4 +125,33 @@ inline Scene nested_scene() {
     return s;
 }
 
+// A forest: `trees` placements of one tree that places `leaves` leaves (a trunk box and leaves
+// placed around it).
+inline Scene forest_scene(int trees, int leaves) {
+    auto tree = std::make_shared<Scene>();
+    tree->materials = {Material{glm::vec3(0.4f, 0.3f, 0.2f)}, Material{glm::vec3(0.2f, 0.6f, 0.2f)}};
+    tree->tubes = box_part(glm::vec3(0.1f, 2.0f, 0.1f), 0);
+    tree->prototypes = {leaf_part(1)};
+    tree->prototype_names = {"leaf"};
+    for (int k = 0; k < leaves; ++k) {
+        glm::mat4 m = glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, 1.0f + 0.001f * float(k), 0.0f));
+        m = glm::rotate(m, 0.37f * float(k), glm::vec3(0, 1, 0));
+        tree->instances.push_back(Instance{0, m});
+    }
+    tree->update_bounds();
+    Scene s;
+    s.materials = {Material{}};
+    s.scene_prototypes = {tree};
+    s.scene_prototype_names = {"tree"};
+    for (int t = 0; t < trees; ++t) {
+        glm::mat4 m =
+            glm::translate(glm::mat4(1.0f), glm::vec3(3.0f * float(t % 10), 0.0f, 3.0f * float(t / 10)));
+        m = glm::scale(glm::rotate(m, 0.5f * float(t), glm::vec3(0, 1, 0)),
+                       glm::vec3(1.0f + 0.01f * float(t)));
+        s.scene_instances.push_back(Instance{0, m});
+    }
+    s.update_bounds();
+    return s;
+}
+
 } // namespace plant::test

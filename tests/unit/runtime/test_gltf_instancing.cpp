@@ -12,6 +12,7 @@
 
 #include <cstring>
 #include <limits>
+#include <set>
 #include <string>
 
 using namespace plant;
@@ -191,4 +192,71 @@ TEST_CASE("prototypes with the same content are one mesh", "[export][gltf]") {
     CHECK(gpu.accessors[std::size_t(attribute(*node_named(gpu, "a"), "TRANSLATION"))].count == 2);
     scene.prototypes[2].positions[1].x += 0.5f; // no longer the same
     CHECK(detail::shared_prototypes(scene) == std::vector<std::uint32_t>{0, 1, 2});
+}
+
+namespace {
+
+glm::mat4 node_matrix(const tinygltf::Node& node) {
+    if (!node.matrix.empty()) {
+        glm::mat4 m;
+        for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 4; ++r) m[c][r] = float(node.matrix[std::size_t(c * 4 + r)]);
+        return m;
+    }
+    glm::mat4 m(1.0f);
+    if (!node.translation.empty())
+        m = glm::translate(m, glm::vec3(node.translation[0], node.translation[1], node.translation[2]));
+    if (!node.rotation.empty())
+        m *= glm::mat4_cast(glm::quat(float(node.rotation[3]), float(node.rotation[0]),
+                                      float(node.rotation[1]), float(node.rotation[2])));
+    if (!node.scale.empty()) m = glm::scale(m, glm::vec3(node.scale[0], node.scale[1], node.scale[2]));
+    return m;
+}
+
+} // namespace
+
+TEST_CASE("a scene prototype with many parts placed a few times stays one node per placement, its "
+          "instance accessors shared",
+          "[export][gltf]") {
+    const Scene scene = test::forest_scene(100, 1000); // 100 x 1,001 parts: past kNestedFrom
+    const tinygltf::Model gpu = parse_glb(scene, GltfLayout::GpuInstancing);
+    CHECK(gpu.meshes.size() == 2); // trunk and leaf
+    CHECK(gpu.scenes[0].nodes.size() == 100);
+    int leaf_nodes = 0;
+    std::set<int> translations;
+    const Scene flat = flatten(scene);
+    for (std::size_t t = 0; t < gpu.scenes[0].nodes.size(); ++t) {
+        const tinygltf::Node& tree = gpu.nodes[std::size_t(gpu.scenes[0].nodes[t])];
+        CHECK(tree.name == "tree");
+        CHECK(tree.matrix.empty()); // a rigid placement is written as translation, rotation, scale
+        REQUIRE(tree.children.size() == 2);
+        for (int child : tree.children) {
+            const tinygltf::Node& c = gpu.nodes[std::size_t(child)];
+            if (!c.extensions.count("EXT_mesh_gpu_instancing")) continue;
+            ++leaf_nodes;
+            translations.insert(attribute(c, "TRANSLATION"));
+            CHECK(gpu.accessors[std::size_t(attribute(c, "TRANSLATION"))].count == 1000);
+            // leaf k of tree t, in the world: as flatten() places it
+            for (std::size_t k : {std::size_t(0), std::size_t(517), std::size_t(999)}) {
+                const glm::vec4 tr = element(gpu, attribute(c, "TRANSLATION"), k, 3);
+                const glm::vec4 q = element(gpu, attribute(c, "ROTATION"), k, 4);
+                const glm::vec4 sc = element(gpu, attribute(c, "SCALE"), k, 3);
+                const glm::mat4 local = glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(tr)) *
+                                                       glm::mat4_cast(glm::quat(q.w, q.x, q.y, q.z)),
+                                                   glm::vec3(sc));
+                const glm::mat4 world = node_matrix(tree) * local;
+                // flatten() lists each tree's tubes, then its 1,000 leaves
+                const glm::mat4& want = flat.instances[t * 1001 + 1 + k].transform;
+                for (int col = 0; col < 4; ++col)
+                    for (int row = 0; row < 4; ++row)
+                        CHECK(world[col][row] == Approx(want[col][row]).margin(1e-4));
+            }
+        }
+    }
+    CHECK(leaf_nodes == 100);
+    CHECK(translations.size() == 1); // one accessor for every tree's leaves
+
+    // a tree placed a few times with few parts is drawn into one level, as before
+    const tinygltf::Model small = parse_glb(test::forest_scene(3, 20), GltfLayout::GpuInstancing);
+    CHECK(small.scenes[0].nodes.size() == 2); // an instanced trunk node, an instanced leaf node
 }
