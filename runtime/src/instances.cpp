@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <optional>
 
@@ -79,12 +80,48 @@ class InstanceBuilder {
 
     // What the scene would take flattened (the exporters that bake everything do): refused past
     // the budget, before anything is flattened.
-    void check_flattened(const Scene& scene) const {
+    double check_flattened(const Scene& scene) const {
+        const double bytes = flat_size(scene);
+        if (bytes > budget_) memory_error("drawn out in full, the plant's instances", bytes);
+        return bytes;
+    }
+
+    // The scene's bounds: exact (every point placed) while that is cheap, else the box around its
+    // placed scene prototypes' boxes, which holds every point too.
+    static void set_bounds(Scene& scene, double flat_bytes) {
+        constexpr double kExactBoundsBytes = 64.0 * 1024 * 1024;
+        if (flat_bytes <= kExactBoundsBytes || !scene.nested()) {
+            scene.update_bounds();
+            return;
+        }
+        glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+        auto add = [&](const glm::vec3& p) {
+            lo = glm::min(lo, p);
+            hi = glm::max(hi, p);
+        };
+        for (const auto& p : scene.tubes.positions) add(p);
+        for (const auto& inst : scene.instances)
+            for (const auto& p : scene.prototypes[inst.prototype].positions)
+                add(glm::vec3(inst.transform * glm::vec4(p, 1.0f)));
+        for (const Instance& i : scene.scene_instances) {
+            const Scene& p = *scene.scene_prototypes[i.prototype];
+            for (int c = 0; c < 8; ++c)
+                add(glm::vec3(i.transform * glm::vec4((c & 1) ? p.bounds_max.x : p.bounds_min.x,
+                                                      (c & 2) ? p.bounds_max.y : p.bounds_min.y,
+                                                      (c & 4) ? p.bounds_max.z : p.bounds_min.z, 1.0f)));
+        }
+        if (lo.x > hi.x) lo = hi = glm::vec3(0.0f);
+        scene.bounds_min = lo;
+        scene.bounds_max = hi;
+    }
+
+    // What `scene` would take with every placement drawn out.
+    double flat_size(const Scene& scene) const {
         double bytes = bytes_of(scene.tubes);
         for (const Instance& i : scene.instances) bytes += bytes_of(scene.prototypes[i.prototype]);
         for (const Instance& i : scene.scene_instances)
             bytes += flat_bytes(scene.scene_prototypes[i.prototype].get());
-        if (bytes > budget_) memory_error("drawn out in full, the plant's instances", bytes);
+        return bytes;
     }
 
   private:
@@ -153,17 +190,14 @@ class InstanceBuilder {
                  256.0 * double(skeleton.organs.size());
         if (used_ > budget_) memory_error("meshing the instances", used_);
         Scene scene = build(*def.program, skeleton, level);
-        scene.update_bounds();
-        detail::check_single_precision(scene);
         double own = bytes_of(scene.tubes);
         for (const auto& p : scene.prototypes) own += bytes_of(p);
         used_ += own - double(d.string().size()) * 16.0; // the string is freed with the derivation
-        made.flat_bytes = bytes_of(scene.tubes);
-        for (const Instance& i : scene.instances) made.flat_bytes += bytes_of(scene.prototypes[i.prototype]);
-        for (const Instance& i : scene.scene_instances)
-            made.flat_bytes += flat_bytes(scene.scene_prototypes[i.prototype].get());
+        made.flat_bytes = flat_size(scene);
         if (made.flat_bytes > budget_)
             memory_error(fmt::format("drawn out in full, instance {}", made.name).c_str(), made.flat_bytes);
+        set_bounds(scene, made.flat_bytes);
+        detail::check_single_precision(scene);
         made.scene = std::make_shared<const Scene>(std::move(scene));
         flat_[made.scene.get()] = made.flat_bytes;
         return memo_.emplace(std::move(key), std::move(made)).first->second;
@@ -185,8 +219,7 @@ Scene build_scene(const Program& program, const Skeleton& skeleton, const MeshOp
     InstanceBuilder builder(program, options);
     Scene scene = builder.build(program, skeleton, std::nullopt);
     scene.instance_derivations = builder.derivations();
-    if (scene.nested()) builder.check_flattened(scene);
-    scene.update_bounds();
+    builder.set_bounds(scene, builder.check_flattened(scene));
     detail::check_single_precision(scene);
     return scene;
 }
