@@ -77,7 +77,7 @@ axiom: Branch(1) Branch(1, 0.5);
     CHECK(branch->program->instance(*branch->program->symbols.find("Bud")));
 }
 
-TEST_CASE("-D values of outer params reach instance bodies", "[instances]") {
+TEST_CASE("outer params, with their -D values, reach instance bodies", "[instances]") {
     CompileOptions o;
     o.defines = {{"len", "5"}};
     auto c = compile("param len = 2; instance Leaf() { axiom: F(len); } axiom: Leaf;", o);
