@@ -182,6 +182,12 @@ void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list) {
                 ValueType t = compile_expr(c, *m.args[i]);
                 for (int w = 0; w < std::max(1, value_width(t)); ++w) arg_spans.push_back(m.args[i]->span);
                 if (t == ValueType::String) t = ValueType::Number;
+                if (info.instance >= 0 && i == info.param_types.size() && !numeric(t))
+                    diags_->error(
+                        m.args[i]->span,
+                        fmt::format("the scale of instance '{}' (its last argument) must be a number, "
+                                    "found a {}",
+                                    info.name, value_type_name(t)));
                 if (info.arity >= 0 && i < info.param_types.size() &&
                     value_width(t) != value_width(info.param_types[i])) {
                     diags_->error(m.args[i]->span,

@@ -4,6 +4,7 @@
 // section 3.2: object instancing). Instances placed inside an instance are meshed into its
 // prototype the same way, sharing the one memo.
 #include "plant/instances.hpp"
+#include "plant/environment_phase.hpp"
 #include "plant/mesh.hpp"
 #include "plant/skeleton.hpp"
 
@@ -48,7 +49,9 @@ class InstanceBuilder {
         derive_.steps.reset(); // each body has its own `derive N;`
         derive_.seed.reset();
         derive_.on_step = nullptr;
-        derive_.environment_phase = nullptr; // instances are derived apart from environments
+        // instances are derived apart from the outer plant's environments; their query modules
+        // see the instance's own turtle
+        derive_.environment_phase = &phase_;
         view_depth_ = param_value(root, d, "view_depth", 0.0);
         max_view_depth_ = param_value(root, d, "max_view_depth", 20.0);
         depth_unit_ = param_value(root, d, "depth_unit", 0.0);
@@ -204,6 +207,7 @@ class InstanceBuilder {
     }
 
     const MeshOptions& opt_;
+    TurtleEnvironmentPhase phase_;
     std::uint64_t seed_ = 0;
     DeriveOptions derive_;
     double view_depth_ = 0, max_view_depth_ = 20, depth_unit_ = 0;

@@ -171,6 +171,10 @@ TEST_CASE("what an instance body cannot hold says what to write instead", "[inst
     CHECK_THAT(e,
                Catch::Contains("instance 'Bare' has no axiom: add a line such as 'axiom: F;' to its body"));
     CHECK_THAT(c->rendered(), Catch::Contains("test.plant:6:1: error: instance 'Bare' has no axiom"));
+    auto scale = compile("instance L() { axiom: F; } axiom: L(vec3(1, 2, 3));");
+    CHECK(!scale->program);
+    CHECK_THAT(errors(*scale),
+               Catch::Contains("the scale of instance 'L' (its last argument) must be a number"));
     auto dup = compile("module Leaf; instance Leaf() { axiom: F; } axiom: Leaf;");
     CHECK(!dup->program);
     CHECK_THAT(errors(*dup), Catch::Contains("duplicate definition of module 'Leaf'"));

@@ -120,6 +120,14 @@ TEST_CASE("nested instances put every leaf where the plant drawn without instanc
     CHECK_THAT(json, Catch::Contains("\"placements\":[\n{\"prototype\":0"));
 }
 
+TEST_CASE("query modules inside an instance see the instance's own turtle", "[instances]") {
+    Built b = build("instance Q() { derive 1; axiom: F(2) ?P(0, 0, 0); rules { ?P(p) -> F(p.y); } } axiom: "
+                    "f(10) Q;");
+    REQUIRE(b.scene.scene_prototypes.size() == 1);
+    CHECK(b.scene.scene_prototypes[0]->bounds_max.y == Approx(4.0).margin(1e-4)); // F(2) F(2), not F(12)
+    CHECK(b.scene.bounds_max.y == Approx(14.0).margin(1e-4));
+}
+
 TEST_CASE("the same seed gives the same instances", "[instances]") {
     const std::string g =
         "instance R(k) { axiom: F(uniform(1, 2)) +(uniform(0, 90)) F; } axiom: R(1) f R(1) f R(2);";
