@@ -15,6 +15,10 @@ namespace plant {
 namespace {
 
 constexpr int kMaxInstanceDepth = 8; // instances placed inside instances, the outermost counted
+// Each body's program holds its own copy of the declared modules it sees: the product is bounded
+// (a body's program is made in time and memory proportional to what it sees).
+constexpr std::size_t kMaxInstances = 256;
+constexpr std::size_t kMaxInheritedSymbols = 1'000'000; // instances times declared modules
 
 struct BuiltinParam {
     const char* name;
@@ -50,6 +54,15 @@ void Compiler::declare_instances(const ast::File& f) {
                                        [&](const InstanceDef& d) { return d.name == inst.name; });
         if (same != table_->end()) {
             duplicate("instance", inst.name, inst.span, same->span);
+            continue;
+        }
+        if (table_->size() >= kMaxInstances) {
+            if (too_many_instances_) continue; // said once
+            too_many_instances_ = true;
+            diags_->error(inst.span, fmt::format("a grammar may declare at most {} instances: this is one "
+                                                 "more; give one instance a parameter instead of declaring "
+                                                 "variants",
+                                                 kMaxInstances));
             continue;
         }
         InstanceDef def;
@@ -209,6 +222,16 @@ std::unique_ptr<Program> Compiler::compile_instance(const Compiler& parent, cons
 }
 
 void Compiler::compile_instances() {
+    if (own_instances_.empty()) return;
+    std::size_t declared = 0;
+    for (const SymbolInfo& s : P_.symbols.all()) declared += s.declared && !s.turtle && !s.query ? 1 : 0;
+    if (declared * table_->size() > kMaxInheritedSymbols) {
+        diags_->error(own_instances_.front().first->span,
+                      fmt::format("{} instances each see the {} modules declared around them, more than "
+                                  "plant compiles ({} in all): declare fewer modules or instances",
+                                  table_->size(), declared, kMaxInheritedSymbols));
+        return;
+    }
     for (const auto& [decl, index] : own_instances_) {
         // bodies declared inside bodies: as deep as instances may be placed
         std::vector<int> chain{index};

@@ -100,7 +100,8 @@ class Compiler {
 
     // One instance body as its own program (compile_instances.cpp): `parent` is the compiler of
     // the file or body that declares it, `index` its row in the instance table.
-    std::unique_ptr<Program> compile_instance(const Compiler& parent, const ast::InstanceDecl& decl, int index);
+    std::unique_ptr<Program> compile_instance(const Compiler& parent, const ast::InstanceDecl& decl,
+                                              int index);
 
   private:
     // the stages after declarations, shared by the main program and instance bodies
@@ -211,18 +212,19 @@ class Compiler {
     // main program's compiler and every body's.
     struct InstanceGraph {
         std::vector<std::vector<std::pair<int, Span>>> places; // per instance: what it places, where
-        std::vector<int> declared_in;                           // the enclosing instance (-1: top level)
+        std::vector<int> declared_in;                          // the enclosing instance (-1: top level)
     };
     std::shared_ptr<std::vector<InstanceDef>> table_ = std::make_shared<std::vector<InstanceDef>>();
     std::shared_ptr<InstanceGraph> graph_ = std::make_shared<InstanceGraph>();
     int self_index_ = -1; // the instance this compiler compiles (-1: the main program)
     std::vector<std::pair<const ast::InstanceDecl*, int>> own_instances_; // declared here, by index
-    std::set<std::string> placement_params_;   // values known only per derivation (instance params)
+    std::set<std::string> placement_params_;    // values known only per derivation (instance params)
     std::set<std::string> own_instance_params_; // this body's params: not visible in nested bodies
     const char* compile_time_ = nullptr;        // while eval_const runs: what it evaluates
     std::size_t inherited_surfaces_ = 0;        // surfaces of the outer program, which a body may replace
     std::set<std::string> body_surfaces_;
     std::size_t inherited_functions_ = 0; // the outer program's, compiled only when called
+    bool too_many_instances_ = false;
 };
 
 } // namespace plant
