@@ -176,13 +176,19 @@ class InstanceBuilder {
                                            opt_.max_instance_derivations, made.name));
         if (derive_.interrupt && derive_.interrupt->load())
             throw RuntimeError(RuntimeErrorKind::Interrupted, Span{}, "interrupted while deriving instances");
-        Derivation d = instance_derivation(def, shape.instance, shape.args, level, seed_, derive_);
+        // all instance derivations together may reach --max-modules once: each gets what is left
+        DeriveOptions o = derive_;
+        o.max_modules = derive_.max_modules > modules_ ? derive_.max_modules - modules_ : 1;
+        Derivation d = instance_derivation(def, shape.instance, shape.args, level, seed_, std::move(o));
         try {
             d.run();
         } catch (RuntimeError& e) {
-            e.message = fmt::format("instance {}: {}", made.name, e.message);
+            e.message = fmt::format(
+                "instance {}{}: {}", made.name,
+                e.kind == RuntimeErrorKind::ModuleLimit ? " (with the instances before it)" : "", e.message);
             throw;
         }
+        modules_ += d.string().size();
         // what the derivation took, while it lives: its string, then the skeleton
         used_ += double(d.string().size()) * 16.0;
         if (used_ > budget_) memory_error("deriving the instances", used_);
@@ -213,6 +219,7 @@ class InstanceBuilder {
     double view_depth_ = 0, max_view_depth_ = 20, depth_unit_ = 0;
     double budget_ = 0, used_ = 0;
     std::size_t derivations_ = 0;
+    std::size_t modules_ = 0; // in the strings of every instance derivation so far
     std::map<std::tuple<int, std::vector<std::uint64_t>, std::uint64_t>, Made> memo_;
     std::map<const Scene*, double> flat_; // per prototype: Made::flat_bytes
 };

@@ -227,6 +227,17 @@ TEST_CASE("hostile instance use ends with a clear error", "[instances]") {
         CHECK(e.kind == RuntimeErrorKind::Memory);
         CHECK_THAT(e.message, Catch::Contains("--max-memory"));
     }
+    // instance derivations share one module budget
+    DeriveOptions limited;
+    limited.max_modules = 2000;
+    try {
+        build("instance Gr(k) { derive 9; axiom: A; rules { A -> A A; } } axiom: Gr(1) Gr(2) Gr(3) Gr(4);",
+              {}, limited);
+        FAIL("no error");
+    } catch (const RuntimeError& e) {
+        CHECK(e.kind == RuntimeErrorKind::ModuleLimit);
+        CHECK_THAT(e.message, Catch::StartsWith("instance Gr(4) (with the instances before it): "));
+    }
     // an error inside an instance's derivation names the instance
     try {
         build("instance Z(k) { axiom: F(1 / k); } axiom: Z(0);");
