@@ -211,8 +211,8 @@ OutputSummary write_outputs(const Program& program, const Derivation& d,
         check_mesh_memory(skeleton, options);
         MeshOptions mo;
         mo.sides = options.sides;
-        mo.derivation = &d;                 // instances: the seed and limits
-        mo.max_memory = options.max_memory; // instances: their memory
+        mo.derivation = &d; // instances: the seed and limits
+        mo.max_memory = options.max_memory ? options.max_memory : default_max_memory(); // instances
         scene = build_scene(program, skeleton, mo);
         if (options.obstacles) add_environments(d.run_state(), scene);
     }
