@@ -25,11 +25,12 @@ std::string mesh_summary(const Scene& s) {
         vertices += p.positions.size();
         triangles += p.triangle_count();
     }
-    return fmt::format(
+    std::string out = fmt::format(
         "vertices {}\ntriangles {}\nprototypes {}\ninstances {}\nbounds {:.4f} {:.4f} {:.4f} {:.4f} "
         "{:.4f} {:.4f}\n",
         vertices, triangles, s.prototypes.size(), s.instances.size(), s.bounds_min.x, s.bounds_min.y,
         s.bounds_min.z, s.bounds_max.x, s.bounds_max.y, s.bounds_max.z);
+    return out + scene_prototype_summary(s); // nothing without instances
 }
 
 std::string glb_bytes(const OutputSources& from, const std::string& target) {
@@ -56,7 +57,7 @@ std::string skeleton_svg_bytes(const OutputSources& from, const std::string&) {
     return skeleton_svg(from.skeleton);
 }
 std::string skeleton_json_bytes(const OutputSources& from, const std::string&) {
-    return skeleton_json(from.skeleton);
+    return skeleton_json(from.skeleton, &from.scene); // the scene lists instances' prototypes
 }
 std::string string_text_bytes(const OutputSources& from, const std::string&) {
     return format_string(from.program, from.derivation.string()) + "\n";
@@ -222,11 +223,16 @@ OutputSummary write_outputs(const Program& program, const Derivation& d,
     Skeleton skeleton;
     Scene scene;
     if (need_skeleton) skeleton = build_skeleton(program, d.interpreted(d.string()), turtle_options(d));
+    // .skel.json lists the prototypes of instances: they are made with the scene
+    if (need_skeleton && !need_scene && program.instances)
+        for (const auto& p : paths) need_scene = need_scene || format_of(p)->bytes == skeleton_json_bytes;
     if (need_scene) {
         check_mesh_memory(skeleton, options);
         MeshOptions mo;
         mo.sides = options.sides;
-        mo.camera = options.camera;
+        mo.camera = options.camera; // per-placement level of detail
+        mo.derivation = &d;         // instances: the seed and limits
+        mo.max_memory = options.max_memory ? options.max_memory : default_max_memory(); // instances
         scene = build_scene(program, skeleton, mo);
         if (options.obstacles) add_environments(d.run_state(), scene);
     }

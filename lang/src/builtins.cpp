@@ -49,7 +49,21 @@ constexpr BuiltinInfo table[] = {
     {"chance", BuiltinId::Chance, 1, {N, X, X}, B, R, "true with probability p"},
     {"step", BuiltinId::Step, 0, {X, X, X}, N, A, "the current derivation step (0 before the first)"},
     {"id", BuiltinId::Id, 0, {X, X, X}, N, I, "identity of the module being rewritten"},
-    {"lod", BuiltinId::Lod, 3, {N, N, N}, N, A, "round(count * (1 - view_depth / max_view_depth))"},
+    {"lod",
+     BuiltinId::Lod,
+     1,
+     {N, X, X},
+     N,
+     A,
+     "lod(count) = round(count * (1 - view_depth / max_view_depth)) with the program's view_depth and "
+     "max_view_depth, from 0 to count"},
+    {"lod",
+     BuiltinId::Lod,
+     3,
+     {N, N, N},
+     N,
+     A,
+     "lod(count, view_depth, max_view_depth): the same with a view depth of your own"},
 };
 } // namespace
 

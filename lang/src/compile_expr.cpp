@@ -50,7 +50,10 @@ std::optional<ConstVal> Compiler::eval_const(const ast::Expr& e, const char* wha
     c.code = &code;
     c.kind = CtxKind::Global;
     std::size_t errors = diags_->error_count();
+    const char* was = compile_time_;
+    compile_time_ = what; // instance params have no value yet (placement_param_used)
     ValueType t = compile_expr(c, e);
+    compile_time_ = was;
     if (diags_->error_count() != errors) return std::nullopt;
     if (t == ValueType::String) {
         diags_->error(e.span, fmt::format("{} must be a number or vector, not a string", what));
@@ -266,8 +269,11 @@ ValueType Compiler::compile_name(Ctx& c, const ast::Expr& e) {
         for (int k = 0; k < value_width(v.type); ++k) emit_const(c, v.v[k], e.span);
         return v.type;
     }
-    if (auto it = P_.global_index.find(e.text); it != P_.global_index.end()) {
+    auto it = P_.global_index.find(e.text);
+    if (it == P_.global_index.end() && builtin_param(e.text)) it = P_.global_index.find(e.text);
+    if (it != P_.global_index.end()) {
         const Global& g = P_.globals[it->second];
+        if (compile_time_ && placement_params_.count(e.text)) placement_param_used(e.text, e.span);
         emit(c, Op::LoadGlobal, static_cast<std::int32_t>(g.slot), value_width(g.type), e.span);
         return g.type;
     }
@@ -465,6 +471,16 @@ ValueType Compiler::compile_call(Ctx& c, const ast::Expr& e) {
         }
         if (b.per_module() && c.function >= 0) fn_random_[static_cast<std::size_t>(c.function)] = true;
         if (b.id == BuiltinId::Id) P_.uses_id = true;
+        if (b.id == BuiltinId::Lod && types.size() == 1) { // lod(count): the program's view depth
+            for (const char* param : {"view_depth", "max_view_depth"}) {
+                ast::Expr read;
+                read.kind = ast::ExprKind::Name;
+                read.span = e.span;
+                read.text = param;
+                compile_name(c, read);
+            }
+            width = 3;
+        }
         emit(c, Op::Builtin, static_cast<std::int32_t>(b.id), width, e.span,
              static_cast<std::uint16_t>(value_width(b.result)));
         return b.result;

@@ -141,12 +141,16 @@ void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list) {
             int width = 0;
             std::size_t nargs = last ? m.args.size() : 0;
             if (info.arity >= 0 && (last ? m.has_args || info.arity > 0 : info.arity > 0) &&
-                static_cast<int>(nargs) != info.arity) {
+                static_cast<int>(nargs) != info.arity && !instance_arity_ok(info, nargs)) {
                 diags_->error(last ? m.span : Span{parts[k].second},
-                              fmt::format("module '{}' takes {} parameter{}, given {} (declared at {})",
-                                          info.name, info.arity, info.arity == 1 ? "" : "s", nargs,
+                              fmt::format("module '{}' takes {} parameter{}{}, given {} (declared at {})",
+                                          info.name, info.arity, info.arity == 1 ? "" : "s",
+                                          info.instance >= 0 ? " and an optional scale" : "", nargs,
                                           where(info.decl_span)));
             }
+            if (info.instance >= 0 && self_index_ >= 0) // what this body places (check_instance_graph)
+                graph_->places[static_cast<std::size_t>(self_index_)].emplace_back(
+                    info.instance, last ? m.span : Span{parts[k].second});
             if (info.turtle_op == TurtleOp::Push || info.turtle_op == TurtleOp::Pop) {
                 // the turtle table's only count it enforces: brackets take none
                 if (nargs > turtle_symbol(info.turtle_op)->max_params)
@@ -178,6 +182,12 @@ void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list) {
                 ValueType t = compile_expr(c, *m.args[i]);
                 for (int w = 0; w < std::max(1, value_width(t)); ++w) arg_spans.push_back(m.args[i]->span);
                 if (t == ValueType::String) t = ValueType::Number;
+                if (info.instance >= 0 && i == info.param_types.size() && !numeric(t))
+                    diags_->error(
+                        m.args[i]->span,
+                        fmt::format("the scale of instance '{}' (its last argument) must be a number, "
+                                    "found a {}",
+                                    info.name, value_type_name(t)));
                 if (info.arity >= 0 && i < info.param_types.size() &&
                     value_width(t) != value_width(info.param_types[i])) {
                     diags_->error(m.args[i]->span,
@@ -220,7 +230,7 @@ std::vector<PatternModule> Compiler::compile_pattern(Ctx& c, const ast::ModuleLi
                                           : "brackets are allowed only in a right context");
             }
             std::size_t nargs = last ? m.args.size() : 0;
-            if (info.arity >= 0 && static_cast<int>(nargs) != info.arity) {
+            if (info.arity >= 0 && static_cast<int>(nargs) != info.arity && !instance_arity_ok(info, nargs)) {
                 diags_->error(
                     last ? m.span : pm.span,
                     fmt::format("module '{}' takes {} parameter{}, the pattern gives {} (declared at {})",

@@ -64,7 +64,9 @@ void Compiler::compile_surface(const ast::ShapeDecl& s) {
     std::size_t replace = P_.surfaces.size();
     for (std::size_t i = 0; i < P_.surfaces.size(); ++i) {
         if (P_.surfaces[i].name != s.name) continue;
-        if (P_.surfaces[i].span.file == s.span.file) {
+        // an instance body's surface replaces the outer program's (inherited_surfaces_) once
+        const bool inherited = i < inherited_surfaces_ && !body_surfaces_.count(s.name);
+        if (P_.surfaces[i].span.file == s.span.file && !inherited) {
             duplicate("surface", s.name, s.span, P_.surfaces[i].span);
             return;
         }
@@ -102,6 +104,7 @@ void Compiler::compile_surface(const ast::ShapeDecl& s) {
             fmt::format("unknown surface kind '{}': expected polygon(...) or load(\"file\")", s.kind));
         return;
     }
+    if (replace < inherited_surfaces_) body_surfaces_.insert(s.name);
     if (replace < P_.surfaces.size())
         P_.surfaces[replace] = std::move(def);
     else

@@ -81,12 +81,36 @@ std::unique_ptr<Program> Compiler::compile(std::uint32_t main_file) {
     if (diags_->has_errors()) return nullptr; // do not pile checks on a broken parse
 
     declare();
+    declare_builtin_params();
     check_defines_used();
+    compile_stages();
+    current_file_ = main_file;
+    if (!has_axiom_) {
+        diags_->error(Span{main_file, 0, 0}, "the grammar has no axiom: add a line such as 'axiom: F;'");
+    }
+    if (!diags_->has_errors()) check_instance_graph();
+    if (!diags_->has_errors()) {
+        check_raw_runs();
+        check_never_applying();
+    }
+    if (diags_->has_errors()) return nullptr;
+    if (!table_->empty()) {
+        P_.instance_table = table_;
+        P_.instances = table_.get();
+    }
+    return std::move(program_);
+}
+
+// Shapes, functions, instance bodies, settings, rules and hooks, in the order data flows.
+void Compiler::compile_stages() {
     for (const ast::ShapeDecl* s : curve_decls_) compile_curve(*s); // before the code that calls them
     for (const ast::ShapeDecl* s : env_decls_) compile_environment(*s);
     check_bound_modules();
-    for (std::uint32_t i = 0; i < P_.functions.size(); ++i) ensure_function_compiled(i);
+    // an outer program's functions, inherited by an instance body, are compiled when called
+    for (auto i = static_cast<std::uint32_t>(inherited_functions_); i < P_.functions.size(); ++i)
+        ensure_function_compiled(i);
     for (const ast::ShapeDecl* s : surface_decls_) compile_surface(*s);
+    compile_instances(); // they see the shapes and functions above
     for (const auto& lf : order_) {
         current_file_ = lf.file->source;
         compile_settings(*lf.file);
@@ -94,17 +118,7 @@ std::unique_ptr<Program> Compiler::compile(std::uint32_t main_file) {
         compile_hooks(*lf.file);
     }
     compile_hook_bodies();
-    current_file_ = main_file;
-    if (!has_axiom_) {
-        diags_->error(Span{main_file, 0, 0}, "the grammar has no axiom: add a line such as 'axiom: F;'");
-    }
     finish();
-    if (!diags_->has_errors()) {
-        check_raw_runs();
-        check_never_applying();
-    }
-    if (diags_->has_errors()) return nullptr;
-    return std::move(program_);
 }
 
 // Every file's names, in the order files were loaded (imports first): modules, then functions,
@@ -115,6 +129,10 @@ void Compiler::declare() {
     for (const auto& lf : order_) {
         current_file_ = lf.file->source;
         declare_modules(*lf.file);
+    }
+    for (const auto& lf : order_) {
+        current_file_ = lf.file->source;
+        declare_instances(*lf.file);
     }
     for (const auto& lf : order_) {
         current_file_ = lf.file->source;
@@ -131,7 +149,6 @@ void Compiler::declare() {
             surface_decls_.push_back(&s);
             P_.symbols.intern("~" + s.name);
         }
-        // instances are parsed but have no meaning yet: nothing of them is compiled
         for (const auto& rb : lf.file->rule_blocks) {
             if (rb.kind != ast::RuleKind::Rules || rb.group.empty()) continue;
             if (P_.group_index(rb.group) < 0) {

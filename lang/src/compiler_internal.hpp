@@ -98,7 +98,14 @@ class Compiler {
     ValueType compile_function_body(std::uint32_t index, Code& code, std::uint16_t& frame_size);
     ValueType param_type(const ast::ParamName& p);
 
+    // One instance body as its own program (compile_instances.cpp): `parent` is the compiler of
+    // the file or body that declares it, `index` its row in the instance table.
+    std::unique_ptr<Program> compile_instance(const Compiler& parent, const ast::InstanceDecl& decl,
+                                              int index);
+
   private:
+    // the stages after declarations, shared by the main program and instance bodies
+    void compile_stages();
     // the stages, in the order data flows
     void load(std::uint32_t file_id, std::map<std::string, std::pair<const ast::Expr*, Span>> overrides,
               std::vector<std::string>& stack);
@@ -111,6 +118,15 @@ class Compiler {
     void declare();
     void declare_modules(const ast::File& f);
     void declare_values(const LoadedFile& lf);
+    // instances and level of detail (compile_instances.cpp)
+    void declare_instances(const ast::File& f);
+    void declare_builtin_params();
+    bool builtin_param(const std::string& name);
+    void inherit(const Compiler& parent, const ast::InstanceDecl& decl);
+    void compile_instances();
+    void check_instance_graph();
+    bool instance_arity_ok(const SymbolInfo& info, std::size_t nargs) const;
+    void placement_param_used(const std::string& name, Span span);
     void compile_rules(const ast::File& f);
     void compile_production(const ast::Production& p, RuleSet& set);
     void compile_hooks(const ast::File& f);
@@ -191,6 +207,24 @@ class Compiler {
     bool has_ignore_ = false, has_consider_ = false, has_axiom_ = false;
     std::vector<std::pair<std::string, Span>> group_decls_;
     std::array<std::vector<const ast::Hook*>, ast::kHooks.size()> hook_bodies_;
+
+    // instances (compile_instances.cpp). The table and the placement graph are shared by the
+    // main program's compiler and every body's.
+    struct InstanceGraph {
+        std::vector<std::vector<std::pair<int, Span>>> places; // per instance: what it places, where
+        std::vector<int> declared_in;                          // the enclosing instance (-1: top level)
+    };
+    std::shared_ptr<std::vector<InstanceDef>> table_ = std::make_shared<std::vector<InstanceDef>>();
+    std::shared_ptr<InstanceGraph> graph_ = std::make_shared<InstanceGraph>();
+    int self_index_ = -1; // the instance this compiler compiles (-1: the main program)
+    std::vector<std::pair<const ast::InstanceDecl*, int>> own_instances_; // declared here, by index
+    std::set<std::string> placement_params_;    // values known only per derivation (instance params)
+    std::set<std::string> own_instance_params_; // this body's params: not visible in nested bodies
+    const char* compile_time_ = nullptr;        // while eval_const runs: what it evaluates
+    std::size_t inherited_surfaces_ = 0;        // surfaces of the outer program, which a body may replace
+    std::set<std::string> body_surfaces_;
+    std::size_t inherited_functions_ = 0; // the outer program's, compiled only when called
+    bool too_many_instances_ = false;
 };
 
 } // namespace plant

@@ -184,7 +184,10 @@ int apply_per_module(BuiltinId id, const double* a, double* r, EvalEnv& env) {
         r[0] = static_cast<double>(env.id & ~kNewIdBit);
         return 1;
     case BuiltinId::Lod:
-        r[0] = a[2] == 0 ? a[0] : std::round(a[0] * (1 - a[1] / a[2]));
+        // Yan & Chiba, section 3.3 (LeafNum), clamped to [0, count]; no maximum depth: count
+        r[0] = a[2] <= 0 ? a[0]
+                         : std::clamp(std::round(a[0] * (1 - a[1] / a[2])), std::min(0.0, a[0]),
+                                      std::max(0.0, a[0]));
         return 1;
     default:
         return 0;

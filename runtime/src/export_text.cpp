@@ -2,8 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <fmt/ranges.h>
+
 #include <algorithm>
 #include <limits>
+#include <map>
 
 namespace plant {
 
@@ -27,9 +30,90 @@ std::string json_string(const std::string& s) {
     return out + "\"";
 }
 
+// Every scene prototype reachable from `scene`, each once, in the order first met.
+void collect_prototypes(const Scene& scene, std::map<const Scene*, std::size_t>& index,
+                        std::vector<std::pair<const Scene*, const SceneSource*>>& out) {
+    for (std::size_t k = 0; k < scene.scene_prototypes.size(); ++k) {
+        const Scene* p = scene.scene_prototypes[k].get();
+        if (!p || index.count(p)) continue;
+        index[p] = out.size();
+        out.emplace_back(p, k < scene.scene_prototype_sources.size() ? &scene.scene_prototype_sources[k]
+                                                                     : nullptr);
+        collect_prototypes(*p, index, out);
+    }
+}
+
+template <class Matrix> void json_matrix(std::string& out, const Matrix& m) {
+    out += "[";
+    for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r)
+            fmt::format_to(std::back_inserter(out), "{}{}", c || r ? "," : "", m[c][r]);
+    out += "]";
+}
+
+// The placements of `scene`'s scene prototypes, by index in the collected list.
+void json_placements(std::string& out, const Scene& scene, const std::map<const Scene*, std::size_t>& index) {
+    out += "[";
+    for (std::size_t k = 0; k < scene.scene_instances.size(); ++k) {
+        const Instance& i = scene.scene_instances[k];
+        const Scene* p =
+            i.prototype < scene.scene_prototypes.size() ? scene.scene_prototypes[i.prototype].get() : nullptr;
+        auto it = index.find(p);
+        fmt::format_to(std::back_inserter(out), "{}{{\"prototype\":{},\"matrix\":", k ? ",\n" : "\n",
+                       it == index.end() ? -1 : static_cast<long>(it->second));
+        json_matrix(out, i.transform);
+        out += "}";
+    }
+    out += "]";
+}
+
+// Placements drawn when `scene` is drawn out in full, its scene prototypes' own counted in.
+double placements_drawn(const Scene& scene, std::map<const Scene*, double>& memo) {
+    double n = 0;
+    for (const Instance& i : scene.scene_instances) {
+        const Scene* p =
+            i.prototype < scene.scene_prototypes.size() ? scene.scene_prototypes[i.prototype].get() : nullptr;
+        if (!p) continue;
+        auto it = memo.find(p);
+        if (it == memo.end()) it = memo.emplace(p, placements_drawn(*p, memo)).first;
+        n += 1 + it->second;
+    }
+    return n;
+}
+
+// The prototypes and placements, appended to the skeleton's JSON object.
+void json_instances(std::string& out, const Scene& scene) {
+    std::map<const Scene*, std::size_t> index;
+    std::vector<std::pair<const Scene*, const SceneSource*>> protos;
+    collect_prototypes(scene, index, protos);
+    out += ",\"prototypes\":[";
+    for (std::size_t k = 0; k < protos.size(); ++k) {
+        const SceneSource* src = protos[k].second;
+        out += k ? ",\n" : "\n";
+        fmt::format_to(std::back_inserter(out),
+                       "{{\"instance\":{},\"args\":[{}],\"view_depth\":{},\"placements\":",
+                       json_string(src ? src->instance : ""),
+                       src ? fmt::format("{}", fmt::join(src->args, ",")) : "", src ? src->view_depth : 0.0);
+        json_placements(out, *protos[k].first, index);
+        out += "}";
+    }
+    out += "],\"placements\":";
+    json_placements(out, scene, index);
+}
+
 } // namespace
 
-std::string skeleton_json(const Skeleton& sk) {
+std::string scene_prototype_summary(const Scene& scene) {
+    if (scene.scene_prototypes.empty()) return {};
+    std::map<const Scene*, std::size_t> index;
+    std::vector<std::pair<const Scene*, const SceneSource*>> protos;
+    collect_prototypes(scene, index, protos);
+    std::map<const Scene*, double> memo;
+    return fmt::format("scene prototypes {}\nscene placements {}\nplacements drawn {}\n", protos.size(),
+                       scene.scene_instances.size(), placements_drawn(scene, memo));
+}
+
+std::string skeleton_json(const Skeleton& sk, const Scene* scene) {
     std::string out = "{\"format\":\"plant-skeleton\",\"version\":1,\"axes\":[";
     for (std::size_t a = 0; a < sk.axes.size(); ++a) {
         const SkeletonAxis& axis = sk.axes[a];
@@ -66,7 +150,9 @@ std::string skeleton_json(const Skeleton& sk) {
         json_vec(out, g.color);
         fmt::format_to(std::back_inserter(out), ",\"id\":{}}}", g.id);
     }
-    out += "]}\n";
+    out += "]";
+    if (scene && !scene->scene_prototypes.empty()) json_instances(out, *scene);
+    out += "}\n";
     return out;
 }
 

@@ -6,6 +6,7 @@
 
 #include "mesh_file.hpp"
 #include "openmesh.hpp"
+#include "scene_build.hpp"
 
 #include <fmt/format.h>
 
@@ -17,26 +18,35 @@
 
 namespace plant {
 
-void Scene::update_bounds() {
-    if (nested()) {
-        const Scene flat = flatten(*this); // its bounds are of everything placed
-        bounds_min = flat.bounds_min;
-        bounds_max = flat.bounds_max;
-        return;
-    }
-    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-    for (const auto& p : tubes.positions) {
+namespace {
+
+// Grows [lo, hi] by every point of `scene` drawn with `placed` (placed scenes too, as flatten
+// would draw them, without copying them).
+void grow_bounds(const Scene& scene, const glm::mat4* placed, glm::vec3& lo, glm::vec3& hi) {
+    auto add = [&](const glm::vec3& p) {
         lo = glm::min(lo, p);
         hi = glm::max(hi, p);
+    };
+    for (const auto& p : scene.tubes.positions) add(placed ? glm::vec3(*placed * glm::vec4(p, 1.0f)) : p);
+    for (const auto& inst : scene.instances) {
+        const MeshPart& proto = scene.prototypes[inst.prototype];
+        const glm::mat4 m = placed ? *placed * inst.transform : inst.transform;
+        for (const auto& p : proto.positions) add(glm::vec3(m * glm::vec4(p, 1.0f)));
     }
-    for (const auto& inst : instances) {
-        const MeshPart& proto = prototypes[inst.prototype];
-        for (const auto& p : proto.positions) {
-            glm::vec3 w = glm::vec3(inst.transform * glm::vec4(p, 1.0f));
-            lo = glm::min(lo, w);
-            hi = glm::max(hi, w);
-        }
+    for (const auto& inst : scene.scene_instances) {
+        if (inst.prototype >= scene.scene_prototypes.size() || !scene.scene_prototypes[inst.prototype])
+            throw std::out_of_range("a placement of scene prototype " + std::to_string(inst.prototype) +
+                                    " but the scene has " + std::to_string(scene.scene_prototypes.size()));
+        const glm::mat4 m = placed ? *placed * inst.transform : inst.transform;
+        grow_bounds(*scene.scene_prototypes[inst.prototype], &m, lo, hi);
     }
+}
+
+} // namespace
+
+void Scene::update_bounds() {
+    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    grow_bounds(*this, nullptr, lo, hi);
     if (lo.x > hi.x) lo = hi = glm::vec3(0.0f);
     bounds_min = lo;
     bounds_max = hi;
@@ -232,7 +242,9 @@ MeshPart organ_mesh(const Program& program, const OrganShape& shape) {
 
 } // namespace
 
-Scene build_scene(const Program& program, const Skeleton& skeleton, const MeshOptions& options) {
+namespace detail {
+
+Scene mesh_skeleton(const Program& program, const Skeleton& skeleton, const MeshOptions& options) {
     Scene scene;
     std::map<std::array<float, 3>, std::uint32_t> material_index;
     auto material_of = [&](const glm::vec3& c) -> std::uint32_t {
@@ -266,6 +278,7 @@ Scene build_scene(const Program& program, const Skeleton& skeleton, const MeshOp
     std::map<std::pair<OrganShape, std::uint32_t>, std::uint32_t> prototype_index;
     std::map<OrganShape, MeshPart> shapes;
     for (const auto& organ : skeleton.organs) {
+        if (organ.shape.kind == OrganKind::Instance) continue; // placed by build_scene (instances.cpp)
         std::uint32_t material = material_of(organ.color);
         auto key = std::pair{organ.shape, material};
         auto it = prototype_index.find(key);
@@ -282,7 +295,10 @@ Scene build_scene(const Program& program, const Skeleton& skeleton, const MeshOp
         scene.instances.push_back(Instance{it->second, glm::mat4(organ.transform)});
     }
     if (scene.materials.empty()) scene.materials.push_back(Material{});
-    scene.update_bounds();
+    return scene;
+}
+
+void check_single_precision(const Scene& scene) {
     // meshes are single precision: a plant beyond its range cannot be meshed
     for (float v : {scene.bounds_min.x, scene.bounds_min.y, scene.bounds_min.z, scene.bounds_max.x,
                     scene.bounds_max.y, scene.bounds_max.z})
@@ -290,7 +306,8 @@ Scene build_scene(const Program& program, const Skeleton& skeleton, const MeshOp
             throw RuntimeError(RuntimeErrorKind::Geometry, Span{},
                                "the plant reaches coordinates beyond the range of single-precision numbers "
                                "(about 3e38) and cannot be meshed");
-    return scene;
 }
+
+} // namespace detail
 
 } // namespace plant

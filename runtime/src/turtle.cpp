@@ -4,6 +4,7 @@
 #include "plant/turtle.hpp"
 #include "plant/derive.hpp"
 #include "plant/environment.hpp"
+#include "plant/instances.hpp"
 
 #include "geometry.hpp"
 
@@ -63,7 +64,13 @@ glm::dmat4 frame_matrix(const TurtleState& t, double scale) {
 } // namespace
 
 std::string organ_label(const OrganShape& shape) {
-    return shape.kind == OrganKind::Sphere ? std::string(turtle_symbol(TurtleOp::Sphere)->name) : shape.name;
+    if (shape.kind == OrganKind::Sphere) return std::string(turtle_symbol(TurtleOp::Sphere)->name);
+    if (shape.kind != OrganKind::Instance) return shape.name;
+    // an instance with its argument tuple, as written: Branch(12, 0.5)
+    std::string out = shape.name;
+    for (std::size_t k = 0; k < shape.args.size(); ++k)
+        out += (k ? ", " : "(") + format_double(shape.args[k]);
+    return shape.args.empty() ? out : out + ")";
 }
 
 glm::vec3 palette_color(int index) {
@@ -102,6 +109,8 @@ class Turtle {
             bound_[k] = !info.bound_to.empty();
             ops_[k] = info.turtle_op;
         }
+        instance_.assign(n, -1);
+        for (std::size_t k = 0; k < n; ++k) instance_[k] = program.symbols.all()[k].instance;
     }
 
     void run() {
@@ -112,6 +121,8 @@ class Turtle {
                 bound_segment(i);
             else if (ops_[sym] != TurtleOp::None)
                 apply(ops_[sym], i);
+            else if (instance_[sym] >= 0)
+                place_instance(i, instance_[sym]);
         }
     }
 
@@ -214,6 +225,29 @@ class Turtle {
 
     void apply(TurtleOp op, std::size_t i);
 
+    // An instance's module (docs/language.md, instances): its arguments, then an optional scale;
+    // the instance is placed in the turtle's frame at that scale (the width does not scale it).
+    void place_instance(std::size_t i, int index) {
+        const std::size_t width = program_.instances ? instance_arg_width((*program_.instances)[index]) : 0;
+        const std::uint32_t n = s_.arity(i);
+        const double* a = s_.args(i);
+        std::vector<double> args(a, a + std::min<std::size_t>(n, width));
+        args.resize(width, 0.0);
+        const double scale = n > width ? a[width] : 1.0;
+        if (!std::isfinite(scale) || scale <= 0)
+            throw RuntimeError(
+                RuntimeErrorKind::Turtle, Span{},
+                fmt::format("module {} ('{}') of the string places an instance at scale {}: the "
+                            "scale must be a positive number",
+                            i + 1, program_.symbols[s_.sym[i]].name, scale));
+        sink_.organ(
+            TurtleOrgan{{OrganKind::Instance, program_.symbols[s_.sym[i]].name, index, std::move(args)},
+                        frame_matrix(t_, scale),
+                        t_.color,
+                        i,
+                        s_.id(i)});
+    }
+
     const Program& program_;
     const ModuleString& s_;
     const TurtleOptions& options_;
@@ -225,6 +259,7 @@ class Turtle {
     std::vector<int> parent_stack_;
     std::vector<char> bound_;
     std::vector<TurtleOp> ops_;
+    std::vector<int> instance_; // per symbol: the instance it places, or -1
 };
 
 // One row of plant/turtle_symbols.hpp each (its doc says what the case does).

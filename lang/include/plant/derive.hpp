@@ -112,6 +112,7 @@ class Derivation {
     void use_group(int group) { group_ = group; } // -1: none (the REPL's :use)
     ModuleId next_id() const;
     const Program& program() const { return prog_; }
+    const DeriveOptions& options() const { return opt_; }
     // The live environments, made from the program's declarations by start().
     const RunState& run_state() const { return run_; }
     RunState& run_state() { return run_; }

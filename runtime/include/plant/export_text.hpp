@@ -3,11 +3,17 @@
 #pragma once
 
 #include "plant/export.hpp"
+#include "plant/scene.hpp"
 #include "plant/skeleton.hpp"
 
 namespace plant {
 
-std::string skeleton_json(const Skeleton& skeleton);
+// With a scene that places instances (Scene::scene_prototypes), the JSON also lists every
+// prototype (instance, arguments, view depth, its own placements) and the top-level placements.
+std::string skeleton_json(const Skeleton& skeleton, const Scene* scene = nullptr);
+// The .mesh.txt lines about instances: distinct scene prototypes, top-level placements and
+// placements drawn at every level. Empty when the scene places none.
+std::string scene_prototype_summary(const Scene& scene);
 std::string skeleton_svg(const Skeleton& skeleton);
 void write_skeleton_json(const Skeleton& skeleton, const std::string& path);
 void write_svg(const Skeleton& skeleton, const std::string& path);

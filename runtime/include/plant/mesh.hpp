@@ -1,6 +1,7 @@
 // From skeleton to triangles: one generalized cylinder per axis, organ prototypes meshed once.
 #pragma once
 
+#include "plant/derive.hpp"
 #include "plant/scene.hpp"
 #include "plant/skeleton.hpp"
 
@@ -18,6 +19,13 @@ struct MeshOptions {
     // instance placement's view depth comes from its distance to it (docs/language.md, level of
     // detail). None: every placement has the program's own view_depth.
     std::optional<glm::dvec3> camera;
+    // Instances (docs/language.md, instances): the outer derivation, whose seed and limits (module
+    // count, instructions, interrupt) each instance's derivation takes; none: seed 0, default
+    // limits. The memory all instance derivations and their flattened geometry may take (0: 4 GB),
+    // and how many distinct instance derivations a scene may need.
+    const Derivation* derivation = nullptr;
+    std::uint64_t max_memory = 0;
+    std::size_t max_instance_derivations = 10000;
 };
 
 // The points one tube runs through, in order.
@@ -38,8 +46,10 @@ void mesh_tube(const TubePath& path, const MeshOptions& options, MeshPart& part,
                std::vector<std::vector<std::uint32_t>>& indices_by_material,
                const std::function<std::uint32_t(const glm::vec3&)>& material_of);
 
-// The whole scene: tubes, prototypes for every surface (and @O spheres) used, instances.
-// Throws RuntimeError when a surface cannot be loaded.
+// The whole scene: tubes, prototypes for every surface (and @O spheres) used, instances, and
+// each instance the turtle placed derived and meshed once per (instance, arguments, view depth)
+// as a scene prototype, placed by transform (instances.cpp). Throws RuntimeError when a surface
+// cannot be loaded, and when instances would take more than the options allow.
 Scene build_scene(const Program& program, const Skeleton& skeleton, const MeshOptions& options);
 
 } // namespace plant

@@ -41,6 +41,14 @@ struct Instance {
     glm::mat4 transform{1.0f};
 };
 
+// What a scene prototype was made from: an instance, its argument tuple and its view depth
+// (docs/language.md, instances).
+struct SceneSource {
+    std::string instance;
+    std::vector<double> args;
+    double view_depth = 0;
+};
+
 struct Scene {
     MeshPart tubes;                   // every generalized cylinder, in world space
     std::vector<MeshPart> prototypes; // organ shapes (leaves, flowers, spheres), in their own frame
@@ -51,7 +59,9 @@ struct Scene {
     std::vector<std::shared_ptr<const Scene>> scene_prototypes;
     std::vector<std::string> scene_prototype_names;
     std::vector<Instance> scene_instances;
-    std::vector<Material> materials;              // at least one
+    std::vector<SceneSource> scene_prototype_sources; // per scene prototype when build_scene made it
+    std::size_t instance_derivations = 0; // instance derivations build_scene ran for it (nested ones too)
+    std::vector<Material> materials;      // at least one
     glm::vec3 bounds_min{0.0f}, bounds_max{0.0f}; // of everything, instances and placed scenes included
     void update_bounds();
     bool nested() const { return !scene_instances.empty(); }
