@@ -3,7 +3,7 @@ BUILD ?= build
 JOBS ?= 2
 CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
 
-.PHONY: all deps configure build demo test test-sanitize fuzz bench install format format-check clean
+.PHONY: all deps configure build demo test test-sanitize fuzz bench install package format format-check clean
 
 all: build
 
@@ -44,6 +44,9 @@ bench: build
 PREFIX ?= /usr/local
 install: build
 	cmake --install $(BUILD) --prefix $(PREFIX)
+
+package: build
+	cd $(BUILD) && cpack -G DEB
 
 # Every tracked C++ file, formatted by .clang-format (Debian's clang-format 14, from install-deps).
 FORMAT_FILES = git ls-files -z -- '*.cpp' '*.hpp' '*.h'
