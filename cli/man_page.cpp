@@ -60,7 +60,7 @@ const char* const kExitStatus = R"(.TP
 success
 .TP
 .B 1
-a test failed (plant test)
+a test failed (plant test), or a command of a script piped into plant repl did
 .TP
 .B 64
 usage error
