@@ -20,6 +20,7 @@ version=$(sed -n 's/^project(plant VERSION \([0-9.]*\).*/\1/p' "$src/CMakeLists.
 check "dpkg-deb reads plant's control" 0 dpkg-deb -f "$deb" Package Version Maintainer Depends Description
 control=$tmp/control.txt
 cp "$tmp/stdout" "$control"
+grep '^Depends:' "$control" # in the test's log
 contains "package name" "$control" "Package: plant"
 contains "package version" "$control" "Version: $version"
 contains "maintainer" "$control" "Maintainer: "
