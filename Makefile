@@ -3,7 +3,7 @@ BUILD ?= build
 JOBS ?= 2
 CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
 
-.PHONY: all deps configure build demo test test-sanitize fuzz bench format format-check clean
+.PHONY: all deps configure build demo test test-sanitize fuzz bench install package format format-check clean
 
 all: build
 
@@ -38,6 +38,15 @@ fuzz: | deps
 
 bench: build
 	bash bench/run
+
+# Installing and packaging (docs/install.md): plant, its standard library, docs, man page and
+# the C++ API under PREFIX; the Debian packages plant and plant-dev into $(BUILD)/.
+PREFIX ?= /usr/local
+install: build
+	cmake --install $(BUILD) --prefix $(PREFIX)
+
+package: build
+	cd $(BUILD) && cpack -G DEB
 
 # Every tracked C++ file, formatted by .clang-format (Debian's clang-format 14, from install-deps).
 FORMAT_FILES = git ls-files -z -- '*.cpp' '*.hpp' '*.h'

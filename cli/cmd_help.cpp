@@ -2,6 +2,7 @@
 // of (built-ins, environment kinds and their methods, output formats, REPL commands), printed
 // from those tables themselves so that the help cannot drift from what the program does.
 #include "commands.hpp"
+#include "man_page.hpp"
 #include "outputs.hpp"
 #include "repl.hpp"
 
@@ -22,6 +23,7 @@ namespace {
 struct HelpArgs {
     std::vector<std::string> words; // the topic and what follows it
     bool names = false;             // only the names, one per line (for scripts and the docs test)
+    bool man = false;               // the man page plant.1 (troff), made at build time
 };
 
 std::string signature(const char* name, std::span<const ValueType> args, ValueType result) {
@@ -189,6 +191,16 @@ const HelpTopic kTopics[] = {
 };
 
 int help_main(CLI::App& app, const HelpArgs& a) {
+    if (a.man) {
+        if (!a.words.empty() || a.names) {
+            std::cerr << "plant: help --man prints the whole man page: give it no topic and no --names\n";
+            return kUsage;
+        }
+        std::vector<std::pair<std::string, std::string>> topics;
+        for (const auto& t : kTopics) topics.emplace_back(t.name, t.summary);
+        std::cout << man_page(app, topics);
+        return kOk;
+    }
     if (a.words.empty()) {
         std::vector<std::pair<std::string, std::string>> commands, topics;
         for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
@@ -226,6 +238,7 @@ void setup_help(CLI::App& app, int& exit_code) {
     cmd->add_option("TOPIC", a->words, "A command or a topic, and for env a kind: plant help env climber")
         ->type_name("");
     cmd->add_flag("--names", a->names, "Print only the names the topic lists, one per line");
+    cmd->add_flag("--man", a->man, "Print the man page plant.1 (troff), made from the commands' help");
     std::string topics = "Topics:\n";
     for (const auto& t : kTopics) topics += fmt::format("  {:<10} {}\n", t.name, t.summary);
     cmd->footer(topics);

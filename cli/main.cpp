@@ -1,5 +1,6 @@
 // plant: grow plants from parametric L-system grammars.
 #include "commands.hpp"
+#include "version.hpp"
 
 #include <fmt/format.h>
 
@@ -14,6 +15,8 @@ int main(int argc, char** argv) {
         "plant"};
     app.require_subcommand(1);
     app.set_help_all_flag("--help-all", "Show help for every command");
+    app.set_version_flag("--version", fmt::format("plant {} (commit {})", kVersion, kCommit),
+                         "Print the version and the git commit plant was built from");
     int exit_code = kOk;
     setup_run(app, exit_code);
     setup_derive(app, exit_code);
@@ -28,6 +31,9 @@ int main(int argc, char** argv) {
         return kOk;
     } catch (const CLI::CallForAllHelp&) {
         std::cout << app.help("", CLI::AppFormatMode::All);
+        return kOk;
+    } catch (const CLI::CallForVersion& e) {
+        std::cout << e.what() << "\n";
         return kOk;
     } catch (const CLI::ParseError& e) {
         // CLI11 reports --help of a subcommand as CallForHelp too, caught above; everything else

@@ -11,6 +11,12 @@
 
 namespace plant {
 
+// The standard library's folder: PREFIX/share/plant/stdlib beside an installed PREFIX/bin/plant
+// (so a moved install still finds its own), else, for a program whose executable lies in the build
+// folder it was configured in, the source tree's stdlib/; else the path an install would have
+// (missing, so that a failed import names it). Found once per process.
+const std::string& standard_library_dir();
+
 // The folders searched for `import name`: -I, then PLANT_PATH, then the standard library.
 std::vector<std::string> library_dirs(const CompileOptions& options);
 
