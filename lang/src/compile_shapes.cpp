@@ -153,7 +153,10 @@ void Compiler::declare_texture(const ast::ShapeDecl& s) {
         duplicate("texture", s.name, s.span, v->second);
         return;
     } else if (P_.textures.size() >= kMaxTextures) {
-        diags_->error(s.span, fmt::format("a program may declare at most {} textures", kMaxTextures));
+        if (!too_many_textures_) // said once
+            diags_->error(s.span, fmt::format("a program may declare at most {} textures: this is one more",
+                                              kMaxTextures));
+        too_many_textures_ = true;
         return;
     }
     TextureDef def;

@@ -234,6 +234,7 @@ class Compiler {
     std::unordered_map<std::string, std::size_t> texture_index_;
     std::size_t inherited_textures_ = 0;
     std::set<std::string> body_textures_;
+    bool too_many_textures_ = false;
     struct TextureFiles {
         std::map<std::string, std::shared_ptr<const std::string>> by_identity;
         std::size_t bytes = 0;
