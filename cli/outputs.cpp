@@ -8,17 +8,30 @@
 #include "plant/mesh.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <set>
 #include <unistd.h>
 
 namespace plant::cli {
 
 namespace {
 
-// Counts and bounds of the meshed scene in a fixed format, for golden files.
+// The names of the textures the scene's materials use, its scene prototypes' included.
+void used_textures(const Scene& s, std::set<std::string>& names, std::set<const Scene*>& seen) {
+    if (!seen.insert(&s).second) return;
+    for (const Material& m : s.materials)
+        if (m.texture >= 0 && static_cast<std::size_t>(m.texture) < s.textures.size())
+            names.insert(s.textures[static_cast<std::size_t>(m.texture)].name);
+    for (const auto& p : s.scene_prototypes)
+        if (p) used_textures(*p, names, seen);
+}
+
+// Counts and bounds of the meshed scene in a fixed format, for golden files; a line naming the
+// textures used, when there are any.
 std::string mesh_summary(const Scene& s) {
     std::size_t vertices = s.tubes.positions.size(), triangles = s.tubes.triangle_count();
     for (const auto& p : s.prototypes) {
@@ -30,6 +43,10 @@ std::string mesh_summary(const Scene& s) {
         "{:.4f} {:.4f}\n",
         vertices, triangles, s.prototypes.size(), s.instances.size(), s.bounds_min.x, s.bounds_min.y,
         s.bounds_min.z, s.bounds_max.x, s.bounds_max.y, s.bounds_max.z);
+    std::set<std::string> textures;
+    std::set<const Scene*> seen;
+    used_textures(s, textures, seen);
+    if (!textures.empty()) out += fmt::format("textures {}\n", fmt::join(textures, " "));
     return out + scene_prototype_summary(s); // nothing without instances
 }
 

@@ -168,6 +168,10 @@ void Compiler::inherit(const Compiler& parent, const ast::InstanceDecl& decl) {
     curve_names_ = parent.curve_names_;
     P_.surfaces = parent.P_.surfaces;
     inherited_surfaces_ = P_.surfaces.size();
+    P_.textures = parent.P_.textures; // their names came with the consts
+    texture_index_ = parent.texture_index_;
+    inherited_textures_ = P_.textures.size();
+    texture_files_ = parent.texture_files_;
     placement_params_.insert("view_depth");
     // the instance's own params: globals whose values each derivation sets
     InstanceDef& def = (*table_)[static_cast<std::size_t>(self_index_)];

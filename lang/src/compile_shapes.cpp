@@ -10,6 +10,30 @@ namespace plant {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// Textures (docs/language.md, textures): how many a program may declare, and how many bytes of
+// image files a grammar may read for them in all.
+constexpr std::size_t kMaxTextures = 1024;
+constexpr std::size_t kMaxTextureBytes = kMaxSourceBytes;
+
+// The image's MIME type from its first bytes (the PNG signature, JPEG's start-of-image marker),
+// or empty when it is neither.
+std::string image_mime_type(const std::string& bytes) {
+    static constexpr unsigned char png[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    static constexpr unsigned char jpeg[] = {0xff, 0xd8, 0xff};
+    auto starts = [&](const unsigned char* magic, std::size_t n) {
+        return bytes.size() >= n && std::equal(magic, magic + n, bytes.begin(), [](unsigned char m, char c) {
+                   return m == static_cast<unsigned char>(c);
+               });
+    };
+    if (starts(png, sizeof png)) return "image/png";
+    if (starts(jpeg, sizeof jpeg)) return "image/jpeg";
+    return {};
+}
+
+} // namespace
+
 void Compiler::compile_curve(const ast::ShapeDecl& s) {
     CurveDef def;
     def.name = s.name;
@@ -109,6 +133,87 @@ void Compiler::compile_surface(const ast::ShapeDecl& s) {
         P_.surfaces[replace] = std::move(def);
     else
         P_.surfaces.push_back(std::move(def));
+}
+
+// `texture name = image("file");`: the name becomes a const holding the texture's index, declared
+// even when the image cannot be used (so that uses of the name are not reported as unknown too).
+// A texture in an importing file or an instance body replaces the one of the same name it sees,
+// keeping its index; twice in one file is an error, as for surfaces.
+void Compiler::declare_texture(const ast::ShapeDecl& s) {
+    std::size_t index = P_.textures.size();
+    if (auto it = texture_index_.find(s.name); it != texture_index_.end()) {
+        const TextureDef& first = P_.textures[it->second];
+        const bool inherited = it->second < inherited_textures_ && !body_textures_.count(s.name);
+        if (first.span.file == s.span.file && !inherited) {
+            duplicate("texture", s.name, s.span, first.span);
+            return;
+        }
+        index = it->second;
+    } else if (auto v = value_spans_.find(s.name); v != value_spans_.end()) {
+        duplicate("texture", s.name, s.span, v->second);
+        return;
+    } else if (P_.textures.size() >= kMaxTextures) {
+        if (!too_many_textures_) // said once
+            diags_->error(s.span, fmt::format("a program may declare at most {} textures: this is one more",
+                                              kMaxTextures));
+        too_many_textures_ = true;
+        return;
+    }
+    TextureDef def;
+    def.name = s.name;
+    def.span = s.span;
+    if (s.kind != "image") {
+        diags_->error(s.kind_span,
+                      fmt::format("unknown texture kind '{}': expected image(\"file.png\")", s.kind));
+    } else if (s.args.size() != 1 || s.args[0]->kind != ast::ExprKind::String) {
+        diags_->error(s.span, "image(...) takes one quoted file name, as in image(\"bark.png\")");
+    } else {
+        fs::path p(s.args[0]->text);
+        if (p.is_relative()) p = fs::path(sm_.file(s.span.file).name()).parent_path() / p;
+        def.path = p.lexically_normal().string();
+        if (std::string id = readable(s.args[0]->text, def.path, s.args[0]->span); !id.empty())
+            def.bytes = texture_bytes(s, id);
+        if (def.bytes) {
+            def.mime_type = image_mime_type(*def.bytes);
+            if (def.mime_type.empty())
+                diags_->error(s.args[0]->span,
+                              fmt::format("'{}' is not a PNG or JPEG image (its first bytes are neither "
+                                          "signature): a texture must be a .png or .jpg file",
+                                          s.args[0]->text));
+        }
+    }
+    ConstVal value;
+    value.v[0] = static_cast<double>(index);
+    value.span = s.span;
+    consts_[s.name] = value;
+    value_spans_[s.name] = s.span;
+    texture_index_[s.name] = index;
+    if (index < inherited_textures_) body_textures_.insert(s.name);
+    if (index < P_.textures.size())
+        P_.textures[index] = std::move(def);
+    else
+        P_.textures.push_back(std::move(def));
+}
+
+// The bytes of the image file of identity `id`, read once per grammar; null after an input error.
+std::shared_ptr<const std::string> Compiler::texture_bytes(const ast::ShapeDecl& s, const std::string& id) {
+    if (auto it = texture_files_->by_identity.find(id); it != texture_files_->by_identity.end())
+        return it->second;
+    const std::string& written = s.args[0]->text;
+    const std::size_t left = kMaxTextureBytes - texture_files_->bytes;
+    auto text = std::make_shared<std::string>();
+    if (ReadFailure why = read_input_file(id, *text, left); why != ReadFailure::None) {
+        diags_->input_error(s.args[0]->span,
+                            why == ReadFailure::TooLarge && left < kMaxTextureBytes
+                                ? fmt::format("cannot read texture image '{}': the grammar's texture images "
+                                              "together may take at most {} MB",
+                                              written, kMaxTextureBytes >> 20)
+                                : fmt::format("cannot read texture image '{}': {}", written, describe(why)));
+        return nullptr;
+    }
+    texture_files_->bytes += text->size();
+    texture_files_->by_identity[id] = text;
+    return text;
 }
 
 void Compiler::compile_environment(const ast::ShapeDecl& s) {

@@ -145,6 +145,7 @@ void Compiler::declare() {
             curve_names_.insert(cv.name);
             curve_decls_.push_back(&cv);
         }
+        for (const auto& t : lf.file->textures) declare_texture(t); // before the values: names are consts
         for (const auto& s : lf.file->surfaces) {
             surface_decls_.push_back(&s);
             P_.symbols.intern("~" + s.name);

@@ -153,6 +153,8 @@ class Compiler {
     void check_raw_runs();
     void build_template(Production& p);
     void compile_surface(const ast::ShapeDecl& s);
+    void declare_texture(const ast::ShapeDecl& s);
+    std::shared_ptr<const std::string> texture_bytes(const ast::ShapeDecl& s, const std::string& id);
     void compile_curve(const ast::ShapeDecl& s);
     void compile_environment(const ast::ShapeDecl& s);
     ValueType compile_env_call(Ctx& c, const ast::Expr& e, std::size_t env);
@@ -224,6 +226,20 @@ class Compiler {
     std::size_t inherited_surfaces_ = 0;        // surfaces of the outer program, which a body may replace
     std::set<std::string> body_surfaces_;
     std::size_t inherited_functions_ = 0; // the outer program's, compiled only when called
+
+    // textures (compile_shapes.cpp): each name's index in P_.textures, those inherited from the
+    // outer program (a body may replace each once), and the image files read so far by identity,
+    // shared by every compiler of one grammar so that a file is read once and all of them
+    // together stay within kMaxTextureBytes
+    std::unordered_map<std::string, std::size_t> texture_index_;
+    std::size_t inherited_textures_ = 0;
+    std::set<std::string> body_textures_;
+    bool too_many_textures_ = false;
+    struct TextureFiles {
+        std::map<std::string, std::shared_ptr<const std::string>> by_identity;
+        std::size_t bytes = 0;
+    };
+    std::shared_ptr<TextureFiles> texture_files_ = std::make_shared<TextureFiles>();
     bool too_many_instances_ = false;
 };
 

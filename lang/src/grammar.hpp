@@ -34,6 +34,7 @@ PLANT_KW(fn, "fn");
 PLANT_KW(curve, "curve");
 PLANT_KW(surface, "surface");
 PLANT_KW(env, "env");
+PLANT_KW(texture, "texture");
 PLANT_KW(instance, "instance");
 PLANT_KW(derive, "derive");
 PLANT_KW(angle, "angle");
@@ -200,6 +201,8 @@ struct fn_item : if_must<kw_fn, name, param_list, sor<fn_expr_body, block>> {};
 struct shape_kind : name {};
 struct curve_item : if_must<kw_curve, name, equals, shape_kind, call_args, semi> {};
 struct surface_item : if_must<kw_surface, name, equals, shape_kind, call_args, semi> {};
+// texture name = image("file.png");
+struct texture_item : if_must<kw_texture, name, equals, shape_kind, call_args, semi> {};
 // env name = kind(key: value, ...);
 struct key_arg : seq<opt<name, colon>, expr> {};
 struct key_args : if_must<open_paren, opt<list<key_arg, comma>>, close_paren> {};
@@ -224,9 +227,9 @@ struct override_block : if_must<open_brace, opt<list<override_item, comma>>, opt
 struct import_target : sor<seq<string_lit, ws>, name> {};
 struct with_clause : if_must<kw_with, override_block> {};
 struct import_item : if_must<kw_import, import_target, opt<with_clause>, semi> {};
-struct item : sor<param_item, const_item, var_item, module_item, fn_item, curve_item, surface_item, env_item,
-                  instance_item, setting_item, axiom_item, symbol_set_item, rules_item, decompose_item,
-                  interpret_item, hook_item, import_item> {};
+struct item : sor<param_item, const_item, var_item, module_item, fn_item, curve_item, surface_item,
+                  texture_item, env_item, instance_item, setting_item, axiom_item, symbol_set_item,
+                  rules_item, decompose_item, interpret_item, hook_item, import_item> {};
 
 // The file is parsed one item at a time (parser.cpp) so that an error in one item does not hide
 // errors in later ones.

@@ -97,6 +97,7 @@ PLANT_CONSTRUCT(module_item);
 PLANT_CONSTRUCT(fn_item);
 PLANT_CONSTRUCT(curve_item);
 PLANT_CONSTRUCT(surface_item);
+PLANT_CONSTRUCT(texture_item);
 PLANT_CONSTRUCT(env_item);
 PLANT_CONSTRUCT(setting_item);
 PLANT_CONSTRUCT(axiom_item);

@@ -29,11 +29,11 @@ using selector = pt::selector<
         g::if_stmt, g::else_part, g::for_stmt, g::produce_stmt, g::nproduce_stmt, g::use_stmt, g::stop_stmt,
         g::return_stmt, g::expr_stmt, g::param_item, g::const_item, g::var_item, g::module_item,
         g::module_decl, g::param_list, g::param_decl, g::bound_clause, g::fn_item, g::fn_expr_body,
-        g::curve_item, g::surface_item, g::shape_kind, g::env_item, g::key_args, g::key_arg, g::instance_item,
-        g::instance_body, g::setting_item, g::setting_key, g::axiom_item, g::symbol_set_item,
-        g::symbol_set_kind, g::rules_item, g::group_name, g::rules_body, g::decompose_item, g::interpret_item,
-        g::max_depth_clause, g::hook_item, g::hook_name, g::import_item, g::import_target, g::with_clause,
-        g::override_block, g::override_item>,
+        g::curve_item, g::surface_item, g::texture_item, g::shape_kind, g::env_item, g::key_args, g::key_arg,
+        g::instance_item, g::instance_body, g::setting_item, g::setting_key, g::axiom_item,
+        g::symbol_set_item, g::symbol_set_kind, g::rules_item, g::group_name, g::rules_body,
+        g::decompose_item, g::interpret_item, g::max_depth_clause, g::hook_item, g::hook_name, g::import_item,
+        g::import_target, g::with_clause, g::override_block, g::override_item>,
     // (ternary_then and ternary_else are selected only so that their nesting is counted: the tree
     // builder calls the grammar's control for selected rules alone; each has one child, which
     // fold_one puts in its place)
@@ -427,6 +427,8 @@ class Lowering {
             f.curves.push_back(shape(n));
         } else if (n.is_type<g::surface_item>()) {
             f.surfaces.push_back(shape(n));
+        } else if (n.is_type<g::texture_item>()) {
+            f.textures.push_back(shape(n));
         } else if (n.is_type<g::env_item>()) {
             f.envs.push_back(shape(n));
         } else if (n.is_type<g::instance_item>()) {
@@ -538,10 +540,10 @@ void report(const g::GrammarError& e, const SourceFile& src, std::uint32_t file_
 // error (the error may be the keyword itself, as when a ';' is missing at the end of the line
 // before), but always after `item_start` so that parsing makes progress.
 std::size_t resync(const std::string& text, std::size_t from, std::size_t item_start) {
-    static const char* keywords[] = {"param ",    "const ",    "var ",      "module ", "fn ",      "curve ",
-                                     "surface ",  "env ",      "instance ", "derive ", "angle ",   "step ",
-                                     "width ",    "seed ",     "axiom",     "ignore",  "consider", "rules",
-                                     "decompose", "interpret", "on ",       "import ", "/*"};
+    static const char* keywords[] = {"param ",   "const ",    "var ",      "module ",   "fn ",     "curve ",
+                                     "surface ", "texture ",  "env ",      "instance ", "derive ", "angle ",
+                                     "step ",    "width ",    "seed ",     "axiom",     "ignore",  "consider",
+                                     "rules",    "decompose", "interpret", "on ",       "import ", "/*"};
     std::size_t b = from;
     while (b > 0 && text[b - 1] != '\n') --b; // start of the error's line
     while (b < text.size()) {

@@ -6,6 +6,9 @@
 // vertex accessors and has its own index accessor, a window into the part's index view. With GPU
 // instancing, each instanced node's TRANSLATION (vec3), ROTATION (vec4) and SCALE (vec3) views
 // follow the meshes. All components are 4 bytes, so every view and accessor is 4-byte aligned.
+// Each texture image a material uses is written once, as its file's bytes in a buffer view of its
+// own (padded to 4 bytes like the others), where its material first needs it; every texture
+// shares one sampler (repeat in both directions, linear filtering with mipmaps).
 #include "plant/export.hpp"
 
 #include "export_placement.hpp"
@@ -52,6 +55,7 @@ struct GltfBuilder {
     const std::vector<detail::NestedGroup>& groups; // scene prototypes kept as nodes
     tinygltf::Model model;
     std::vector<int> material_index;   // scene material -> glTF material, -1 while unused
+    std::vector<int> texture_index;    // scene texture -> glTF texture, -1 while unused
     std::vector<std::uint32_t> shared; // prototype -> the first prototype with the same mesh
     std::vector<int> proto_mesh;       // prototype -> its mesh, -1 while none (or empty)
     std::vector<bool> meshed;          // prototype -> add_mesh was called for it
@@ -60,6 +64,7 @@ struct GltfBuilder {
         model.asset.version = "2.0";
         model.asset.generator = "plant";
         material_index.assign(std::max<std::size_t>(scene.materials.size(), 1), -1);
+        texture_index.assign(scene.textures.size(), -1);
     }
 
     std::vector<unsigned char>& data() {
@@ -105,11 +110,47 @@ struct GltfBuilder {
         auto channel = [](float x) { return std::isfinite(x) ? tidy(std::clamp(x, 0.0f, 1.0f)) : 0.0; };
         mat.pbrMetallicRoughness.baseColorFactor = {channel(color.color.r), channel(color.color.g),
                                                     channel(color.color.b), 1.0};
+        if (color.texture >= 0) { // the image replaces the colour (docs/language.md, textures)
+            mat.pbrMetallicRoughness.baseColorTexture.index = texture(color.texture, part);
+            mat.pbrMetallicRoughness.baseColorTexture.texCoord = 0;
+            mat.pbrMetallicRoughness.baseColorFactor = {1.0, 1.0, 1.0, 1.0};
+        }
         mat.pbrMetallicRoughness.metallicFactor = 0.0;
         mat.pbrMetallicRoughness.roughnessFactor = 0.9;
         mat.doubleSided = true;
         model.materials.push_back(std::move(mat));
         index = static_cast<int>(model.materials.size() - 1);
+        return index;
+    }
+
+    // The glTF texture of scene texture t: its image (the file's bytes in a buffer view) and the
+    // one sampler, added on first use.
+    int texture(int t, const std::string& part) {
+        if (static_cast<std::size_t>(t) >= scene.textures.size() || !scene.textures[std::size_t(t)].bytes)
+            throw ExportError("glTF export: " + part + " uses texture " + std::to_string(t) +
+                              " but the scene has " + std::to_string(scene.textures.size()));
+        int& index = texture_index[std::size_t(t)];
+        if (index >= 0) return index;
+        const Texture& given = scene.textures[std::size_t(t)];
+        if (model.samplers.empty()) {
+            tinygltf::Sampler sampler;
+            sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
+            sampler.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
+            sampler.wrapS = TINYGLTF_TEXTURE_WRAP_REPEAT;
+            sampler.wrapT = TINYGLTF_TEXTURE_WRAP_REPEAT;
+            model.samplers.push_back(std::move(sampler));
+        }
+        tinygltf::Image image;
+        image.name = given.name;
+        image.mimeType = given.mime_type;
+        image.bufferView = add_view(given.bytes->data(), given.bytes->size(), 0);
+        model.images.push_back(std::move(image));
+        tinygltf::Texture tex;
+        tex.name = given.name;
+        tex.sampler = 0;
+        tex.source = static_cast<int>(model.images.size() - 1);
+        model.textures.push_back(std::move(tex));
+        index = static_cast<int>(model.textures.size() - 1);
         return index;
     }
 

@@ -166,6 +166,7 @@ Scene split_nested(const Scene& scene, std::vector<NestedGroup>& groups, const s
     rest.prototype_names = scene.prototype_names;
     rest.instances = scene.instances;
     rest.materials = scene.materials;
+    rest.textures = scene.textures;
     rest.scene_prototypes = scene.scene_prototypes;
     rest.scene_prototype_names = scene.scene_prototype_names;
     for (const Instance& i : scene.scene_instances) {
@@ -193,12 +194,9 @@ Scene split_nested(const Scene& scene, std::vector<NestedGroup>& groups, const s
     } catch (const std::out_of_range& e) {
         throw ExportError(what + ": " + e.what());
     }
-    // each nested prototype's parts join the result's prototypes, their materials by colour
-    std::map<std::array<float, 3>, std::uint32_t> material_index;
-    for (std::uint32_t m = static_cast<std::uint32_t>(out.materials.size()); m-- > 0;) {
-        const glm::vec3& c = out.materials[m].color;
-        material_index[{c.x, c.y, c.z}] = m;
-    }
+    // each nested prototype's parts join the result's prototypes, their materials by colour and
+    // texture
+    MaterialMerger merger(out);
     for (std::size_t k = 0; k < n; ++k) {
         if (group_of[k] < 0) continue;
         NestedGroup& g = groups[std::size_t(group_of[k])];
@@ -209,13 +207,8 @@ Scene split_nested(const Scene& scene, std::vector<NestedGroup>& groups, const s
             throw ExportError(what + ": " + e.what());
         }
         std::vector<std::uint32_t> material(inner.materials.size());
-        for (std::size_t m = 0; m < inner.materials.size(); ++m) {
-            const glm::vec3& c = inner.materials[m].color;
-            auto [it, added] = material_index.emplace(std::array<float, 3>{c.x, c.y, c.z},
-                                                      static_cast<std::uint32_t>(out.materials.size()));
-            if (added) out.materials.push_back(inner.materials[m]);
-            material[m] = it->second;
-        }
+        for (std::size_t m = 0; m < inner.materials.size(); ++m)
+            material[m] = merger.add(inner, static_cast<std::uint32_t>(m));
         auto add = [&](MeshPart part, const std::string& name) {
             for (auto& p : part.primitives) {
                 if (p.material >= material.size())

@@ -1,6 +1,7 @@
 // PNG preview: a small software rasterizer (orthographic 3/4 view, or a perspective camera the
 // user places; z-buffer, Gouraud-shaded two-sided Lambert lighting, 2x2 supersampling) and the PNG
 // writer on top of it.
+// A textured material is drawn in its image's average colour (texture_image.hpp).
 //
 // Triangles are set up in 28.4 fixed point with exact 64-bit edge functions and a consistent
 // tie-breaking rule, so meshes are watertight (no background speckles along shared edges) and
@@ -10,6 +11,8 @@
 
 #include "plant/export.hpp"
 #include "plant/raster.hpp"
+
+#include "texture_image.hpp"
 
 #include <fmt/format.h>
 #include <glm/glm.hpp>
@@ -339,14 +342,15 @@ float clamp01(float v) {
     return std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f;
 }
 
-std::array<float, 3> lut_scale_for(const Scene& scene, std::uint32_t material) {
-    Material m;
-    if (material < scene.materials.size())
-        m = scene.materials[material];
-    else if (!scene.materials.empty())
-        m = scene.materials.front();
+// `colors`: per material, what it is drawn in (a texture's average colour, detail::flat_colors).
+std::array<float, 3> lut_scale_for(const std::vector<glm::vec3>& colors, std::uint32_t material) {
+    glm::vec3 c = Material{}.color;
+    if (material < colors.size())
+        c = colors[material];
+    else if (!colors.empty())
+        c = colors.front();
     const float s = float(kLutSize - 1);
-    return {clamp01(m.color.r) * s, clamp01(m.color.g) * s, clamp01(m.color.b) * s};
+    return {clamp01(c.r) * s, clamp01(c.g) * s, clamp01(c.b) * s};
 }
 
 // A vertex in a perspective camera's view coordinates (right, up, depth), with its lighting terms.
@@ -363,6 +367,7 @@ struct Renderer {
     glm::dvec3 light_view; // the light in (right, up, toward) coordinates
     std::vector<ScreenVertex> verts;
     std::vector<ViewVertex> view_verts; // for a perspective camera
+    std::vector<glm::vec3> colors;      // per material: detail::flat_colors
 
     // Transforms the part's vertices (by `model` first, if given) to a perspective camera's view.
     void transform_perspective(const MeshPart& part, const glm::dmat4* model) {
@@ -555,7 +560,7 @@ struct Renderer {
         const std::size_t n = part.indices.size();
         if (first >= n) return;
         const std::size_t end = first + std::min(count, n - first);
-        const std::array<float, 3> color = lut_scale_for(scene, material);
+        const std::array<float, 3> color = lut_scale_for(colors, material);
         const std::size_t nv = cam.perspective ? view_verts.size() : verts.size();
         for (std::size_t i = first; i + 3 <= end; i += 3) {
             const std::uint32_t ia = part.indices[i], ib = part.indices[i + 1], ic = part.indices[i + 2];
@@ -620,7 +625,8 @@ Image render_scene(const Scene& scene, int width, int height, const std::optiona
                  glm::dvec3(glm::dot(cam.light, cam.right), glm::dot(cam.light, cam.up),
                             glm::dot(cam.light, cam.toward)),
                  {},
-                 {}};
+                 {},
+                 detail::flat_colors(scene)};
     ren.draw_part(scene.tubes, nullptr);
     for (const Instance& inst : scene.instances) {
         if (inst.prototype >= scene.prototypes.size()) continue;

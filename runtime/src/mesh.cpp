@@ -26,6 +26,7 @@ struct Ring {
     double miter = 1.0; // stretch along `bend`
     glm::vec3 color;
     double slope = 0.0; // d radius / d arc length, for normals of tapering tubes
+    int texture = -1;   // SkeletonPoint::texture
 };
 
 // Smallest rotation taking unit vector a to unit vector b, applied to v (Rodrigues' formula with
@@ -74,7 +75,8 @@ void rings_of(const TubePath& path, const MeshOptions& o, Scratch& s) {
         const SkeletonPoint& p = *pts[k];
         double r = std::max(p.radius, 1e-6);
         if (k == 0 || k == m) {
-            rings.push_back(Ring{p.position, k == 0 ? dir(0) : dir(m - 1), r, glm::dvec3(0), 1.0, p.color});
+            rings.push_back(Ring{p.position, k == 0 ? dir(0) : dir(m - 1), r, glm::dvec3(0), 1.0, p.color,
+                                 0.0, p.texture});
             continue;
         }
         glm::dvec3 d0 = dir(k - 1), d1 = dir(k);
@@ -87,7 +89,8 @@ void rings_of(const TubePath& path, const MeshOptions& o, Scratch& s) {
             double bl = glm::length(bend);
             // 1 / cos(theta / 2), from the half-angle identity
             double miter = 1.0 / std::sqrt(0.5 * (1.0 + cos_theta));
-            rings.push_back(Ring{p.position, t, r, bl > 1e-12 ? bend / bl : glm::dvec3(0), miter, p.color});
+            rings.push_back(Ring{p.position, t, r, bl > 1e-12 ? bend / bl : glm::dvec3(0), miter, p.color,
+                                 0.0, p.texture});
             continue;
         }
         // round the corner with a circular arc tangent to both segments, of radius 1.5 tube radii
@@ -110,7 +113,7 @@ void rings_of(const TubePath& path, const MeshOptions& o, Scratch& s) {
             double phi = theta * j / n;
             glm::dvec3 c = center + rotate(start - center, turn, phi);
             glm::dvec3 t = rotate(d0, turn, phi);
-            rings.push_back(Ring{c, glm::normalize(t), r, glm::dvec3(0), 1.0, p.color});
+            rings.push_back(Ring{c, glm::normalize(t), r, glm::dvec3(0), 1.0, p.color, 0.0, p.texture});
         }
     }
     rings.back().radius *= o.tip_taper; // a tapered tip
@@ -190,6 +193,13 @@ std::vector<TubePath> tube_paths(const Skeleton& skeleton, const MeshOptions& o)
 void mesh_tube(const TubePath& path, const MeshOptions& o, MeshPart& part,
                std::vector<std::vector<std::uint32_t>>& indices_by_material,
                const std::function<std::uint32_t(const glm::vec3&)>& material_of) {
+    mesh_tube(path, o, part, indices_by_material,
+              [&](const glm::vec3& color, int) { return material_of(color); });
+}
+
+void mesh_tube(const TubePath& path, const MeshOptions& o, MeshPart& part,
+               std::vector<std::vector<std::uint32_t>>& indices_by_material,
+               const std::function<std::uint32_t(const glm::vec3&, int)>& material_of) {
     thread_local Scratch s;
     rings_of(path, o, s);
     const std::vector<Ring>& rings = s.rings;
@@ -241,13 +251,16 @@ void mesh_tube(const TubePath& path, const MeshOptions& o, MeshPart& part,
             *uv++ = glm::vec2(static_cast<float>(double(j) / sides), static_cast<float>(arc));
         }
     }
-    // triangles, grouped by material (looked up only when the colour changes along the tube)
+    // triangles, grouped by material (looked up only when the colour or texture changes along the
+    // tube)
     std::vector<std::uint32_t>* idx = nullptr;
     glm::vec3 last_color(-1.0f);
+    int last_texture = -1;
     for (std::size_t k = 0; k + 1 < rings.size(); ++k) {
-        if (!idx || rings[k + 1].color != last_color) {
+        if (!idx || rings[k + 1].color != last_color || rings[k + 1].texture != last_texture) {
             last_color = rings[k + 1].color;
-            const std::uint32_t material = material_of(last_color);
+            last_texture = rings[k + 1].texture;
+            const std::uint32_t material = material_of(last_color, last_texture);
             if (material >= indices_by_material.size()) indices_by_material.resize(material + 1);
             idx = &indices_by_material[material];
         }

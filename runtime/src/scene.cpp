@@ -52,6 +52,49 @@ void Scene::update_bounds() {
     bounds_max = hi;
 }
 
+namespace {
+
+const std::string* texture_key(const Scene& s, int texture) {
+    return texture >= 0 && static_cast<std::size_t>(texture) < s.textures.size()
+               ? s.textures[static_cast<std::size_t>(texture)].bytes.get()
+               : nullptr;
+}
+
+} // namespace
+
+MaterialMerger::MaterialMerger(Scene& out) : out_(out) {
+    for (std::uint32_t m = static_cast<std::uint32_t>(out.materials.size()); m-- > 0;) {
+        const Material& mat = out.materials[m];
+        // the first material of each colour and texture
+        index_[{mat.color.x, mat.color.y, mat.color.z, texture_key(out, mat.texture)}] = m;
+    }
+}
+
+std::uint32_t MaterialMerger::add(const Scene& from, std::uint32_t m) {
+    const Material& mat = from.materials.at(m);
+    const std::string* bytes = texture_key(from, mat.texture);
+    return add(mat, bytes ? &from.textures[static_cast<std::size_t>(mat.texture)] : nullptr);
+}
+
+std::uint32_t MaterialMerger::add(const Material& material, const Texture* texture) {
+    const glm::vec3& c = material.color;
+    const std::string* bytes = texture ? texture->bytes.get() : nullptr;
+    auto [it, added] =
+        index_.emplace(std::tuple{c.x, c.y, c.z, bytes}, static_cast<std::uint32_t>(out_.materials.size()));
+    if (!added) return it->second;
+    Material made{c, -1};
+    if (bytes) {
+        for (std::size_t t = 0; t < out_.textures.size() && made.texture < 0; ++t)
+            if (out_.textures[t].bytes.get() == bytes) made.texture = static_cast<int>(t);
+        if (made.texture < 0) {
+            made.texture = static_cast<int>(out_.textures.size());
+            out_.textures.push_back(*texture);
+        }
+    }
+    out_.materials.push_back(made);
+    return it->second;
+}
+
 Scene flatten(const Scene& scene) {
     if (!scene.nested()) return scene;
     Scene out;
@@ -60,17 +103,8 @@ Scene flatten(const Scene& scene) {
     out.prototype_names = scene.prototype_names;
     out.instances = scene.instances;
     out.materials = scene.materials;
-    std::map<std::array<float, 3>, std::uint32_t> material_index;
-    for (std::uint32_t m = static_cast<std::uint32_t>(out.materials.size()); m-- > 0;) {
-        const glm::vec3& c = out.materials[m].color;
-        material_index[{c.x, c.y, c.z}] = m; // the first material of each color
-    }
-    auto material_of = [&](const glm::vec3& c) {
-        auto [it, added] = material_index.emplace(std::array<float, 3>{c.x, c.y, c.z},
-                                                  static_cast<std::uint32_t>(out.materials.size()));
-        if (added) out.materials.push_back(Material{c});
-        return it->second;
-    };
+    out.textures = scene.textures;
+    MaterialMerger merger(out);
     // per scene prototype, once placed: the result's prototype of its tubes (or none) and of each
     // of its own prototypes, and its instances in its own frame
     struct Drawn {
@@ -91,7 +125,7 @@ Scene flatten(const Scene& scene) {
                     : "scene" + std::to_string(k);
             std::vector<std::uint32_t> material(inner.materials.size());
             for (std::size_t m = 0; m < inner.materials.size(); ++m)
-                material[m] = material_of(inner.materials[m].color);
+                material[m] = merger.add(inner, static_cast<std::uint32_t>(m));
             auto add = [&](MeshPart part, const std::string& part_name) {
                 for (auto& p : part.primitives) p.material = material.at(p.material);
                 out.prototypes.push_back(std::move(part));
@@ -246,13 +280,16 @@ namespace detail {
 
 Scene mesh_skeleton(const Program& program, const Skeleton& skeleton, const MeshOptions& options) {
     Scene scene;
-    std::map<std::array<float, 3>, std::uint32_t> material_index;
-    auto material_of = [&](const glm::vec3& c) -> std::uint32_t {
-        std::array<float, 3> key{c.x, c.y, c.z};
+    for (const TextureDef& t : program.textures)
+        scene.textures.push_back(Texture{t.name, t.mime_type, t.bytes});
+    // one material per colour and texture
+    std::map<std::tuple<float, float, float, int>, std::uint32_t> material_index;
+    auto material_of = [&](const glm::vec3& c, int texture) -> std::uint32_t {
+        std::tuple<float, float, float, int> key{c.x, c.y, c.z, texture};
         auto it = material_index.find(key);
         if (it != material_index.end()) return it->second;
         auto id = static_cast<std::uint32_t>(scene.materials.size());
-        scene.materials.push_back(Material{c});
+        scene.materials.push_back(Material{c, texture});
         material_index.emplace(key, id);
         return id;
     };
@@ -279,7 +316,7 @@ Scene mesh_skeleton(const Program& program, const Skeleton& skeleton, const Mesh
     std::map<OrganShape, MeshPart> shapes;
     for (const auto& organ : skeleton.organs) {
         if (organ.shape.kind == OrganKind::Instance) continue; // placed by build_scene (instances.cpp)
-        std::uint32_t material = material_of(organ.color);
+        std::uint32_t material = material_of(organ.color, organ.texture);
         auto key = std::pair{organ.shape, material};
         auto it = prototype_index.find(key);
         if (it == prototype_index.end()) {

@@ -225,6 +225,28 @@ class Turtle {
 
     void apply(TurtleOp op, std::size_t i);
 
+    // SetTexture(t): t is a declared texture's index (its name in the grammar), -1 or nothing for
+    // none (docs/language.md, textures).
+    void set_texture(std::size_t i) {
+        const double t = arg(i, 0, -1.0);
+        if (t == -1) {
+            t_.texture = -1;
+            return;
+        }
+        const std::size_t n = program_.textures.size();
+        if (!(t >= 0) || t != std::floor(t) || t >= static_cast<double>(n))
+            throw RuntimeError(
+                RuntimeErrorKind::Turtle, Span{},
+                fmt::format("module {} ('{}') of the string sets texture {}, but the grammar declares {}: "
+                            "declare one with 'texture bark = image(\"bark.png\");' and write "
+                            "SetTexture(bark), or SetTexture(-1) for none",
+                            i + 1, program_.symbols[s_.sym[i]].name, format_double(t),
+                            n == 0   ? std::string("no textures")
+                            : n == 1 ? std::string("only texture 0")
+                                     : fmt::format("textures 0 to {}", n - 1)));
+        t_.texture = static_cast<int>(t);
+    }
+
     // An instance's module (docs/language.md, instances): its arguments, then an optional scale;
     // the instance is placed in the turtle's frame at that scale (the width does not scale it).
     void place_instance(std::size_t i, int index) {
@@ -324,7 +346,8 @@ void Turtle::apply(TurtleOp op, std::size_t i) {
                                 frame_matrix(t_, arg(i, 0, t_.width / 2)),
                                 t_.color,
                                 i,
-                                s_.id(i)});
+                                s_.id(i),
+                                t_.texture});
         break;
     case TurtleOp::Surface:
         // "~name": the surface's name follows the prefix row's name
@@ -336,7 +359,8 @@ void Turtle::apply(TurtleOp op, std::size_t i) {
             frame_matrix(t_, arg(i, 0, 1.0)),
             t_.color,
             i,
-            s_.id(i)});
+            s_.id(i),
+            t_.texture});
         break;
     case TurtleOp::SetHeading:
         if (s_.arity(i) >= 6)
@@ -349,6 +373,9 @@ void Turtle::apply(TurtleOp op, std::size_t i) {
         if (s_.arity(i) >= 3) t_.position = vec_arg(i, 0);
         t_.axis = -1;
         check(i);
+        break;
+    case TurtleOp::SetTexture:
+        set_texture(i);
         break;
     case TurtleOp::Tropism:
         if (s_.arity(i) >= 3) t_.tropism = vec_arg(i, 0);

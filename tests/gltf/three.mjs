@@ -5,6 +5,9 @@
 // mesh's placements in node order, instanced or plain, children placed by their parents).
 //   node tests/gltf/three.mjs [--expect NAME=COUNT]... INSTANCED NODES [INSTANCED NODES]...
 // INSTANCED is a file written with GPU instancing, NODES the same scene with plain nodes.
+// Textures: every material three.js built for a glTF material with a baseColorTexture has a map
+// whose image holds the bytes of the file's image, and no other material has one. Images are not
+// decoded under node (see imageStub below).
 // --expect: three.js built an InstancedMesh of COUNT instances for the node named NAME (in every
 // INSTANCED file). Exits 1 when a check fails, 2 on bad usage.
 import { readGltf, gpuInstancing } from './gltf.mjs';
@@ -19,6 +22,56 @@ globalThis.ProgressEvent ??= class ProgressEvent extends Event {
         Object.assign(this, init);
     }
 };
+
+// Images under node: three.js's GLTFLoader makes a texture's image with createImageBitmap (and
+// reads `self.URL`), which node lacks. This stand-in does not decode the image: it reads its size
+// from the PNG or JPEG header and keeps its bytes, which the texture check compares with the file.
+globalThis.self ??= globalThis;
+globalThis.createImageBitmap ??= async function imageStub(blob) {
+    const bytes = new Uint8Array(await blob.arrayBuffer());
+    return { ...imageSize(bytes), bytes, close() {} };
+};
+
+function imageSize(b) {
+    const be = (k, n) => (n === 4 ? ((b[k] << 24) | (b[k + 1] << 16) | (b[k + 2] << 8) | b[k + 3]) >>> 0 : (b[k] << 8) | b[k + 1]);
+    if (b[0] === 0x89 && b[1] === 0x50) return { width: be(16, 4), height: be(20, 4) }; // PNG's IHDR
+    for (let k = 2; k + 9 < b.length; k += 2 + be(k + 2, 2)) { // JPEG: the first start-of-frame
+        const m = b[k + 1];
+        if (m >= 0xc0 && m <= 0xcf && m !== 0xc4 && m !== 0xc8 && m !== 0xcc) return { width: be(k + 7, 2), height: be(k + 5, 2) };
+    }
+    return { width: 0, height: 0 };
+}
+
+function sameBytes(a, b) {
+    return a !== undefined && a.length === b.length && a.every((x, k) => x === b[k]);
+}
+
+// Each three.js material made for a glTF material: a map exactly when that has a baseColorTexture,
+// holding the image's bytes. Returns the number of textured materials seen.
+function checkTextures(loaded, gltf, problems) {
+    const json = gltf.json, parser = loaded.parser;
+    let textured = 0;
+    const seen = new Set();
+    loaded.scene.traverse((o) => {
+        for (const material of o.isMesh ? [o.material].flat() : []) {
+            const index = parser.associations.get(material)?.materials;
+            if (index === undefined || seen.has(material)) continue;
+            seen.add(material);
+            const want = json.materials[index].pbrMetallicRoughness?.baseColorTexture;
+            if (!want !== !material.map) {
+                problems.push(`material ${index}: ${material.map ? 'a map without' : 'no map for'} its baseColorTexture`);
+                continue;
+            }
+            if (!want) continue;
+            ++textured;
+            const view = json.bufferViews[json.images[json.textures[want.index].source].bufferView];
+            const start = view.byteOffset ?? 0;
+            if (!sameBytes(material.map.image?.bytes, gltf.buffer.subarray(start, start + view.byteLength)))
+                problems.push(`material ${index}: its map's image is not the file's image ${want.index}`);
+        }
+    });
+    return textured;
+}
 
 function usage() {
     console.error('usage: node tests/gltf/three.mjs [--expect NAME=COUNT]... INSTANCED NODES [INSTANCED NODES]...');
@@ -157,9 +210,10 @@ async function check(instancedFile, nodesFile) {
     for (const [name, count] of expect)
         if (counts.get(name) !== count)
             problems.push(`node '${name}': three.js built ${counts.get(name) ?? 'no'} instances, expected ${count}`);
+    const textured = checkTextures(loaded, instanced, problems);
     const total = [...built.values()].reduce((a, list) => a + list.length, 0);
     console.log(`${instancedFile}: three.js built ${total} InstancedMeshes for ${instancedNodes} instanced nodes, ` +
-                `${problems.length} problems`);
+                `${textured} textured materials, ${problems.length} problems`);
     return problems;
 }
 

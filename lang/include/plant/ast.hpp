@@ -218,7 +218,7 @@ struct FnDecl {
     std::vector<Stmt> body;
 };
 
-// curve / surface / env: name = kind(args)
+// curve / surface / texture / env: name = kind(args)
 struct ShapeDecl {
     Span span;
     std::string name;
@@ -273,7 +273,7 @@ struct File {
     std::vector<ValueDecl> values; // params, consts and vars in file order
     std::vector<ModuleDecl> modules;
     std::vector<FnDecl> functions;
-    std::vector<ShapeDecl> curves, surfaces, envs;
+    std::vector<ShapeDecl> curves, surfaces, envs, textures;
     std::vector<InstanceDecl> instances;
     std::vector<Setting> settings;
     std::vector<Axiom> axioms;

@@ -248,6 +248,17 @@ struct SurfaceDef {
     Span span;
 };
 
+// `texture name = image("file.png");` (docs/language.md, textures): an image read whole at compile
+// time, PNG or JPEG as its first bytes say. The name is also a const holding the texture's index
+// in Program::textures, which SetTexture(name) passes to the turtle.
+struct TextureDef {
+    std::string name;
+    std::string path;                         // resolved against the declaring file
+    std::string mime_type;                    // "image/png" or "image/jpeg"
+    std::shared_ptr<const std::string> bytes; // the file's bytes, shared by the programs that see it
+    Span span;
+};
+
 class Environment;
 struct EnvironmentKind;
 
@@ -313,6 +324,7 @@ struct Program {
     std::array<std::uint16_t, ast::kHooks.size()> hook_frame{};
 
     std::vector<SurfaceDef> surfaces;
+    std::vector<TextureDef> textures; // by index: the value of the texture's name
     std::vector<CurveDef> curves;
     std::vector<EnvironmentDecl> environments; // `env` declarations, in file order
     std::vector<ProgramFile> files;            // in the order they were read: the main file first

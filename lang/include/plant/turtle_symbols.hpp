@@ -42,6 +42,7 @@ enum class TurtleOp : std::uint8_t {
     QueryUp,       // ?U
     QueryLeft,     // ?L
     Communicate,   // ?E
+    SetTexture,    // SetTexture
 };
 
 enum class TurtleKind : std::uint8_t {
@@ -67,7 +68,7 @@ struct TurtleSymbol {
 };
 
 // The order of rows is the order of registration, which fixes the symbols' ids: keep it, append.
-inline constexpr std::array<TurtleSymbol, 29> kTurtleSymbols{{
+inline constexpr std::array<TurtleSymbol, 30> kTurtleSymbols{{
     {"F", TurtleOp::Forward, 0, 2, TurtleKind::Turtle, "l, w",
      "move by l (default the grammar's step) drawing a segment; w sets the width first; then tropism"},
     {"f", TurtleOp::Move, 0, 1, TurtleKind::Turtle, "l",
@@ -118,6 +119,8 @@ inline constexpr std::array<TurtleSymbol, 29> kTurtleSymbols{{
     {"?L", TurtleOp::QueryLeft, 3, 3, TurtleKind::Query, "x, y, z", "receives the turtle's left vector"},
     {"?E", TurtleOp::Communicate, 2, kAnyParams, TurtleKind::Query, "env, slots...",
      "communication module: environment env fills the slots with its answers at this place"},
+    {"SetTexture", TurtleOp::SetTexture, 0, 1, TurtleKind::Turtle, "t",
+     "texture t (a name declared with `texture t = image(...)`) on what follows; -1 or no t: none"},
 }};
 
 // The row of an operation (the first, for operations two names share); nullptr for None.

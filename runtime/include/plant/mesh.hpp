@@ -39,9 +39,15 @@ using TubePath = std::vector<const SkeletonPoint*>;
 // Fig. 2.7) is one tube per segment, each with a hidden tapered tip inside the next.
 std::vector<TubePath> tube_paths(const Skeleton& skeleton, const MeshOptions& options);
 
-// Appends one tube to `part`, with primitives grouped by `material_of` (a color -> material
-// index map the caller keeps across tubes). Rings are shared between consecutive segments;
-// frames are parallel-transported from the first point's left vector.
+// Appends one tube to `part`, with primitives grouped by `material_of` (a (color, texture) ->
+// material index map the caller keeps across tubes; the texture is SkeletonPoint::texture). Rings
+// are shared between consecutive segments; frames are parallel-transported from the first point's
+// left vector. Texture coordinates: u runs around the ring from 0 to 1, v is the arc length along
+// the axis in world units.
+void mesh_tube(const TubePath& path, const MeshOptions& options, MeshPart& part,
+               std::vector<std::vector<std::uint32_t>>& indices_by_material,
+               const std::function<std::uint32_t(const glm::vec3&, int)>& material_of);
+// The same with materials by colour alone (textures ignored).
 void mesh_tube(const TubePath& path, const MeshOptions& options, MeshPart& part,
                std::vector<std::vector<std::uint32_t>>& indices_by_material,
                const std::function<std::uint32_t(const glm::vec3&)>& material_of);

@@ -6,14 +6,25 @@
 #include <glm/glm.hpp>
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace plant {
 
+// An image a material is drawn with (docs/language.md, textures): the file's bytes as the grammar
+// named them, PNG or JPEG.
+struct Texture {
+    std::string name;
+    std::string mime_type;                    // "image/png" or "image/jpeg"
+    std::shared_ptr<const std::string> bytes; // shared with the program and other scenes
+};
+
 struct Material {
     glm::vec3 color{0.45f, 0.32f, 0.2f}; // linear RGB, 0..1
+    int texture = -1; // an index in Scene::textures, -1 for none; the image replaces the colour
 };
 
 // Triangles of one material: indices[first, first + count) of the part's index buffer.
@@ -62,6 +73,7 @@ struct Scene {
     std::vector<SceneSource> scene_prototype_sources; // per scene prototype when build_scene made it
     std::size_t instance_derivations = 0; // instance derivations build_scene ran for it (nested ones too)
     std::vector<Material> materials;      // at least one
+    std::vector<Texture> textures;        // what materials name (the program's, used or not)
     glm::vec3 bounds_min{0.0f}, bounds_max{0.0f}; // of everything, instances and placed scenes included
     void update_bounds();
     bool nested() const { return !scene_instances.empty(); }
@@ -74,5 +86,20 @@ struct Scene {
 // without placed scenes comes back unchanged. Throws std::out_of_range for a placement of a
 // scene prototype that does not exist.
 Scene flatten(const Scene& scene);
+
+// Gathers materials from several scenes into one: one material per colour and texture image (told
+// apart by their bytes), each image added to the result's textures once. The result's own
+// materials keep their indices.
+class MaterialMerger {
+  public:
+    explicit MaterialMerger(Scene& out);
+    // The result's index of material `m` of `from` (which may be the result itself).
+    std::uint32_t add(const Scene& from, std::uint32_t m);
+
+  private:
+    std::uint32_t add(const Material& material, const Texture* texture);
+    Scene& out_;
+    std::map<std::tuple<float, float, float, const std::string*>, std::uint32_t> index_;
+};
 
 } // namespace plant

@@ -18,6 +18,7 @@ struct SkeletonPoint {
     glm::vec3 color{0.45f, 0.32f, 0.2f};
     ModuleId id = 0;    // module that drew the segment ending here (0 for an axis start)
     std::string module; // its name
+    int texture = -1;   // an index in Program::textures, -1 for none
 };
 
 // One generalized cylinder: consecutive F's of one branch level, lateral branches between them
@@ -32,6 +33,7 @@ struct SkeletonOrgan {
     glm::dmat4 transform;
     glm::vec3 color;
     ModuleId id = 0;
+    int texture = -1; // an index in Program::textures, -1 for none
 };
 
 struct Skeleton {

@@ -27,6 +27,7 @@ struct TurtleState {
     double angle = 90.0;               // default turn in degrees
     int color_index = 0;               // ;(c)
     glm::vec3 color{0.45f, 0.32f, 0.2f};
+    int texture = -1;                   // SetTexture: an index in Program::textures, -1 for none
     glm::dvec3 tropism{0.0, -1.0, 0.0}; // @Tp
     double elasticity = 0.0;            // @Ts; 0: no tropism
     int axis = -1;                      // axis being drawn, -1 when the next F starts a new one
@@ -64,6 +65,7 @@ struct TurtleOrgan {
     glm::vec3 color;
     std::size_t module;
     ModuleId id;
+    int texture = -1; // the turtle's texture (an index in Program::textures), -1 for none
 };
 
 // Receives what the turtle does. Every method has a no-op default (PlantGL's split of turtle,
