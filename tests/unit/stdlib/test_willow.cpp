@@ -411,3 +411,25 @@ TEST_CASE(
     CHECK(branch_meshes <= static_cast<int>(levels.size()));
     CHECK(leaf_meshes == 1);
 }
+
+TEST_CASE("willow: an importing file's surface leaf replaces the leaf every weeping branch places",
+          "[willow]") {
+    auto leaf_corners = [](const Scene& scene) {
+        const Scene flat = flatten(scene);
+        std::set<std::size_t> corners;
+        for (const Instance& i : flat.instances)
+            if (ends_with(flat.prototype_names.at(i.prototype), "/leaf"))
+                corners.insert(flat.prototypes[i.prototype].positions.size());
+        return corners;
+    };
+    Grown lance = grow({}, {}, {}, "import willow with { t = 4 };\n");
+    Grown mine = grow({}, {}, {},
+                      "import willow with { t = 4 };\n"
+                      "surface leaf = polygon(vec3(0, 0, 0), vec3(0.1, 0.5, 0), vec3(0, 1, 0));\n");
+    CHECK(mine.leaves == paper_count(12, 5, 4));
+    CHECK(flat_leaves(mine.scene) == mine.leaves);
+    const auto a = leaf_corners(lance.scene), b = leaf_corners(mine.scene);
+    REQUIRE(a.size() == 1); // one leaf mesh
+    REQUIRE(b.size() == 1);
+    CHECK(*b.begin() < *a.begin()); // a triangle, not the 12-corner lance
+}
