@@ -163,25 +163,30 @@ ValueType Compiler::compile_function_body(std::uint32_t index, Code& code, std::
     return result;
 }
 
+// Compiles a function's body quietly to learn its result type, which recursive calls need, and
+// calls from functions compiled before it (a function declared later, or an outer function an
+// instance body compiles when first called) while their own result types are inferred.
+void Compiler::infer_function_result(std::uint32_t index) {
+    Diagnostics scratch;
+    Diagnostics* saved = diags_;
+    const bool was_inferring = inferring_;
+    diags_ = &scratch;
+    inferring_ = true;
+    Code code;
+    std::uint16_t frame = 0;
+    ValueType t = compile_function_body(index, code, frame);
+    diags_ = saved;
+    inferring_ = was_inferring;
+    P_.functions[index].result = t == ValueType::Void ? ValueType::Number : t;
+    fn_result_known_[index] = true;
+}
+
 void Compiler::ensure_function_compiled(std::uint32_t index) {
     if (fn_state_[index] != 0) return; // compiled, or being compiled (recursion)
     fn_state_[index] = 1;
-    // First pass, quietly: learn the result type, which recursive calls need. Second pass: the
-    // real code, with recursive calls typed.
-    {
-        Diagnostics scratch;
-        Diagnostics* saved = diags_;
-        const bool was_inferring = inferring_;
-        diags_ = &scratch;
-        inferring_ = true;
-        Code code;
-        std::uint16_t frame = 0;
-        ValueType t = compile_function_body(index, code, frame);
-        diags_ = saved;
-        inferring_ = was_inferring;
-        P_.functions[index].result = t == ValueType::Void ? ValueType::Number : t;
-        fn_result_known_[index] = true;
-    }
+    // First pass, quietly: learn the result type. Second pass: the real code, with recursive
+    // calls typed.
+    infer_function_result(index);
     Code code;
     std::uint16_t frame = 0;
     ValueType result = compile_function_body(index, code, frame);

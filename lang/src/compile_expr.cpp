@@ -403,8 +403,14 @@ ValueType Compiler::compile_call(Ctx& c, const ast::Expr& e) {
     if (auto it = fn_index_.find(name); it != fn_index_.end()) {
         Function& fn = P_.functions[it->second];
         // while a result type is being inferred, other functions are not compiled yet (their
-        // diagnostics would be lost with the inference's); their result is unknown for now
-        if (!inferring_ || fn_state_[it->second] != 0) ensure_function_compiled(it->second);
+        // diagnostics would be lost with the inference's), only their result types inferred
+        if (!inferring_ || fn_state_[it->second] != 0) {
+            ensure_function_compiled(it->second);
+        } else if (!fn_result_known_[it->second]) {
+            fn_state_[it->second] = 1; // a call back into the caller's chain stays unknown
+            infer_function_result(it->second);
+            fn_state_[it->second] = 0;
+        }
         if (fn_random_[it->second]) {
             if (c.kind == CtxKind::Global)
                 diags_->error(e.span,

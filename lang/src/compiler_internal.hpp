@@ -95,6 +95,7 @@ class Compiler {
     SymbolId module_symbol(const std::string& name);
     void declare_function(const ast::FnDecl& fd);
     void ensure_function_compiled(std::uint32_t index);
+    void infer_function_result(std::uint32_t index);
     ValueType compile_function_body(std::uint32_t index, Code& code, std::uint16_t& frame_size);
     ValueType param_type(const ast::ParamName& p);
 
