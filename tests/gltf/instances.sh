@@ -64,6 +64,11 @@ node "$here/validate.mjs" "$tmp/fig05_near.glb" "$tmp/fig05_near.nodes.glb" "$tm
   "$tmp/row.glb" "$tmp/row.nodes.glb"
 node "$here/three.mjs" "${near[@]}" "$tmp/fig05_near.glb" "$tmp/fig05_near.nodes.glb"
 node "$here/three.mjs" "${row[@]}" "$tmp/row.glb" "$tmp/row.nodes.glb"
+# the bark: the standard library's image once, on the tree's tubes only (the weeping branches keep
+# their twig colour and the leaves theirs)
+node "$here/textures.mjs" --image "$repo/stdlib/textures/bark.png" --textured "Willow(8, 0)@5/tubes" \
+  --plain "Willow(8, 0)@5/WeepingBranch(12)@5/tubes" --plain "Willow(8, 0)@5/WeepingBranch(12)@5/leaf" \
+  "$tmp/fig05_near.glb" "$tmp/fig05_near.nodes.glb"
 # instanced, the tree is at least 5 times smaller than flattened (docs/willow.md)
 inst_size=$(stat -c %s "$tmp/fig05_near.glb")
 flat_size=$(stat -c %s "$tmp/fig05_near.flat.glb")
