@@ -4,6 +4,7 @@
 
 #include "plant/scene.hpp"
 
+#include <iosfwd>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -66,5 +67,7 @@ enum class MeshFileFormat : std::uint8_t { Obj, Ply, Off };
 void write_mesh_file(const Scene& scene, const std::string& path, MeshFileFormat format);
 // The bytes write_mesh_file writes; `path` names the file in messages only.
 std::string mesh_file_bytes(const Scene& scene, MeshFileFormat format, const std::string& path);
+// The same written to `out`; throws ExportError when the stream fails to take all of it.
+void write_mesh_stream(const Scene& scene, MeshFileFormat format, const std::string& path, std::ostream& out);
 
 } // namespace plant
