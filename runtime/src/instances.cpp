@@ -29,13 +29,14 @@ double bytes_of(const MeshPart& m) {
     return double(m.positions.size()) * 32.0 + double(m.indices.size()) * 4.0;
 }
 
-// A param of the program as the derivation left it (or its declared value), or `fallback`.
-double param_value(const Program& p, const Derivation* d, const char* name, double fallback) {
+// A param of the program as compiled (after -D and import overrides), or `fallback`. Instances
+// see every param so (docs/language.md, instances: visibility): a hook's assignment in the outer
+// derivation does not reach them, view_depth and max_view_depth included.
+double param_value(const Program& p, const char* name, double fallback) {
     auto it = p.global_index.find(name);
     if (it == p.global_index.end()) return fallback;
     const std::uint32_t slot = p.globals[it->second].slot;
-    const std::vector<double>& g = d && &d->program() == &p ? d->globals() : p.global_values;
-    return slot < g.size() ? g[slot] : fallback;
+    return slot < p.global_values.size() ? p.global_values[slot] : fallback;
 }
 
 class InstanceBuilder {
@@ -52,9 +53,9 @@ class InstanceBuilder {
         // instances are derived apart from the outer plant's environments; their query modules
         // see the instance's own turtle
         derive_.environment_phase = &phase_;
-        view_depth_ = param_value(root, d, "view_depth", 0.0);
-        max_view_depth_ = param_value(root, d, "max_view_depth", 20.0);
-        depth_unit_ = param_value(root, d, "depth_unit", 0.0);
+        view_depth_ = param_value(root, "view_depth", 0.0);
+        max_view_depth_ = param_value(root, "max_view_depth", 20.0);
+        depth_unit_ = param_value(root, "depth_unit", 0.0);
         budget_ = double(options.max_memory ? options.max_memory : kDefaultInstanceMemory);
     }
 
