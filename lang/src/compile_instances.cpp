@@ -287,7 +287,7 @@ std::unique_ptr<Program> Compiler::compile_instance(const Compiler& parent, cons
     for (const auto& im : body.imports)
         diags_->error(im.span, fmt::format("instance '{}' cannot import: write 'import {};' at the top of "
                                            "the file, and what it declares is visible inside the instance",
-                                           decl.name, im.target));
+                                           decl.name, im.is_path ? "\"" + im.target + "\"" : im.target));
     order_.push_back({decl.body.get(), {}});
     declare();
     for (const ast::ShapeDecl* e : env_decls_)

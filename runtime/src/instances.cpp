@@ -196,9 +196,11 @@ class InstanceBuilder {
         try {
             d.run();
         } catch (RuntimeError& e) {
-            e.message = fmt::format(
-                "instance {}{}: {}", made.name,
-                e.kind == RuntimeErrorKind::ModuleLimit ? " (with the instances before it)" : "", e.message);
+            e.message = fmt::format("instance {}{}: {}", made.name,
+                                    e.kind == RuntimeErrorKind::ModuleLimit && modules_ > 0
+                                        ? " (with the instances before it)"
+                                        : "",
+                                    e.message);
             throw;
         }
         modules_ += d.string().size();

@@ -253,6 +253,15 @@ TEST_CASE("hostile instance use ends with a clear error", "[instances]") {
         CHECK(e.kind == RuntimeErrorKind::ModuleLimit);
         CHECK_THAT(e.message, Catch::StartsWith("instance Gr(4) (with the instances before it): "));
     }
+    // the first instance has no instances before it
+    limited.max_modules = 200;
+    try {
+        build("instance Gr(k) { derive 9; axiom: A; rules { A -> A A; } } axiom: Gr(1);", {}, limited);
+        FAIL("no error");
+    } catch (const RuntimeError& e) {
+        CHECK(e.kind == RuntimeErrorKind::ModuleLimit);
+        CHECK_THAT(e.message, Catch::StartsWith("instance Gr(1): "));
+    }
     // an error inside an instance's derivation names the instance
     try {
         build("instance Z(k) { axiom: F(1 / k); } axiom: Z(0);");
