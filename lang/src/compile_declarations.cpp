@@ -57,6 +57,7 @@ void Compiler::declare_values(const LoadedFile& lf) {
                       v.name, v.name_span, prev);
             continue;
         }
+        if (builtin_param_redeclared(v)) continue;
         value_spans_[v.name] = v.name_span;
         const ast::Expr* value = v.value.get();
         if (auto it = lf.overrides.find(v.name); it != lf.overrides.end()) {

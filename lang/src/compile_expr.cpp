@@ -175,6 +175,7 @@ void Compiler::unknown_name(Ctx& c, const std::string& name, Span span, Unknown 
         for (const auto& f : P_.functions) names.push_back(f.name);
         for (const auto& b : builtin_table()) names.emplace_back(b.name);
     }
+    if (kind != Unknown::Function && outer_name_explained(name, span)) return;
     std::string near = nearest_name(name, names);
     diags_->error(span, near.empty() ? fmt::format("unknown {} '{}'", what, name)
                                      : fmt::format("unknown {} '{}'; did you mean '{}'?", what, name, near));
@@ -263,6 +264,10 @@ ValueType Compiler::compile_name(Ctx& c, const ast::Expr& e) {
     if (const LocalVar* l = find_local(c, e.text)) {
         emit(c, Op::LoadLocal, l->slot, value_width(l->type), e.span);
         return l->type;
+    }
+    if (outer_name_hidden(c, e.text, e.span)) {
+        emit_const(c, 0, e.span);
+        return ValueType::Number;
     }
     if (auto it = consts_.find(e.text); it != consts_.end()) {
         const ConstVal& v = it->second;

@@ -15,10 +15,12 @@ namespace plant {
 namespace {
 
 constexpr int kMaxInstanceDepth = 8; // instances placed inside instances, the outermost counted
-// Each body's program holds its own copy of the declared modules it sees: the product is bounded
-// (a body's program is made in time and memory proportional to what it sees).
+// Each body's program holds its own copy of the declared modules, params, consts and functions it
+// sees: the product is bounded (a body's program is made in time and memory proportional to what
+// it sees).
 constexpr std::size_t kMaxInstances = 256;
-constexpr std::size_t kMaxInheritedSymbols = 1'000'000; // instances times declared modules
+// instances times the names each sees (modules, params, consts, functions)
+constexpr std::size_t kMaxInheritedSymbols = 1'000'000;
 
 struct BuiltinParam {
     const char* name;
@@ -136,6 +138,79 @@ void Compiler::placement_param_used(const std::string& name, Span span) {
                                           name, self, compile_time_));
 }
 
+// view_depth and max_view_depth are params of the whole grammar (docs/language.md, level of
+// detail): a body cannot declare them (each of its derivations gets view_depth from where it is
+// placed, and max_view_depth from the top level), nor can a var or const take their names.
+bool Compiler::builtin_param_redeclared(const ast::ValueDecl& v) {
+    const bool builtin = std::any_of(std::begin(kBuiltinParams), std::end(kBuiltinParams),
+                                     [&](const BuiltinParam& b) { return v.name == b.name; });
+    if (!builtin || (v.kind == ast::DeclKind::Param && self_index_ < 0)) return false;
+    const char* kind = v.kind == ast::DeclKind::Const ? "const"
+                       : v.kind == ast::DeclKind::Var ? "var"
+                                                      : "param";
+    if (self_index_ >= 0)
+        diags_->error(
+            v.name_span,
+            fmt::format("'{}' is a built-in param of the whole grammar, so instance '{}' cannot declare "
+                        "it: {}; declare 'param {} = ...;' at the top level or set it with -D",
+                        v.name, (*table_)[static_cast<std::size_t>(self_index_)].name,
+                        v.name == std::string("view_depth")
+                            ? "each derivation of an instance gets it from where it is placed"
+                            : "every instance takes it from the top level",
+                        v.name));
+    else
+        diags_->error(v.name_span,
+                      fmt::format("'{}' is a built-in param and cannot be a {}: write 'param {} = "
+                                  "...;' (lod() and the instances read it)",
+                                  v.name, kind, v.name));
+    return true;
+}
+
+// Inside an outer function that a body compiles when it calls it: a name the function's own scope
+// does not have (a param of the body or of an enclosing instance) is an error naming the body,
+// never the body's value of the same name.
+bool Compiler::outer_name_hidden(Ctx& c, const std::string& name, Span span) {
+    if (c.kind != CtxKind::Function || c.function < 0 ||
+        static_cast<std::size_t>(c.function) >= inherited_functions_)
+        return false;
+    const auto outer = enclosing_params_.find(name);
+    if (outer == enclosing_params_.end() && !own_instance_params_.count(name)) return false;
+    const std::string self = (*table_)[static_cast<std::size_t>(self_index_)].name;
+    const std::string& fn = P_.functions[static_cast<std::size_t>(c.function)].name;
+    diags_->error(
+        span, outer != enclosing_params_.end()
+                  ? fmt::format("function '{}' reads '{}', a parameter of instance '{}', which instance "
+                                "'{}' (calling it) does not see: give '{}' a parameter for it and pass "
+                                "the value",
+                                fn, name, outer->second, self, fn)
+                  : fmt::format("function '{}' is declared outside instance '{}' (calling it) and cannot "
+                                "read its parameter '{}': give '{}' a parameter for it and pass the value",
+                                fn, self, name, fn));
+    return true;
+}
+
+// An unknown name that the program around a body has: says why the body does not see it.
+bool Compiler::outer_name_explained(const std::string& name, Span span) {
+    if (self_index_ < 0) return false;
+    const std::string self = (*table_)[static_cast<std::size_t>(self_index_)].name;
+    if (auto it = enclosing_params_.find(name); it != enclosing_params_.end()) {
+        diags_->error(span,
+                      fmt::format("'{}' is a parameter of the enclosing instance '{}', which instance '{}' "
+                                  "does not see: pass it to '{}' as an argument",
+                                  name, it->second, self, self));
+        return true;
+    }
+    if (outer_vars_.count(name)) {
+        diags_->error(span,
+                      fmt::format("'{}' is a var of the program around instance '{}', which the instance "
+                                  "does not see (a var changes as the outer plant grows): pass its value "
+                                  "to '{}' as an argument",
+                                  name, self, self));
+        return true;
+    }
+    return false;
+}
+
 // What a body sees of the program around it (docs/language.md, instances: visibility).
 void Compiler::inherit(const Compiler& parent, const ast::InstanceDecl& decl) {
     table_ = parent.table_;
@@ -150,7 +225,13 @@ void Compiler::inherit(const Compiler& parent, const ast::InstanceDecl& decl) {
         info.bound_env = -1;
     }
     max_declared_len_ = parent.max_declared_len_;
+    enclosing_params_ = parent.enclosing_params_;
+    outer_vars_ = parent.outer_vars_;
+    if (parent.self_index_ >= 0)
+        for (const auto& name : parent.own_instance_params_)
+            enclosing_params_[name] = (*table_)[static_cast<std::size_t>(parent.self_index_)].name;
     for (const Global& g : parent.P_.globals) {
+        if (g.kind != GlobalKind::Param) outer_vars_.insert(g.name);
         if (g.kind != GlobalKind::Param || parent.own_instance_params_.count(g.name)) continue;
         Global copy = g;
         copy.slot = static_cast<std::uint32_t>(P_.global_values.size());
@@ -206,7 +287,7 @@ std::unique_ptr<Program> Compiler::compile_instance(const Compiler& parent, cons
     for (const auto& im : body.imports)
         diags_->error(im.span, fmt::format("instance '{}' cannot import: write 'import {};' at the top of "
                                            "the file, and what it declares is visible inside the instance",
-                                           decl.name, im.target));
+                                           decl.name, im.is_path ? "\"" + im.target + "\"" : im.target));
     order_.push_back({decl.body.get(), {}});
     declare();
     for (const ast::ShapeDecl* e : env_decls_)
@@ -229,11 +310,13 @@ void Compiler::compile_instances() {
     if (own_instances_.empty()) return;
     std::size_t declared = 0;
     for (const SymbolInfo& s : P_.symbols.all()) declared += s.declared && !s.turtle && !s.query ? 1 : 0;
-    if (declared * table_->size() > kMaxInheritedSymbols) {
+    const std::size_t values = P_.globals.size() + consts_.size() + fn_decls_.size();
+    if ((declared + values) * table_->size() > kMaxInheritedSymbols) {
         diags_->error(own_instances_.front().first->span,
-                      fmt::format("{} instances each see the {} modules declared around them, more than "
-                                  "plant compiles ({} in all): declare fewer modules or instances",
-                                  table_->size(), declared, kMaxInheritedSymbols));
+                      fmt::format("{} instances each see the {} modules and {} params, consts and functions "
+                                  "declared around them, more than plant compiles ({} in all): declare fewer "
+                                  "of them or fewer instances (an instance parameter can stand for variants)",
+                                  table_->size(), declared, values, kMaxInheritedSymbols));
         return;
     }
     for (const auto& [decl, index] : own_instances_) {

@@ -128,6 +128,9 @@ class Compiler {
     void check_instance_graph();
     bool instance_arity_ok(const SymbolInfo& info, std::size_t nargs) const;
     void placement_param_used(const std::string& name, Span span);
+    bool builtin_param_redeclared(const ast::ValueDecl& v);
+    bool outer_name_hidden(Ctx& c, const std::string& name, Span span);
+    bool outer_name_explained(const std::string& name, Span span);
     void compile_rules(const ast::File& f);
     void compile_production(const ast::Production& p, RuleSet& set);
     void compile_hooks(const ast::File& f);
@@ -223,8 +226,12 @@ class Compiler {
     std::vector<std::pair<const ast::InstanceDecl*, int>> own_instances_; // declared here, by index
     std::set<std::string> placement_params_;    // values known only per derivation (instance params)
     std::set<std::string> own_instance_params_; // this body's params: not visible in nested bodies
-    const char* compile_time_ = nullptr;        // while eval_const runs: what it evaluates
-    std::size_t inherited_surfaces_ = 0;        // surfaces of the outer program, which a body may replace
+    // names a body does not see, for messages and for the outer functions it compiles: the params
+    // of the enclosing instances (-> the instance's name) and the outer programs' vars
+    std::map<std::string, std::string> enclosing_params_;
+    std::set<std::string> outer_vars_;
+    const char* compile_time_ = nullptr; // while eval_const runs: what it evaluates
+    std::size_t inherited_surfaces_ = 0; // surfaces of the outer program, which a body may replace
     std::set<std::string> body_surfaces_;
     std::size_t inherited_functions_ = 0; // the outer program's, compiled only when called
 

@@ -69,7 +69,7 @@ const Scene& exported_scene(const Scene& scene, Scene& storage, const std::strin
     const Scene* s = &scene;
     if (scene.nested()) {
         try {
-            storage = flatten(scene);
+            storage = flatten_keeping_bounds(scene); // the writers do not read the bounds
         } catch (const std::out_of_range& e) {
             throw ExportError(what + ": " + e.what());
         }

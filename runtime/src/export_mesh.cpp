@@ -85,7 +85,8 @@ class Flattener {
 
 } // namespace
 
-std::string mesh_file_bytes(const Scene& given, MeshFileFormat format, const std::string& path) {
+void write_mesh_stream(const Scene& given, MeshFileFormat format, const std::string& path,
+                       std::ostream& out) {
     // OpenMesh picks its writer by an extension, whatever the file is called
     static constexpr const char* kOpenMeshExtension[] = {".obj", ".ply", ".off"};
     const std::string ext = kOpenMeshExtension[static_cast<int>(format)];
@@ -119,10 +120,19 @@ std::string mesh_file_bytes(const Scene& given, MeshFileFormat format, const std
     // OFF stays plain NOFF: few readers understand texture coordinates in OFF files.
     if (format != MeshFileFormat::Off) options += OpenMesh::IO::Options::VertexTexCoord;
 
-    std::ostringstream out(std::ios::out | std::ios::binary);
     if (!OpenMesh::IO::write_mesh(mesh, out, ext, options, 7))
         throw ExportError("cannot write " + quoted(path) + ": OpenMesh failed to write the " + ext.substr(1) +
                           " file");
+    // OpenMesh reports success whatever the stream did: a stream that could not take everything
+    // (out of memory, a full disk) is a failed write, not a shorter file
+    if (!out.flush())
+        throw ExportError("cannot write " + quoted(path) + ": the " + ext.substr(1) +
+                          " file could not be written in full (out of memory?)");
+}
+
+std::string mesh_file_bytes(const Scene& scene, MeshFileFormat format, const std::string& path) {
+    std::ostringstream out(std::ios::out | std::ios::binary);
+    write_mesh_stream(scene, format, path, out);
     return std::move(out).str();
 }
 

@@ -190,7 +190,7 @@ Scene split_nested(const Scene& scene, std::vector<NestedGroup>& groups, const s
     }
     Scene out;
     try {
-        out = flatten(rest);
+        out = flatten_keeping_bounds(rest); // glTF does not read the bounds
     } catch (const std::out_of_range& e) {
         throw ExportError(what + ": " + e.what());
     }
@@ -202,7 +202,7 @@ Scene split_nested(const Scene& scene, std::vector<NestedGroup>& groups, const s
         NestedGroup& g = groups[std::size_t(group_of[k])];
         Scene inner;
         try {
-            inner = flatten(*scene.scene_prototypes[k]);
+            inner = flatten_keeping_bounds(*scene.scene_prototypes[k]);
         } catch (const std::out_of_range& e) {
             throw ExportError(what + ": " + e.what());
         }

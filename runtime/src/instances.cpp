@@ -29,13 +29,14 @@ double bytes_of(const MeshPart& m) {
     return double(m.positions.size()) * 32.0 + double(m.indices.size()) * 4.0;
 }
 
-// A param of the program as the derivation left it (or its declared value), or `fallback`.
-double param_value(const Program& p, const Derivation* d, const char* name, double fallback) {
+// A param of the program as compiled (after -D and import overrides), or `fallback`. Instances
+// see every param so (docs/language.md, instances: visibility): a hook's assignment in the outer
+// derivation does not reach them, view_depth and max_view_depth included.
+double param_value(const Program& p, const char* name, double fallback) {
     auto it = p.global_index.find(name);
     if (it == p.global_index.end()) return fallback;
     const std::uint32_t slot = p.globals[it->second].slot;
-    const std::vector<double>& g = d && &d->program() == &p ? d->globals() : p.global_values;
-    return slot < g.size() ? g[slot] : fallback;
+    return slot < p.global_values.size() ? p.global_values[slot] : fallback;
 }
 
 class InstanceBuilder {
@@ -52,9 +53,9 @@ class InstanceBuilder {
         // instances are derived apart from the outer plant's environments; their query modules
         // see the instance's own turtle
         derive_.environment_phase = &phase_;
-        view_depth_ = param_value(root, d, "view_depth", 0.0);
-        max_view_depth_ = param_value(root, d, "max_view_depth", 20.0);
-        depth_unit_ = param_value(root, d, "depth_unit", 0.0);
+        view_depth_ = param_value(root, "view_depth", 0.0);
+        max_view_depth_ = param_value(root, "max_view_depth", 20.0);
+        depth_unit_ = param_value(root, "depth_unit", 0.0);
         budget_ = double(options.max_memory ? options.max_memory : kDefaultInstanceMemory);
     }
 
@@ -90,10 +91,11 @@ class InstanceBuilder {
     }
 
     // The scene's bounds: exact (every point placed) while that is cheap, else the box around its
-    // placed scene prototypes' boxes, which holds every point too.
-    static void set_bounds(Scene& scene, double flat_bytes) {
-        constexpr double kExactBoundsBytes = 64.0 * 1024 * 1024;
-        if (flat_bytes <= kExactBoundsBytes || !scene.nested()) {
+    // placed scene prototypes' boxes, which holds every point too. Cheap: few bytes and few
+    // placements drawn out (placements of instances that draw nothing cost time all the same).
+    void set_bounds(Scene& scene, double bytes, double drawn_placements) const {
+        constexpr double kExactBoundsBytes = 64.0 * 1024 * 1024, kExactBoundsPlacements = 1 << 20;
+        if ((bytes <= kExactBoundsBytes && drawn_placements <= kExactBoundsPlacements) || !scene.nested()) {
             scene.update_bounds();
             return;
         }
@@ -108,6 +110,7 @@ class InstanceBuilder {
                 add(glm::vec3(inst.transform * glm::vec4(p, 1.0f)));
         for (const Instance& i : scene.scene_instances) {
             const Scene& p = *scene.scene_prototypes[i.prototype];
+            if (flat_bytes(&p) == 0) continue; // draws nothing: its bounds are no point of the plant
             for (int c = 0; c < 8; ++c)
                 add(glm::vec3(i.transform * glm::vec4((c & 1) ? p.bounds_max.x : p.bounds_min.x,
                                                       (c & 2) ? p.bounds_max.y : p.bounds_min.y,
@@ -116,6 +119,16 @@ class InstanceBuilder {
         if (lo.x > hi.x) lo = hi = glm::vec3(0.0f);
         scene.bounds_min = lo;
         scene.bounds_max = hi;
+    }
+
+    // How many placements `scene` draws out, at every level.
+    double placements_of(const Scene& scene) const {
+        double n = double(scene.instances.size());
+        for (const Instance& i : scene.scene_instances) {
+            auto it = placements_.find(scene.scene_prototypes[i.prototype].get());
+            n += 1 + (it == placements_.end() ? 0.0 : it->second);
+        }
+        return n;
     }
 
     // What `scene` would take with every placement drawn out.
@@ -183,9 +196,11 @@ class InstanceBuilder {
         try {
             d.run();
         } catch (RuntimeError& e) {
-            e.message = fmt::format(
-                "instance {}{}: {}", made.name,
-                e.kind == RuntimeErrorKind::ModuleLimit ? " (with the instances before it)" : "", e.message);
+            e.message = fmt::format("instance {}{}: {}", made.name,
+                                    e.kind == RuntimeErrorKind::ModuleLimit && modules_ > 0
+                                        ? " (with the instances before it)"
+                                        : "",
+                                    e.message);
             throw;
         }
         modules_ += d.string().size();
@@ -205,10 +220,12 @@ class InstanceBuilder {
         made.flat_bytes = flat_size(scene);
         if (made.flat_bytes > budget_)
             memory_error(fmt::format("drawn out in full, instance {}", made.name).c_str(), made.flat_bytes);
-        set_bounds(scene, made.flat_bytes);
+        const double placements = placements_of(scene);
+        set_bounds(scene, made.flat_bytes, placements);
         detail::check_single_precision(scene);
         made.scene = std::make_shared<const Scene>(std::move(scene));
         flat_[made.scene.get()] = made.flat_bytes;
+        placements_[made.scene.get()] = placements;
         return memo_.emplace(std::move(key), std::move(made)).first->second;
     }
 
@@ -221,7 +238,8 @@ class InstanceBuilder {
     std::size_t derivations_ = 0;
     std::size_t modules_ = 0; // in the strings of every instance derivation so far
     std::map<std::tuple<int, std::vector<std::uint64_t>, std::uint64_t>, Made> memo_;
-    std::map<const Scene*, double> flat_; // per prototype: Made::flat_bytes
+    std::map<const Scene*, double> flat_;       // per prototype: Made::flat_bytes
+    std::map<const Scene*, double> placements_; // per prototype: the placements it draws out
 };
 
 } // namespace
@@ -230,7 +248,7 @@ Scene build_scene(const Program& program, const Skeleton& skeleton, const MeshOp
     InstanceBuilder builder(program, options);
     Scene scene = builder.build(program, skeleton, std::nullopt);
     scene.instance_derivations = builder.derivations();
-    builder.set_bounds(scene, builder.check_flattened(scene));
+    builder.set_bounds(scene, builder.check_flattened(scene), builder.placements_of(scene));
     detail::check_single_precision(scene);
     return scene;
 }

@@ -44,6 +44,36 @@ void grow_bounds(const Scene& scene, const glm::mat4* placed, glm::vec3& lo, glm
 
 } // namespace
 
+namespace {
+
+DrawnSize drawn_size(const Scene& scene, std::map<const Scene*, DrawnSize>& memo) {
+    DrawnSize n{double(scene.tubes.positions.size()), double(scene.tubes.triangle_count()), 0};
+    for (const Instance& inst : scene.instances) {
+        if (inst.prototype >= scene.prototypes.size()) continue;
+        n.vertices += double(scene.prototypes[inst.prototype].positions.size());
+        n.triangles += double(scene.prototypes[inst.prototype].triangle_count());
+        n.placements += 1;
+    }
+    for (const Instance& inst : scene.scene_instances) {
+        if (inst.prototype >= scene.scene_prototypes.size() || !scene.scene_prototypes[inst.prototype])
+            continue;
+        const Scene* p = scene.scene_prototypes[inst.prototype].get();
+        auto it = memo.find(p);
+        if (it == memo.end()) it = memo.emplace(p, drawn_size(*p, memo)).first;
+        n.vertices += it->second.vertices;
+        n.triangles += it->second.triangles;
+        n.placements += it->second.placements + (p->tubes.empty() ? 0 : 1);
+    }
+    return n;
+}
+
+} // namespace
+
+DrawnSize drawn_size(const Scene& scene) {
+    std::map<const Scene*, DrawnSize> memo;
+    return drawn_size(scene, memo);
+}
+
 void Scene::update_bounds() {
     glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
     grow_bounds(*this, nullptr, lo, hi);
@@ -97,6 +127,13 @@ std::uint32_t MaterialMerger::add(const Material& material, const Texture* textu
 
 Scene flatten(const Scene& scene) {
     if (!scene.nested()) return scene;
+    Scene out = flatten_keeping_bounds(scene);
+    out.update_bounds();
+    return out;
+}
+
+Scene flatten_keeping_bounds(const Scene& scene) {
+    if (!scene.nested()) return scene;
     Scene out;
     out.tubes = scene.tubes;
     out.prototypes = scene.prototypes;
@@ -118,7 +155,7 @@ Scene flatten(const Scene& scene) {
             throw std::out_of_range("a placement of scene prototype " + std::to_string(k) +
                                     " but the scene has " + std::to_string(scene.scene_prototypes.size()));
         if (!drawn[k]) {
-            const Scene inner = flatten(*scene.scene_prototypes[k]);
+            const Scene inner = flatten_keeping_bounds(*scene.scene_prototypes[k]); // its parts only
             const std::string name =
                 k < scene.scene_prototype_names.size() && !scene.scene_prototype_names[k].empty()
                     ? scene.scene_prototype_names[k]
@@ -150,7 +187,8 @@ Scene flatten(const Scene& scene) {
             out.instances.push_back(Instance{i.prototype, placement.transform * i.transform});
     }
     if (out.materials.empty()) out.materials.push_back(Material{});
-    out.update_bounds();
+    out.bounds_min = scene.bounds_min;
+    out.bounds_max = scene.bounds_max;
     return out;
 }
 

@@ -4,6 +4,7 @@
 
 #include "plant/scene.hpp"
 
+#include <iosfwd>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -18,9 +19,9 @@ struct ExportError : std::runtime_error {
 // normals or uvs present but not one per position, a partial triangle, an index out of range.
 void check_mesh_part(const MeshPart& part, const std::string& what);
 
-// What a writer draws: `scene` itself, or its flattened copy (plant/scene.hpp), kept in
-// `storage`, when it places whole scenes. Throws ExportError, naming `what` ("glTF export"), when
-// an instance places a prototype the scene does not have.
+// What a writer draws: `scene` itself, or its flattened copy (flatten_keeping_bounds in
+// plant/scene.hpp: the bounds are scene's), kept in `storage`, when it places whole scenes. Throws
+// ExportError, naming `what` ("glTF export"), when an instance places a prototype the scene does not have.
 const Scene& exported_scene(const Scene& scene, Scene& storage, const std::string& what);
 
 // Writes `bytes` to `path` through a temporary file and a rename.
@@ -66,5 +67,7 @@ enum class MeshFileFormat : std::uint8_t { Obj, Ply, Off };
 void write_mesh_file(const Scene& scene, const std::string& path, MeshFileFormat format);
 // The bytes write_mesh_file writes; `path` names the file in messages only.
 std::string mesh_file_bytes(const Scene& scene, MeshFileFormat format, const std::string& path);
+// The same written to `out`; throws ExportError when the stream fails to take all of it.
+void write_mesh_stream(const Scene& scene, MeshFileFormat format, const std::string& path, std::ostream& out);
 
 } // namespace plant

@@ -86,6 +86,19 @@ struct Scene {
 // without placed scenes comes back unchanged. Throws std::out_of_range for a placement of a
 // scene prototype that does not exist.
 Scene flatten(const Scene& scene);
+// The same without working out the result's bounds, which stay `scene`'s own: a box that holds
+// every point drawn (tight when scene's was), for writers that do not read the bounds. Placing
+// every point of every placement again is a large part of flattening a big scene.
+Scene flatten_keeping_bounds(const Scene& scene);
+
+// What `scene` draws with every placed scene drawn out, counted without drawing it: the vertices
+// and triangles of its tubes and of every placement (placed scenes once per placement, at every
+// level), and the placements that draw something, which are the instances flatten() makes: of
+// organ prototypes, and of a placed scene's tubes when it has any, at every level.
+struct DrawnSize {
+    double vertices = 0, triangles = 0, placements = 0;
+};
+DrawnSize drawn_size(const Scene& scene);
 
 // Gathers materials from several scenes into one: one material per colour and texture image (told
 // apart by their bytes), each image added to the result's textures once. The result's own

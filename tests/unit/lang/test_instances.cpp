@@ -168,6 +168,10 @@ TEST_CASE("what an instance body cannot hold says what to write instead", "[inst
     CHECK_THAT(e,
                Catch::Contains("instance 'Leaf' cannot import: write 'import foo;' at the top of the file"));
     CHECK_THAT(e, Catch::Contains("instance 'Leaf' cannot declare an environment"));
+    // a path keeps its quotes
+    auto q = compile("instance Leaf() {\n    import \"lib/leaf.plant\";\n    axiom: F;\n}\naxiom: Leaf;\n");
+    REQUIRE(!q->program);
+    CHECK_THAT(errors(*q), Catch::Contains("write 'import \"lib/leaf.plant\";' at the top of the file"));
     CHECK_THAT(e,
                Catch::Contains("instance 'Bare' has no axiom: add a line such as 'axiom: F;' to its body"));
     CHECK_THAT(c->rendered(), Catch::Contains("test.plant:6:1: error: instance 'Bare' has no axiom"));

@@ -11,6 +11,8 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <sstream>
+#include <streambuf>
 
 using namespace plant;
 
@@ -71,6 +73,46 @@ TEST_CASE("writers leave no partial file when they fail", "[export]") {
     CHECK_THROWS_AS(write_gltf(s, "/nonexistent-dir/x.glb", GltfContainer::Binary), ExportError);
     CHECK_THROWS_AS(write_mesh_file(s, "/nonexistent-dir/x.obj", MeshFileFormat::Obj), ExportError);
     CHECK(!std::filesystem::exists("/nonexistent-dir"));
+}
+
+namespace {
+
+// A stream buffer that takes `room` bytes and then refuses, as a string stream does when it cannot
+// grow: the stream that writes to it goes bad.
+class FullBuffer : public std::streambuf {
+  public:
+    explicit FullBuffer(std::size_t room) : room_(room) {}
+    std::size_t taken = 0;
+
+  protected:
+    int_type overflow(int_type c) override {
+        if (taken >= room_ || traits_type::eq_int_type(c, traits_type::eof())) return traits_type::eof();
+        ++taken;
+        return c;
+    }
+    std::streamsize xsputn(const char*, std::streamsize n) override {
+        const auto k = std::min<std::streamsize>(n, static_cast<std::streamsize>(room_ - taken));
+        taken += static_cast<std::size_t>(k);
+        return k;
+    }
+
+  private:
+    std::size_t room_;
+};
+
+} // namespace
+
+TEST_CASE("a mesh file the stream cannot take in full is an error, not a shorter file", "[export][mesh]") {
+    Scene s = scene_of("axiom: F F [ + F ] F;");
+    for (MeshFileFormat f : {MeshFileFormat::Obj, MeshFileFormat::Ply, MeshFileFormat::Off}) {
+        std::ostringstream whole;
+        write_mesh_stream(s, f, "x", whole); // the whole file fits
+        REQUIRE(whole.str().size() > 200);
+        FullBuffer full(100);
+        std::ostream out(&full);
+        CHECK_THROWS_AS(write_mesh_stream(s, f, "x", out), ExportError);
+        CHECK(full.taken == 100);
+    }
 }
 
 TEST_CASE("the skeleton JSON lists axes with points and organs with matrices", "[export]") {

@@ -196,6 +196,21 @@ axiom: f(20) Branch;
     CHECK(branch.scene_prototype_sources[0].view_depth == 6); // 25 / 4 = 6.25
 }
 
+TEST_CASE("instances see the params as compiled: a hook's assignment does not reach them", "[instances]") {
+    // view_depth, max_view_depth and any other param alike (docs/language.md, instances: visibility)
+    Built b = build(R"(param view_depth = 5;
+param max_view_depth = 20;
+param length = 4;
+instance Branch() { axiom: F(length) f(lod(12)) F(1); }
+on end { view_depth = 10; max_view_depth = 10; length = 7; }
+axiom: Branch;
+)");
+    REQUIRE(b.scene.scene_prototypes.size() == 1);
+    CHECK(b.scene.scene_prototype_names[0] == "Branch@5");
+    // 4 + lod(12) at 5 of 20 (9) + 1; the hook's values would give 7 + 0 + 1
+    CHECK(b.scene.scene_prototypes[0]->bounds_max.y == Approx(14.0f));
+}
+
 TEST_CASE("hostile instance use ends with a clear error", "[instances]") {
     // too many distinct tuples
     MeshOptions few;
@@ -237,6 +252,15 @@ TEST_CASE("hostile instance use ends with a clear error", "[instances]") {
     } catch (const RuntimeError& e) {
         CHECK(e.kind == RuntimeErrorKind::ModuleLimit);
         CHECK_THAT(e.message, Catch::StartsWith("instance Gr(4) (with the instances before it): "));
+    }
+    // the first instance has no instances before it
+    limited.max_modules = 200;
+    try {
+        build("instance Gr(k) { derive 9; axiom: A; rules { A -> A A; } } axiom: Gr(1);", {}, limited);
+        FAIL("no error");
+    } catch (const RuntimeError& e) {
+        CHECK(e.kind == RuntimeErrorKind::ModuleLimit);
+        CHECK_THAT(e.message, Catch::StartsWith("instance Gr(1): "));
     }
     // an error inside an instance's derivation names the instance
     try {
