@@ -358,7 +358,9 @@ void Compiler::check_instance_graph() {
                 std::vector<int> cycle(std::find(chain.begin(), chain.end(), j), chain.end());
                 cycle.push_back(j);
                 diags_->error(span, fmt::format("instance cycle: {}: an instance cannot place itself, "
-                                                "directly or through others",
+                                                "directly or through others; to repeat a shape, place "
+                                                "it several times from the outer rules or give the "
+                                                "repeated part its own instance",
                                                 chain_text(table, cycle)));
                 stop = true;
                 break;

@@ -233,8 +233,9 @@ std::vector<PatternModule> Compiler::compile_pattern(Ctx& c, const ast::ModuleLi
             if (info.arity >= 0 && static_cast<int>(nargs) != info.arity && !instance_arity_ok(info, nargs)) {
                 diags_->error(
                     last ? m.span : pm.span,
-                    fmt::format("module '{}' takes {} parameter{}, the pattern gives {} (declared at {})",
-                                info.name, info.arity, info.arity == 1 ? "" : "s", nargs,
+                    fmt::format("module '{}' takes {} parameter{}{}, the pattern gives {} (declared at {})",
+                                info.name, info.arity, info.arity == 1 ? "" : "s",
+                                info.instance >= 0 ? " and an optional scale" : "", nargs,
                                 where(info.decl_span)));
             }
             for (std::size_t i = 0; i < nargs; ++i) {

@@ -104,8 +104,10 @@ TEST_CASE("instance cycles are positioned errors naming the chain", "[instances]
     auto c = compile("instance Tree(n) {\n    axiom: F Branch(n);\n}\ninstance Branch(n) {\n    axiom: F "
                      "Tree(n);\n}\naxiom: Tree(1);\n");
     REQUIRE(!c->program);
-    CHECK(errors(*c) == "instance cycle: Tree -> Branch -> Tree: an instance cannot place itself, directly "
-                        "or through others\n");
+    CHECK(errors(*c) ==
+          "instance cycle: Tree -> Branch -> Tree: an instance cannot place itself, directly "
+          "or through others; to repeat a shape, place it several times from the outer rules or "
+          "give the repeated part its own instance\n");
     CHECK_THAT(c->rendered(), Catch::Contains("test.plant:5:14: error: instance cycle"));
 
     auto self = compile("instance A() {\n  axiom: F;\n  rules { F -> F A; }\n}\naxiom: A;\n");
