@@ -208,7 +208,7 @@ void setup_run(CLI::App& app, int& exit_code) {
     add_grammar_options(*cmd, c->g, true);
     cmd->add_option("-o,--output", c->outputs,
                     "Output file, its format chosen by extension (listed below); repeat for several "
-                    "(default: out/NAME.glb and out/NAME.png)")
+                    "(default: out/NAME.glb and out/NAME.png; for many variants out/NAME-{n}.glb)")
         ->type_name("FILE");
     cmd->add_option("--sides", c->sides, "Vertices around each ring of a branch")->check(CLI::Range(3, 64));
     cmd->add_option("--size", c->size, "Size of PNG previews")->type_name("WxH");
