@@ -53,8 +53,8 @@ bool read_seeds(const std::string& text, BatchPlan& plan, std::string& error) {
                                               : read_whole(std::string_view(text).substr(0, dots), a) &&
                                                     read_whole(std::string_view(text).substr(dots + 2), b);
     if (!ok || b < a) {
-        error = fmt::format("--seeds expects A..B, whole numbers with A <= B (as 1..100), found {}",
-                            shown(text));
+        error =
+            fmt::format("--seeds expects A..B, whole numbers with A <= B (as 1..100), found {}", shown(text));
         return false;
     }
     plan.seed_first = a;
