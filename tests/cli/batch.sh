@@ -65,6 +65,15 @@ if cmp -s j1/bush-1.glb j1/bush-2.glb; then bad "seeds 1 and 2 give the same pla
 check "single run" 0 "$plant" run "$bush" --seed 17 -o single.glb
 same "variant = single run" single.glb j2/bush-17.glb
 
+# environments (a climber's physics, its obstacles) belong to each variant's derivation
+boxes=$here/../../grammars/climbers/fig09_boxes.plant
+for jobs in 1 2; do
+  check "climber on $jobs jobs" 0 "$plant" run "$boxes" --seeds 1..6 --jobs "$jobs" -o "c$jobs/{seed}.glb"
+done
+for f in c1/*.glb; do cmp -s "$f" "c2/${f#c1/}" && ok || bad "climber: $f differs on 2 jobs"; done
+check "climber single run" 0 "$plant" run "$boxes" --seed 4 -o climber.glb
+same "climber variant = single run" climber.glb c2/4.glb
+
 # --- failing variants: a manifest row each, the others written, exit 1 ---------------------------
 check "failing variants" 1 "$plant" run "$unlucky" --seeds 1..64 -o 'u/u-{seed}.glb' --manifest u/m.csv
 failed=$(grep -c ',runtime_error,' u/m.csv)
