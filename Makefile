@@ -3,7 +3,7 @@ BUILD ?= build
 JOBS ?= 2
 CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
 
-.PHONY: all deps configure build demo test test-sanitize fuzz bench install package format format-check clean
+.PHONY: all deps configure build demo test test-sanitize test-cluster fuzz bench install package format format-check clean
 
 all: build
 
@@ -29,6 +29,12 @@ test: build format-check
 # build-asan/, the tests, the hostile inputs and the mutation fuzzer run on them; under 30 minutes.
 test-sanitize: | deps
 	bash scripts/test-sanitize
+
+# A single-node Slurm (Debian's slurm-wlm and munge, installed when missing, started by hand in a
+# scratch folder) runs examples/cluster/roses.sbatch as 4 array tasks; the merged manifest and the
+# roses must be those of one run (docs/batch.md). Needs root; not part of make test.
+test-cluster: build
+	bash scripts/test-cluster
 
 # The libFuzzer targets (docs/testing.md), built with clang into build-fuzz/, each run for
 # FUZZ_SECONDS seconds; a finding fails it and is saved in build-fuzz/findings/.
