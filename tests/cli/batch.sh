@@ -91,6 +91,19 @@ while IFS=, read -r n seed outputs rest; do
   esac
 done < <(tail -n +2 u/m.csv)
 
+# a file that cannot be written is an output_error row; commas and quotes survive CSV and JSON
+touch blocker
+check "output error" 1 "$plant" run "$bush" --seeds 1..2 -o 'blocker/{n}.txt' --manifest oe.jsonl
+contains "output_error row" oe.jsonl '"status":"output_error","message":"cannot write '"'"'blocker/0.txt'"'"': cannot create a file in'
+check "odd names" 0 "$plant" run "$bush" --seeds 1..2 -o 'odd/we"ird,{n}.txt' --manifest odd.csv
+check "odd names, json" 0 "$plant" run "$bush" --seeds 1..2 -o 'odd/we"ird,{n}.txt' --manifest odd.jsonl
+python3 - <<'PY' && ok || bad "CSV or JSON quoting"
+import csv, json
+rows = list(csv.DictReader(open("odd.csv")))
+assert [r["outputs"] for r in rows] == ['odd/we"ird,0.txt', 'odd/we"ird,1.txt'], rows
+assert [json.loads(l)["outputs"] for l in open("odd.jsonl")] == [['odd/we"ird,0.txt'], ['odd/we"ird,1.txt']]
+PY
+
 # --- --shard: every variant in exactly one slice; the slices' rows make the whole manifest -------
 check "whole" 0 "$plant" run "$bush" --seeds 1..64 -o 'w/{n}.txt' --manifest whole.jsonl
 for N in 1 3 7; do
