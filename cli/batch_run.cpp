@@ -35,15 +35,18 @@ void on_stop(int sig) {
 
 // SIGINT and SIGTERM only set g_stop while a batch runs: the workers stop at their next look,
 // abandon the variants under way (PendingFiles removes their files) and the batch ends by the
-// signal after writing the manifest of the variants done.
+// signal after writing the manifest of the variants done. A signal ignored when plant started
+// (a background job of a script: nohup, `&`) stays ignored.
 class StopOnSignal {
   public:
     StopOnSignal() {
         struct sigaction sa {};
         sa.sa_handler = on_stop;
         sigemptyset(&sa.sa_mask);
-        sigaction(SIGINT, &sa, &old_int_);
-        sigaction(SIGTERM, &sa, &old_term_);
+        for (auto [sig, old] : {std::pair{SIGINT, &old_int_}, {SIGTERM, &old_term_}}) {
+            sigaction(sig, nullptr, old);
+            if ((old->sa_flags & SA_SIGINFO) || old->sa_handler != SIG_IGN) sigaction(sig, &sa, nullptr);
+        }
         PendingFiles::share_signals(&g_stop);
     }
     ~StopOnSignal() {

@@ -193,5 +193,15 @@ seed=$(grep -o '"seed":[0-9]*' r/m.jsonl | tail -1 | cut -d: -f2)
 check "reference rose" 0 "$plant" run "$here/../../grammars/rose/fig12c.plant" --seed "$seed" -o ref.glb
 same "the last rose written is whole" ref.glb "r/rose-$seed.glb"
 
+# a SIGINT ignored when plant starts (a background job of a script) stays ignored
+bash -c "trap '' INT; exec '$plant' run '$here/../../grammars/rose/fig12c.plant' --seeds 1..40 \
+  -o 'i/rose-{seed}.glb'" 2>/dev/null &
+pid=$!
+for _ in $(seq 100); do [ "$(ls i 2>/dev/null | grep -c glb)" -ge 2 ] && break; sleep 0.05; done
+kill -INT $pid
+wait $pid
+equal "ignored SIGINT: the batch goes on" $? 0
+equal "ignored SIGINT: every rose" "$(ls i | grep -c glb)" 40
+
 echo "batch: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
