@@ -172,7 +172,12 @@ void worker(Shared& s, std::atomic<std::uint64_t>& next) {
     for (std::uint64_t i; !g_stop.load() && (i = next.fetch_add(1)) < count;) {
         const auto t0 = std::chrono::steady_clock::now();
         ManifestRow row;
-        if (!run_variant(s, s.job.plan.variant(i), row)) break;
+        try {
+            if (!run_variant(s, s.job.plan.variant(i), row)) break;
+        } catch (const std::exception& e) { // a thread must not end by an exception
+            row.status = "runtime_error";
+            row.message = fmt::format("internal error: {}", escape_controls(e.what()));
+        }
         row.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         if (row.status != "ok")
             s.progress.print(fmt::format("plant: variant {}{}: {}", row.n,
