@@ -3,7 +3,7 @@ BUILD ?= build
 JOBS ?= 2
 CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
 
-.PHONY: all deps configure build demo test test-sanitize fuzz bench install package format format-check clean
+.PHONY: all deps configure build demo test test-sanitize test-cluster fuzz bench install package format format-check clean
 
 all: build
 
@@ -30,14 +30,22 @@ test: build format-check
 test-sanitize: | deps
 	bash scripts/test-sanitize
 
+# A single-node Slurm (Debian's slurm-wlm and munge, installed when missing, started by hand in a
+# scratch folder) runs examples/cluster/roses.sbatch as 4 array tasks; the merged manifest and the
+# roses must be those of one run (docs/batch.md). Needs root; not part of make test.
+test-cluster: build
+	bash scripts/test-cluster
+
 # The libFuzzer targets (docs/testing.md), built with clang into build-fuzz/, each run for
 # FUZZ_SECONDS seconds; a finding fails it and is saved in build-fuzz/findings/.
 FUZZ_SECONDS ?= 60
 fuzz: | deps
 	FUZZ_SECONDS=$(FUZZ_SECONDS) bash scripts/fuzz
 
+# bench/run (the derivation, meshing and end-to-end figures), then bench/run-batch (1,000 roses
+# on 1 and 2 jobs); fails when either misses a target.
 bench: build
-	bash bench/run
+	status=0; bash bench/run || status=1; bash bench/run-batch || status=1; exit $$status
 
 # Installing and packaging (docs/install.md): plant, its standard library, docs, man page and
 # the C++ API under PREFIX; the Debian packages plant and plant-dev into $(BUILD)/.

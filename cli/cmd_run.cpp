@@ -1,4 +1,5 @@
 // plant run: derive, interpret with the turtle, mesh and write every requested file.
+#include "batch.hpp"
 #include "commands.hpp"
 #include "outputs.hpp"
 
@@ -32,6 +33,7 @@ struct RunCmd {
     std::string max_memory;
     bool no_gpu_instancing = false, flatten = false;
     std::optional<std::string> camera, look_at; // as given, even empty
+    BatchOptions batch;                         // --seeds, --grid, --shard, --manifest, --jobs
 };
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
@@ -65,8 +67,9 @@ bool read_view(const RunCmd& c, std::optional<glm::dvec3>& camera, std::optional
     return true;
 }
 
-int run_main(RunCmd& c) {
-    // check the outputs before doing any work
+// Reads --size, --max-memory, the view and the layout into `oo`, and checks the outputs' formats
+// (the default outputs when none are given). Returns kOk, or kUsage having said why.
+int read_output_options(RunCmd& c, OutputOptions& oo) {
     int width = 0, height = 0;
     if (std::sscanf(c.size.c_str(), "%dx%d", &width, &height) != 2 || width < 16 || height < 16 ||
         width > 16384 || height > 16384 || static_cast<long long>(width) * height > 64LL * 1000 * 1000) {
@@ -78,7 +81,8 @@ int run_main(RunCmd& c) {
     }
     if (c.outputs.empty()) {
         std::string stem = fs::path(c.g.file).stem().string();
-        c.outputs = {"out/" + stem + ".glb", "out/" + stem + ".png"};
+        c.outputs = c.batch.any() ? std::vector<std::string>{"out/" + stem + "-{n}.glb"}
+                                  : std::vector<std::string>{"out/" + stem + ".glb", "out/" + stem + ".png"};
     }
     for (const auto& o : c.outputs) {
         if (!format_of(o)) {
@@ -95,6 +99,46 @@ int run_main(RunCmd& c) {
     }
     std::optional<glm::dvec3> camera, look_at;
     if (!read_view(c, camera, look_at)) return kUsage;
+    oo.sides = c.sides;
+    oo.obstacles = !c.no_obstacles;
+    oo.width = width;
+    oo.height = height;
+    oo.max_memory = max_memory;
+    oo.gltf_layout = c.flatten             ? GltfLayout::Baked
+                     : c.no_gpu_instancing ? GltfLayout::Nodes
+                                           : GltfLayout::GpuInstancing;
+    oo.camera = camera;
+    oo.look_at = look_at;
+    return kOk;
+}
+
+// Many variants: --seeds, --grid, --shard (docs/batch.md).
+int run_many(RunCmd& c, const OutputOptions& oo) {
+    if (c.g.seed && !c.batch.seeds.empty()) {
+        std::cerr << "plant: --seed and --seeds both set the seed: keep one of them\n";
+        return kUsage;
+    }
+    BatchJob job{c.g, c.outputs, oo, c.batch, {}};
+    std::string error;
+    auto plan = make_plan(c.batch, c.g.defines, error);
+    if (!plan) {
+        std::cerr << "plant: " << error << "\n";
+        return kUsage;
+    }
+    job.plan = std::move(*plan);
+    return run_batch(job);
+}
+
+int run_main(RunCmd& c) {
+    // check the outputs before doing any work
+    OutputOptions oo;
+    if (int code = read_output_options(c, oo); code != kOk) return code;
+    if (c.batch.jobs > 0 && !c.batch.any()) {
+        std::cerr << "plant: --jobs runs several variants at once: give --seeds or --grid too\n";
+        return kUsage;
+    }
+    if (c.batch.any()) return run_many(c, oo);
+    const std::uint64_t max_memory = oo.max_memory;
     int exit_code = kOk;
     SourceManager sources;
     auto program = load_program(c.g, sources, exit_code);
@@ -114,17 +158,6 @@ int run_main(RunCmd& c) {
     if (!run_derivation(d, sources, c.g.color)) return kRuntime;
     if (progress) std::cerr << "\r\x1b[K" << std::flush;
     try {
-        OutputOptions oo;
-        oo.sides = c.sides;
-        oo.obstacles = !c.no_obstacles;
-        oo.width = width;
-        oo.height = height;
-        oo.max_memory = max_memory;
-        oo.gltf_layout = c.flatten             ? GltfLayout::Baked
-                         : c.no_gpu_instancing ? GltfLayout::Nodes
-                                               : GltfLayout::GpuInstancing;
-        oo.camera = camera;
-        oo.look_at = look_at;
         OutputSummary summary = write_outputs(*program, d, c.outputs, oo);
         if (progress)
             std::cerr << fmt::format("{} modules, {} triangles, {} organs in {:.0f} ms\n", d.string().size(),
@@ -139,6 +172,33 @@ int run_main(RunCmd& c) {
     return kOk;
 }
 
+void add_batch_options(CLI::App& cmd, BatchOptions& b) {
+    const char* group = "Many variants (docs/batch.md)";
+    cmd.add_option("--seeds", b.seeds,
+                   "Grow one variant per seed from A to B; outputs then need a placeholder: {seed}, {n} "
+                   "(the variant's number from 0) or {NAME} of a --grid parameter")
+        ->type_name("A..B")
+        ->group(group);
+    cmd.add_option("--grid", b.grid,
+                   "Sweep a param over FROM, FROM+STEP, ... up to TO (or the values V1,V2,...); repeat "
+                   "for several: every combination with every seed is a variant")
+        ->type_name("NAME=FROM:TO:STEP")
+        ->group(group);
+    cmd.add_option("--jobs", b.jobs, "Variants grown at once (default: one per core)")
+        ->check(CLI::Range(1, 256))
+        ->group(group);
+    cmd.add_option("--shard", b.shard,
+                   "Grow only the K-th of N slices of the variants (those whose number n has n mod N = "
+                   "K - 1), for job arrays")
+        ->type_name("K/N")
+        ->group(group);
+    cmd.add_option("--manifest", b.manifest,
+                   "Write a row per variant (seed, params, outputs, modules, triangles, ms, status, "
+                   "message) as JSON lines (.jsonl) or CSV (.csv)")
+        ->type_name("FILE")
+        ->group(group);
+}
+
 } // namespace
 
 void setup_run(CLI::App& app, int& exit_code) {
@@ -148,7 +208,7 @@ void setup_run(CLI::App& app, int& exit_code) {
     add_grammar_options(*cmd, c->g, true);
     cmd->add_option("-o,--output", c->outputs,
                     "Output file, its format chosen by extension (listed below); repeat for several "
-                    "(default: out/NAME.glb and out/NAME.png)")
+                    "(default: out/NAME.glb and out/NAME.png; for many variants out/NAME-{n}.glb)")
         ->type_name("FILE");
     cmd->add_option("--sides", c->sides, "Vertices around each ring of a branch")->check(CLI::Range(3, 64));
     cmd->add_option("--size", c->size, "Size of PNG previews")->type_name("WxH");
@@ -172,6 +232,7 @@ void setup_run(CLI::App& app, int& exit_code) {
         ->type_name("X,Y,Z");
     cmd->add_flag("--no-obstacles", c->no_obstacles,
                   "Leave the environments' obstacles (a climber's walls, say) out of meshes and images");
+    add_batch_options(*cmd, c->batch);
     std::string formats = "Output formats:\n";
     for (const auto& f : output_formats()) formats += fmt::format("  {:<11} {}\n", f.extension, f.doc);
     cmd->footer(formats);

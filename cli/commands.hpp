@@ -46,8 +46,10 @@ void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation);
 // --allow-read DIR (repeatable), on every command that compiles a grammar.
 void add_allow_read(CLI::App& cmd, std::vector<std::string>& dirs);
 
-// Compiles the grammar, printing diagnostics to stderr. On failure sets `exit_code`.
-std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& sources, int& exit_code);
+// Compiles the grammar, printing diagnostics to stderr (or appending them to `*messages`, when
+// given, in the same words). On failure sets `exit_code`.
+std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& sources, int& exit_code,
+                                      std::string* messages = nullptr);
 
 // Runs a derivation, printing a runtime error as a diagnostic. Returns false on error.
 bool run_derivation(Derivation& d, const SourceManager& sources, bool color);

@@ -67,13 +67,22 @@ std::uint64_t parse_count(const std::string& option, const std::string& text, st
     return v;
 }
 
-std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& sources, int& exit_code) {
+std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& sources, int& exit_code,
+                                      std::string* messages) {
+    std::string printed;
+    std::string& out = messages ? *messages : printed;
+    struct Flush { // prints what was gathered, on every way out, unless the caller takes it
+        std::string& text;
+        bool print;
+        ~Flush() {
+            if (print) std::cerr << text;
+        }
+    } flush{out, messages == nullptr};
     std::string text;
     if (ReadFailure f = read_input_file(o.file, text, kMaxSourceBytes, false); f != ReadFailure::None) {
         std::error_code ec;
-        std::cerr << fmt::format("plant: cannot read '{}': {}\n", escape_controls(o.file),
-                                 std::filesystem::is_directory(o.file, ec) ? "it is a directory"
-                                                                           : describe(f));
+        out += fmt::format("plant: cannot read '{}': {}\n", escape_controls(o.file),
+                           std::filesystem::is_directory(o.file, ec) ? "it is a directory" : describe(f));
         exit_code = kNoInput;
         return nullptr;
     }
@@ -86,7 +95,7 @@ std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& so
     for (const auto& d : o.defines) {
         auto eq = d.find('=');
         if (eq == std::string::npos || eq == 0) {
-            std::cerr << fmt::format("plant: -D expects name=value, found '{}'\n", escape_controls(d));
+            out += fmt::format("plant: -D expects name=value, found '{}'\n", escape_controls(d));
             exit_code = kUsage;
             return nullptr;
         }
@@ -95,10 +104,9 @@ std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& so
     Diagnostics diags;
     std::uint32_t id = sources.add(o.file, std::move(text));
     auto program = compile_source(sources, id, co, diags);
-    std::cerr << render_all(diags, sources, o.color);
+    out += render_all(diags, sources, o.color);
     if (diags.error_count() > diags.all().size())
-        std::cerr << fmt::format("plant: {} more errors not shown\n",
-                                 diags.error_count() - diags.all().size());
+        out += fmt::format("plant: {} more errors not shown\n", diags.error_count() - diags.all().size());
     if (!program) exit_code = diags.has_input_errors() ? kNoInput : kGrammar;
     return program;
 }

@@ -29,6 +29,7 @@ struct Registry {
     }, old_term{};
 };
 std::atomic<Registry*> g_registry{nullptr};
+std::atomic<const std::atomic<bool>*> g_shared_stop{nullptr}; // share_signals()
 
 void on_signal(int sig, siginfo_t* info, void* context) {
     Registry* r = g_registry.load();
@@ -69,6 +70,8 @@ PendingFiles::PendingFiles(const std::vector<std::string>& targets)
                                      std::to_string(::getpid()) + "-" + std::to_string(counter++)))
                 .string());
     }
+    if (g_shared_stop.load()) return; // a batch: its own handlers stop it
+    owns_signals_ = true;
     auto* r = new Registry{temps_.data(), live_.get(), temps_.size(), {}, {}};
     struct sigaction sa {};
     sa.sa_sigaction = on_signal;
@@ -85,7 +88,7 @@ PendingFiles::PendingFiles(const std::vector<std::string>& targets)
 }
 
 PendingFiles::~PendingFiles() {
-    Registry* r = g_registry.load();
+    Registry* r = owns_signals_ ? g_registry.load() : nullptr;
     if (r) {
         sigaction(SIGINT, &r->old_int, nullptr);
         sigaction(SIGTERM, &r->old_term, nullptr);
@@ -127,7 +130,13 @@ void PendingFiles::write(std::size_t k, const std::string& bytes) {
     if (err != 0) throw ExportError("cannot write " + in_quotes(target) + ": " + std::strerror(err));
 }
 
+void PendingFiles::share_signals(const std::atomic<bool>* stop) {
+    g_shared_stop.store(stop);
+}
+
 void PendingFiles::commit() {
+    if (const std::atomic<bool>* stop = g_shared_stop.load(); stop && stop->load())
+        throw ExportError("interrupted");
     // a rename onto a folder fails: find it before any file is renamed
     for (const auto& t : targets_) {
         struct stat st {};

@@ -28,9 +28,17 @@ class PendingFiles {
     // rename fails (after checking beforehand what can be checked: a target that is a folder).
     void commit();
 
+    // Batch runs (docs/batch.md) keep many PendingFiles at once on several threads: the batch
+    // installs SIGINT and SIGTERM handlers of its own that only set `*stop`, and calls this
+    // before making any. Objects made while it is set leave the signal handlers alone (their
+    // destructor removes what is not committed), and commit() renames nothing once *stop is
+    // true: it throws ExportError("interrupted"). nullptr ends that mode.
+    static void share_signals(const std::atomic<bool>* stop);
+
   private:
     std::vector<std::string> targets_, temps_;
     std::unique_ptr<std::atomic<bool>[]> live_; // the temporary file may exist: remove it
+    bool owns_signals_ = false;                 // this object installed the handlers
 };
 
 } // namespace plant::cli
