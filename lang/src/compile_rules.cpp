@@ -148,6 +148,15 @@ void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list) {
                                           info.instance >= 0 ? " and an optional scale" : "", nargs,
                                           where(info.decl_span)));
             }
+            if (info.instance >= 0 && last && m.args.size() == static_cast<std::size_t>(info.arity) + 1) {
+                // a placement scale known now must be positive (the turtle checks the others)
+                const ast::Expr& scale = *m.args.back();
+                if (auto v = fold_number(scale); v && !(*v > 0))
+                    diags_->error(scale.span, fmt::format("'{}' places the instance at scale {}: the scale, "
+                                                          "its last number, must be positive (leave it "
+                                                          "out for scale 1)",
+                                                          info.name, *v));
+            }
             if (info.instance >= 0 && self_index_ >= 0) // what this body places (check_instance_graph)
                 graph_->places[static_cast<std::size_t>(self_index_)].emplace_back(
                     info.instance, last ? m.span : Span{parts[k].second});
