@@ -438,10 +438,10 @@ bool Session::is_edit(const std::string& line) const {
     return false;
 }
 
-void Session::export_files(const std::vector<std::string>& paths) {
+void Session::export_files(const std::vector<std::string>& paths, const OutputOptions& options) {
     if (!need_derivation()) return;
     try {
-        OutputSummary s = write_outputs(*program_, current(), paths, OutputOptions{});
+        OutputSummary s = write_outputs(*program_, current(), paths, options);
         for (const auto& p : paths) out_ << "wrote " << escape_controls(p) << "\n";
         out_ << fmt::format("{} triangles, {} organs\n", s.triangles, s.organs);
     } catch (const RuntimeError& e) {

@@ -5,6 +5,8 @@
 #include "plant/compiler.hpp"
 #include "plant/derive.hpp"
 
+#include "outputs.hpp"
+
 #include <atomic>
 #include <chrono>
 #include <map>
@@ -97,7 +99,7 @@ class Session {
     void rules();
     void params();
     void evaluate(const std::string& expr);
-    void export_files(const std::vector<std::string>& paths);
+    void export_files(const std::vector<std::string>& paths, const OutputOptions& options = {});
     bool need_derivation();
     // :do STATEMENTS: adds them as an edit at the current step and replays.
     void edit(std::string statements);

@@ -68,8 +68,10 @@ std::span<const ReplCommand> Session::commands() {
          "modules per symbol, branch depth, steps and the time of the last step", C::Nothing},
         {"time", "", [](S& s, A, A) { s.out_ << fmt::format("last step: {:.3f} ms\n", s.last_step_ms_); },
          ":time", "the time of the last step", C::Nothing},
-        {"export", "", [](S& s, A, A rest) { s.export_command(rest); }, ":export FILE...",
-         "write files as plant run does (.glb .png .obj .svg .txt .skel.json ...)", C::Files},
+        {"export", "", [](S& s, A, A rest) { s.export_command(rest); }, ":export [OPTION]... FILE...",
+         "write files as plant run does (.glb .png .obj .svg .txt .skel.json ...); options "
+         "--flatten, --no-gpu-instancing, --camera X,Y,Z, --look-at X,Y,Z",
+         C::Files},
         {"render", "",
          [](S& s, A, A rest) { s.export_files({rest.empty() ? std::string("out/repl.png") : rest}); },
          ":render [FILE.png]", "write a PNG preview (default out/repl.png)", C::Files},
@@ -205,11 +207,43 @@ void Session::use(const std::string& rest) {
 void Session::export_command(const std::string& rest) {
     std::istringstream in(rest);
     std::vector<std::string> paths;
-    for (std::string p; in >> p;) paths.push_back(p);
+    OutputOptions options;
+    std::vector<std::string> words;
+    for (std::string w; in >> w;) words.push_back(w);
+    for (std::size_t k = 0; k < words.size(); ++k) {
+        const std::string& w = words[k];
+        if (w == "--flatten" || w == "--no-gpu-instancing") {
+            options.gltf_layout = w == "--flatten" ? GltfLayout::Baked : GltfLayout::Nodes;
+        } else if (w == "--camera" || w == "--look-at") {
+            const auto point = k + 1 < words.size() ? parse_point(words[k + 1]) : std::nullopt;
+            if (!point) {
+                error() << fmt::format("':export {}' expects a point X,Y,Z after it, such as {} 0,5,20\n", w,
+                                       w);
+                return;
+            }
+            (w == "--camera" ? options.camera : options.look_at) = *point;
+            ++k;
+        } else if (w.size() > 1 && w[0] == '-' && w[1] == '-') {
+            error() << fmt::format("':export' has no option '{}': it takes --flatten, --no-gpu-instancing, "
+                                   "--camera X,Y,Z and --look-at X,Y,Z before the file names\n",
+                                   escape_controls(w));
+            return;
+        } else {
+            paths.push_back(w);
+        }
+    }
+    if (options.look_at && !options.camera) {
+        error() << "':export --look-at' needs --camera: the point is where the camera looks\n";
+        return;
+    }
+    if (options.camera && options.look_at && *options.camera == *options.look_at) {
+        error() << "':export --camera' must not be the point it looks at\n";
+        return;
+    }
     if (paths.empty())
         error() << "':export' expects one or more file names\n";
     else
-        export_files(paths);
+        export_files(paths, options);
 }
 
 ReplCompletion Session::completion_kind(const std::string& before) const {
