@@ -160,15 +160,8 @@ Scene split_nested(const Scene& scene, std::vector<NestedGroup>& groups, const s
     }
     std::map<const Scene*, std::uint64_t> memo;
     std::vector<int> group_of(n, -1);
-    Scene rest;
-    rest.tubes = scene.tubes;
-    rest.prototypes = scene.prototypes;
-    rest.prototype_names = scene.prototype_names;
-    rest.instances = scene.instances;
-    rest.materials = scene.materials;
-    rest.textures = scene.textures;
-    rest.scene_prototypes = scene.scene_prototypes;
-    rest.scene_prototype_names = scene.scene_prototype_names;
+    Scene rest = scene; // the placements of nested prototypes taken out below
+    rest.scene_instances.clear();
     for (const Instance& i : scene.scene_instances) {
         const std::uint32_t k = i.prototype;
         const std::uint64_t parts = part_count(*scene.scene_prototypes[k], memo);

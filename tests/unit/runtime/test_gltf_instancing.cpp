@@ -3,6 +3,7 @@
 #include "export_placement.hpp"
 #include "plant/export.hpp"
 #include "runtime/nested_scene.hpp"
+#include "runtime/parse_glb.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -16,21 +17,9 @@
 #include <string>
 
 using namespace plant;
+using plant::test::parse_glb;
 
 namespace {
-
-tinygltf::Model parse_glb(const Scene& scene, GltfLayout layout) {
-    const std::string bytes = gltf_bytes(scene, GltfContainer::Binary, "test.glb", layout);
-    tinygltf::TinyGLTF loader;
-    tinygltf::Model model;
-    std::string err, warn;
-    const bool ok =
-        loader.LoadBinaryFromMemory(&model, &err, &warn, reinterpret_cast<const unsigned char*>(bytes.data()),
-                                    static_cast<unsigned>(bytes.size()));
-    INFO(err);
-    REQUIRE(ok);
-    return model;
-}
 
 const tinygltf::Node* node_named(const tinygltf::Model& model, const std::string& name) {
     for (const auto& node : model.nodes)

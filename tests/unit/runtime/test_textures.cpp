@@ -6,6 +6,7 @@
 #include "plant/export.hpp"
 #include "plant/mesh.hpp"
 #include "runtime/nested_scene.hpp"
+#include "runtime/parse_glb.hpp"
 #include "texture_image.hpp"
 
 #include <catch2/catch.hpp>
@@ -18,6 +19,7 @@
 #include <sstream>
 
 using namespace plant;
+using plant::test::parse_glb;
 
 namespace {
 
@@ -65,19 +67,6 @@ Built build(const std::string& grammar) {
     mo.derivation = &d;
     b.scene = build_scene(p, b.skeleton, mo);
     return b;
-}
-
-tinygltf::Model parse_glb(const Scene& scene, GltfLayout layout) {
-    const std::string bytes = gltf_bytes(scene, GltfContainer::Binary, "test.glb", layout);
-    tinygltf::TinyGLTF loader;
-    tinygltf::Model model;
-    std::string err, warn;
-    const bool ok =
-        loader.LoadBinaryFromMemory(&model, &err, &warn, reinterpret_cast<const unsigned char*>(bytes.data()),
-                                    static_cast<unsigned>(bytes.size()));
-    INFO(err);
-    REQUIRE(ok);
-    return model;
 }
 
 const tinygltf::Mesh& mesh_named(const tinygltf::Model& model, const std::string& name) {

@@ -10,6 +10,7 @@
 #include "plant/mesh.hpp"
 #include "plant/skeleton.hpp"
 #include "plant/turtle.hpp"
+#include "runtime/parse_glb.hpp"
 
 #include <catch2/catch.hpp>
 #include <fmt/format.h>
@@ -27,6 +28,7 @@
 #include <vector>
 
 using namespace plant;
+using plant::test::parse_glb;
 
 namespace {
 
@@ -218,18 +220,6 @@ long flat_leaves(const Scene& scene) {
         n += name == "leaf" || (name.size() > 5 && name.compare(name.size() - 5, 5, "/leaf") == 0);
     }
     return n;
-}
-
-tinygltf::Model parse_glb(const std::string& bytes) {
-    tinygltf::TinyGLTF loader;
-    tinygltf::Model model;
-    std::string err, warn;
-    const bool ok =
-        loader.LoadBinaryFromMemory(&model, &err, &warn, reinterpret_cast<const unsigned char*>(bytes.data()),
-                                    static_cast<unsigned>(bytes.size()));
-    INFO(err);
-    REQUIRE(ok);
-    return model;
 }
 
 bool ends_with(const std::string& s, const std::string& tail) {
