@@ -73,4 +73,6 @@ if(PLANT_PYTHON_BUILT)
     endforeach()
   endif()
   add_subdirectory(python)
+  # the plant Debian package holds the module (the runtime component); NumPy makes its arrays
+  set(CPACK_DEBIAN_RUNTIME_PACKAGE_RECOMMENDS "python3-numpy")
 endif()

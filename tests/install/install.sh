@@ -3,12 +3,16 @@
 # elsewhere, then the moved install grows a rose from a grammar outside the source tree, finds
 # only its own standard library (the import search names it and never the source tree; with
 # the source tree hidden by an empty mount it still works), and the C++ example builds against
-# its CMake package and grows the same rose.
-#   install.sh CMAKE BUILD_DIR SOURCE_DIR
+# its CMake package and grows the same rose. With PYTHON and PYTHON_DIR (the Python module was
+# built; PYTHON_DIR is where it installs under the prefix), tests/python runs against the moved
+# install's package too, also with the source tree hidden.
+#   install.sh CMAKE BUILD_DIR SOURCE_DIR [PYTHON PYTHON_DIR]
 set -u
-cmake=${1:?usage: install.sh CMAKE BUILD_DIR SOURCE_DIR}
+cmake=${1:?usage: install.sh CMAKE BUILD_DIR SOURCE_DIR [PYTHON PYTHON_DIR]}
 build=$(realpath "${2:?}")
 src=$(realpath "${3:?}")
+python=${4:-}
+pydir=${5:-}
 . "$(dirname "$0")/lib.sh"
 golden=$src/grammars/rose/fig12c.mesh.txt
 
@@ -87,12 +91,31 @@ if [ "$(head -c 4 api.glb)" = "glTF" ]; then pass=$((pass + 1)); else
   echo "FAIL the example's api.glb is not a GLB"
 fi
 
+# the Python module: tests/python, with the grammar and docs it reads copied out of the source
+# tree, against the moved install's package (the tests check it is that one, reading that stdlib)
+if [ -n "$python" ]; then
+  exists "installed Python package" "$p/$pydir/plant/__init__.py"
+  mkdir -p "$tmp/py/grammars/rose" "$tmp/py/docs" "$tmp/py/tests"
+  cp -r "$src/tests/python" "$tmp/py/tests/"
+  cp "$src/grammars/rose/fig12c.plant" "$src/grammars/rose/fig12c.mesh.txt" "$tmp/py/grammars/rose/"
+  cp "$src/docs/api.md" "$tmp/py/docs/"
+  pytest=(env PYTHONPATH="$p/$pydir" PYTHONDONTWRITEBYTECODE=1 PLANT_SOURCE_DIR="$tmp/py" PLANT_EXE="$p/bin/plant"
+    PLANT_EXPECT_PREFIX="$p" "$python" -m pytest -q -p no:cacheprovider -rs "$tmp/py/tests/python")
+  check "the Python tests against the install" 0 "${pytest[@]}"
+  tail -3 "$tmp/stdout"
+  lacks "no Python test skipped" "$tmp/stdout" "skipped"
+fi
+
 # with the source tree (and the build tree in it) hidden: the install and the example still work
 if can_hide; then
   check "moved install, source tree hidden" 0 hidden "$src" "$p/bin/plant" run fig12c.plant -o hidden.mesh.txt
   same "rose with the source tree hidden" hidden.mesh.txt "$golden"
   check "example, source tree hidden" 0 hidden "$src" "$tmp/example/grow" fig12c.plant hidden.glb
   check "copied program, source tree hidden, finds no rose" 65 hidden "$src" "$tmp/lonely/bin/plant" check fig12c.plant
+  if [ -n "$python" ]; then
+    check "the Python tests against the install, source tree hidden" 0 hidden "$src" "${pytest[@]}"
+    tail -3 "$tmp/stdout"
+  fi
 else
   echo "SKIP hiding the source tree: no private mount namespace here (unshare -rm)"
 fi

@@ -2,11 +2,15 @@
 # The Debian packages (docs/install.md): cpack -G DEB makes plant and plant-dev; their control
 # fields are checked, both are unpacked with dpkg -x into a scratch root, and the unpacked plant
 # grows a rose with the source tree out of reach, while the headers and CMake package are there.
-#   package.sh CPACK BUILD_DIR SOURCE_DIR
+# With PYTHON and PYTHON_DIR (the Python module was built), plant holds the Python package too,
+# and the unpacked one grows the rose.
+#   package.sh CPACK BUILD_DIR SOURCE_DIR [PYTHON PYTHON_DIR]
 set -u
-cpack=${1:?usage: package.sh CPACK BUILD_DIR SOURCE_DIR}
+cpack=${1:?usage: package.sh CPACK BUILD_DIR SOURCE_DIR [PYTHON PYTHON_DIR]}
 build=$(realpath "${2:?}")
 src=$(realpath "${3:?}")
+python=${4:-}
+pydir=${5:-}
 . "$(dirname "$0")/lib.sh"
 golden=$src/grammars/rose/fig12c.mesh.txt
 
@@ -61,4 +65,12 @@ printf 'import nosuchlib;\naxiom: F;\n' >missing.plant
 check "the unpacked plant: a missing library" 65 "${run[@]}" "$root/usr/bin/plant" check missing.plant
 contains "it searched the unpacked stdlib" "$tmp/stderr" "$root/usr/share/plant/stdlib/nosuchlib.plant"
 lacks "and not the source tree" "$tmp/stderr" "$src"
+if [ -n "$python" ]; then
+  exists "plant holds the Python package" "$root/usr/$pydir/plant/__init__.py"
+  check "the unpacked Python package grows a rose" 0 "${run[@]}" env PYTHONPATH="$root/usr/$pydir" \
+    PYTHONDONTWRITEBYTECODE=1 "$python" -c \
+    'import plant; plant.compile("fig12c.plant").derive().save("py.mesh.txt"); print(plant.STDLIB)'
+  same "the unpacked Python package's rose matches the golden" py.mesh.txt "$golden"
+  contains "it reads the unpacked stdlib" "$tmp/stdout" "$root/usr/share/plant/stdlib"
+fi
 finish
