@@ -1,8 +1,10 @@
-// Environment kinds: bounds (ellipsoid), proximity of other stems (spatial hash over the
-// skeleton's segments) and obstacles (signed distances to boxes, spheres and planes).
+// Environment kinds: bounds (ellipsoid), crown silhouettes (envelope), proximity of other stems
+// (spatial hash over the skeleton's segments) and obstacles (signed distances to boxes, spheres
+// and planes).
 #include "plant/environments.hpp"
 
 #include "plant/climber.hpp"
+#include "plant/silhouette.hpp"
 
 #include "geometry.hpp"
 #include "obstacle_args.hpp"
@@ -336,60 +338,62 @@ class Obstacles : public Environment {
 
 // ---- envelope ------------------------------------------------------------------------------
 
-// Cescatti's asymmetric crown envelope (as used by Boudon et al. 2003, Fig. 6): P1 the top, P2
-// the bottom, P3 and P5 the widest points on the +x and -x sides, P4 and P6 on the +z and -z
-// sides (each at its own height), C1 and C2 the shapes above and below the peripheral line.
-// Between two neighbouring peripheral points the line is a quarter ellipse; above it the crown
-// is the superellipse (r/R)^C1 + ((y - Y)/(top - Y))^C1 = 1, below it the same with C2.
-enum class EnvelopeMethod : std::uint8_t { Contains, Level };
+// Cescatti's asymmetric crown envelope (Boudon et al. 2003, Fig. 6), with the axis and the
+// control point T of a silhouette (section 3): the geometry is plant::Silhouette
+// (lang/include/plant/silhouette.hpp), here in world coordinates.
+enum class EnvelopeMethod : std::uint8_t { Contains, Level, Reach, Axis, Heading, Base, Tip };
 constexpr EnvMethod kEnvelopeMethods[] = {
     env_method(EnvelopeMethod::Contains, "contains", {V}, B, Pure, true, "p inside the envelope"),
     env_method(EnvelopeMethod::Level, "level", {V}, N, Pure, true,
                "how far out p is: below 1 inside, 1 on the surface"),
+    env_method(EnvelopeMethod::Reach, "reach", {V, V}, N, Pure, false,
+               "distance from p along d to where the ray leaves the envelope (0 if p is outside)"),
+    env_method(EnvelopeMethod::Axis, "axis", {N}, V, Pure, false, "the point of the axis at t in [0, 1]"),
+    env_method(EnvelopeMethod::Heading, "heading", {N}, V, Pure, false, "the axis's unit tangent at t"),
+    env_method(EnvelopeMethod::Base, "base", {}, V, Pure, false, "the axis's first point B"),
+    env_method(EnvelopeMethod::Tip, "tip", {}, V, Pure, false, "the control point T"),
 };
-static_assert(method_table(kEnvelopeMethods, EnvelopeMethod::Level));
+static_assert(method_table(kEnvelopeMethods, EnvelopeMethod::Tip));
 constexpr EnvironmentKind kEnvelope{"envelope", "Cescatti's asymmetric crown envelope", kEnvelopeMethods};
 
-class Envelope : public Environment {
+class EnvelopeEnv : public Environment {
   public:
-    glm::dvec3 top, bottom;
-    double radius[4]; // +x, +z, -x, -z, from the axis through the bottom point
-    double height[4];
-    double c_top = 2, c_bottom = 2;
-
+    explicit EnvelopeEnv(Silhouette s) : s_(std::move(s)) {}
     const EnvironmentKind& kind() const override { return kEnvelope; }
-    std::unique_ptr<Environment> clone() const override { return std::make_unique<Envelope>(*this); }
-    double level(const glm::dvec3& p) const {
-        const double dx = p.x - bottom.x, dz = p.z - bottom.z;
-        const double r = std::hypot(dx, dz);
-        double theta = std::atan2(dz, dx);
-        if (theta < 0) theta += 2 * std::numbers::pi;
-        const int q = std::min(3, static_cast<int>(theta / (std::numbers::pi / 2)));
-        const double phi = theta - q * std::numbers::pi / 2; // angle within the quadrant
-        const double a = radius[q], b = radius[(q + 1) % 4];
-        const double c = std::cos(phi), s = std::sin(phi);
-        const double R = a * b / std::sqrt((b * c) * (b * c) + (a * s) * (a * s)); // quarter ellipse
-        const double Y = height[q] * c * c + height[(q + 1) % 4] * s * s;
-        if (p.y >= Y) {
-            if (p.y > top.y) return 1e300;
-            double h = std::max(top.y - Y, 1e-12);
-            return std::pow(std::pow(r / R, c_top) + std::pow((p.y - Y) / h, c_top), 1 / c_top);
-        }
-        if (p.y < bottom.y) return 1e300;
-        double h = std::max(Y - bottom.y, 1e-12);
-        return std::pow(std::pow(r / R, c_bottom) + std::pow((Y - p.y) / h, c_bottom), 1 / c_bottom);
-    }
+    std::unique_ptr<Environment> clone() const override { return std::make_unique<EnvelopeEnv>(*this); }
     void query(std::size_t method, const double* a, double* r) const override {
-        double l = level(vec(a));
+        auto put = [&](const glm::dvec3& v) {
+            r[0] = v.x;
+            r[1] = v.y;
+            r[2] = v.z;
+        };
         switch (static_cast<EnvelopeMethod>(method)) {
         case EnvelopeMethod::Contains:
-            r[0] = l <= 1.0 ? 1.0 : 0.0;
+            r[0] = s_.envelope.level(vec(a)) <= 1.0 ? 1.0 : 0.0;
             break;
         case EnvelopeMethod::Level:
-            r[0] = l;
+            r[0] = s_.envelope.level(vec(a));
+            break;
+        case EnvelopeMethod::Reach:
+            r[0] = s_.envelope.reach(vec(a), vec(a + 3));
+            break;
+        case EnvelopeMethod::Axis:
+            put(s_.axis.point(a[0]));
+            break;
+        case EnvelopeMethod::Heading:
+            put(s_.axis.heading(a[0]));
+            break;
+        case EnvelopeMethod::Base:
+            put(s_.base());
+            break;
+        case EnvelopeMethod::Tip:
+            put(s_.tip);
             break;
         }
     }
+
+  private:
+    Silhouette s_;
 };
 
 // ---- light ---------------------------------------------------------------------------------
@@ -545,39 +549,53 @@ Made make_obstacles(const std::vector<EnvArg>& args, std::string& error) {
     return o;
 }
 
+// The envelope's axis: `axis` points make a polyline, `bezier` points a Bezier curve (each key
+// as often as needed, not both); without either, the vertical from the bottom to the top's height.
+bool envelope_axis(const std::vector<EnvArg>& args, const Envelope& e, AxisCurve& axis, std::string& error) {
+    std::vector<glm::dvec3> polyline, bezier;
+    for (const auto& arg : args) {
+        if (arg.key != "axis" && arg.key != "bezier") continue;
+        if (arg.type != V) {
+            error = fmt::format("envelope: '{}' must be a vec3", arg.key);
+            return false;
+        }
+        (arg.key == "axis" ? polyline : bezier).push_back(vec(arg));
+    }
+    if (!polyline.empty() && !bezier.empty()) {
+        error = "envelope: the axis is either a polyline (`axis` points) or a Bezier curve (`bezier` points)";
+        return false;
+    }
+    if (polyline.empty() && bezier.empty()) polyline = {e.bottom, e.control_point(0)};
+    axis = AxisCurve::make(bezier.empty() ? AxisCurve::Kind::Polyline : AxisCurve::Kind::Bezier,
+                           bezier.empty() ? polyline : bezier, error);
+    if (!error.empty()) error = "envelope: " + error;
+    return error.empty();
+}
+
 Made make_envelope(const std::vector<EnvArg>& args, std::string& error) {
     Args a(kEnvelope.name, args, error);
-    if (!a.only({"top", "bottom", "px", "pz", "nx", "nz", "top_shape", "bottom_shape"})) return nullptr;
-    auto e = std::make_unique<Envelope>();
+    if (!a.only(
+            {"top", "bottom", "px", "pz", "nx", "nz", "top_shape", "bottom_shape", "axis", "bezier", "tip"}))
+        return nullptr;
     const EnvArg *t = a.find("top", V), *b = a.find("bottom", V);
     const EnvArg* side[4] = {a.find("px", V), a.find("pz", V), a.find("nx", V), a.find("nz", V)};
-    const EnvArg *ct = a.find("top_shape", N), *cb = a.find("bottom_shape", N);
+    const EnvArg *ct = a.find("top_shape", N), *cb = a.find("bottom_shape", N), *tip = a.find("tip", V);
     if (!a.ok()) return nullptr;
     if (!t || !b || !side[0] || !side[1] || !side[2] || !side[3]) {
         error = "envelope: needs top, bottom and the four widest points px, pz, nx, nz";
         return nullptr;
     }
-    e->top = vec(*t);
-    e->bottom = vec(*b);
-    const double rad[4] = {side[0]->v[0] - e->bottom.x, side[1]->v[2] - e->bottom.z,
-                           e->bottom.x - side[2]->v[0], e->bottom.z - side[3]->v[2]};
-    for (int k = 0; k < 4; ++k) {
-        e->radius[k] = rad[k];
-        e->height[k] = side[k]->v[1];
-        if (!(rad[k] > 0) || e->height[k] >= e->top.y || e->height[k] <= e->bottom.y) {
-            error = "envelope: each widest point lies on its own side of the axis through the bottom "
-                    "point, "
-                    "between the bottom and the top";
-            return nullptr;
-        }
-    }
-    e->c_top = ct ? ct->v[0] : 2.0;
-    e->c_bottom = cb ? cb->v[0] : 2.0;
-    if (!(e->c_top > 0) || !(e->c_bottom > 0)) {
-        error = "envelope: the shape coefficients must be positive";
+    Silhouette s;
+    std::string why;
+    s.envelope = Envelope::make(vec(*t), vec(*b), vec(*side[0]), vec(*side[1]), vec(*side[2]), vec(*side[3]),
+                                ct ? ct->v[0] : 2.0, cb ? cb->v[0] : 2.0, why);
+    if (!why.empty()) {
+        error = "envelope: " + why;
         return nullptr;
     }
-    return e;
+    if (!envelope_axis(args, s.envelope, s.axis, error)) return nullptr;
+    s.tip = tip ? vec(*tip) : vec(*t);
+    return std::make_unique<EnvelopeEnv>(std::move(s));
 }
 
 Made make_light(const std::vector<EnvArg>& args, std::string& error) {
