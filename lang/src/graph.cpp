@@ -305,7 +305,8 @@ void DecompositionGraph::resolve() {
             }
             const int from = source[static_cast<std::size_t>(parent) * P + p];
             const NodeValue& inherited = values_[static_cast<std::size_t>(from) * P + p];
-            v.from = from;
+            // where the value was last set: past ancestors that inherited it themselves
+            v.from = inherited.status == ValueStatus::Inherited ? inherited.from : from;
             v.number = inherited.number;
             v.curve = inherited.curve;
             if (l.status == ValueStatus::Offset) {
