@@ -96,13 +96,14 @@ void setup_derive(CLI::App& app, int& exit_code) {
 
 void setup_check(CLI::App& app, int& exit_code) {
     auto c = std::make_shared<GrammarOptions>();
-    CLI::App* cmd = app.add_subcommand("check", "Parse and check a grammar; print its diagnostics only");
+    CLI::App* cmd = app.add_subcommand(
+        "check", "Parse and check a grammar; print its diagnostics (and its graph's dormant edits) only");
     add_grammar_options(*cmd, *c, false);
     cmd->callback([c, &exit_code] {
         SourceManager sources;
         int code = kOk;
         auto program = load_program(*c, sources, code);
-        exit_code = program ? kOk : code;
+        exit_code = program ? report_dormant_edits(*c, *program, sources) : code;
     });
 }
 

@@ -35,6 +35,9 @@ struct GrammarOptions {
     std::size_t max_modules = 50'000'000;
     std::uint64_t max_steps = kDefaultMaxSteps; // instructions one evaluation may run
     bool color = false;
+    // --edits FILE: the decomposition graph's edits (docs/language.md, decomposition graphs);
+    // empty: the grammar's `edits "file";`, if any.
+    std::string edits;
 };
 
 // Reads a whole number from 0 (`lowest`) to 2^64 - 1 written in decimal digits; throws
@@ -51,6 +54,12 @@ void add_allow_read(CLI::App& cmd, std::vector<std::string>& dirs);
 std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& sources, int& exit_code,
                                       std::string* messages = nullptr);
 
+// Reads the edits of a program with a graph into program.graph.edits: the --edits file, else the
+// grammar's default (a default that does not exist yet is no edits). Errors are printed like the
+// grammar's (exit 65; 66 when the file cannot be read). False on error.
+bool load_edits(const GrammarOptions& o, Program& program, SourceManager& sources, std::string& out,
+                int& exit_code);
+
 // Runs a derivation, printing a runtime error as a diagnostic. Returns false on error.
 bool run_derivation(Derivation& d, const SourceManager& sources, bool color);
 
@@ -62,5 +71,10 @@ void setup_test(CLI::App& app, int& exit_code);
 void setup_run(CLI::App& app, int& exit_code);
 void setup_repl(CLI::App& app, int& exit_code);
 void setup_help(CLI::App& app, int& exit_code);
+void setup_graph(CLI::App& app, int& exit_code);
+
+// plant check: derives a program with a graph and edits, and prints each dormant edit as a warning
+// at its line of the edits file (cmd_graph.cpp). Returns the exit code.
+int report_dormant_edits(const GrammarOptions& o, const Program& program, const SourceManager& sources);
 
 } // namespace plant::cli

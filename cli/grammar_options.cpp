@@ -20,6 +20,9 @@ void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation) {
     cmd.add_option("-I,--include", o.include_dirs, "Add a directory to the library search path")
         ->type_name("DIR");
     add_allow_read(cmd, o.allow_read);
+    cmd.add_option("--edits", o.edits,
+                   "Apply the decomposition graph's edits from FILE (default: the grammar's 'edits \"F\";')")
+        ->type_name("FILE");
     if (derivation) {
         cmd.add_option("-n,--steps", o.steps,
                        "Number of derivation steps (default: the grammar's 'derive N;')")
@@ -108,7 +111,36 @@ std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& so
     if (diags.error_count() > diags.all().size())
         out += fmt::format("plant: {} more errors not shown\n", diags.error_count() - diags.all().size());
     if (!program) exit_code = diags.has_input_errors() ? kNoInput : kGrammar;
+    if (program && !load_edits(o, *program, sources, out, exit_code)) return nullptr;
     return program;
+}
+
+bool load_edits(const GrammarOptions& o, Program& program, SourceManager& sources, std::string& out,
+                int& exit_code) {
+    std::string path = o.edits.empty() ? program.graph.edits_path : o.edits;
+    if (path.empty()) return true;
+    if (!program.graph.declared) {
+        out += fmt::format("plant: --edits '{}': the grammar declares no graph, so it takes no edits\n",
+                           escape_controls(path));
+        exit_code = kUsage;
+        return false;
+    }
+    std::string text;
+    ReadFailure f = read_input_file(path, text, kMaxSourceBytes, o.edits.empty());
+    if (f == ReadFailure::Missing && o.edits.empty()) return true; // a default not written yet
+    if (f != ReadFailure::None) {
+        out +=
+            fmt::format("plant: cannot read the edits file '{}': {}\n", escape_controls(path), describe(f));
+        exit_code = kNoInput;
+        return false;
+    }
+    Diagnostics diags;
+    const std::uint32_t id = sources.add(path, std::move(text));
+    program.graph.edits = parse_edits(program, sources, id, diags);
+    out += render_all(diags, sources, o.color);
+    if (program.graph.edits) return true;
+    exit_code = kGrammar;
+    return false;
 }
 
 DeriveOptions derive_options(const GrammarOptions& o) {

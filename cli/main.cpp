@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
     setup_run(app, exit_code);
     setup_derive(app, exit_code);
     setup_check(app, exit_code);
+    setup_graph(app, exit_code);
     setup_test(app, exit_code);
     setup_repl(app, exit_code);
     setup_help(app, exit_code);

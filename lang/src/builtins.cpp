@@ -10,6 +10,8 @@ constexpr ValueType X = ValueType::Void;
 constexpr BuiltinReads A = BuiltinReads::Arguments;
 constexpr BuiltinReads R = BuiltinReads::Random;
 constexpr BuiltinReads I = BuiltinReads::Identity;
+constexpr ValueType G = ValueType::Node;
+constexpr BuiltinReads D = BuiltinReads::Graph;
 
 constexpr BuiltinInfo table[] = {
     {"sin", BuiltinId::Sin, 1, {N, X, X}, N, A, "sine of an angle in radians"},
@@ -64,6 +66,37 @@ constexpr BuiltinInfo table[] = {
      N,
      A,
      "lod(count, view_depth, max_view_depth): the same with a view depth of your own"},
+    {"root",
+     BuiltinId::Root,
+     0,
+     {X, X, X},
+     G,
+     D,
+     "the root node of the decomposition graph: the whole plant"},
+    {"child",
+     BuiltinId::Child,
+     2,
+     {G, N, X},
+     G,
+     D,
+     "child(n, position): the node of the branch at position (0 base, 1 tip) along n's axis, made when "
+     "new"},
+    {"child",
+     BuiltinId::ChildIndex,
+     3,
+     {G, N, N},
+     G,
+     D,
+     "child(n, position, index): the same for branch `index` of several at one position"},
+    {"depth",
+     BuiltinId::Depth,
+     1,
+     {G, X, X},
+     N,
+     D,
+     "a node's depth in the decomposition graph (0: the root)"},
+    {"position", BuiltinId::Position, 1, {G, X, X}, N, D, "a node's position along its parent's axis"},
+    {"index", BuiltinId::BranchIndex, 1, {G, X, X}, N, D, "a node's branch index at its position"},
 };
 } // namespace
 
@@ -83,6 +116,8 @@ const char* value_type_name(ValueType t) {
         return "string";
     case ValueType::Void:
         return "nothing";
+    case ValueType::Node:
+        return "node";
     }
     return "?";
 }

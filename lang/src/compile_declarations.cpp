@@ -129,7 +129,8 @@ ValueType Compiler::param_type(const ast::ParamName& p) {
     if (p.type.empty() || p.type == "number") return ValueType::Number;
     if (p.type == "vec3") return ValueType::Vec3;
     if (p.type == "bool") return ValueType::Bool;
-    diags_->error(p.span, fmt::format("unknown type '{}': expected number, bool or vec3", p.type));
+    if (p.type == "node") return ValueType::Node;
+    diags_->error(p.span, fmt::format("unknown type '{}': expected number, bool, vec3 or node", p.type));
     return ValueType::Number;
 }
 

@@ -242,6 +242,7 @@ ValueType Compiler::compile_expr(Ctx& c, const ast::Expr& e) {
         return compile_call(c, e);
     case K::Member: {
         ValueType t = compile_expr(c, *e.args[0]);
+        if (t == ValueType::Node) return compile_node_read(c, e, nullptr);
         int comp = e.text == "x" ? 0 : e.text == "y" ? 1 : e.text == "z" ? 2 : -1;
         if (t != ValueType::Vec3 || comp < 0) {
             diags_->error(
@@ -306,7 +307,9 @@ ValueType Compiler::compile_method(Ctx& c, const ast::Expr& e) {
         for (std::size_t k = 0; k < P_.environments.size(); ++k)
             if (P_.environments[k].name == obj.text && P_.environments[k].kind) env = k;
     if (env < P_.environments.size()) return compile_env_call(c, e, env);
-    if (obj.kind == K::Name && env_names_.count(obj.text)) {
+    const bool env_name = obj.kind == K::Name && env_names_.count(obj.text);
+    if (!env_name && compile_expr(c, obj) == ValueType::Node) return compile_node_read(c, e, &obj);
+    if (env_name) {
         diags_->error(
             e.span,
             opts_.environments
@@ -317,7 +320,9 @@ ValueType Compiler::compile_method(Ctx& c, const ast::Expr& e) {
     } else {
         diags_->error(
             e.span,
-            fmt::format("'.{}(...)' is a method call, and only environment objects have methods", e.text));
+            fmt::format(
+                "'.{}(...)' is a method call, and only environment objects and graph nodes have methods",
+                e.text));
     }
     emit_const(c, 0, e.span);
     return ValueType::Number;
@@ -470,7 +475,9 @@ ValueType Compiler::compile_call(Ctx& c, const ast::Expr& e) {
         bool ok = true;
         int width = 0;
         for (std::size_t i = 0; i < types.size(); ++i) {
-            ok = ok && (b.args[i] == ValueType::Vec3 ? types[i] == ValueType::Vec3 : numeric(types[i]));
+            const ValueType want = b.args[i];
+            ok = ok &&
+                 (want == ValueType::Vec3 || want == ValueType::Node ? types[i] == want : numeric(types[i]));
             width += value_width(types[i]);
         }
         if (!ok) continue;
@@ -481,6 +488,7 @@ ValueType Compiler::compile_call(Ctx& c, const ast::Expr& e) {
                                       name));
         }
         if (b.per_module() && c.function >= 0) fn_random_[static_cast<std::size_t>(c.function)] = true;
+        if (b.reads == BuiltinReads::Graph) return compile_graph_call(c, e, b, width);
         if (b.id == BuiltinId::Id) P_.uses_id = true;
         if (b.id == BuiltinId::Lod && types.size() == 1) { // lod(count): the program's view depth
             for (const char* param : {"view_depth", "max_view_depth"}) {

@@ -198,7 +198,8 @@ void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list) {
                                     "found a {}",
                                     info.name, value_type_name(t)));
                 if (info.arity >= 0 && i < info.param_types.size() &&
-                    value_width(t) != value_width(info.param_types[i])) {
+                    (value_width(t) != value_width(info.param_types[i]) ||
+                     (t == ValueType::Node) != (info.param_types[i] == ValueType::Node))) {
                     diags_->error(m.args[i]->span,
                                   fmt::format("parameter '{}' of '{}' is a {}, found a {}",
                                               info.param_names[i], info.name,

@@ -35,48 +35,54 @@ std::string image_mime_type(const std::string& bytes) {
 } // namespace
 
 void Compiler::compile_curve(const ast::ShapeDecl& s) {
-    CurveDef def;
-    def.name = s.name;
-    def.span = s.span;
     for (const auto& other : P_.curves) {
         if (other.name == s.name) {
             duplicate("curve", s.name, s.span, other.span);
             return;
         }
     }
-    if (s.kind != "linear" && s.kind != "bezier") {
-        diags_->error(s.kind_span,
-                      fmt::format("unknown curve kind '{}': expected linear(...) or bezier(...)", s.kind));
-        return;
+    if (auto def = make_curve(s.name, s.kind, s.kind_span, s.args, s.span))
+        P_.curves.push_back(std::move(*def));
+}
+
+// A curve from its kind and control values (a `curve` declaration, a graph parameter).
+std::optional<CurveDef> Compiler::make_curve(const std::string& name, const std::string& kind, Span kind_span,
+                                             const std::vector<ast::ExprPtr>& args, Span span) {
+    CurveDef def;
+    def.name = name;
+    def.span = span;
+    if (kind != "linear" && kind != "bezier") {
+        diags_->error(kind_span,
+                      fmt::format("unknown curve kind '{}': expected linear(...) or bezier(...)", kind));
+        return std::nullopt;
     }
-    def.bezier = s.kind == "bezier";
+    def.bezier = kind == "bezier";
     bool points = false;
-    for (std::size_t i = 0; i < s.args.size(); ++i) {
-        auto v = eval_const(*s.args[i], "a curve's control value");
-        if (!v) return;
+    for (std::size_t i = 0; i < args.size(); ++i) {
+        auto v = eval_const(*args[i], "a curve's control value");
+        if (!v) return std::nullopt;
         bool vec = v->type == ValueType::Vec3;
         if (i == 0) points = vec;
         if (vec != points) {
-            diags_->error(s.args[i]->span, "a curve's control values are all numbers or all vec3 points");
-            return;
+            diags_->error(args[i]->span, "a curve's control values are all numbers or all vec3 points");
+            return std::nullopt;
         }
         def.xs.push_back(vec ? v->v[0] : 0.0);
         def.ys.push_back(vec ? v->v[1] : v->v[0]);
     }
     if (def.ys.size() < 2) {
-        diags_->error(s.span, fmt::format("curve '{}' needs at least two control values", s.name));
-        return;
+        diags_->error(span, fmt::format("curve '{}' needs at least two control values", name));
+        return std::nullopt;
     }
     if (!points)
         for (std::size_t i = 0; i < def.xs.size(); ++i) def.xs[i] = double(i) / double(def.xs.size() - 1);
     for (std::size_t i = 1; i < def.xs.size(); ++i) {
         if (def.xs[i] < def.xs[i - 1]) {
-            diags_->error(s.args[i]->span,
-                          "the x of a curve's points must not decrease (x is t, from 0 to 1)");
-            return;
+            diags_->error(args[i]->span, "the x of a curve's points must not decrease (x is t, from 0 to 1)");
+            return std::nullopt;
         }
     }
-    P_.curves.push_back(std::move(def));
+    return def;
 }
 
 void Compiler::compile_surface(const ast::ShapeDecl& s) {

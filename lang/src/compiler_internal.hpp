@@ -18,6 +18,8 @@
 
 namespace plant {
 
+struct BuiltinInfo;
+
 enum class CtxKind { Global, Axiom, Production, Hook, Function };
 enum class PatternRole { Strict, Left, LeftNew, Right, RightNew };
 
@@ -162,6 +164,14 @@ class Compiler {
     void compile_curve(const ast::ShapeDecl& s);
     void compile_environment(const ast::ShapeDecl& s);
     ValueType compile_env_call(Ctx& c, const ast::Expr& e, std::size_t env);
+    // decomposition graphs (compile_graph.cpp)
+    void compile_graph();
+    void compile_graph_block(const ast::GraphBlock& g);
+    void compile_graph_param(const ast::GraphParam& p);
+    ValueType compile_node_read(Ctx& c, const ast::Expr& e, const ast::Expr* object);
+    ValueType compile_graph_call(Ctx& c, const ast::Expr& e, const BuiltinInfo& b, int width);
+    std::optional<CurveDef> make_curve(const std::string& name, const std::string& kind, Span kind_span,
+                                       const std::vector<ast::ExprPtr>& args, Span span);
 
     // helpers (compile_expr.cpp; where and duplicate in compiler.cpp)
     void emit(Ctx& c, Op op, std::int32_t a, int n, Span span, std::uint16_t b = 0);

@@ -54,10 +54,15 @@ ModuleString Derivation::interpreted(const ModuleString& s) const {
     return engine_->interpreted(*this, s);
 }
 
+void Derivation::commit_graph() {
+    if (DecompositionGraph* g = run_.graph()) g->commit();
+}
+
 void Derivation::run_hook(HookKind kind) {
     const auto k = static_cast<std::size_t>(kind);
     if (!prog_.has_hook[k]) return;
     EvalEnv env;
+    env.graph_records = true;
     HookEffects effects;
     env.prog = &prog_;
     env.run = &run_;
@@ -79,13 +84,21 @@ void Derivation::run_hook(HookKind kind) {
         e.message = fmt::format("step {}, on {}: {}", step_, ast::spelling(kind), e.message);
         throw;
     }
+    try {
+        commit_graph();
+    } catch (RuntimeError& e) {
+        e.message = fmt::format("step {}, on {}: {}", step_, ast::spelling(kind), e.message);
+        throw;
+    }
     if (!effects.printed.empty() && opt_.on_print) opt_.on_print(effects.printed);
     if (effects.use_group != -2) group_ = effects.use_group;
     if (effects.stop) stopped_ = true;
 }
 
 void Derivation::start() {
-    run_ = RunState(prog_); // the environments as declared: a second start begins afresh
+    run_ = RunState(
+        prog_, opt_.edits ? opt_.edits
+                          : prog_.graph.edits); // the environments as declared: a second start begins afresh
     EvalEnv env;
     env.prog = &prog_;
     env.run = &run_;
@@ -127,8 +140,10 @@ void Derivation::start() {
     env.out = &axiom;
     env.max_output = opt_.max_modules;
     env.id_base = engine_->next_id;
+    env.graph_records = true;
     try {
         plant::run(prog_.axiom, nullptr, env);
+        commit_graph();
     } catch (const RuntimeError& e) {
         if (e.kind == RuntimeErrorKind::ModuleLimit) engine_->check_limits(*this, axiom);
         throw;
@@ -137,6 +152,7 @@ void Derivation::start() {
     current_.swap(axiom);
     try {
         engine_->decompose(*this, current_, 0);
+        commit_graph();
         Engine::apply_cut(prog_, current_);
     } catch (RuntimeError& e) {
         e.at_step(0);
@@ -168,12 +184,14 @@ bool Derivation::step() {
     ++step_;
     try {
         engine_->rewrite(*this, current_, next, plan, stream::step(step_), step_);
+        commit_graph();
         current_.swap(next);
         if (next.bytes() <= Engine::kMaxSpareBytes)
             engine_->spare = std::move(next); // (the spare string: see Engine::spare)
         else
             ModuleString().swap(next); // a large one is freed before decomposition
         engine_->decompose(*this, current_, step_);
+        commit_graph();
         Engine::apply_cut(prog_, current_);
     } catch (RuntimeError& e) {
         e.at_step(step_);

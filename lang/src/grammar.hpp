@@ -63,6 +63,9 @@ PLANT_KW(stop, "stop");
 PLANT_KW(return, "return");
 PLANT_KW(true, "true");
 PLANT_KW(false, "false");
+PLANT_KW(graph, "graph");
+PLANT_KW(match, "match");
+PLANT_KW(edits, "edits");
 #undef PLANT_KW
 
 struct semi : pad<one<';'>> {};
@@ -227,9 +230,18 @@ struct override_block : if_must<open_brace, opt<list<override_item, comma>>, opt
 struct import_target : sor<seq<string_lit, ws>, name> {};
 struct with_clause : if_must<kw_with, override_block> {};
 struct import_item : if_must<kw_import, import_target, opt<with_clause>, semi> {};
-struct item : sor<param_item, const_item, var_item, module_item, fn_item, curve_item, surface_item,
-                  texture_item, env_item, instance_item, setting_item, axiom_item, symbol_set_item,
-                  rules_item, decompose_item, interpret_item, hook_item, import_item> {};
+// graph [match range|single] { name = value; ... }   (docs/language.md, decomposition graphs)
+struct match_clause : if_must<kw_match, name> {};
+struct graph_param : seq<name, must<equals, expr, semi>> {};
+struct graph_body : if_must<open_brace, star<graph_param>, close_brace> {};
+struct graph_item : if_must<kw_graph, opt<match_clause>, graph_body> {};
+// edits "file.edits";
+struct edits_target : seq<string_lit, ws> {};
+struct edits_item : if_must<kw_edits, edits_target, semi> {};
+struct item
+    : sor<param_item, const_item, var_item, module_item, fn_item, curve_item, surface_item, texture_item,
+          env_item, instance_item, setting_item, axiom_item, symbol_set_item, rules_item, decompose_item,
+          interpret_item, hook_item, import_item, graph_item, edits_item> {};
 
 // The file is parsed one item at a time (parser.cpp) so that an error in one item does not hide
 // errors in later ones.

@@ -57,6 +57,8 @@ PLANT_ERR(hook_name, "expected a hook name: {hooks}"); // the names from ast::kH
 PLANT_ERR(import_target, "expected a library name or a quoted path after 'import'");
 PLANT_ERR(override_block, "expected '{' and parameter overrides after 'with'");
 PLANT_ERR(override_item, "expected 'name = value'");
+PLANT_ERR(graph_body, "expected '{' and the graph's parameters, as in graph { length = 10; }");
+PLANT_ERR(edits_target, "expected a quoted file name after 'edits', as in edits \"plant.edits\";");
 using else_target = sor<if_stmt, block>;
 using fn_body = sor<fn_expr_body, block>;
 using module_decls = list_must<module_decl, comma>;
@@ -103,6 +105,8 @@ PLANT_CONSTRUCT(setting_item);
 PLANT_CONSTRUCT(axiom_item);
 PLANT_CONSTRUCT(symbol_set_item);
 PLANT_CONSTRUCT(import_item);
+PLANT_CONSTRUCT(graph_item);
+PLANT_CONSTRUCT(edits_item);
 PLANT_CONSTRUCT(let_stmt);
 PLANT_CONSTRUCT(assign_stmt);
 PLANT_CONSTRUCT(produce_stmt);

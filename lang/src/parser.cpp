@@ -33,7 +33,8 @@ using selector = pt::selector<
         g::instance_item, g::instance_body, g::setting_item, g::setting_key, g::axiom_item,
         g::symbol_set_item, g::symbol_set_kind, g::rules_item, g::group_name, g::rules_body,
         g::decompose_item, g::interpret_item, g::max_depth_clause, g::hook_item, g::hook_name, g::import_item,
-        g::import_target, g::with_clause, g::override_block, g::override_item>,
+        g::import_target, g::with_clause, g::override_block, g::override_item, g::graph_item, g::match_clause,
+        g::graph_body, g::graph_param, g::edits_item, g::edits_target>,
     // (ternary_then and ternary_else are selected only so that their nesting is counted: the tree
     // builder calls the grammar's control for selected rules alone; each has one child, which
     // fold_one puts in its place)
@@ -369,6 +370,27 @@ class Lowering {
         return s;
     }
 
+    void graph_block(const Node& n, ast::File& f) {
+        ast::GraphBlock gb;
+        gb.span = span(n);
+        for (const auto& c : n.children) {
+            if (c->is_type<g::match_clause>()) {
+                gb.match = c->children.at(0)->string();
+                gb.match_span = span(*c->children.at(0));
+                continue;
+            }
+            for (const auto& p : c->children) {
+                ast::GraphParam gp;
+                gp.span = span(*p);
+                gp.name = p->children.at(0)->string();
+                gp.name_span = span(*p->children.at(0));
+                gp.value = expr(*p->children.at(1));
+                gb.params.push_back(std::move(gp));
+            }
+        }
+        f.graphs.push_back(std::move(gb));
+    }
+
     void rule_block(const Node& n, ast::File& f, ast::RuleKind kind) {
         ast::RuleBlock rb;
         rb.kind = kind;
@@ -478,6 +500,15 @@ class Lowering {
                 diags_.error(h.span,
                              fmt::format("unknown hook '{}': expected {}", when, ast::hook_list("", " or ")));
             f.hooks.push_back(std::move(h));
+        } else if (n.is_type<g::graph_item>()) {
+            graph_block(n, f);
+        } else if (n.is_type<g::edits_item>()) {
+            ast::EditsDecl ed;
+            ed.span = span(n);
+            const Node& t = *n.children.at(0)->children.at(0);
+            ed.path = unescape(t.string_view());
+            ed.path_span = span(t);
+            f.edits_files.push_back(std::move(ed));
         } else if (n.is_type<g::import_item>()) {
             ast::Import im;
             im.span = span(n);
@@ -543,7 +574,8 @@ std::size_t resync(const std::string& text, std::size_t from, std::size_t item_s
     static const char* keywords[] = {"param ",   "const ",    "var ",      "module ",   "fn ",     "curve ",
                                      "surface ", "texture ",  "env ",      "instance ", "derive ", "angle ",
                                      "step ",    "width ",    "seed ",     "axiom",     "ignore",  "consider",
-                                     "rules",    "decompose", "interpret", "on ",       "import ", "/*"};
+                                     "rules",    "decompose", "interpret", "on ",       "import ", "graph",
+                                     "edits ",   "/*"};
     std::size_t b = from;
     while (b > 0 && text[b - 1] != '\n') --b; // start of the error's line
     while (b < text.size()) {
@@ -602,6 +634,30 @@ ast::ExprPtr parse_expression(const SourceManager& sources, std::uint32_t file_i
                               g::control>(in, state);
         if (!root || root->children.empty()) {
             diags.error({file_id, 0, 1}, "expected an expression");
+            return nullptr;
+        }
+        Lowering lower(file_id, diags);
+        return lower.expr(*root->children.at(0));
+    } catch (const g::GrammarError& e) {
+        report(e, src, file_id, diags);
+        return nullptr;
+    }
+}
+
+ast::ExprPtr parse_expression(const SourceManager& sources, std::uint32_t file_id, std::uint32_t begin,
+                              std::uint32_t end, Diagnostics& diags) {
+    const SourceFile& src = sources.file(file_id);
+    const std::string& text = src.text();
+    end = std::min<std::uint32_t>(end, static_cast<std::uint32_t>(text.size()));
+    begin = std::min(begin, end);
+    LineCol lc = src.line_col(begin);
+    tao::pegtl::memory_input<> in(text.data() + begin, text.data() + end, src.name(), begin, lc.line, lc.col);
+    g::ParseState state;
+    try {
+        auto root = pt::parse<tao::pegtl::seq<g::ws, g::expr, tao::pegtl::eof>, selector, tao::pegtl::nothing,
+                              g::control>(in, state);
+        if (!root || root->children.empty()) {
+            diags.error({file_id, begin, end}, "expected an expression");
             return nullptr;
         }
         Lowering lower(file_id, diags);

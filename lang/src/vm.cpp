@@ -2,6 +2,8 @@
 // superinstruction pass (fuse) and the stack check of compiled code (check_stack).
 #include "plant/vm.hpp"
 
+#include "graph_ops.hpp"
+
 #include "plant/builtins.hpp"
 #include "plant/environment.hpp"
 #include "plant/random.hpp"
@@ -548,6 +550,17 @@ RunStatus execute(const Code& code, double* frame, EvalEnv& env, double* result)
                 object->query(I.b, st + sp, r);
             }
             for (int k = 0; k < value_width(method.result); ++k) st[sp++] = r[k];
+            break;
+        }
+        case Op::GraphCall:
+        case Op::GraphRead: {
+            sp -= I.n;
+            double r[1] = {0};
+            std::string error = I.op == Op::GraphCall
+                                    ? graph_builtin(static_cast<BuiltinId>(I.a), st + sp, r, env)
+                                    : graph_read(I.a, I.n == 2, st + sp, r, env);
+            if (!error.empty()) fail(code, pc, std::move(error));
+            st[sp++] = r[0];
             break;
         }
         }

@@ -254,6 +254,28 @@ struct Import {
     std::vector<Span> override_spans;
 };
 
+// graph [match range|single] { name = value; ... } (docs/language.md, decomposition graphs)
+struct GraphParam {
+    Span span;
+    Span name_span;
+    std::string name;
+    ExprPtr value; // a number expression, linear(...), bezier(...) or silhouette(...)
+};
+
+struct GraphBlock {
+    Span span;
+    std::string match; // empty: the default, range
+    Span match_span;
+    std::vector<GraphParam> params;
+};
+
+// edits "file.edits";
+struct EditsDecl {
+    Span span;
+    std::string path;
+    Span path_span;
+};
+
 struct File;
 
 struct InstanceDecl {
@@ -281,6 +303,8 @@ struct File {
     std::vector<RuleBlock> rule_blocks; // in file order
     std::vector<Hook> hooks;
     std::vector<Import> imports;
+    std::vector<GraphBlock> graphs;
+    std::vector<EditsDecl> edits_files;
 };
 
 } // namespace plant::ast

@@ -48,6 +48,12 @@ enum class BuiltinId : std::uint16_t {
     Step,
     Id,
     Lod,
+    Root,
+    Child,
+    ChildIndex,
+    Depth,
+    Position,
+    BranchIndex,
 };
 
 // What a built-in reads besides its arguments that belongs to the module being rewritten. Such a
@@ -57,6 +63,7 @@ enum class BuiltinReads : std::uint8_t {
     Arguments, // nothing else: a pure function (or the step number, known to every module)
     Random,    // draws random numbers from the module's counter-based stream
     Identity,  // the module's identity
+    Graph,     // the derivation's decomposition graph (compiled to Op::GraphCall, graph_ops.hpp)
 };
 
 struct BuiltinInfo {

@@ -78,6 +78,9 @@ struct DeriveOptions {
     // derivation writes 8 bytes less per module; they are kept anyway when the program can
     // observe them (it calls id(), or has query modules or environments).
     bool identities = true;
+    // The edits applied to the decomposition graph (docs/language.md, decomposition graphs); null:
+    // none. Read with parse_edits (graph.hpp); ignored when the program declares no graph.
+    std::shared_ptr<const GraphEdits> edits;
 };
 
 class Derivation {
@@ -126,6 +129,8 @@ class Derivation {
     friend struct Engine; // reads the program, options, settings and string it rewrites
 
     void run_hook(HookKind kind);
+    // Commits the graph nodes made in the pass that just ended (no-op without a graph).
+    void commit_graph();
 
     const Program& prog_;
     DeriveOptions opt_;

@@ -65,3 +65,8 @@ OPCODE(LoadAddConst, 0, 1, Next, "push frame[a] + consts[b]")
 OPCODE(Curve, 1, 1, Next, "replace t on top by curves[a](t)")
 OPCODE(EnvCall, n, 3, Next,
        "method b of environment a (the run state's), on n numbers; pushes its result (at most a vec3)")
+// ---- decomposition graphs (graph_ops.hpp) ----
+OPCODE(GraphCall, n, b, Next, "graph built-in a (root, child, depth, ...) on n numbers, giving b numbers")
+OPCODE(
+    GraphRead, n, 1, Next,
+    "parameter a of a node: pops the node (n = 1), or the node and t for a curve (n = 2); pushes its value")

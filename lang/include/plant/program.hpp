@@ -4,6 +4,7 @@
 
 #include "plant/ast.hpp"
 #include "plant/diagnostics.hpp"
+#include "plant/graph.hpp"
 #include "plant/module_string.hpp"
 #include "plant/turtle_symbols.hpp"
 
@@ -18,7 +19,8 @@
 
 namespace plant {
 
-enum class ValueType : std::uint8_t { Number, Bool, Vec3, String, Void };
+// Node: a node of the decomposition graph, one number (its handle; graph.hpp).
+enum class ValueType : std::uint8_t { Number, Bool, Vec3, String, Void, Node };
 inline int value_width(ValueType t) {
     return t == ValueType::Vec3 ? 3 : (t == ValueType::Void ? 0 : 1);
 }
@@ -328,6 +330,16 @@ struct Program {
     std::vector<CurveDef> curves;
     std::vector<EnvironmentDecl> environments; // `env` declarations, in file order
     std::vector<ProgramFile> files;            // in the order they were read: the main file first
+
+    // The decomposition graph's parameters (`graph { }`, graph.hpp), and, when there is one, the
+    // consts by name, which edits files may use in their values.
+    GraphDecl graph;
+    struct NamedConst {
+        std::string name;
+        ValueType type = ValueType::Number;
+        double v[3] = {0, 0, 0};
+    };
+    std::vector<NamedConst> constants;
 
     // Every instance declaration of the grammar (top level, imported and nested), in one table
     // owned by the root program; an instance's program reads the same table through `instances`

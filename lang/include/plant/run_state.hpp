@@ -6,6 +6,7 @@
 #pragma once
 
 #include "plant/environment.hpp"
+#include "plant/graph.hpp"
 
 #include <memory>
 #include <vector>
@@ -17,10 +18,13 @@ class RunState {
     RunState() = default;
     // A clone of each declaration's object as declared (null where the program has none: it
     // was compiled without a runtime).
-    explicit RunState(const Program& program) {
+    // With a `graph` block, the decomposition graph's root, with `edits` to match as it grows.
+    explicit RunState(const Program& program, std::shared_ptr<const GraphEdits> edits = nullptr) {
         environments_.reserve(program.environments.size());
         for (const EnvironmentDecl& d : program.environments)
             environments_.push_back(d.initial ? d.initial->clone() : nullptr);
+        if (program.graph.declared)
+            graph_ = std::make_unique<DecompositionGraph>(program.graph, std::move(edits));
     }
     RunState(const RunState& other) { *this = other; }
     RunState& operator=(const RunState& other) {
@@ -29,6 +33,7 @@ class RunState {
         copy.reserve(other.environments_.size());
         for (const auto& e : other.environments_) copy.push_back(e ? e->clone() : nullptr);
         environments_ = std::move(copy);
+        graph_ = other.graph_ ? std::make_unique<DecompositionGraph>(*other.graph_) : nullptr;
         return *this;
     }
     RunState(RunState&&) noexcept = default;
@@ -42,8 +47,13 @@ class RunState {
     Environment* environment(std::size_t k) { return environments_[k].get(); }
     const Environment* environment(std::size_t k) const { return environments_[k].get(); }
 
+    // The decomposition graph (graph.hpp); null when the program declares none.
+    DecompositionGraph* graph() { return graph_.get(); }
+    const DecompositionGraph* graph() const { return graph_.get(); }
+
   private:
     std::vector<std::unique_ptr<Environment>> environments_;
+    std::unique_ptr<DecompositionGraph> graph_;
 };
 
 } // namespace plant

@@ -69,6 +69,10 @@ struct EvalEnv {
     ModuleId id_base = kNewIdBit; // a new module's identity is id_base + new_count
     bool produced = false;
 
+    // Whether child() records new nodes of the decomposition graph: in the rewrite, decomposition,
+    // the axiom and hooks, not in interpretation (which changes nothing that lives on).
+    bool graph_records = false;
+
     HookEffects* effects = nullptr; // non-null only while a hook runs
     int call_depth = 0;
     std::vector<double> arena; // operand stacks and frames of nested calls

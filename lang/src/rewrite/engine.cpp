@@ -97,6 +97,7 @@ void Engine::rewrite(const Derivation& d, const ModuleString& in, ModuleString& 
         w.env.max_params = d.opt_.max_bytes / sizeof(double);
         w.env.interrupt = d.opt_.interrupt;
         w.env.max_steps = d.opt_.max_steps;
+        w.env.graph_records = !interpreting; // interpretation makes no node that lives on
         w.out.keep_ids = in.keep_ids;
     };
     out.clear();
@@ -338,6 +339,11 @@ ModuleString Engine::interpreted(const Derivation& d, const ModuleString& s) {
     if (prog.interpret.empty()) return cur;
     std::vector<const RuleSet*> sets{&prog.interpret};
     ModuleId saved = next_id;
+    interpreting = true;
+    struct Reset {
+        bool& flag;
+        ~Reset() { flag = false; }
+    } reset{interpreting};
     for (int pass = 0; pass < prog.interpret.max_depth; ++pass) {
         if (!any_candidate(cur, prog.interpret)) break;
         ModuleString next;

@@ -46,6 +46,7 @@ struct Engine {
     const RulePlan& step_plan(const Derivation& d);
 
     ModuleId next_id = 1;                    // the identity the next new module gets
+    bool interpreting = false;               // within interpreted(): child() records no node
     double growth = 2.0, param_growth = 2.0; // last step's growth, for reserving memory
     std::vector<std::shared_ptr<const RulePlan>> plans;
     std::vector<const RulePlan*> step_plans;   // per group + 1 (index 0: no group), from plans

@@ -1,0 +1,323 @@
+// The decomposition graph a derivation builds (Boudon et al. 2003, section 4): nodes identified by
+// their paths, committed at the end of each pass, edits matched to them (by range or by exact
+// position), and every node's parameters resolved by the inheritance rules of sections 2.1 and
+// 2.2 (docs/language.md, decomposition graphs).
+#include "plant/graph.hpp"
+
+#include "plant/derive.hpp"
+#include "plant/program.hpp"
+#include "plant/random.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace plant {
+
+namespace {
+constexpr std::uint64_t kHandleMask = (std::uint64_t{1} << 52) - 1;
+constexpr double kSamePosition = 1e-9; // positions this close are one position
+} // namespace
+
+const char* graph_param_kind_name(GraphParamKind k) {
+    switch (k) {
+    case GraphParamKind::Number:
+        return "number";
+    case GraphParamKind::Curve:
+        return "curve";
+    case GraphParamKind::Silhouette:
+        return "silhouette";
+    }
+    return "?";
+}
+
+const char* value_status_name(ValueStatus s) {
+    switch (s) {
+    case ValueStatus::Explicit:
+        return "explicit";
+    case ValueStatus::Inherited:
+        return "inherited";
+    case ValueStatus::Offset:
+        return "relative-offset";
+    case ValueStatus::Fraction:
+        return "relative-fraction";
+    case ValueStatus::Shared:
+        return "shared";
+    }
+    return "?";
+}
+
+int GraphDecl::find(std::string_view name) const {
+    for (std::size_t k = 0; k < params.size(); ++k)
+        if (params[k].name == name) return static_cast<int>(k);
+    return -1;
+}
+
+double NodeValue::at(double t) const {
+    double v = 0;
+    for (const CurveTerm& term : curve) {
+        const double c = (*term.curve)(t);
+        v = term.op == EditOp::Set ? c : term.op == EditOp::Offset ? v + c : v * c;
+    }
+    return v;
+}
+
+DecompositionGraph::DecompositionGraph(const GraphDecl& decl, std::shared_ptr<const GraphEdits> edits)
+    : decl_(&decl), edits_(std::move(edits)) {
+    add_node(kRoot, -1, 0, 0);
+    resolve();
+}
+
+DecompositionGraph::DecompositionGraph(const DecompositionGraph& other)
+    : decl_(other.decl_), edits_(other.edits_), nodes_(other.nodes_), by_handle_(other.by_handle_),
+      values_(other.values_), matches_(other.matches_) {
+    std::lock_guard lock(*other.pending_mutex_);
+    pending_ = other.pending_;
+}
+
+std::uint64_t DecompositionGraph::child_handle(std::uint64_t parent, double position, int index) {
+    const auto q = static_cast<std::uint64_t>(std::llround(position / kSamePosition));
+    std::uint64_t h = mix64(parent * 0x9e3779b97f4a7c15ULL ^ mix64(q + 0x632be59bd9b4e019ULL) ^
+                            mix64(static_cast<std::uint64_t>(index) + 0x1d8e4e27c47d124fULL));
+    h &= kHandleMask;
+    return h <= kRoot ? h + 2 : h;
+}
+
+bool DecompositionGraph::record(std::uint64_t handle, std::uint64_t parent, double position,
+                                int index) const {
+    std::lock_guard lock(*pending_mutex_);
+    auto [it, added] = pending_.try_emplace(handle, Pending{parent, position, index});
+    if (added) return true;
+    const Pending& p = it->second;
+    return p.parent == parent && std::fabs(p.position - position) <= kSamePosition && p.index == index;
+}
+
+bool DecompositionGraph::is_pending(std::uint64_t handle) const {
+    std::lock_guard lock(*pending_mutex_);
+    return pending_.count(handle) > 0;
+}
+
+void DecompositionGraph::add_node(std::uint64_t handle, int parent, double position, int index) {
+    GraphNode n;
+    n.handle = handle;
+    n.parent = parent;
+    n.position = position;
+    n.index = index;
+    n.depth = parent < 0 ? 0 : nodes_[static_cast<std::size_t>(parent)].depth + 1;
+    const int k = static_cast<int>(nodes_.size());
+    by_handle_[handle] = k;
+    nodes_.push_back(std::move(n));
+    if (parent < 0) return;
+    auto& siblings = nodes_[static_cast<std::size_t>(parent)].children;
+    auto before = [&](int a, int b) {
+        const GraphNode &x = nodes_[static_cast<std::size_t>(a)], &y = nodes_[static_cast<std::size_t>(b)];
+        return x.position != y.position ? x.position < y.position : x.index < y.index;
+    };
+    siblings.insert(std::upper_bound(siblings.begin(), siblings.end(), k, before), k);
+}
+
+void DecompositionGraph::commit() {
+    std::vector<std::pair<std::uint64_t, Pending>> fresh;
+    {
+        std::lock_guard lock(*pending_mutex_);
+        if (pending_.empty()) return;
+        fresh.assign(pending_.begin(), pending_.end());
+        pending_.clear();
+    }
+    if (nodes_.size() + fresh.size() > kMaxNodes)
+        throw RuntimeError{RuntimeErrorKind::General, Span{},
+                           fmt::format("the decomposition graph would have more than {} nodes", kMaxNodes)};
+    // by handle, then parents before children: the same nodes in the same order on any threads
+    std::sort(fresh.begin(), fresh.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    bool progress = true;
+    while (!fresh.empty() && progress) {
+        progress = false;
+        std::vector<std::pair<std::uint64_t, Pending>> later;
+        for (const auto& [h, p] : fresh) {
+            if (int known = find(h); known >= 0) {
+                const GraphNode& n = nodes_[static_cast<std::size_t>(known)];
+                const bool same = n.parent >= 0 &&
+                                  nodes_[static_cast<std::size_t>(n.parent)].handle == p.parent &&
+                                  std::fabs(n.position - p.position) <= kSamePosition && n.index == p.index;
+                if (!same)
+                    throw RuntimeError{
+                        RuntimeErrorKind::General, Span{},
+                        fmt::format("two paths of the decomposition graph have the same handle "
+                                    "({} and a child at {} of another node)",
+                                    path(known), format_double(p.position))};
+                progress = true;
+                continue;
+            }
+            const int parent = find(p.parent);
+            if (parent < 0) {
+                later.emplace_back(h, p);
+                continue;
+            }
+            add_node(h, parent, p.position, p.index);
+            progress = true;
+        }
+        fresh = std::move(later);
+    }
+    // (a parent that is never committed cannot happen: child() checks that it is a node)
+    resolve();
+}
+
+std::string DecompositionGraph::path(int node, bool with_ranges) const {
+    if (node <= 0) return "/";
+    std::vector<int> chain;
+    for (int k = node; k > 0; k = nodes_[static_cast<std::size_t>(k)].parent) chain.push_back(k);
+    std::string out;
+    for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+        const GraphNode& n = nodes_[static_cast<std::size_t>(*it)];
+        out += "/" + format_double(n.position);
+        if (n.index != 0) out += fmt::format("#{}", n.index);
+        if (!with_ranges) continue;
+        // halfway to the neighbouring siblings of the same index; 0 or 1 at an end
+        double lo = 0, hi = 1;
+        for (int s : nodes_[static_cast<std::size_t>(n.parent)].children) {
+            const GraphNode& o = nodes_[static_cast<std::size_t>(s)];
+            if (o.index != n.index || s == *it) continue;
+            if (o.position < n.position) lo = std::max(lo, (o.position + n.position) / 2);
+            if (o.position > n.position) hi = std::min(hi, (o.position + n.position) / 2);
+        }
+        out += "[" + format_double(lo) + ".." + format_double(hi) + "]";
+    }
+    return out;
+}
+
+// The node an edit's path names now: each component picks, among the children of the same index,
+// the one at its exact position or (range matching) the one in its range nearest its centre.
+int DecompositionGraph::match(const GraphEdit& e) const {
+    int cur = 0;
+    for (const EditStep& step : e.path) {
+        int best = -1;
+        double best_d = 0;
+        const bool ranged = step.ranged && decl_->match == GraphMatch::Range;
+        for (int c : nodes_[static_cast<std::size_t>(cur)].children) {
+            const GraphNode& n = nodes_[static_cast<std::size_t>(c)];
+            if (n.index != step.index) continue;
+            if (!ranged) {
+                if (std::fabs(n.position - step.position) <= kSamePosition) {
+                    best = c;
+                    break;
+                }
+                continue;
+            }
+            if (n.position < step.lo - kSamePosition || n.position > step.hi + kSamePosition) continue;
+            const double d = std::fabs(n.position - (step.lo + step.hi) / 2);
+            if (best < 0 || d < best_d - kSamePosition) { // ties: the lower position (children are sorted)
+                best = c;
+                best_d = d;
+            }
+        }
+        if (best < 0) return -1;
+        cur = best;
+    }
+    return cur;
+}
+
+namespace {
+// A node's own setting of one parameter, before inheritance.
+struct Local {
+    ValueStatus status = ValueStatus::Inherited;
+    bool is_private = false;
+    double number = 0;
+    const CurveDef* curve = nullptr;
+    int edit = -1;
+};
+
+void apply(Local& l, const GraphEdit& e, int k) {
+    switch (e.op) {
+    case EditOp::Set:
+        l.status = e.share ? ValueStatus::Shared : ValueStatus::Explicit;
+        break;
+    case EditOp::Offset:
+        l.status = ValueStatus::Offset;
+        break;
+    case EditOp::Fraction:
+        l.status = ValueStatus::Fraction;
+        break;
+    case EditOp::Inherit:
+        l.status = ValueStatus::Inherited;
+        break;
+    case EditOp::Private:
+        l.is_private = true;
+        return;
+    case EditOp::Public:
+        l.is_private = false;
+        return;
+    }
+    l.number = e.number;
+    l.curve = e.curve.get();
+    l.edit = k;
+}
+} // namespace
+
+void DecompositionGraph::resolve() {
+    const std::size_t P = decl_->params.size(), N = nodes_.size();
+    std::vector<Local> local(N * P);
+    for (std::size_t p = 0; p < P; ++p) {
+        local[p].status = ValueStatus::Explicit;
+        local[p].number = decl_->params[p].number;
+        local[p].curve = decl_->params[p].curve.get();
+    }
+    const std::size_t E = edits_ ? edits_->edits.size() : 0;
+    matches_.assign(E, -1);
+    // shares first, then the node edits (which override a share on their node), each in file order
+    for (int pass = 0; pass < 2; ++pass) {
+        for (std::size_t k = 0; k < E; ++k) {
+            const GraphEdit& e = edits_->edits[k];
+            if (e.share != (pass == 0)) continue;
+            const auto p = static_cast<std::size_t>(e.param);
+            if (e.share) {
+                for (std::size_t n = 0; n < N; ++n) {
+                    if (nodes_[n].depth != e.level) continue;
+                    if (matches_[k] < 0) matches_[k] = static_cast<int>(n);
+                    apply(local[n * P + p], e, static_cast<int>(k));
+                }
+                continue;
+            }
+            const int m = match(e);
+            matches_[k] = m;
+            if (m >= 0) apply(local[static_cast<std::size_t>(m) * P + p], e, static_cast<int>(k));
+        }
+    }
+    // parents come before their children in nodes_, so one pass resolves everything
+    values_.assign(N * P, NodeValue{});
+    std::vector<int> source(N * P); // the node whose value this node's children inherit
+    for (std::size_t n = 0; n < N; ++n) {
+        const int parent = nodes_[n].parent;
+        for (std::size_t p = 0; p < P; ++p) {
+            const Local& l = local[n * P + p];
+            NodeValue& v = values_[n * P + p];
+            v.status = l.status;
+            v.is_private = n > 0 && l.is_private; // the root's are always public
+            v.edit = l.edit;
+            source[n * P + p] =
+                v.is_private ? source[static_cast<std::size_t>(parent) * P + p] : static_cast<int>(n);
+            const bool own = l.status == ValueStatus::Explicit || l.status == ValueStatus::Shared;
+            if (own || parent < 0) {
+                v.from = static_cast<int>(n);
+                v.number = l.number;
+                if (l.curve) v.curve = {CurveTerm{EditOp::Set, l.curve}};
+                continue;
+            }
+            const int from = source[static_cast<std::size_t>(parent) * P + p];
+            const NodeValue& inherited = values_[static_cast<std::size_t>(from) * P + p];
+            // where the value was last set: past ancestors that inherited it themselves
+            v.from = inherited.status == ValueStatus::Inherited ? inherited.from : from;
+            v.number = inherited.number;
+            v.curve = inherited.curve;
+            if (l.status == ValueStatus::Offset) {
+                v.number += l.number;
+                if (l.curve) v.curve.push_back({EditOp::Offset, l.curve});
+            } else if (l.status == ValueStatus::Fraction) {
+                v.number *= l.number;
+                if (l.curve) v.curve.push_back({EditOp::Fraction, l.curve});
+            }
+        }
+    }
+}
+
+} // namespace plant

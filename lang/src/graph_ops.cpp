@@ -1,0 +1,105 @@
+// Graph built-ins and parameter reads for the VM (graph_ops.hpp; docs/language.md,
+// decomposition graphs). A node is its handle, one double; child() records a new node for the
+// end of the pass (DecompositionGraph::commit) and reads see only committed nodes.
+#include "graph_ops.hpp"
+
+#include "plant/derive.hpp"
+#include "plant/graph.hpp"
+#include "plant/run_state.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+namespace plant {
+
+namespace {
+
+constexpr double kMaxHandle = 4503599627370495.0; // 2^52 - 1
+constexpr double kMaxIndex = 1e6;
+
+bool as_handle(double v, std::uint64_t& h) {
+    if (!(v >= 0 && v <= kMaxHandle) || v != std::floor(v)) return false;
+    h = static_cast<std::uint64_t>(v);
+    return true;
+}
+
+// The committed node `v` names, or an error message.
+std::string committed(const DecompositionGraph& g, double v, int& node) {
+    std::uint64_t h = 0;
+    node = as_handle(v, h) ? g.find(h) : -1;
+    if (node >= 0) return {};
+    if (as_handle(v, h) && g.is_pending(h)) // recorded in this pass, not yet committed
+        return "this node was made in the current pass: read it from the next step "
+               "(nodes are committed when a pass ends)";
+    return fmt::format("{} is not a node of the decomposition graph", format_double(v));
+}
+
+std::string make_child(const DecompositionGraph& g, const double* a, bool with_index, bool records,
+                       double& r) {
+    std::uint64_t parent = 0;
+    const bool parent_ok = as_handle(a[0], parent) && (g.find(parent) >= 0 || g.is_pending(parent));
+    if (!parent_ok) return fmt::format("{} is not a node of the decomposition graph", format_double(a[0]));
+    const double pos = a[1];
+    if (!(pos >= 0 && pos <= 1))
+        return fmt::format("a child's position along its parent's axis is from 0 to 1, found {}",
+                           format_double(pos));
+    const double idx = with_index ? a[2] : 0;
+    if (!(idx >= 0 && idx <= kMaxIndex) || idx != std::floor(idx))
+        return fmt::format("a child's branch index is a whole number from 0 to 1000000, found {}",
+                           format_double(idx));
+    const int index = static_cast<int>(idx);
+    const std::uint64_t h = DecompositionGraph::child_handle(parent, pos, index);
+    r = static_cast<double>(h);
+    if (int known = g.find(h); known >= 0) {
+        const GraphNode& n = g.node(known);
+        if (n.parent >= 0 && g.node(n.parent).handle == parent && std::fabs(n.position - pos) <= 1e-9 &&
+            n.index == index)
+            return {};
+        return fmt::format("two paths of the decomposition graph have the same handle: {} and a child at "
+                           "{} of another node",
+                           g.path(known), format_double(pos));
+    }
+    if (records && !g.record(h, parent, pos, index))
+        return "two paths of the decomposition graph made in this pass have the same handle";
+    return {};
+}
+
+} // namespace
+
+std::string graph_builtin(BuiltinId id, const double* a, double* r, const EvalEnv& env) {
+    const DecompositionGraph* g = env.run ? env.run->graph() : nullptr;
+    if (!g) return "the decomposition graph exists only while the plant is derived";
+    int node = -1;
+    switch (id) {
+    case BuiltinId::Root:
+        r[0] = static_cast<double>(DecompositionGraph::kRoot);
+        return {};
+    case BuiltinId::Child:
+        return make_child(*g, a, false, env.graph_records, r[0]);
+    case BuiltinId::ChildIndex:
+        return make_child(*g, a, true, env.graph_records, r[0]);
+    case BuiltinId::Depth:
+    case BuiltinId::Position:
+    case BuiltinId::BranchIndex: {
+        if (std::string e = committed(*g, a[0], node); !e.empty()) return e;
+        const GraphNode& n = g->node(node);
+        r[0] = id == BuiltinId::Depth ? n.depth : id == BuiltinId::Position ? n.position : n.index;
+        return {};
+    }
+    default:
+        return "not a graph built-in";
+    }
+}
+
+std::string graph_read(int param, bool curve, const double* a, double* r, const EvalEnv& env) {
+    const DecompositionGraph* g = env.run ? env.run->graph() : nullptr;
+    if (!g) return "the decomposition graph exists only while the plant is derived";
+    int node = -1;
+    if (std::string e = committed(*g, a[0], node); !e.empty()) return e;
+    const NodeValue& v = g->value(node, param);
+    r[0] = curve ? v.at(a[1]) : v.number;
+    return {};
+}
+
+} // namespace plant

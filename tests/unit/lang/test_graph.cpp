@@ -1,0 +1,249 @@
+// Decomposition graphs (lang/include/plant/graph.hpp; docs/language.md, decomposition graphs):
+// each inheritance rule of Boudon et al. 2003, sections 2.1 and 2.2, on small graphs against
+// hand-computed values, and the Fig. 10 sequence with range and single-position matching.
+#include "helpers.hpp"
+#include "plant/graph.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+namespace plant {
+
+namespace {
+
+// Three levels of three branches (at 0.25, 0.5 and 0.75) below the root: 40 nodes.
+const char* kTree = R"(
+graph { length = 10; bend = linear(0, 1); }
+module A(n: node, k), R(v, w);
+derive 4;
+axiom: A(root(), 0);
+rules {
+  A(n, k) : k < 3 -> R(n.length, n.bend(0.5)) [ A(child(n, 0.25), k + 1) ] [ A(child(n, 0.5), k + 1) ]
+                     [ A(child(n, 0.75), k + 1) ];
+}
+)";
+
+// Fig. 10: `density` laterals on one axis at i / (density + 1), each with its bend curve.
+const char* kFig10 = R"(
+param density = 3;
+graph %s { bend = linear(0, 0); }
+module Axis(n: node), Lat(n: node);
+derive 2;
+axiom: Axis(root());
+rules {
+  Axis(n) { for i in 1..density + 1 { nproduce F [ Lat(child(n, i / (density + 1))) ]; } produce F; }
+}
+)";
+
+struct Run {
+    std::unique_ptr<test::Compiled> c;
+    std::unique_ptr<Derivation> d;
+    const DecompositionGraph& g() const { return *d->run_state().graph(); }
+    int at(const std::string& path) const {
+        for (std::size_t k = 0; k < g().size(); ++k)
+            if (g().path(static_cast<int>(k)) == path) return static_cast<int>(k);
+        FAIL("no node " << path);
+        return -1;
+    }
+    const NodeValue& value(const std::string& path, const char* param) const {
+        return g().value(at(path), g().decl().find(param));
+    }
+    double number(const std::string& path) const { return value(path, "length").number; }
+};
+
+Run derive(const std::string& grammar, const std::string& edits, CompileOptions co = {},
+           DeriveOptions opt = {}) {
+    Run r;
+    r.c = test::compile(grammar, std::move(co));
+    INFO(r.c->rendered());
+    REQUIRE(r.c->program);
+    const std::uint32_t id = r.c->sources.add("test.edits", edits);
+    opt.edits = parse_edits(*r.c->program, r.c->sources, id, r.c->diags);
+    INFO(r.c->rendered());
+    REQUIRE(opt.edits);
+    r.d = std::make_unique<Derivation>(*r.c->program, opt);
+    r.d->run();
+    return r;
+}
+
+std::string fig10(const char* match) {
+    char buf[1024];
+    std::snprintf(buf, sizeof buf, kFig10, match);
+    return buf;
+}
+
+} // namespace
+
+TEST_CASE("graph: child() makes nodes that are committed each step with paths and handles") {
+    Run r = derive(kTree, "");
+    CHECK(r.g().size() == 40);
+    CHECK(r.g().node(r.at("/0.5/0.25/0.75")).depth == 3);
+    CHECK(r.g().node(r.at("/0.5/0.25")).position == 0.25);
+    // the handle is a 52-bit hash of the path, the same in every derivation
+    CHECK(r.g().node(r.at("/0.5")).handle ==
+          DecompositionGraph::child_handle(DecompositionGraph::kRoot, 0.5, 0));
+    CHECK(r.g().node(r.at("/0.5")).handle < (std::uint64_t{1} << 52));
+    // every node reads the root's defaults when there are no edits
+    CHECK(r.number("/0.75/0.75/0.75") == 10);
+    CHECK(r.value("/0.75/0.75/0.75", "length").status == ValueStatus::Inherited);
+    CHECK(r.value("/0.75/0.75/0.75", "length").from == 0);
+}
+
+TEST_CASE("graph: explicit and inherited from the parent") {
+    Run r = derive(kTree, "/0.5 length = 4\n");
+    CHECK(r.number("/0.5") == 4);
+    CHECK(r.value("/0.5", "length").status == ValueStatus::Explicit);
+    CHECK(r.value("/0.5", "length").from == r.at("/0.5"));
+    CHECK(r.number("/0.5/0.25") == 4); // inherited from the parent
+    CHECK(r.value("/0.5/0.25", "length").from == r.at("/0.5"));
+    CHECK(r.number("/0.5/0.25/0.75") == 4); // and further down
+    CHECK(r.number("/0.25") == 10);         // the siblings keep the root's
+    // the productions read the resolved values: R(length, bend(0.5)) of /0.5 and of /0.5/0.25
+    CHECK(test::derive(kTree).find("R(10,0.5)") != std::string::npos);
+}
+
+TEST_CASE("graph: a private parent is skipped, the value comes from the public grandparent") {
+    Run r = derive(kTree, "/0.5 length = 4\n/0.5/0.5 length = 2\n/0.5/0.5 length private\n");
+    CHECK(r.number("/0.5/0.5") == 2); // the private node keeps its own value
+    CHECK(r.value("/0.5/0.5", "length").is_private);
+    CHECK(r.number("/0.5/0.5/0.25") == 4); // its children inherit past it, from /0.5
+    CHECK(r.value("/0.5/0.5/0.25", "length").from == r.at("/0.5"));
+    // private on /0.5 too: the nearest public ancestor is the root
+    Run r2 = derive(kTree, "/0.5 length = 4\n/0.5 length private\n/0.5/0.5 length private\n");
+    CHECK(r2.number("/0.5/0.5/0.25") == 10);
+    CHECK(r2.value("/0.5/0.5/0.25", "length").from == 0);
+    // public again: the children see it
+    Run r3 = derive(kTree, "/0.5 length = 4\n/0.5 length private\n/0.5 length public\n");
+    CHECK(r3.number("/0.5/0.75") == 4);
+}
+
+TEST_CASE("graph: relative values, an offset and a fraction of the inherited value") {
+    Run r =
+        derive(kTree, "/0.25 length += 1.5\n/0.75 length *= 0.5\n/0.5 length *= 0.5\n/0.5/0.5 length += 1\n");
+    CHECK(r.number("/0.25") == 11.5);
+    CHECK(r.value("/0.25", "length").status == ValueStatus::Offset);
+    CHECK(r.number("/0.75") == 5);
+    CHECK(r.value("/0.75", "length").status == ValueStatus::Fraction);
+    CHECK(r.number("/0.5/0.5") == 6);      // (10 * 0.5) + 1: relative values resolve recursively
+    CHECK(r.number("/0.5/0.5/0.25") == 6); // and are inherited as resolved
+    CHECK(r.value("/0.5/0.5", "length").from == r.at("/0.5"));
+}
+
+TEST_CASE("graph: relative curves are the sum or product of the inherited and local curves") {
+    // root: bend(t) = t. /0.25: t + linear(1, 1, 3)(t); /0.75: t * linear(2, 0)(t) = 2t(1 - t)
+    Run r = derive(
+        kTree, "/0.25 bend += linear(1, 1, 3)\n/0.75 bend *= linear(2, 0)\n/0.5 bend = bezier(0, 0, 1)\n");
+    const NodeValue& sum = r.value("/0.25", "bend");
+    const double ts[] = {0, 0.25, 0.5, 0.75, 1};
+    const double sums[] = {1, 1.25, 1.5, 2.75, 4};
+    for (int k = 0; k < 5; ++k) CHECK(sum.at(ts[k]) == Approx(sums[k]));
+    const NodeValue& product = r.value("/0.75", "bend");
+    const double products[] = {0, 0.375, 0.5, 0.375, 0};
+    for (int k = 0; k < 5; ++k) CHECK(product.at(ts[k]) == Approx(products[k]));
+    // inherited by the children as resolved
+    CHECK(r.value("/0.75/0.5", "bend").at(0.25) == Approx(0.375));
+    // explicit curve: Bezier with control values 0, 0, 1 is t^2
+    CHECK(r.value("/0.5", "bend").at(0.5) == Approx(0.25));
+    CHECK(r.value("/0.5/0.25", "bend").at(0.5) == Approx(0.25));
+    // a number for a curve is the constant curve: `*= 0.5` halves it
+    Run r2 = derive(kTree, "/0.25 bend *= 0.5\n");
+    CHECK(r2.value("/0.25", "bend").at(0.8) == Approx(0.4));
+}
+
+TEST_CASE("graph: a shared value gives every node of one level one explicit value") {
+    Run r = derive(kTree, "share 2 length = 7\n/0.5/0.25 length = 3\n");
+    CHECK(r.number("/0.25/0.25") == 7);
+    CHECK(r.number("/0.75/0.5") == 7);
+    CHECK(r.value("/0.75/0.5", "length").status == ValueStatus::Shared);
+    CHECK(r.number("/0.25") == 10);         // other levels are not touched
+    CHECK(r.number("/0.75/0.5/0.25") == 7); // the level below inherits the share
+    CHECK(r.number("/0.5/0.25") == 3);      // a node edit overrides the share on its node
+    CHECK(r.value("/0.5/0.25", "length").status == ValueStatus::Explicit);
+}
+
+TEST_CASE("graph: reverting to inherited is an edit like any other") {
+    Run r = derive(kTree, "/0.25 length = 3\n/0.25 length inherit\n");
+    CHECK(r.number("/0.25") == 10);
+    CHECK(r.value("/0.25", "length").status == ValueStatus::Inherited);
+    Run r2 = derive(kTree, "share 1 length = 7\n/0.5 length inherit\n");
+    CHECK(r2.number("/0.5") == 10); // out of the share, back to the root's
+    CHECK(r2.number("/0.25") == 7);
+}
+
+TEST_CASE("graph: Fig. 10, range matching keeps the edit through density changes") {
+    const std::string edit = "/0.25[0..0.375] bend = linear(0, 0.4, 0.8)\n";
+    CompileOptions four;
+    four.defines.emplace_back("density", "4");
+    Run a = derive(fig10(""), edit);
+    CHECK(a.value("/0.25", "bend").at(1) == Approx(0.8));
+    CHECK(a.value("/0.5", "bend").at(1) == 0);
+    Run b = derive(fig10(""), edit, four);
+    CHECK(b.value("/0.2", "bend").at(1) == Approx(0.8)); // the branch at 0.2 carries it
+    for (const char* p : {"/0.4", "/0.6", "/0.8"}) CHECK(b.value(p, "bend").at(1) == 0);
+    Run c = derive(fig10(""), edit);
+    CHECK(c.value("/0.25", "bend").at(1) == Approx(0.8)); // density 3 again: curved again
+}
+
+TEST_CASE("graph: Fig. 10, single-position matching loses the edit at density four") {
+    const std::string edit = "/0.25[0..0.375] bend = linear(0, 0.4, 0.8)\n";
+    CompileOptions four;
+    four.defines.emplace_back("density", "4");
+    Run a = derive(fig10("match single"), edit);
+    CHECK(a.value("/0.25", "bend").at(1) == Approx(0.8));
+    Run b = derive(fig10("match single"), edit, four);
+    for (const char* p : {"/0.2", "/0.4", "/0.6", "/0.8"}) CHECK(b.value(p, "bend").at(1) == 0);
+    CHECK(b.g().matches()[0] == -1); // dormant
+}
+
+TEST_CASE("graph: nodes of the current pass cannot be read and copies of a derivation own their graph") {
+    auto c = test::compile(R"(
+graph { length = 10; }
+module A(n: node), R(v);
+derive 1;
+axiom: A(root());
+rules { A(n) -> R(child(n, 0.5).length); }
+)");
+    REQUIRE(c->program);
+    Derivation d(*c->program, {});
+    try {
+        d.run();
+        FAIL("expected a runtime error");
+    } catch (const RuntimeError& e) {
+        CHECK(e.message.find("read it from the next step") != std::string::npos);
+    }
+    auto t = test::compile(kTree);
+    REQUIRE(t->program);
+    Derivation first(*t->program, {});
+    first.start();
+    first.step();
+    Derivation copy = first;
+    first.step();
+    CHECK(first.run_state().graph()->size() == 13);
+    CHECK(copy.run_state().graph()->size() == 4);
+    copy.step();
+    CHECK(copy.run_state().graph()->size() == 13);
+}
+
+TEST_CASE("graph: compile errors name the parameter and suggest one") {
+    auto c = test::compile(R"(
+graph { length = 10; bend = linear(0, 1); }
+module A(n: node);
+axiom: A(root());
+rules { A(n) -> F(n.lenght) F(n.bend) F(n.length(1)); }
+)");
+    CHECK(!c->program);
+    const std::string msg = c->rendered();
+    CHECK(msg.find("5:19: error: the graph has no parameter 'lenght'; did you mean 'length'?") !=
+          std::string::npos);
+    CHECK(msg.find("'bend' is a curve: read it at a t from 0 to 1") != std::string::npos);
+    CHECK(msg.find("'length' is a number: read it as n.length") != std::string::npos);
+    auto s = test::compile("graph { crown = silhouette(); }\naxiom: F;\n");
+    CHECK(s->rendered().find("silhouette parameters are not supported yet") != std::string::npos);
+    auto n = test::compile("module A(n: node);\naxiom: A(3);\n");
+    CHECK(n->rendered().find("parameter 'n' of 'A' is a node, found a number") != std::string::npos);
+    auto g = test::compile("axiom: F(depth(root()));\n");
+    CHECK(g->rendered().find("'root' needs a decomposition graph") != std::string::npos);
+}
+
+} // namespace plant
