@@ -166,6 +166,10 @@ class DecompositionGraph {
     const GraphEdits* edits() const { return edits_.get(); }
     // Per edit: the node it applies to (a share: its level's first node), -1 when dormant.
     const std::vector<int>& matches() const { return matches_; }
+    // Whether dormant edit k lost its node: the path stops at a node whose axis has branches of
+    // the component's index, none at the position (not an axis that has not grown yet). The
+    // REPL drops such edits under single-position matching (the paper's Fig. 10 c).
+    bool orphaned(std::size_t k) const;
 
   private:
     struct Pending {
