@@ -84,9 +84,19 @@ std::uint64_t DecompositionGraph::child_handle(std::uint64_t parent, double posi
     return h <= kRoot ? h + 2 : h;
 }
 
+bool DecompositionGraph::full() const {
+    std::lock_guard lock(*pending_mutex_);
+    const std::size_t n = nodes_.size() + pending_.size() + 1;
+    return n > kMaxNodes || n * std::max<std::size_t>(decl_->params.size(), 1) > kMaxValues;
+}
+
 bool DecompositionGraph::record(std::uint64_t handle, std::uint64_t parent, double position,
                                 int index) const {
     std::lock_guard lock(*pending_mutex_);
+    if (pending_.count(handle) == 0) {
+        const std::size_t n = nodes_.size() + pending_.size() + 1;
+        if (n > kMaxNodes || n * std::max<std::size_t>(decl_->params.size(), 1) > kMaxValues) return false;
+    }
     auto [it, added] = pending_.try_emplace(handle, Pending{parent, position, index});
     if (added) return true;
     const Pending& p = it->second;
