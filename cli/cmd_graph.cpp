@@ -51,7 +51,7 @@ std::string value_text(const DecompositionGraph& g, int node, int param, bool js
     return json ? "[" + out + "]" : out;
 }
 
-void tree(const DecompositionGraph& g, int node, std::string& out) {
+void tree(const DecompositionGraph& g, int node, std::string& out, bool children = true) {
     const GraphNode& n = g.node(node);
     const std::string pad(static_cast<std::size_t>(2 * n.depth), ' ');
     out += pad + g.path(node) + "\n";
@@ -63,7 +63,8 @@ void tree(const DecompositionGraph& g, int node, std::string& out) {
                            value_text(g, node, static_cast<int>(p), false), value_status_name(v.status),
                            v.is_private ? "private" : "public", g.path(v.from));
     }
-    for (int c : n.children) tree(g, c, out);
+    if (children)
+        for (int c : n.children) tree(g, c, out);
 }
 
 void json_nodes(const DecompositionGraph& g, int node, std::string& out) {
@@ -137,6 +138,18 @@ int graph_main(const GraphCmd& c) {
 }
 
 } // namespace
+
+std::string graph_tree(const DecompositionGraph& g, int node, bool children) {
+    std::string out;
+    tree(g, node, out, children);
+    return out;
+}
+
+int graph_node_at(const DecompositionGraph& g, const std::string& path) {
+    for (std::size_t k = 0; k < g.size(); ++k)
+        if (g.path(static_cast<int>(k)) == path) return static_cast<int>(k);
+    return -1;
+}
 
 int report_dormant_edits(const GrammarOptions& o, const Program& program, const SourceManager& sources) {
     if (!program.graph.declared || !program.graph.edits || program.graph.edits->edits.empty()) return kOk;

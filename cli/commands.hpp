@@ -76,5 +76,9 @@ void setup_graph(CLI::App& app, int& exit_code);
 // plant check: derives a program with a graph and edits, and prints each dormant edit as a warning
 // at its line of the edits file (cmd_graph.cpp). Returns the exit code.
 int report_dormant_edits(const GrammarOptions& o, const Program& program, const SourceManager& sources);
+// The graph from `node` down as plant graph prints it (only that node without `children`), and the
+// node with a path as printed ("/0.25/0.5"), -1 if none (cmd_graph.cpp; the REPL's :graph, :node).
+std::string graph_tree(const DecompositionGraph& g, int node, bool children);
+int graph_node_at(const DecompositionGraph& g, const std::string& path);
 
 } // namespace plant::cli

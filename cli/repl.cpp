@@ -35,6 +35,7 @@ DeriveOptions Session::options() const {
     o.environment_phase = &phase;
     std::ostream* out = &out_;
     o.on_print = [out](const std::string& text) { *out << escape_controls(text, true); };
+    o.edits = graph_edits_;
     return o;
 }
 
@@ -99,6 +100,7 @@ bool Session::rebuild(int steps, const std::string* extra_fn) {
         last_error_runtime_ = false;
         return false;
     }
+    if (!parse_graph_lines(*program, *sources)) return false;
     std::vector<std::unique_ptr<Derivation>> history;
     try {
         history.push_back(std::make_unique<Derivation>(*program, options()));
@@ -130,7 +132,7 @@ bool Session::rebuild(int steps, const std::string* extra_fn) {
     sources_ = std::move(sources);
     program_ = std::move(program);
     history_ = std::move(history);
-    return true;
+    return drop_orphaned_edits(steps);
 }
 
 int Session::load(const std::string& path) {
@@ -141,7 +143,8 @@ int Session::load(const std::string& path) {
         return 66;
     }
     // a new grammar starts a new session; a grammar that does not build leaves the old one as it was
-    auto saved = std::tuple{file_, file_text_, axiom_, extra_rules_, params_, seed_, uses_, edits_};
+    auto saved =
+        std::tuple{file_, file_text_, axiom_, extra_rules_, params_, seed_, uses_, edits_, graph_lines_};
     file_ = fs::path(path).lexically_normal().string(); // as given: messages stay short and portable
     read_file(file_, file_text_);
     axiom_.reset();
@@ -150,8 +153,12 @@ int Session::load(const std::string& path) {
     seed_.reset();
     uses_.clear();
     edits_.clear();
-    if (!rebuild(0)) {
-        std::tie(file_, file_text_, axiom_, extra_rules_, params_, seed_, uses_, edits_) = saved;
+    graph_lines_.clear();
+    graph_undo_.clear();
+    if (!rebuild(0) || (read_default_edits() && !rebuild(0))) {
+        std::tie(file_, file_text_, axiom_, extra_rules_, params_, seed_, uses_, edits_, graph_lines_) =
+            saved;
+        graph_undo_.clear();
         return last_error_runtime_ ? 70 : last_error_input_ ? 66 : 65;
     }
     out_ << fmt::format("loaded {}: {} at step 0\n", escape_controls(path),
@@ -421,9 +428,11 @@ void Session::edit(std::string statements) {
 }
 
 void Session::list_edits() {
-    if (edits_.empty()) out_ << "no edits\n";
+    const DecompositionGraph* g = history_.empty() ? nullptr : current().run_state().graph();
+    if (edits_.empty() && (!g || !g->edits() || g->edits()->edits.empty())) out_ << "no edits\n";
     for (const auto& [at, statements] : edits_)
         out_ << fmt::format("  before step {}: {}\n", at + 1, statements);
+    list_graph_edits();
 }
 
 bool Session::is_edit(const std::string& line) const {
@@ -455,6 +464,7 @@ void Session::export_files(const std::vector<std::string>& paths, const OutputOp
 void Session::back_command(const std::string& name, const std::string& rest) {
     auto count = [&](int fallback) { return count_arg(name, rest, fallback); };
     if (auto n = count(1); n && need_derivation()) {
+        if (undo_graph_edit()) return; // the last thing done was a graph edit
         int k = std::min<int>(*n, static_cast<int>(history_.size()) - 1);
         if (k == 0)
             out_ << "nothing to undo\n";

@@ -109,6 +109,18 @@ class Session {
     // Going back to step k: uses and edits made after it are forgotten. Whether it derived again
     // (it does when edits were undone: the steps kept have their own environments).
     bool back_to(int k);
+    // the decomposition graph's edits (repl_graph.cpp): :graph, :node, :edit, :inherit, :private,
+    // :public, :share, :save, and the graph part of :edits and :back
+    const DecompositionGraph* graph();
+    void graph_command(const std::string& rest, bool one_node);
+    void graph_edit(const std::string& command, const std::string& rest);
+    void save_edits(const std::string& rest);
+    void list_graph_edits();
+    bool undo_graph_edit();
+    // Reads graph_lines_ against a freshly compiled program into graph_edits_ (errors rendered).
+    bool parse_graph_lines(const Program& program, SourceManager& sources);
+    bool read_default_edits(); // true when it read some lines
+    bool drop_orphaned_edits(int steps);
     Derivation& current() { return *history_.back(); }
     DeriveOptions options() const;
 
@@ -135,6 +147,12 @@ class Session {
     bool last_error_runtime_ = false;
     bool last_error_input_ = false; // the last compile failed on a file it could not read
     std::ostream& error();          // err_, marking the line as failed
+
+    // The graph's edits as edits-file lines (the grammar's default file, then those typed), what
+    // they read as, and for :back the lines before each typed edit with the history size then.
+    std::vector<std::string> graph_lines_;
+    std::shared_ptr<const GraphEdits> graph_edits_;
+    std::vector<std::pair<std::size_t, std::vector<std::string>>> graph_undo_;
 
     std::unique_ptr<SourceManager> sources_;
     std::unique_ptr<Program> program_;

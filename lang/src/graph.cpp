@@ -84,9 +84,19 @@ std::uint64_t DecompositionGraph::child_handle(std::uint64_t parent, double posi
     return h <= kRoot ? h + 2 : h;
 }
 
+bool DecompositionGraph::full() const {
+    std::lock_guard lock(*pending_mutex_);
+    const std::size_t n = nodes_.size() + pending_.size() + 1;
+    return n > kMaxNodes || n * std::max<std::size_t>(decl_->params.size(), 1) > kMaxValues;
+}
+
 bool DecompositionGraph::record(std::uint64_t handle, std::uint64_t parent, double position,
                                 int index) const {
     std::lock_guard lock(*pending_mutex_);
+    if (pending_.count(handle) == 0) {
+        const std::size_t n = nodes_.size() + pending_.size() + 1;
+        if (n > kMaxNodes || n * std::max<std::size_t>(decl_->params.size(), 1) > kMaxValues) return false;
+    }
     auto [it, added] = pending_.try_emplace(handle, Pending{parent, position, index});
     if (added) return true;
     const Pending& p = it->second;
@@ -181,7 +191,8 @@ std::string DecompositionGraph::path(int node, bool with_ranges) const {
             if (o.position < n.position) lo = std::max(lo, (o.position + n.position) / 2);
             if (o.position > n.position) hi = std::min(hi, (o.position + n.position) / 2);
         }
-        out += "[" + format_double(lo) + ".." + format_double(hi) + "]";
+        auto rounded = [](double x) { return std::round(x * 1e9) / 1e9; }; // 0.3, not 0.30000000000000004
+        out += "[" + format_double(rounded(lo)) + ".." + format_double(rounded(hi)) + "]";
     }
     return out;
 }
@@ -215,6 +226,24 @@ int DecompositionGraph::match(const GraphEdit& e) const {
         cur = best;
     }
     return cur;
+}
+
+bool DecompositionGraph::orphaned(std::size_t k) const {
+    if (!edits_ || k >= edits_->edits.size() || matches_[k] >= 0) return false;
+    const GraphEdit& e = edits_->edits[k];
+    if (e.share) return false;
+    GraphEdit prefix = e;
+    for (std::size_t n = 0; n < e.path.size(); ++n) {
+        prefix.path.assign(e.path.begin(), e.path.begin() + static_cast<std::ptrdiff_t>(n));
+        const int at = match(prefix);
+        prefix.path.push_back(e.path[n]);
+        if (at >= 0 && match(prefix) < 0) {
+            for (int c : nodes_[static_cast<std::size_t>(at)].children)
+                if (nodes_[static_cast<std::size_t>(c)].index == e.path[n].index) return true;
+            return false;
+        }
+    }
+    return false;
 }
 
 namespace {

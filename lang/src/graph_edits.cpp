@@ -156,7 +156,8 @@ class LineReader {
         edit.param = g.find(name);
         if (edit.param < 0) {
             std::vector<std::string> names;
-            for (const auto& p : g.params) names.push_back(p.name);
+            if (name.size() <= 64) // (a suggestion for a short name only: the distance is quadratic)
+                for (const auto& p : g.params) names.push_back(p.name);
             const std::string near = nearest_name(name, names);
             fail(at, static_cast<std::uint32_t>(at + name.size()),
                  near.empty()
@@ -320,8 +321,10 @@ class LineReader {
             if (c.name == e.text && c.type != ValueType::Vec3) return c.v[0];
         if (e.text == "pi") return std::numbers::pi;
         std::vector<std::string> names;
-        for (const auto& g : prog_.globals) names.push_back(g.name);
-        for (const auto& c : prog_.constants) names.push_back(c.name);
+        for (const auto& g : prog_.globals)
+            if (e.text.size() <= 64) names.push_back(g.name);
+        for (const auto& c : prog_.constants)
+            if (e.text.size() <= 64) names.push_back(c.name);
         const std::string near = nearest_name(e.text, names);
         fail(e.span.begin, e.span.end,
              near.empty()

@@ -61,7 +61,10 @@ std::string make_child(const DecompositionGraph& g, const double* a, bool with_i
                            g.path(known), format_double(pos));
     }
     if (records && !g.record(h, parent, pos, index))
-        return "two paths of the decomposition graph made in this pass have the same handle";
+        return g.full() ? fmt::format("the decomposition graph would have more than {} nodes (or {} values: "
+                                      "nodes times parameters)",
+                                      DecompositionGraph::kMaxNodes, DecompositionGraph::kMaxValues)
+                        : "two paths of the decomposition graph made in this pass have the same handle";
     return {};
 }
 

@@ -107,6 +107,17 @@ contains "graph shows the private explicit edit" "$tmp/n" "bend(0..1) = 1 1 1 1 
 grep -A1 '^  /0.25$' "$tmp/stdout" >"$tmp/n"
 contains "the default edits are replaced" "$tmp/n" "$straight"
 
+# the REPL: edits typed, then :save; plant run --edits of the saved file writes the same plant, byte
+# for byte, as the REPL's :export
+printf ':step 2\n:set density 4\n:edit /0.6 bend = linear(0, 1)\n:private /0.2 bend\n:export %s\n:save %s\n' \
+  "$tmp/repl.txt" "$tmp/repl.edits" >"$tmp/script"
+check "repl edits and :save" 0 "$plant" repl "$range" <"$tmp/script"
+contains "repl wrote the edits" "$tmp/stdout" "wrote $tmp/repl.edits (6 lines)"
+contains "saved with the node's range" "$tmp/repl.edits" "/0.6[0.5..0.7] bend = linear(0, 1)"
+check "run the saved edits" 0 "$plant" run "$range" -D density=4 --edits "$tmp/repl.edits" -o "$tmp/run.txt"
+if cmp -s "$tmp/repl.txt" "$tmp/run.txt" && grep -q -- "-(3.125)F(0.2)" "$tmp/run.txt"; then pass=$((pass + 1)); else
+  fail=$((fail + 1)); echo "FAIL :save then plant run --edits gives the REPL's plant"; fi
+
 # errors: a missing --edits file, edits for a grammar without graph, a malformed edits file
 check "missing --edits file" 66 "$plant" derive "$range" --edits "$tmp/none.edits"
 contains "missing --edits names the file" "$tmp/stderr" "cannot read the edits file"

@@ -129,6 +129,8 @@ class DecompositionGraph {
     static constexpr std::uint64_t kRoot = 1;
     // A bound on the nodes of one graph: a runaway grammar stops with a runtime error.
     static constexpr std::size_t kMaxNodes = 1'000'000;
+    // A bound on nodes times parameters: the resolved values a graph holds.
+    static constexpr std::size_t kMaxValues = 20'000'000;
 
     DecompositionGraph(const GraphDecl& decl, std::shared_ptr<const GraphEdits> edits);
     DecompositionGraph(const DecompositionGraph& other);
@@ -148,6 +150,8 @@ class DecompositionGraph {
     bool record(std::uint64_t handle, std::uint64_t parent, double position, int index) const;
     // Whether `handle` was recorded in this pass and is not committed yet.
     bool is_pending(std::uint64_t handle) const;
+    // Whether one more node would pass kMaxNodes or kMaxValues (record() then refuses it).
+    bool full() const;
     // Commits the nodes recorded since the last commit (sorted by path, so the result does not
     // depend on the threads), then matches the edits and resolves every value. Throws
     // RuntimeError (kind General) on a hash collision or too many nodes.
@@ -166,6 +170,10 @@ class DecompositionGraph {
     const GraphEdits* edits() const { return edits_.get(); }
     // Per edit: the node it applies to (a share: its level's first node), -1 when dormant.
     const std::vector<int>& matches() const { return matches_; }
+    // Whether dormant edit k lost its node: the path stops at a node whose axis has branches of
+    // the component's index, none at the position (not an axis that has not grown yet). The
+    // REPL drops such edits under single-position matching (the paper's Fig. 10 c).
+    bool orphaned(std::size_t k) const;
 
   private:
     struct Pending {
