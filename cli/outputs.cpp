@@ -13,10 +13,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <set>
 #include <unistd.h>
 
 namespace plant::cli {
+
+namespace fs = std::filesystem;
 
 namespace {
 
@@ -57,7 +60,10 @@ std::string gltf_json_bytes(const OutputSources& from, const std::string& target
     return gltf_bytes(from.scene, GltfContainer::Json, target, from.options.gltf_layout);
 }
 std::string obj_bytes(const OutputSources& from, const std::string& target) {
-    return mesh_file_bytes(from.scene, MeshFileFormat::Obj, target);
+    return obj_file_bytes(from.scene, target, fs::path(sidecar_path(target, ".mtl")).filename().string());
+}
+std::string mtl_sidecar_bytes(const OutputSources& from, const std::string&) {
+    return mtl_file_bytes(from.scene);
 }
 std::string ply_bytes(const OutputSources& from, const std::string& target) {
     return mesh_file_bytes(from.scene, MeshFileFormat::Ply, target);
@@ -65,13 +71,28 @@ std::string ply_bytes(const OutputSources& from, const std::string& target) {
 std::string off_bytes(const OutputSources& from, const std::string& target) {
     return mesh_file_bytes(from.scene, MeshFileFormat::Off, target);
 }
+// What drawn widths are multiplied by: --width-scale, else the grammar's `width_scale`.
+double width_scale_of(const OutputOptions& options, const Derivation& d) {
+    return options.width_scale.value_or(d.width_scale());
+}
+
 std::string scene_png_bytes(const OutputSources& from, const std::string& target) {
-    std::optional<PngView> view;
-    if (from.options.camera) view = PngView{*from.options.camera, from.options.look_at};
-    return png_bytes(from.scene, from.options.width, from.options.height, target, view);
+    PngOptions po;
+    if (from.options.camera) po.camera = PngView{*from.options.camera, from.options.look_at};
+    po.view = from.options.view;
+    po.skeleton = &from.skeleton;
+    po.lines = from.options.lines;
+    po.min_line_px = from.options.min_line_px;
+    po.width_scale = width_scale_of(from.options, from.derivation);
+    return png_bytes(from.scene, from.options.width, from.options.height, target, po);
 }
 std::string skeleton_svg_bytes(const OutputSources& from, const std::string&) {
-    return skeleton_svg(from.skeleton);
+    SvgOptions so;
+    if (from.options.size_given) {
+        so.width = from.options.width;
+        so.height = from.options.height;
+    }
+    return skeleton_svg(from.skeleton, so);
 }
 std::string skeleton_json_bytes(const OutputSources& from, const std::string&) {
     return skeleton_json(from.skeleton, &from.scene); // the scene lists instances' prototypes
@@ -88,12 +109,15 @@ constexpr OutputFormat kFormats[] = {
     {".glb", OutputNeeds::Scene, glb_bytes,
      "glTF 2.0, binary; each organ or instance is one mesh, placed by EXT_mesh_gpu_instancing"},
     {".gltf", OutputNeeds::Scene, gltf_json_bytes, "glTF 2.0 as JSON, the buffer embedded as a data URI"},
-    {".obj", OutputNeeds::Scene, obj_bytes, "Wavefront OBJ, everything in one triangle mesh"},
-    {".ply", OutputNeeds::Scene, ply_bytes, "PLY, everything in one triangle mesh"},
+    {".obj", OutputNeeds::Scene, obj_bytes,
+     "Wavefront OBJ, one object per organ kind, with its colours in a .mtl file beside it", ".mtl",
+     mtl_sidecar_bytes},
+    {".ply", OutputNeeds::Scene, ply_bytes, "PLY, everything in one triangle mesh, with vertex colours"},
     {".off", OutputNeeds::Scene, off_bytes, "OFF, everything in one triangle mesh"},
     {".png", OutputNeeds::Scene, scene_png_bytes,
-     "a shaded preview from a 3/4 view (or from --camera), --size pixels"},
-    {".svg", OutputNeeds::Skeleton, skeleton_svg_bytes, "a line drawing of the XY plane, for 2D grammars"},
+     "a shaded preview (--view, --camera, --lines), --size pixels"},
+    {".svg", OutputNeeds::Skeleton, skeleton_svg_bytes,
+     "a line drawing of the XY plane, for 2D grammars (--size fits it in WxH)"},
     {".txt", OutputNeeds::String, string_text_bytes, "the derived string, as plant derive prints it"},
     {".skel.json", OutputNeeds::Skeleton, skeleton_json_bytes,
      "the skeleton, what the turtle drew before meshing (docs/skeleton.md)"},
@@ -129,6 +153,21 @@ std::string known_extensions() {
                                                : " ") +
                std::string(kFormats[k].extension);
     return out;
+}
+
+std::string sidecar_path(const std::string& target, const std::string& extension) {
+    return fs::path(target).replace_extension(extension).string();
+}
+
+std::optional<PngViewKind> parse_view(const std::string& text) {
+    static constexpr std::pair<const char*, PngViewKind> kViews[] = {{"auto", PngViewKind::Auto},
+                                                                     {"front", PngViewKind::Front},
+                                                                     {"top", PngViewKind::Top},
+                                                                     {"side", PngViewKind::Side},
+                                                                     {"iso", PngViewKind::Iso}};
+    for (const auto& [name, kind] : kViews)
+        if (text == name) return kind;
+    return std::nullopt;
 }
 
 std::uint64_t default_max_memory() {
@@ -285,6 +324,7 @@ OutputSummary write_outputs(const Program& program, const Derivation& d,
         check_mesh_memory(skeleton, options);
         MeshOptions mo;
         mo.sides = options.sides;
+        mo.width_scale = width_scale_of(options, d);
         mo.camera = options.camera; // per-placement level of detail
         mo.derivation = &d;         // instances: the seed and limits
         mo.max_memory = options.max_memory ? options.max_memory : default_max_memory(); // instances
@@ -295,9 +335,19 @@ OutputSummary write_outputs(const Program& program, const Derivation& d,
     // All or nothing across the run: every file is written under a temporary name beside its
     // target, and only when all are written are they renamed (PendingFiles removes them on an
     // error and on SIGINT or SIGTERM).
-    PendingFiles pending(paths);
+    // Sidecars (an OBJ's .mtl) are written and renamed with the outputs.
+    std::vector<std::string> targets = paths;
+    std::vector<std::size_t> sidecar_of; // per sidecar, its output
     for (std::size_t k = 0; k < formats.size(); ++k)
-        pending.write(k, formats[k]->bytes(OutputSources{program, d, skeleton, scene, options}, paths[k]));
+        if (formats[k]->sidecar_extension) {
+            targets.push_back(sidecar_path(paths[k], formats[k]->sidecar_extension));
+            sidecar_of.push_back(k);
+        }
+    PendingFiles pending(targets);
+    const OutputSources from{program, d, skeleton, scene, options};
+    for (std::size_t k = 0; k < formats.size(); ++k) pending.write(k, formats[k]->bytes(from, paths[k]));
+    for (std::size_t j = 0; j < sidecar_of.size(); ++j)
+        pending.write(paths.size() + j, formats[sidecar_of[j]]->sidecar_bytes(from, paths[sidecar_of[j]]));
     pending.commit();
     return OutputSummary{scene.tubes.triangle_count(), scene.instances.size()};
 }
