@@ -2,6 +2,7 @@
 #include "batch.hpp"
 #include "commands.hpp"
 #include "outputs.hpp"
+#include "run_progress.hpp"
 
 #include "plant/environment_phase.hpp"
 #include "plant/export.hpp"
@@ -37,6 +38,7 @@ struct RunCmd {
     bool lines = false, tubes = false;
     double min_line_width = 1.0;
     std::optional<double> width_scale;
+    double max_triangles = kDefaultMaxTriangles;
     bool sides_given = false, size_given = false;
     BatchOptions batch; // --seeds, --grid, --shard, --manifest, --jobs
 };
@@ -141,6 +143,7 @@ int read_output_options(RunCmd& c, OutputOptions& oo) {
     oo.lines = c.lines ? PngLines::Lines : c.tubes ? PngLines::Tubes : PngLines::Auto;
     oo.min_line_px = c.min_line_width;
     oo.width_scale = c.width_scale;
+    oo.max_triangles = c.max_triangles;
     oo.size_given = c.size_given;
     warn_unused_options(c);
     return kOk;
@@ -177,7 +180,7 @@ int run_main(RunCmd& c) {
     SourceManager sources;
     auto program = load_program(c.g, sources, exit_code);
     if (!program) return exit_code;
-    const bool progress = isatty(2) != 0;
+    RunProgress progress(isatty(2) != 0);
     auto t0 = std::chrono::steady_clock::now();
     DeriveOptions opt = derive_options(c.g);
     // the string's share of --max-memory: a step holds the string it reads and the one it writes
@@ -185,21 +188,26 @@ int run_main(RunCmd& c) {
     TurtleEnvironmentPhase phase;
     opt.environment_phase = &phase;
     opt.on_print = [](const std::string& text) { std::cerr << escape_controls(text, true); };
-    opt.on_step = [&](const StepStats& s) {
-        if (progress) std::cerr << fmt::format("\rstep {}: {} modules   ", s.step, s.modules) << std::flush;
-    };
+    const Derivation* running = nullptr; // the target step is known once it has started
+    opt.on_step = [&](const StepStats& s) { progress.step(s, running ? running->target_steps() : s.step); };
     Derivation d(*program, opt);
-    if (!run_derivation(d, sources, c.g.color)) return kRuntime;
-    if (progress) std::cerr << "\r\x1b[K" << std::flush;
+    running = &d;
+    if (progress.enabled()) oo.progress = [&progress](const std::string& what) { progress.stage(what); };
+    const bool derived = run_derivation(d, sources, c.g.color);
+    progress.clear();
+    if (!derived) return kRuntime;
     try {
         OutputSummary summary = write_outputs(*program, d, c.outputs, oo);
-        if (progress)
+        progress.clear();
+        if (progress.enabled())
             std::cerr << fmt::format("{} modules, {} triangles, {} organs in {:.0f} ms\n", d.string().size(),
                                      summary.triangles, summary.organs, ms_since(t0));
     } catch (const RuntimeError& e) {
+        progress.clear();
         std::cerr << render(Diagnostic{Severity::Error, e.span, e.message, {}}, sources, c.g.color);
         return e.kind == RuntimeErrorKind::Input ? kNoInput : kRuntime; // a mesh file it cannot read
     } catch (const ExportError& e) {
+        progress.clear();
         std::cerr << "plant: " << escape_controls(e.what(), true) << "\n";
         return kCantCreate;
     }
@@ -272,6 +280,11 @@ void setup_run(CLI::App& app, int& exit_code) {
                     "and a run whose meshing and export would need more stops before meshing "
                     "(default: 8G for the string, half the physical memory for meshing)")
         ->type_name("SIZE");
+    cmd->add_option("--max-triangles", c->max_triangles,
+                    "Stop before meshing when the mesh is estimated to have more triangles than this "
+                    "(default 50 million, about 6 GB while meshing and a 1.5 GB .glb)")
+        ->check(CLI::Range(1.0, 1e12))
+        ->type_name("N");
     auto* nodes = cmd->add_flag("--no-gpu-instancing", c->no_gpu_instancing,
                                 "glTF: place each organ and instance by a plain node sharing its mesh, for "
                                 "viewers without EXT_mesh_gpu_instancing");

@@ -1,5 +1,6 @@
 #include "outputs.hpp"
 #include "pending_files.hpp"
+#include "run_progress.hpp"
 
 #include "plant/environment.hpp"
 
@@ -228,6 +229,32 @@ static void check_mesh_memory(const Skeleton& skeleton, const OutputOptions& opt
                                        bytes / 1e9, points, sides, double(budget) / 1e9));
 }
 
+// Before meshing: the triangles the tubes will have (2 * sides per segment, a fifth more for the
+// rounded sharp bends) and the organs (kOrganTriangles each, a leaf's or a petal's order), and the
+// bytes they take in memory (about 40 a triangle, three copies: scene, export, file). Stops with a
+// Memory error naming --max-triangles past it; tells the progress line otherwise.
+static void check_triangles(const Skeleton& skeleton, const OutputOptions& options) {
+    constexpr double kOrganTriangles = 32, kBendShare = 1.2, kBytesPerTriangle = 3 * 40.0;
+    double segments = 0, organs = 0;
+    for (const auto& a : skeleton.axes)
+        if (a.points.size() > 1) segments += double(a.points.size() - 1);
+    for (const auto& o : skeleton.organs) // instances are counted when they are drawn out
+        if (o.shape.kind != OrganKind::Instance) organs += 1;
+    const double triangles =
+        segments * 2.0 * std::max(options.sides, 3) * kBendShare + organs * kOrganTriangles;
+    if (triangles > options.max_triangles)
+        throw RuntimeError(
+            RuntimeErrorKind::Memory, Span{},
+            fmt::format("meshing would make about {} triangles ({:.0f} segments of {} sides, "
+                        "{:.0f} organs), more than --max-triangles {} allows: lower the number "
+                        "of steps (-n) or --sides, or raise --max-triangles",
+                        human_count(triangles), segments, options.sides, organs,
+                        human_count(options.max_triangles)));
+    if (options.progress)
+        options.progress(fmt::format("meshing about {} triangles ({})", human_count(triangles),
+                                     human_bytes(triangles * kBytesPerTriangle)));
+}
+
 // Before drawing every placement out (.obj, .ply and .off always, .glb and .gltf with --flatten):
 // what that takes per drawn vertex, measured on 131,071 placements of an 18-vertex tube (2.4
 // million vertices): OBJ and PLY peaked at 250 bytes a vertex, the --flatten GLB at 180; the
@@ -316,12 +343,14 @@ OutputSummary write_outputs(const Program& program, const Derivation& d,
     }
     Skeleton skeleton;
     Scene scene;
+    if (need_skeleton && options.progress) options.progress("interpreting the string");
     if (need_skeleton) skeleton = build_skeleton(program, d.interpreted(d.string()), turtle_options(d));
     // .skel.json lists the prototypes of instances: they are made with the scene
     if (need_skeleton && !need_scene && program.instances)
         for (const auto& p : paths) need_scene = need_scene || format_of(p)->bytes == skeleton_json_bytes;
     if (need_scene) {
         check_mesh_memory(skeleton, options);
+        check_triangles(skeleton, options);
         MeshOptions mo;
         mo.sides = options.sides;
         mo.width_scale = width_scale_of(options, d);
@@ -345,7 +374,12 @@ OutputSummary write_outputs(const Program& program, const Derivation& d,
         }
     PendingFiles pending(targets);
     const OutputSources from{program, d, skeleton, scene, options};
-    for (std::size_t k = 0; k < formats.size(); ++k) pending.write(k, formats[k]->bytes(from, paths[k]));
+    for (std::size_t k = 0; k < formats.size(); ++k) {
+        if (options.progress)
+            options.progress(
+                fmt::format("writing {} ({} of {})", escape_controls(paths[k]), k + 1, formats.size()));
+        pending.write(k, formats[k]->bytes(from, paths[k]));
+    }
     for (std::size_t j = 0; j < sidecar_of.size(); ++j)
         pending.write(paths.size() + j, formats[sidecar_of[j]]->sidecar_bytes(from, paths[sidecar_of[j]]));
     pending.commit();

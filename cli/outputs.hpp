@@ -7,12 +7,15 @@
 #include "plant/scene.hpp"
 #include "plant/skeleton.hpp"
 
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
 namespace plant::cli {
+
+inline constexpr double kDefaultMaxTriangles = 50e6;
 
 struct OutputOptions {
     int sides = 8;
@@ -32,6 +35,11 @@ struct OutputOptions {
     // --width-scale: replaces the grammar's `width_scale` (what drawn widths are multiplied by)
     std::optional<double> width_scale;
     bool size_given = false; // --size was given: an .svg takes it too
+    // --max-triangles: a run whose meshing is estimated to make more stops before meshing
+    double max_triangles = kDefaultMaxTriangles;
+    // Called with each stage (interpreting, meshing with its estimate, writing each file), for
+    // plant run's progress line; none: quiet.
+    std::function<void(const std::string&)> progress;
 };
 
 // "front", "top", "side", "iso" or "auto"; none for anything else.

@@ -107,13 +107,6 @@ void write_mesh_stream(const Scene& given, MeshFileFormat format, const std::str
     // OpenMesh picks its writer by an extension, whatever the file is called
     static constexpr const char* kOpenMeshExtension[] = {".obj", ".ply", ".off"};
     const std::string ext = kOpenMeshExtension[static_cast<int>(format)];
-    if (format == MeshFileFormat::Obj) {
-        const std::string bytes =
-            obj_file_bytes(given, path, fs::path(path).replace_extension(".mtl").filename().string());
-        if (!out.write(bytes.data(), std::streamsize(bytes.size())) || !out.flush())
-            throw ExportError("cannot write " + quoted(path) + ": the obj file could not be written in full");
-        return;
-    }
     quiet_openmesh();
     Scene flattened;
     const Scene& scene = exported_scene(given, flattened, "mesh export");
@@ -165,8 +158,6 @@ std::string mesh_file_bytes(const Scene& scene, MeshFileFormat format, const std
 }
 
 void write_mesh_file(const Scene& scene, const std::string& path, MeshFileFormat format) {
-    if (format == MeshFileFormat::Obj) // its materials first, so the OBJ never names a missing file
-        write_file_atomically(fs::path(path).replace_extension(".mtl").string(), mtl_file_bytes(scene));
     write_file_atomically(path, mesh_file_bytes(scene, format, path));
 }
 

@@ -102,11 +102,12 @@ std::string obj_file_bytes(const Scene& scene, const std::string& path, const st
 // in (a texture's average colour), linear RGB.
 std::string mtl_file_bytes(const Scene& scene);
 
-// The mesh files OpenMesh writes for us (.obj: obj_file_bytes and mtl_file_bytes instead).
+// The mesh files OpenMesh writes for us: plain, without materials (plant run writes .obj with
+// obj_file_bytes and mtl_file_bytes instead).
 enum class MeshFileFormat : std::uint8_t { Obj, Ply, Off };
 // Everything flattened into one triangle mesh with vertex normals (and texture coordinates, but
-// for OFF; vertex colours for PLY), written through OpenMesh in `format`, but OBJ, which is
-// obj_file_bytes (write_mesh_file writes its .mtl beside it); the path's extension is not read.
+// for OFF; vertex colours for PLY), written through OpenMesh in `format`; the path's extension
+// is not read.
 void write_mesh_file(const Scene& scene, const std::string& path, MeshFileFormat format);
 // The bytes write_mesh_file writes; `path` names the file in messages only.
 std::string mesh_file_bytes(const Scene& scene, MeshFileFormat format, const std::string& path);
