@@ -260,7 +260,7 @@ void setup_run(CLI::App& app, int& exit_code) {
         ->each([c](const std::string&) { c->size_given = true; });
     cmd->add_option("--width-scale", c->width_scale,
                     "Multiply every drawn width by this (replaces the grammar's `width_scale`; ABOP's "
-                    "!(w) is in pixels: try 0.01)")
+                    "!(w) is in pixels: try 0.02)")
         ->check(CLI::Range(1e-9, 1e6))
         ->type_name("X");
     cmd->add_option("--view", c->view,

@@ -528,7 +528,9 @@ Image render_scene(const Scene& scene, int width, int height, const PngOptions& 
         tubes = options.lines == PngLines::Auto &&
                 detail::widest_tube(*options.skeleton, cam, options.width_scale) >= kAutoLinePx * ss;
         const double min_samples = std::clamp(options.min_line_px, 0.0, 1000.0) * ss;
-        ren.draw_quads(detail::line_quads(*options.skeleton, cam, options.width_scale, min_samples));
+        // under tubes, bands only min_line_px wide: hidden inside every tube wider than that
+        ren.draw_quads(
+            detail::line_quads(*options.skeleton, cam, tubes ? 0.0 : options.width_scale, min_samples));
     }
     if (tubes) ren.draw_part(scene.tubes, nullptr);
     for (const Instance& inst : scene.instances) {
