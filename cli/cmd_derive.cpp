@@ -64,7 +64,6 @@ int derive_main(const DeriveCmd& c) {
     Derivation d(*program, opt);
     bool ok = run_derivation(d, sources, c.g.color);
     if (progress) std::cerr << "\r\x1b[K" << std::flush;
-    if (!ok) return kRuntime;
     if (c.stats) {
         std::string stats_out;
         double total_ms = 0;
@@ -73,11 +72,19 @@ int derive_main(const DeriveCmd& c) {
             stats_out +=
                 fmt::format("step {} modules={} bytes={} ms={:.4f}\n", s.step, s.modules, s.bytes, s.ms);
         }
+        if (!ok) { // the steps that finished, and where it stopped (the error is on stderr)
+            stats_out += fmt::format("failed step={} modules={} ms={:.4f}\n",
+                                     steps.empty() ? 1 : steps.back().step + 1,
+                                     steps.empty() ? 0 : steps.back().modules, total_ms);
+            write_stdout(stats_out);
+            return kRuntime;
+        }
         stats_out +=
             fmt::format("total steps={} modules={} bytes={} ms={:.4f} peak_rss_kb={}\n", d.steps_done(),
                         d.string().size(), d.string().bytes(), total_ms, peak_rss_kb());
         return write_stdout(stats_out);
     }
+    if (!ok) return kRuntime;
     std::string text = format_string(*program, d.string(), c.ids);
     text += '\n';
     return write_stdout(text);
@@ -90,7 +97,9 @@ void setup_derive(CLI::App& app, int& exit_code) {
     CLI::App* cmd = app.add_subcommand("derive", "Derive a grammar and print the string in ABOP notation");
     add_grammar_options(*cmd, c->g, true);
     cmd->add_flag("--ids", c->ids, "Show each module's identity after it, as F(1)#7");
-    cmd->add_flag("--stats", c->stats, "Print counts and timings per step instead of the string");
+    cmd->add_flag("--stats", c->stats,
+                  "Print counts and timings per step instead of the string (the steps finished, when a later "
+                  "one fails)");
     cmd->callback([c, &exit_code] { exit_code = derive_main(*c); });
 }
 

@@ -2,6 +2,7 @@
 #include "batch.hpp"
 #include "commands.hpp"
 #include "outputs.hpp"
+#include "run_progress.hpp"
 
 #include "plant/environment_phase.hpp"
 #include "plant/export.hpp"
@@ -33,7 +34,13 @@ struct RunCmd {
     std::string max_memory;
     bool no_gpu_instancing = false, flatten = false;
     std::optional<std::string> camera, look_at; // as given, even empty
-    BatchOptions batch;                         // --seeds, --grid, --shard, --manifest, --jobs
+    std::string view = "auto";
+    bool lines = false, tubes = false;
+    double min_line_width = 1.0;
+    std::optional<double> width_scale;
+    double max_triangles = kDefaultMaxTriangles;
+    bool sides_given = false, size_given = false;
+    BatchOptions batch; // --seeds, --grid, --shard, --manifest, --jobs
 };
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
@@ -65,6 +72,19 @@ bool read_view(const RunCmd& c, std::optional<glm::dvec3>& camera, std::optional
         return false;
     }
     return true;
+}
+
+// Options no requested output reads are said to be ignored, rather than silently dropped.
+void warn_unused_options(const RunCmd& c) {
+    bool meshed = false, svg = false;
+    for (const auto& o : c.outputs) {
+        const OutputFormat* f = format_of(o);
+        meshed = meshed || (f && f->needs == OutputNeeds::Scene);
+        svg = svg || (f && std::string_view(f->extension) == ".svg");
+    }
+    if (c.sides_given && svg && !meshed)
+        std::cerr << "plant: warning: --sides shapes meshed tubes; an .svg is a line drawing of the "
+                     "skeleton and does not use it\n";
 }
 
 // Reads --size, --max-memory, the view and the layout into `oo`, and checks the outputs' formats
@@ -109,6 +129,23 @@ int read_output_options(RunCmd& c, OutputOptions& oo) {
                                            : GltfLayout::GpuInstancing;
     oo.camera = camera;
     oo.look_at = look_at;
+    const auto view = parse_view(c.view);
+    if (!view) {
+        std::cerr << fmt::format("plant: --view expects front, top, side, iso or auto, found '{}'\n",
+                                 escape_controls(c.view));
+        return kUsage;
+    }
+    if (camera && *view != PngViewKind::Auto) {
+        std::cerr << "plant: --view and --camera both say where the preview is seen from: keep one of them\n";
+        return kUsage;
+    }
+    oo.view = *view;
+    oo.lines = c.lines ? PngLines::Lines : c.tubes ? PngLines::Tubes : PngLines::Auto;
+    oo.min_line_px = c.min_line_width;
+    oo.width_scale = c.width_scale;
+    oo.max_triangles = c.max_triangles;
+    oo.size_given = c.size_given;
+    warn_unused_options(c);
     return kOk;
 }
 
@@ -143,7 +180,7 @@ int run_main(RunCmd& c) {
     SourceManager sources;
     auto program = load_program(c.g, sources, exit_code);
     if (!program) return exit_code;
-    const bool progress = isatty(2) != 0;
+    RunProgress progress(isatty(2) != 0);
     auto t0 = std::chrono::steady_clock::now();
     DeriveOptions opt = derive_options(c.g);
     // the string's share of --max-memory: a step holds the string it reads and the one it writes
@@ -151,21 +188,26 @@ int run_main(RunCmd& c) {
     TurtleEnvironmentPhase phase;
     opt.environment_phase = &phase;
     opt.on_print = [](const std::string& text) { std::cerr << escape_controls(text, true); };
-    opt.on_step = [&](const StepStats& s) {
-        if (progress) std::cerr << fmt::format("\rstep {}: {} modules   ", s.step, s.modules) << std::flush;
-    };
+    const Derivation* running = nullptr; // the target step is known once it has started
+    opt.on_step = [&](const StepStats& s) { progress.step(s, running ? running->target_steps() : s.step); };
     Derivation d(*program, opt);
-    if (!run_derivation(d, sources, c.g.color)) return kRuntime;
-    if (progress) std::cerr << "\r\x1b[K" << std::flush;
+    running = &d;
+    if (progress.enabled()) oo.progress = [&progress](const std::string& what) { progress.stage(what); };
+    const bool derived = run_derivation(d, sources, c.g.color);
+    progress.clear();
+    if (!derived) return kRuntime;
     try {
         OutputSummary summary = write_outputs(*program, d, c.outputs, oo);
-        if (progress)
+        progress.clear();
+        if (progress.enabled())
             std::cerr << fmt::format("{} modules, {} triangles, {} organs in {:.0f} ms\n", d.string().size(),
                                      summary.triangles, summary.organs, ms_since(t0));
     } catch (const RuntimeError& e) {
+        progress.clear();
         std::cerr << render(Diagnostic{Severity::Error, e.span, e.message, {}}, sources, c.g.color);
         return e.kind == RuntimeErrorKind::Input ? kNoInput : kRuntime; // a mesh file it cannot read
     } catch (const ExportError& e) {
+        progress.clear();
         std::cerr << "plant: " << escape_controls(e.what(), true) << "\n";
         return kCantCreate;
     }
@@ -210,13 +252,39 @@ void setup_run(CLI::App& app, int& exit_code) {
                     "Output file, its format chosen by extension (listed below); repeat for several "
                     "(default: out/NAME.glb and out/NAME.png; for many variants out/NAME-{n}.glb)")
         ->type_name("FILE");
-    cmd->add_option("--sides", c->sides, "Vertices around each ring of a branch")->check(CLI::Range(3, 64));
-    cmd->add_option("--size", c->size, "Size of PNG previews")->type_name("WxH");
+    cmd->add_option("--sides", c->sides, "Vertices around each ring of a branch (meshes only; not .svg)")
+        ->check(CLI::Range(3, 64))
+        ->each([c](const std::string&) { c->sides_given = true; });
+    cmd->add_option("--size", c->size, "Size of PNG previews, and of SVG drawings (the figure fitted inside)")
+        ->type_name("WxH")
+        ->each([c](const std::string&) { c->size_given = true; });
+    cmd->add_option("--width-scale", c->width_scale,
+                    "Multiply every drawn width by this (replaces the grammar's `width_scale`; ABOP's "
+                    "!(w) is in pixels: try 0.02)")
+        ->check(CLI::Range(1e-9, 1e6))
+        ->type_name("X");
+    cmd->add_option("--view", c->view,
+                    "PNG preview from the front (looking along -z, y up), top, side (from +x) or iso (3/4 "
+                    "view); default auto: a flat figure face-on, iso otherwise")
+        ->type_name("VIEW");
+    auto* lines = cmd->add_flag("--lines", c->lines,
+                                "PNG: draw branches as lines at least --min-line-width pixels wide instead "
+                                "of tubes (default: lines when every tube would be under 1.5 pixels)");
+    cmd->add_flag("--tubes", c->tubes, "PNG: draw the meshed tubes only, however thin")->excludes(lines);
+    cmd->add_option("--min-line-width", c->min_line_width,
+                    "PNG: the narrowest branch drawn, in pixels (default 1; 0 lets thin tubes vanish)")
+        ->check(CLI::Range(0.0, 100.0))
+        ->type_name("PX");
     cmd->add_option("--max-memory", c->max_memory,
                     "Memory the run may take, as 512M or 4G: the derivation's string may take half of it, "
                     "and a run whose meshing and export would need more stops before meshing "
                     "(default: 8G for the string, half the physical memory for meshing)")
         ->type_name("SIZE");
+    cmd->add_option("--max-triangles", c->max_triangles,
+                    "Stop before meshing when the mesh is estimated to have more triangles than this "
+                    "(default 50 million, about 6 GB while meshing and a 1.5 GB .glb)")
+        ->check(CLI::Range(1.0, 1e12))
+        ->type_name("N");
     auto* nodes = cmd->add_flag("--no-gpu-instancing", c->no_gpu_instancing,
                                 "glTF: place each organ and instance by a plain node sharing its mesh, for "
                                 "viewers without EXT_mesh_gpu_instancing");

@@ -6,12 +6,15 @@
 //   # args: -n 3 --seed 7           extra command-line arguments
 //   # command: check                run `plant check` instead of `plant derive`
 //   # expect: LINE                  one line of standard output, in order
-//   # expect error: 3:14: message   an error at line 3, column 14 (or without position)
-//   # expect warning: 3:14: message a warning
+//   # expect error: 3:14: message   an error at line 3, column 14; without the position, at any
+//                                   place; the message's tail after "; " or ": " may be left out
+//   # expect error contains: TEXT   an error whose line contains TEXT
+//   # expect warning: 3:14: message a warning (and `# expect warning contains: TEXT`)
 //   # expect exit: 70               the exit code (default 65 with errors, else 0)
 // A file without such comments is a golden test: its derived string is compared with the
-// sidecar NAME.txt beside it, which `--bless` rewrites.
+// sidecar NAME.txt beside it, which `--bless` rewrites. docs/testing.md describes them all.
 #include "commands.hpp"
+#include "test_matching.hpp"
 
 #include "plant/export.hpp"
 
@@ -102,7 +105,8 @@ std::vector<std::string> lines_of(const std::string& s) {
 struct Expectations {
     bool script = false;
     std::string command = "derive";
-    std::vector<std::string> args, out, errors, warnings;
+    std::vector<std::string> args, out;
+    std::vector<ExpectedDiagnostic> errors, warnings;
     std::optional<int> exit_code;
     int command_line = 0, command_col = 0; // where `# command:` names the command
     int args_line = 0;                     // the line of `# args:`, and where each word begins
@@ -159,11 +163,17 @@ Expectations read_expectations(const std::string& text) {
             e.command_line = line_no;
             e.command_col = words.empty() ? rest_col : cols[0];
             e.script = true;
+        } else if (take("expect error contains:", rest)) {
+            e.errors.push_back({rest, true});
+            e.script = true;
+        } else if (take("expect warning contains:", rest)) {
+            e.warnings.push_back({rest, true});
+            e.script = true;
         } else if (take("expect error:", rest)) {
-            e.errors.push_back(rest);
+            e.errors.push_back({rest, false});
             e.script = true;
         } else if (take("expect warning:", rest)) {
-            e.warnings.push_back(rest);
+            e.warnings.push_back({rest, false});
             e.script = true;
         } else if (take("expect exit:", rest)) {
             e.exit_code = std::atoi(rest.c_str());
@@ -293,7 +303,7 @@ std::string confine(const fs::path& file, Expectations& e, const fs::path& outdi
 }
 
 // Returns an empty string when the test passed, else what went wrong.
-std::string run_one(const fs::path& file, bool bless, bool& blessed,
+std::string run_one(const fs::path& file, bool bless, std::string& blessed,
                     const std::vector<std::string>& allow_read) {
     std::string text;
     if (!read_file(file.string(), text)) return "  cannot read the file\n";
@@ -311,8 +321,8 @@ std::string run_one(const fs::path& file, bool bless, bool& blessed,
         int want_exit = e.exit_code ? *e.exit_code : (e.errors.empty() ? 0 : 65);
         if (o.exit_code != want_exit)
             msg += fmt::format("  exit code: expected {}, got {}\n", want_exit, o.exit_code);
-        msg += compare_lists("error", e.errors, errors);
-        msg += compare_lists("warning", e.warnings, warnings);
+        msg += compare_diagnostics("error", e.errors, errors);
+        msg += compare_diagnostics("warning", e.warnings, warnings);
         if (!e.out.empty() || o.exit_code == 0) {
             if (!e.out.empty() || (!o.out.empty() && e.command != "check"))
                 msg += compare_lists("output line", e.out, lines_of(o.out));
@@ -347,9 +357,11 @@ std::string run_one(const fs::path& file, bool bless, bool& blessed,
     if (bless) {
         for (const auto& [path, content] : {std::pair{sidecar, o.out}, std::pair{mesh_sidecar, mesh}}) {
             std::string old;
-            if (!read_file(path.string(), old) || old != content) {
+            const bool existed = read_file(path.string(), old);
+            if (!existed || old != content) {
                 if (!write_atomically(path, content)) return "  cannot write " + path.string() + "\n";
-                blessed = true;
+                blessed += fmt::format("wrote {}{}\n{}", escape_controls(path.string()),
+                                       existed ? "" : " (new)", short_diff(old, content));
             }
         }
         return {};
@@ -377,7 +389,7 @@ struct TestCmd {
 };
 
 int test_main(const TestCmd& c) {
-    std::vector<fs::path> files;
+    std::vector<fs::path> files, walked; // walked: found in a folder, not named
     std::vector<std::string> paths = c.paths.empty() ? std::vector<std::string>{"grammars"} : c.paths;
     for (const auto& p : paths) {
         std::error_code ec;
@@ -385,8 +397,10 @@ int test_main(const TestCmd& c) {
             fs::recursive_directory_iterator it(p, fs::directory_options::skip_permission_denied, ec), end;
             for (; !ec && it != end; it.increment(ec)) {
                 std::error_code fe;
-                if (it->is_regular_file(fe) && it->path().extension() == ".plant")
+                if (it->is_regular_file(fe) && it->path().extension() == ".plant") {
                     files.push_back(it->path());
+                    walked.push_back(it->path());
+                }
             }
         } else if (fs::exists(p, ec)) {
             files.emplace_back(p);
@@ -397,15 +411,21 @@ int test_main(const TestCmd& c) {
         }
     }
     std::sort(files.begin(), files.end());
-    int passed = 0, failed = 0, blessed_count = 0;
+    // files imported by others, with no expectations of their own, are libraries, not tests
+    std::vector<fs::path> libraries = library_files(walked);
+    int passed = 0, failed = 0, written = 0;
     for (const auto& f : files) {
-        bool blessed = false;
+        if (std::find(libraries.begin(), libraries.end(), f) != libraries.end()) {
+            if (c.verbose) std::cout << "library " << f.string() << " (imported, not a test)\n";
+            continue;
+        }
+        std::string blessed;
         std::string msg = run_one(f, c.bless, blessed, c.allow_read);
         if (msg.empty()) {
             ++passed;
-            if (blessed) {
-                ++blessed_count;
-                std::cout << "blessed " << f.string() << "\n";
+            if (!blessed.empty()) {
+                for (const std::string& line : lines_of(blessed)) written += line.rfind("wrote ", 0) == 0;
+                std::cout << blessed;
             } else if (c.verbose) {
                 std::cout << "ok " << f.string() << "\n";
             }
@@ -414,8 +434,7 @@ int test_main(const TestCmd& c) {
             std::cout << "FAIL " << f.string() << "\n" << msg;
         }
     }
-    if (c.bless)
-        std::cout << fmt::format("{} sidecar{} rewritten\n", blessed_count, blessed_count == 1 ? "" : "s");
+    if (c.bless) std::cout << fmt::format("{} file{} written\n", written, written == 1 ? "" : "s");
     std::cout << fmt::format("{} passed, {} failed\n", passed, failed);
     return failed == 0 && !files.empty() ? kOk : kFailed;
 }
@@ -427,7 +446,8 @@ void setup_test(CLI::App& app, int& exit_code) {
     CLI::App* cmd = app.add_subcommand("test", "Run golden-file and script tests of grammars");
     cmd->add_option("PATH", c->paths, "Grammar files or directories (default: grammars)");
     cmd->add_flag("--bless", c->bless,
-                  "Rewrite the golden sidecars from the current output (review the diff!)");
+                  "Rewrite the golden files (NAME.txt, NAME.mesh.txt) from the current output; lists each "
+                  "file written with a short diff (review it!)");
     cmd->add_flag("-v,--verbose", c->verbose, "List passing tests too");
     add_allow_read(*cmd, c->allow_read);
     cmd->callback([c, &exit_code] { exit_code = test_main(*c); });

@@ -1,5 +1,6 @@
 #include "outputs.hpp"
 #include "pending_files.hpp"
+#include "run_progress.hpp"
 
 #include "plant/environment.hpp"
 
@@ -13,10 +14,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <set>
 #include <unistd.h>
 
 namespace plant::cli {
+
+namespace fs = std::filesystem;
 
 namespace {
 
@@ -57,7 +61,10 @@ std::string gltf_json_bytes(const OutputSources& from, const std::string& target
     return gltf_bytes(from.scene, GltfContainer::Json, target, from.options.gltf_layout);
 }
 std::string obj_bytes(const OutputSources& from, const std::string& target) {
-    return mesh_file_bytes(from.scene, MeshFileFormat::Obj, target);
+    return obj_file_bytes(from.scene, target, fs::path(sidecar_path(target, ".mtl")).filename().string());
+}
+std::string mtl_sidecar_bytes(const OutputSources& from, const std::string&) {
+    return mtl_file_bytes(from.scene);
 }
 std::string ply_bytes(const OutputSources& from, const std::string& target) {
     return mesh_file_bytes(from.scene, MeshFileFormat::Ply, target);
@@ -65,13 +72,28 @@ std::string ply_bytes(const OutputSources& from, const std::string& target) {
 std::string off_bytes(const OutputSources& from, const std::string& target) {
     return mesh_file_bytes(from.scene, MeshFileFormat::Off, target);
 }
+// What drawn widths are multiplied by: --width-scale, else the grammar's `width_scale`.
+double width_scale_of(const OutputOptions& options, const Derivation& d) {
+    return options.width_scale.value_or(d.width_scale());
+}
+
 std::string scene_png_bytes(const OutputSources& from, const std::string& target) {
-    std::optional<PngView> view;
-    if (from.options.camera) view = PngView{*from.options.camera, from.options.look_at};
-    return png_bytes(from.scene, from.options.width, from.options.height, target, view);
+    PngOptions po;
+    if (from.options.camera) po.camera = PngView{*from.options.camera, from.options.look_at};
+    po.view = from.options.view;
+    po.skeleton = &from.skeleton;
+    po.lines = from.options.lines;
+    po.min_line_px = from.options.min_line_px;
+    po.width_scale = width_scale_of(from.options, from.derivation);
+    return png_bytes(from.scene, from.options.width, from.options.height, target, po);
 }
 std::string skeleton_svg_bytes(const OutputSources& from, const std::string&) {
-    return skeleton_svg(from.skeleton);
+    SvgOptions so;
+    if (from.options.size_given) {
+        so.width = from.options.width;
+        so.height = from.options.height;
+    }
+    return skeleton_svg(from.skeleton, so);
 }
 std::string skeleton_json_bytes(const OutputSources& from, const std::string&) {
     return skeleton_json(from.skeleton, &from.scene); // the scene lists instances' prototypes
@@ -88,12 +110,15 @@ constexpr OutputFormat kFormats[] = {
     {".glb", OutputNeeds::Scene, glb_bytes,
      "glTF 2.0, binary; each organ or instance is one mesh, placed by EXT_mesh_gpu_instancing"},
     {".gltf", OutputNeeds::Scene, gltf_json_bytes, "glTF 2.0 as JSON, the buffer embedded as a data URI"},
-    {".obj", OutputNeeds::Scene, obj_bytes, "Wavefront OBJ, everything in one triangle mesh"},
-    {".ply", OutputNeeds::Scene, ply_bytes, "PLY, everything in one triangle mesh"},
+    {".obj", OutputNeeds::Scene, obj_bytes,
+     "Wavefront OBJ, one object per organ kind, with its colours in a .mtl file beside it", ".mtl",
+     mtl_sidecar_bytes},
+    {".ply", OutputNeeds::Scene, ply_bytes, "PLY, everything in one triangle mesh, with vertex colours"},
     {".off", OutputNeeds::Scene, off_bytes, "OFF, everything in one triangle mesh"},
     {".png", OutputNeeds::Scene, scene_png_bytes,
-     "a shaded preview from a 3/4 view (or from --camera), --size pixels"},
-    {".svg", OutputNeeds::Skeleton, skeleton_svg_bytes, "a line drawing of the XY plane, for 2D grammars"},
+     "a shaded preview (--view, --camera, --lines), --size pixels"},
+    {".svg", OutputNeeds::Skeleton, skeleton_svg_bytes,
+     "a line drawing of the XY plane, for 2D grammars (--size fits it in WxH)"},
     {".txt", OutputNeeds::String, string_text_bytes, "the derived string, as plant derive prints it"},
     {".skel.json", OutputNeeds::Skeleton, skeleton_json_bytes,
      "the skeleton, what the turtle drew before meshing (docs/skeleton.md)"},
@@ -129,6 +154,21 @@ std::string known_extensions() {
                                                : " ") +
                std::string(kFormats[k].extension);
     return out;
+}
+
+std::string sidecar_path(const std::string& target, const std::string& extension) {
+    return fs::path(target).replace_extension(extension).string();
+}
+
+std::optional<PngViewKind> parse_view(const std::string& text) {
+    static constexpr std::pair<const char*, PngViewKind> kViews[] = {{"auto", PngViewKind::Auto},
+                                                                     {"front", PngViewKind::Front},
+                                                                     {"top", PngViewKind::Top},
+                                                                     {"side", PngViewKind::Side},
+                                                                     {"iso", PngViewKind::Iso}};
+    for (const auto& [name, kind] : kViews)
+        if (text == name) return kind;
+    return std::nullopt;
 }
 
 std::uint64_t default_max_memory() {
@@ -187,6 +227,32 @@ static void check_mesh_memory(const Skeleton& skeleton, const OutputOptions& opt
                                        "ring) but --max-memory allows {:.1f} GB: lower --sides or the "
                                        "derivation length, or raise --max-memory",
                                        bytes / 1e9, points, sides, double(budget) / 1e9));
+}
+
+// Before meshing: the triangles the tubes will have (2 * sides per segment, a fifth more for the
+// rounded sharp bends) and the organs (kOrganTriangles each, a leaf's or a petal's order), and the
+// bytes they take in memory (about 40 a triangle, three copies: scene, export, file). Stops with a
+// Memory error naming --max-triangles past it; tells the progress line otherwise.
+static void check_triangles(const Skeleton& skeleton, const OutputOptions& options) {
+    constexpr double kOrganTriangles = 32, kBendShare = 1.2, kBytesPerTriangle = 3 * 40.0;
+    double segments = 0, organs = 0;
+    for (const auto& a : skeleton.axes)
+        if (a.points.size() > 1) segments += double(a.points.size() - 1);
+    for (const auto& o : skeleton.organs) // instances are counted when they are drawn out
+        if (o.shape.kind != OrganKind::Instance) organs += 1;
+    const double triangles =
+        segments * 2.0 * std::max(options.sides, 3) * kBendShare + organs * kOrganTriangles;
+    if (triangles > options.max_triangles)
+        throw RuntimeError(
+            RuntimeErrorKind::Memory, Span{},
+            fmt::format("meshing would make about {} triangles ({:.0f} segments of {} sides, "
+                        "{:.0f} organs), more than --max-triangles {} allows: lower the number "
+                        "of steps (-n) or --sides, or raise --max-triangles",
+                        human_count(triangles), segments, options.sides, organs,
+                        human_count(options.max_triangles)));
+    if (options.progress)
+        options.progress(fmt::format("meshing about {} triangles ({})", human_count(triangles),
+                                     human_bytes(triangles * kBytesPerTriangle)));
 }
 
 // Before drawing every placement out (.obj, .ply and .off always, .glb and .gltf with --flatten):
@@ -277,14 +343,17 @@ OutputSummary write_outputs(const Program& program, const Derivation& d,
     }
     Skeleton skeleton;
     Scene scene;
+    if (need_skeleton && options.progress) options.progress("interpreting the string");
     if (need_skeleton) skeleton = build_skeleton(program, d.interpreted(d.string()), turtle_options(d));
     // .skel.json lists the prototypes of instances: they are made with the scene
     if (need_skeleton && !need_scene && program.instances)
         for (const auto& p : paths) need_scene = need_scene || format_of(p)->bytes == skeleton_json_bytes;
     if (need_scene) {
         check_mesh_memory(skeleton, options);
+        check_triangles(skeleton, options);
         MeshOptions mo;
         mo.sides = options.sides;
+        mo.width_scale = width_scale_of(options, d);
         mo.camera = options.camera; // per-placement level of detail
         mo.derivation = &d;         // instances: the seed and limits
         mo.max_memory = options.max_memory ? options.max_memory : default_max_memory(); // instances
@@ -295,9 +364,24 @@ OutputSummary write_outputs(const Program& program, const Derivation& d,
     // All or nothing across the run: every file is written under a temporary name beside its
     // target, and only when all are written are they renamed (PendingFiles removes them on an
     // error and on SIGINT or SIGTERM).
-    PendingFiles pending(paths);
+    // Sidecars (an OBJ's .mtl) are written and renamed with the outputs.
+    std::vector<std::string> targets = paths;
+    std::vector<std::size_t> sidecar_of; // per sidecar, its output
     for (std::size_t k = 0; k < formats.size(); ++k)
-        pending.write(k, formats[k]->bytes(OutputSources{program, d, skeleton, scene, options}, paths[k]));
+        if (formats[k]->sidecar_extension) {
+            targets.push_back(sidecar_path(paths[k], formats[k]->sidecar_extension));
+            sidecar_of.push_back(k);
+        }
+    PendingFiles pending(targets);
+    const OutputSources from{program, d, skeleton, scene, options};
+    for (std::size_t k = 0; k < formats.size(); ++k) {
+        if (options.progress)
+            options.progress(
+                fmt::format("writing {} ({} of {})", escape_controls(paths[k]), k + 1, formats.size()));
+        pending.write(k, formats[k]->bytes(from, paths[k]));
+    }
+    for (std::size_t j = 0; j < sidecar_of.size(); ++j)
+        pending.write(paths.size() + j, formats[sidecar_of[j]]->sidecar_bytes(from, paths[sidecar_of[j]]));
     pending.commit();
     return OutputSummary{scene.tubes.triangle_count(), scene.instances.size()};
 }

@@ -7,12 +7,15 @@
 #include "plant/scene.hpp"
 #include "plant/skeleton.hpp"
 
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
 namespace plant::cli {
+
+inline constexpr double kDefaultMaxTriangles = 50e6;
 
 struct OutputOptions {
     int sides = 8;
@@ -25,7 +28,22 @@ struct OutputOptions {
     // --camera: where the PNG preview is seen from, and where placements measure their view
     // depth from (MeshOptions::camera); --look-at: the point it looks at
     std::optional<glm::dvec3> camera, look_at;
+    // --view, --lines/--tubes, --min-line-width: how the PNG preview looks (PngOptions)
+    PngViewKind view = PngViewKind::Auto;
+    PngLines lines = PngLines::Auto;
+    double min_line_px = 1.0;
+    // --width-scale: replaces the grammar's `width_scale` (what drawn widths are multiplied by)
+    std::optional<double> width_scale;
+    bool size_given = false; // --size was given: an .svg takes it too
+    // --max-triangles: a run whose meshing is estimated to make more stops before meshing
+    double max_triangles = kDefaultMaxTriangles;
+    // Called with each stage (interpreting, meshing with its estimate, writing each file), for
+    // plant run's progress line; none: quiet.
+    std::function<void(const std::string&)> progress;
 };
+
+// "front", "top", "side", "iso" or "auto"; none for anything else.
+std::optional<PngViewKind> parse_view(const std::string& text);
 
 // "x,y,z": three finite numbers separated by commas; none when the text is not that.
 std::optional<glm::dvec3> parse_point(const std::string& text);
@@ -58,7 +76,15 @@ struct OutputFormat {
     // the file's bytes; `target` names the file in messages only
     std::string (*bytes)(const OutputSources& from, const std::string& target);
     const char* doc; // one line for `plant run --help` and `plant help formats`
+    // A file written beside the output, its extension replacing the output's (an OBJ's .mtl), and
+    // its bytes; written and renamed with the other outputs. Null: none.
+    const char* sidecar_extension = nullptr;
+    std::string (*sidecar_bytes)(const OutputSources& from, const std::string& target) = nullptr;
 };
+
+// The path of `target`'s sidecar: its extension replaced by `extension` ("a/tree.obj" ->
+// "a/tree.mtl").
+std::string sidecar_path(const std::string& target, const std::string& extension);
 
 // The formats, in the order they are listed to users.
 std::span<const OutputFormat> output_formats();

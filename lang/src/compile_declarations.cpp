@@ -234,6 +234,10 @@ void Compiler::compile_settings(const ast::File& f) {
             if (s.key == Key::Seed && (!whole || *v < 0 || *v >= 9.0e18)) // the range start() accepts
                 diags_->error(s.value->span,
                               fmt::format("the seed must be a whole number from 0 to 9e18, found {}", *v));
+            if (s.key == Key::WidthScale && !(*v > 0 && *v <= 1e6))
+                diags_->error(
+                    s.value->span,
+                    fmt::format("width_scale must be a number above 0 and at most 1000000, found {}", *v));
         }
     }
     // ignore / consider

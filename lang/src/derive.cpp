@@ -128,6 +128,11 @@ void Derivation::start() {
     angle_ = setting(Key::Angle, 90);
     step_length_ = setting(Key::Step, 1);
     width_ = setting(Key::Width, 0.1); // a tenth of the default step: a slender branch
+    width_scale_ = setting(Key::WidthScale, 1);
+    if (!(width_scale_ > 0 && width_scale_ <= 1e6))
+        throw RuntimeError{
+            RuntimeErrorKind::Setting, where(Key::WidthScale),
+            fmt::format("width_scale must be a number above 0 and at most 1000000, found {}", width_scale_)};
     step_ = 0;
     stopped_ = false;
     group_ = -1;

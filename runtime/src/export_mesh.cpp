@@ -3,6 +3,7 @@
 #include "plant/export.hpp"
 
 #include "openmesh.hpp"
+#include "texture_image.hpp"
 
 #include <glm/glm.hpp>
 
@@ -40,6 +41,9 @@ class Flattener {
   public:
     explicit Flattener(Mesh& mesh) : mesh_(mesh) {}
 
+    // Per material, the colour PLY vertices carry (detail::flat_colors); empty: no colours.
+    std::vector<glm::vec3> colors;
+
     void add(const MeshPart& part, const glm::mat4& m, bool identity, const std::string& name) {
         const std::size_t nv = part.positions.size();
         check_mesh_part(part, "mesh export: " + name);
@@ -48,6 +52,13 @@ class Flattener {
         const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(m)));
         const bool mirrored = glm::determinant(glm::mat3(m)) < 0.0f; // keep the winding outward
 
+        color_.assign(nv, glm::vec3(Material{}.color));
+        if (!colors.empty()) // a vertex takes the colour of the last primitive that uses it
+            for (const Primitive& prim : part.primitives)
+                for (std::size_t t = prim.first;
+                     t < std::size_t(prim.first) + prim.count && t < part.indices.size(); ++t)
+                    if (part.indices[t] < nv)
+                        color_[part.indices[t]] = colors[prim.material < colors.size() ? prim.material : 0];
         std::vector<Mesh::VertexHandle> handle(nv);
         for (std::uint32_t i = 0; i < nv; ++i) handle[i] = new_vertex(part, m, normal_matrix, identity, i);
 
@@ -77,10 +88,16 @@ class Flattener {
         mesh_.set_normal(vh, Mesh::Normal(n.x, n.y, n.z));
         const glm::vec2 uv = part.uvs.empty() ? glm::vec2(0.0f) : part.uvs[i];
         mesh_.set_texcoord2D(vh, Mesh::TexCoord2D(uv.x, uv.y));
+        if (!colors.empty()) {
+            const glm::vec3 c = glm::clamp(color_[i], 0.0f, 1.0f) * 255.0f + 0.5f;
+            mesh_.set_color(vh, Mesh::Color(static_cast<unsigned char>(c.r), static_cast<unsigned char>(c.g),
+                                            static_cast<unsigned char>(c.b)));
+        }
         return vh;
     }
 
     Mesh& mesh_;
+    std::vector<glm::vec3> color_; // per vertex of the part being added
 };
 
 } // namespace
@@ -93,10 +110,12 @@ void write_mesh_stream(const Scene& given, MeshFileFormat format, const std::str
     quiet_openmesh();
     Scene flattened;
     const Scene& scene = exported_scene(given, flattened, "mesh export");
+    const bool ply = format == MeshFileFormat::Ply;
 
     Mesh mesh;
     mesh.request_vertex_normals();
     mesh.request_vertex_texcoords2D();
+    if (ply) mesh.request_vertex_colors();
     {
         std::size_t nv = scene.tubes.positions.size(), nf = scene.tubes.triangle_count();
         for (const Instance& inst : scene.instances) {
@@ -107,6 +126,7 @@ void write_mesh_stream(const Scene& given, MeshFileFormat format, const std::str
     }
 
     Flattener flat(mesh);
+    if (ply) flat.colors = detail::flat_colors(scene);
     flat.add(scene.tubes, glm::mat4(1.0f), true, "tubes");
     for (const Instance& inst : scene.instances) {
         const std::size_t k = inst.prototype;
@@ -119,6 +139,7 @@ void write_mesh_stream(const Scene& given, MeshFileFormat format, const std::str
     OpenMesh::IO::Options options(OpenMesh::IO::Options::VertexNormal);
     // OFF stays plain NOFF: few readers understand texture coordinates in OFF files.
     if (format != MeshFileFormat::Off) options += OpenMesh::IO::Options::VertexTexCoord;
+    if (ply) options += OpenMesh::IO::Options::VertexColor;
 
     if (!OpenMesh::IO::write_mesh(mesh, out, ext, options, 7))
         throw ExportError("cannot write " + quoted(path) + ": OpenMesh failed to write the " + ext.substr(1) +

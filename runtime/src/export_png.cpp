@@ -12,7 +12,10 @@
 #include "plant/export.hpp"
 #include "plant/raster.hpp"
 
+#include "png_camera.hpp"
 #include "texture_image.hpp"
+
+#include "plant/skeleton.hpp"
 
 #include <fmt/format.h>
 #include <glm/glm.hpp>
@@ -30,10 +33,9 @@
 namespace plant {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kAzimuthDeg = 40.0;   // camera swung this far from the front (+z) toward +x
-constexpr double kElevationDeg = 24.0; // and raised this far above the horizon
-constexpr double kMargin = 0.05;       // of the image size, on each side
+using detail::Camera;
+using detail::finite3;
+
 constexpr float kAmbient = 0.24f;
 constexpr float kKey = 0.66f;  // directional light from above, left of the viewer
 constexpr float kFill = 0.16f; // a weak headlight so faces turned from the key are not flat
@@ -46,152 +48,6 @@ constexpr std::int64_t kMaxSupersampledPixels = std::int64_t(4) << 20; // 2048 x
 // before the preview is given up: a few seconds of drawing. Shipped grammars stay far below.
 constexpr std::int64_t kMaxOverdraw = 400;
 constexpr int kLutSize = 4096;
-
-bool finite3(const glm::dvec3& v) {
-    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-
-struct Box {
-    glm::dvec3 lo{std::numeric_limits<double>::infinity()};
-    glm::dvec3 hi{-std::numeric_limits<double>::infinity()};
-    void add(const glm::dvec3& p) {
-        if (!finite3(p)) return;
-        lo = glm::min(lo, p);
-        hi = glm::max(hi, p);
-    }
-    bool valid() const { return lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z; }
-};
-
-Box part_box(const MeshPart& part) {
-    Box box;
-    for (const glm::vec3& p : part.positions) box.add(glm::dvec3(p));
-    return box;
-}
-
-// The scene's own bounds, unless they are unusable (non-finite, inverted, or a single point
-// while there is geometry, e.g. update_bounds() was not called): then bounds of the geometry,
-// instances through their prototypes' transformed boxes.
-Box framing_box(const Scene& scene) {
-    Box given;
-    given.lo = glm::dvec3(scene.bounds_min);
-    given.hi = glm::dvec3(scene.bounds_max);
-    if (finite3(given.lo) && finite3(given.hi) && given.valid() && given.lo != given.hi) return given;
-
-    Box box = part_box(scene.tubes);
-    std::vector<Box> protos;
-    protos.reserve(scene.prototypes.size());
-    for (const MeshPart& proto : scene.prototypes) protos.push_back(part_box(proto));
-    for (const Instance& inst : scene.instances) {
-        if (inst.prototype >= protos.size() || !protos[inst.prototype].valid()) continue;
-        const Box& pb = protos[inst.prototype];
-        const glm::dmat4 m(inst.transform);
-        for (int corner = 0; corner < 8; ++corner) {
-            glm::dvec3 p((corner & 1) ? pb.hi.x : pb.lo.x, (corner & 2) ? pb.hi.y : pb.lo.y,
-                         (corner & 4) ? pb.hi.z : pb.lo.z);
-            box.add(glm::dvec3(m * glm::dvec4(p, 1.0)));
-        }
-    }
-    if (box.valid()) return box;
-    if (finite3(given.lo) && finite3(given.hi) && given.valid()) return given;
-    Box origin;
-    origin.lo = origin.hi = glm::dvec3(0.0);
-    return origin;
-}
-
-// Orthographic camera in supersampled screen space: x right, y down, in samples; depth grows
-// toward the viewer.
-struct Camera {
-    glm::dvec3 center{0.0};
-    glm::dvec3 right{1, 0, 0}, up{0, 1, 0}, toward{0, 0, 1}; // toward = from the scene to the eye
-    glm::dvec3 light{0, 1, 0};                               // unit, toward the light
-    double scale = 1.0;                                      // samples per world unit
-    double cx = 0.0, cy = 0.0;                               // screen position of `center`
-    // A perspective camera (plant run --camera) sees from `eye` along -toward: a point at view
-    // coordinates (x, y, d) = (right, up, -toward) . (p - eye) lands at (cx + focal x / d,
-    // cy - focal y / d), with depth 1 / d; only d >= near is drawn.
-    bool perspective = false;
-    glm::dvec3 eye{0.0};
-    double focal = 1.0; // samples per unit of x / d
-    double near = 0.0;
-};
-
-void aim(Camera& cam, const glm::dvec3& toward) {
-    cam.toward = toward;
-    const glm::dvec3 forward = -cam.toward;
-    // looking straight up or down, -z is up on the image (the back of the scene at the top)
-    const glm::dvec3 up_hint = std::abs(forward.y) > 0.999 ? glm::dvec3(0, 0, -1) : glm::dvec3(0, 1, 0);
-    cam.right = glm::normalize(glm::cross(forward, up_hint));
-    cam.up = glm::cross(cam.right, forward);
-    cam.light = glm::normalize(0.55 * cam.toward + 0.75 * glm::dvec3(0, 1, 0) - 0.4 * cam.right);
-}
-
-Camera make_camera(const Scene& scene, int width, int height) {
-    Camera cam;
-    const double az = kAzimuthDeg * kPi / 180.0, el = kElevationDeg * kPi / 180.0;
-    aim(cam, glm::dvec3(std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az)));
-
-    const Box box = framing_box(scene);
-    cam.center = 0.5 * (box.lo + box.hi);
-    const glm::dvec3 half = 0.5 * (box.hi - box.lo);
-    // The projection of a box is symmetric about the projected center: its half-size along a
-    // screen axis a is sum |a_i| * half_i.
-    const double hw =
-        std::abs(cam.right.x) * half.x + std::abs(cam.right.y) * half.y + std::abs(cam.right.z) * half.z;
-    const double hh = std::abs(cam.up.x) * half.x + std::abs(cam.up.y) * half.y + std::abs(cam.up.z) * half.z;
-    const double avail_w = 0.5 * width * (1.0 - 2.0 * kMargin);
-    const double avail_h = 0.5 * height * (1.0 - 2.0 * kMargin);
-    double scale = std::numeric_limits<double>::infinity();
-    if (hw > 0.0) scale = std::min(scale, avail_w / hw);
-    if (hh > 0.0) scale = std::min(scale, avail_h / hh);
-    if (!std::isfinite(scale) || scale <= 0.0) scale = 1.0; // a point: nothing has any area
-    cam.scale = scale;
-    cam.cx = 0.5 * width;
-    cam.cy = 0.5 * height;
-    return cam;
-}
-
-// A perspective camera at view.eye looking at view.target (default: the centre of the scene's
-// bounds), its view angle the narrowest that shows every corner of the bounds in front of it,
-// kept between kMinViewDeg and kMaxViewDeg across the image's shorter side.
-Camera make_perspective_camera(const Scene& scene, int width, int height, const PngView& view) {
-    constexpr double kMinViewDeg = 10.0, kMaxViewDeg = 100.0, kFallbackViewDeg = 60.0;
-    Camera cam;
-    cam.perspective = true;
-    cam.eye = view.eye;
-    const Box box = framing_box(scene);
-    const glm::dvec3 target = view.target.value_or(0.5 * (box.lo + box.hi));
-    glm::dvec3 toward = cam.eye - target;
-    const double distance = glm::length(toward);
-    if (distance > 0.0 && std::isfinite(distance)) {
-        aim(cam, toward / distance);
-    } else { // the camera at the point it looks at: look the default 3/4 way
-        const double az = kAzimuthDeg * kPi / 180.0, el = kElevationDeg * kPi / 180.0;
-        aim(cam, glm::dvec3(std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az)));
-    }
-    const double size = glm::length(box.hi - box.lo);
-    cam.near = std::isfinite(size) && size > 0.0 ? 1e-4 * size : 1e-6;
-
-    double need_x = 0.0, need_y = 0.0; // the largest |x / d| and |y / d| of the corners in front
-    for (int corner = 0; corner < 8; ++corner) {
-        const glm::dvec3 p((corner & 1) ? box.hi.x : box.lo.x, (corner & 2) ? box.hi.y : box.lo.y,
-                           (corner & 4) ? box.hi.z : box.lo.z);
-        const glm::dvec3 v = p - cam.eye;
-        const double d = -glm::dot(v, cam.toward);
-        if (!(d > cam.near)) continue;
-        need_x = std::max(need_x, std::abs(glm::dot(v, cam.right)) / d);
-        need_y = std::max(need_y, std::abs(glm::dot(v, cam.up)) / d);
-    }
-    double focal = std::numeric_limits<double>::infinity();
-    if (need_x > 0.0) focal = std::min(focal, 0.5 * width * (1.0 - 2.0 * kMargin) / need_x);
-    if (need_y > 0.0) focal = std::min(focal, 0.5 * height * (1.0 - 2.0 * kMargin) / need_y);
-    const double half = 0.5 * std::min(width, height);
-    auto focal_for = [&](double view_deg) { return half / std::tan(0.5 * view_deg * kPi / 180.0); };
-    if (!std::isfinite(focal)) focal = focal_for(kFallbackViewDeg);
-    cam.focal = std::clamp(focal, focal_for(kMaxViewDeg), focal_for(kMinViewDeg));
-    cam.cx = 0.5 * width;
-    cam.cy = 0.5 * height;
-    return cam;
-}
 
 struct ScreenVertex {
     std::int32_t x = 0, y = 0;  // fixed point, 1/kSub sample
@@ -577,6 +433,26 @@ struct Renderer {
         }
     }
 
+    // Bands of the line mode, flat-shaded in their colours.
+    void draw_quads(const std::vector<detail::ScreenQuad>& quads) {
+        constexpr float kLineLight = 0.8f;
+        const float s = float(kLutSize - 1);
+        for (const detail::ScreenQuad& q : quads) {
+            const std::array<float, 3> color = {clamp01(q.color.r) * s, clamp01(q.color.g) * s,
+                                                clamp01(q.color.b) * s};
+            std::array<ShadedVertex, 4> v{};
+            for (std::size_t k = 0; k < 4; ++k)
+                v[k] = {std::int64_t(std::lround(std::clamp(q.corner[k].x, -kGuard, kGuard) * kSub)),
+                        std::int64_t(std::lround(std::clamp(q.corner[k].y, -kGuard, kGuard) * kSub)),
+                        float(q.corner[k].z), kLineLight};
+            fill_triangle(raster, v[0], v[1], v[2], color);
+            fill_triangle(raster, v[0], v[2], v[3], color);
+            if (raster.budget < 0)
+                throw ExportError(
+                    "the PNG preview is given up: its lines cover the image too many times over");
+        }
+    }
+
     void draw_part(const MeshPart& part, const glm::dmat4* model) {
         if (part.indices.empty() || part.positions.empty()) return;
         transform(part, model);
@@ -591,9 +467,29 @@ struct Renderer {
 } // namespace
 
 Image render_scene(const Scene& scene, int width, int height, const std::optional<PngView>& view) {
+    PngOptions options;
+    options.camera = view;
+    return render_scene(scene, width, height, options);
+}
+
+PngViewKind resolved_view(const Scene& scene, const PngOptions& options) {
+    return detail::view_of(scene, options);
+}
+
+std::optional<glm::dvec2> project_to_image(const Scene& scene, int width, int height,
+                                           const PngOptions& options, const glm::dvec3& p) {
+    // the same supersampling and camera as render_scene
+    const int ss = std::int64_t(width) * height <= kMaxSupersampledPixels ? 2 : 1;
+    const Camera cam = detail::png_camera(scene, width * ss, height * ss, options);
+    const auto s = detail::project(cam, p);
+    if (!s) return std::nullopt;
+    return glm::dvec2(s->x / ss, s->y / ss);
+}
+
+Image render_scene(const Scene& scene, int width, int height, const PngOptions& options) {
     // placed scenes are drawn flattened; an instance of a prototype the scene does not have is
     // skipped rather than failing, as befits a preview
-    if (scene.nested()) return render_scene(flatten(scene), width, height, view);
+    if (scene.nested()) return render_scene(flatten(scene), width, height, options);
     if (width <= 0 || height <= 0)
         throw ExportError("PNG size must be positive, got " + std::to_string(width) + "x" +
                           std::to_string(height));
@@ -617,8 +513,7 @@ Image render_scene(const Scene& scene, int width, int height, const std::optiona
     for (int i = 0; i < kLutSize; ++i) r.encode[i] = linear_to_srgb8(double(i) / (kLutSize - 1));
     r.budget = kMaxOverdraw * std::int64_t(samples);
 
-    const Camera cam = view ? make_perspective_camera(scene, r.width, r.height, *view)
-                            : make_camera(scene, r.width, r.height);
+    const Camera cam = detail::png_camera(scene, r.width, r.height, options);
     Renderer ren{scene,
                  r,
                  cam,
@@ -627,7 +522,17 @@ Image render_scene(const Scene& scene, int width, int height, const std::optiona
                  {},
                  {},
                  detail::flat_colors(scene)};
-    ren.draw_part(scene.tubes, nullptr);
+    // line mode (PngLines): bands of at least min_line_px under (or instead of) the tubes
+    bool tubes = true;
+    if (options.skeleton && options.lines != PngLines::Tubes) {
+        tubes = options.lines == PngLines::Auto &&
+                detail::widest_tube(*options.skeleton, cam, options.width_scale) >= kAutoLinePx * ss;
+        const double min_samples = std::clamp(options.min_line_px, 0.0, 1000.0) * ss;
+        // under tubes, bands only min_line_px wide: hidden inside every tube wider than that
+        ren.draw_quads(
+            detail::line_quads(*options.skeleton, cam, tubes ? 0.0 : options.width_scale, min_samples));
+    }
+    if (tubes) ren.draw_part(scene.tubes, nullptr);
     for (const Instance& inst : scene.instances) {
         if (inst.prototype >= scene.prototypes.size()) continue;
         const glm::dmat4 model(inst.transform);
@@ -687,7 +592,14 @@ void png_sink_write(void* context, void* data, int size) {
 
 std::string png_bytes(const Scene& scene, int width, int height, const std::string& path,
                       const std::optional<PngView>& view) {
-    const Image img = render_scene(scene, width, height, view);
+    PngOptions options;
+    options.camera = view;
+    return png_bytes(scene, width, height, path, options);
+}
+
+std::string png_bytes(const Scene& scene, int width, int height, const std::string& path,
+                      const PngOptions& options) {
+    const Image img = render_scene(scene, width, height, options);
     PngSink sink;
     const int ok = stbi_write_png_to_func(png_sink_write, &sink, img.width, img.height, 3, img.rgb.data(),
                                           img.width * 3);

@@ -156,7 +156,7 @@ std::string skeleton_json(const Skeleton& sk, const Scene* scene) {
     return out;
 }
 
-std::string skeleton_svg(const Skeleton& sk) {
+std::string skeleton_svg(const Skeleton& sk, const SvgOptions& options) {
     double lo_x = std::numeric_limits<double>::max(), lo_y = lo_x, hi_x = -lo_x, hi_y = -lo_x;
     for (const auto& a : sk.axes)
         for (const auto& p : a.points) {
@@ -169,11 +169,14 @@ std::string skeleton_svg(const Skeleton& sk) {
     double w = std::max(hi_x - lo_x, 1e-6), h = std::max(hi_y - lo_y, 1e-6);
     double margin = 0.05 * std::max(w, h);
     double stroke = 0.003 * std::max(w, h);
+    const int width = std::max(options.width, 1);
+    const int height =
+        options.height > 0 ? options.height : static_cast<int>(width * (h + 2 * margin) / (w + 2 * margin));
+    // the default preserveAspectRatio (xMidYMid meet) fits the view box inside, centred
     std::string out =
-        fmt::format("<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"{} {} {} {}\" width=\"800\" "
+        fmt::format("<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"{} {} {} {}\" width=\"{}\" "
                     "height=\"{}\">\n",
-                    lo_x - margin, -hi_y - margin, w + 2 * margin, h + 2 * margin,
-                    static_cast<int>(800 * (h + 2 * margin) / (w + 2 * margin)));
+                    lo_x - margin, -hi_y - margin, w + 2 * margin, h + 2 * margin, width, height);
     out += "<rect x=\"-1e9\" y=\"-1e9\" width=\"2e9\" height=\"2e9\" fill=\"white\"/>\n";
     for (const auto& a : sk.axes) {
         if (a.points.size() < 2) continue;

@@ -73,7 +73,7 @@ void rings_of(const TubePath& path, const MeshOptions& o, Scratch& s) {
     auto seg_len = [&](std::size_t k) { return glm::length(pts[k + 1]->position - pts[k]->position); };
     for (std::size_t k = 0; k <= m; ++k) {
         const SkeletonPoint& p = *pts[k];
-        double r = std::max(p.radius, 1e-6);
+        double r = std::max(p.radius * o.width_scale, 1e-6);
         if (k == 0 || k == m) {
             rings.push_back(Ring{p.position, k == 0 ? dir(0) : dir(m - 1), r, glm::dvec3(0), 1.0, p.color,
                                  0.0, p.texture});

@@ -68,13 +68,14 @@ inline constexpr std::array<Spelled<HookKind>, 4> kHooks = {{
 }};
 
 // The top-level settings `derive N;`, `angle A;` and so on.
-enum class SettingKey : std::uint8_t { Derive, Angle, Step, Width, Seed };
-inline constexpr std::array<Spelled<SettingKey>, 5> kSettings = {{
+enum class SettingKey : std::uint8_t { Derive, Angle, Step, Width, Seed, WidthScale };
+inline constexpr std::array<Spelled<SettingKey>, 6> kSettings = {{
     {SettingKey::Derive, "derive", "the number of steps"},
     {SettingKey::Angle, "angle", "the turtle's default turning angle, in degrees"},
     {SettingKey::Step, "step", "the turtle's default step length"},
     {SettingKey::Width, "width", "the turtle's initial line width"},
     {SettingKey::Seed, "seed", "the seed of the random numbers"},
+    {SettingKey::WidthScale, "width_scale", "what drawn widths are multiplied by (ABOP's !(w) in pixels)"},
 }};
 
 // The spelling of an enum value; the tables are in enum order.

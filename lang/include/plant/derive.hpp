@@ -109,6 +109,8 @@ class Derivation {
     double default_angle() const { return angle_; }
     double default_step() const { return step_length_; }
     double default_width() const { return width_; }
+    // The grammar's `width_scale`: what the mesher multiplies drawn widths by (1 when not set).
+    double width_scale() const { return width_scale_; }
     std::vector<double>& globals() { return globals_; }
     const std::vector<double>& globals() const { return globals_; }
     int active_group() const { return group_; }
@@ -143,7 +145,7 @@ class Derivation {
     bool stopped_ = false;
     bool started_ = false;
     std::uint64_t seed_ = 0;
-    double angle_ = 90, step_length_ = 1, width_ = 1;
+    double angle_ = 90, step_length_ = 1, width_ = 1, width_scale_ = 1;
     detail::EngineHandle engine_; // the rule plans, the identity counter, buffers kept between steps
 };
 

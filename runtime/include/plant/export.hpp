@@ -52,6 +52,37 @@ struct PngView {
     std::optional<glm::dvec3> target;
 };
 
+// The orthographic views of a PNG preview (plant run --view), each framed on the scene's bounds:
+//   Front: from +z looking along -z, y up, x to the right: a figure in the xy plane face-on.
+//   Top: from +y looking down, -z at the top of the image.  Side: from +x, y up.
+//   Iso: from the front right and above (azimuth 40, elevation 24 degrees).
+//   Auto: Front, Side or Top when the skeleton is flat (its extent along z, x or y at most a
+//   thousandth of its largest extent: a 2-D figure is drawn face-on), Iso otherwise.
+enum class PngViewKind : std::uint8_t { Auto, Front, Top, Side, Iso };
+
+// How branches are drawn (plant run --lines, --tubes):
+//   Tubes: the meshed tubes only.
+//   Lines: every skeleton segment as a flat band, its drawn width (Skeleton radius times
+//     width_scale, projected) but at least min_line_px pixels; no tubes. For skeletal figures.
+//   Auto: Lines when the widest tube would be under kAutoLinePx pixels across (every branch a
+//     hairline); otherwise tubes, with every segment also drawn min_line_px wide underneath so
+//     that branches thinner than a pixel stay visible (a tube wider than that hides its line).
+enum class PngLines : std::uint8_t { Auto, Tubes, Lines };
+inline constexpr double kAutoLinePx = 1.5;
+
+struct Skeleton;
+
+// Everything a preview may be asked for. Without a skeleton, the view Auto is chosen from the
+// scene's bounds and no lines are drawn.
+struct PngOptions {
+    PngViewKind view = PngViewKind::Iso;
+    std::optional<PngView> camera; // a perspective camera, instead of `view`
+    const Skeleton* skeleton = nullptr;
+    PngLines lines = PngLines::Tubes;
+    double min_line_px = 1.0; // in output pixels
+    double width_scale = 1.0; // what the tubes were meshed with (MeshOptions::width_scale)
+};
+
 // A PNG preview: software rasterizer with a z-buffer and Lambert shading, white background;
 // without a view, an orthographic 3/4 view framed on the scene's bounding box.
 void write_png(const Scene& scene, const std::string& path, int width, int height,
@@ -59,11 +90,24 @@ void write_png(const Scene& scene, const std::string& path, int width, int heigh
 // The bytes write_png writes; `path` names the file in messages only.
 std::string png_bytes(const Scene& scene, int width, int height, const std::string& path,
                       const std::optional<PngView>& view = std::nullopt);
+std::string png_bytes(const Scene& scene, int width, int height, const std::string& path,
+                      const PngOptions& options);
 
-// The mesh files OpenMesh writes for us.
+// Wavefront OBJ with its colours: `mtllib MTL_NAME`, then one object (`o` and `g` of one name) per
+// organ kind: `branches` for the tubes, then each prototype by its name (`leaf`, `petal`, ...)
+// with every placement of it, and `usemtl m<i>` before the triangles of material i. Positions,
+// texture coordinates and normals per vertex, in world space (placed scenes drawn out).
+std::string obj_file_bytes(const Scene& scene, const std::string& path, const std::string& mtl_name);
+// The .mtl file the OBJ names: `newmtl m<i>` with `Kd` the colour the PNG preview draws material i
+// in (a texture's average colour), linear RGB.
+std::string mtl_file_bytes(const Scene& scene);
+
+// The mesh files OpenMesh writes for us: plain, without materials (plant run writes .obj with
+// obj_file_bytes and mtl_file_bytes instead).
 enum class MeshFileFormat : std::uint8_t { Obj, Ply, Off };
 // Everything flattened into one triangle mesh with vertex normals (and texture coordinates, but
-// for OFF), written through OpenMesh in `format`; the path's extension is not read.
+// for OFF; vertex colours for PLY), written through OpenMesh in `format`; the path's extension
+// is not read.
 void write_mesh_file(const Scene& scene, const std::string& path, MeshFileFormat format);
 // The bytes write_mesh_file writes; `path` names the file in messages only.
 std::string mesh_file_bytes(const Scene& scene, MeshFileFormat format, const std::string& path);

@@ -12,6 +12,7 @@ namespace plant {
 
 struct MeshOptions {
     int sides = 8;                // vertices per ring
+    double width_scale = 1.0;     // drawn radii are the skeleton's times this (`width_scale`)
     double sharp_bend_deg = 45.0; // past this a joint is rounded with extra rings
     double tip_taper = 0.35;      // radius of the last ring, as a fraction of the axis radius there
     bool continue_axes = true;    // an axis's tube goes on into a child axis (see tube_paths)

@@ -25,5 +25,13 @@ struct Image {
 // image is too large (more than 64 million pixels).
 Image render_scene(const Scene& scene, int width, int height,
                    const std::optional<PngView>& view = std::nullopt);
+Image render_scene(const Scene& scene, int width, int height, const PngOptions& options);
+
+// The view `options` resolve to (PngViewKind::Auto made definite; Iso under a camera).
+PngViewKind resolved_view(const Scene& scene, const PngOptions& options);
+// Where the point `p` lands in the image render_scene draws: pixel coordinates (x right, y down,
+// the centre of the top-left pixel at 0.5, 0.5); none when it is behind a perspective camera.
+std::optional<glm::dvec2> project_to_image(const Scene& scene, int width, int height,
+                                           const PngOptions& options, const glm::dvec3& p);
 
 } // namespace plant

@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# plant test itself (docs/testing.md): the worked example project, --bless listing the files
+# it writes with a short diff, libraries in subfolders left out, and how `# expect error:`
+# matches a message given without its position or suggestion, or by `contains:`.
+set -u
+plant=$(realpath "${1:?usage: plant_test.sh PLANT}")
+src=$(cd "$(dirname "$0")/../.." && pwd)
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+pass=0
+fail=0
+ok() { pass=$((pass + 1)); }
+bad() { fail=$((fail + 1)); echo "FAIL $*"; }
+contains() { if grep -qF -- "$3" "$2"; then ok; else bad "$1: '$3' not in output"; sed 's/^/  /' "$2" | head -8; fi; }
+lacks() { if ! grep -qF -- "$3" "$2"; then ok; else bad "$1: '$3' in output"; fi; }
+
+cp -r "$src/examples/testing" "$tmp/project"
+cd "$tmp/project" || exit 1
+"$plant" test . -v >"$tmp/out" 2>&1
+if [ $? -eq 0 ]; then ok; else bad "the example project fails"; cat "$tmp/out"; fi
+contains "the library is named as one" "$tmp/out" "library ./lib/branching.plant (imported, not a test)"
+contains "all pass" "$tmp/out" "8 passed, 0 failed"
+
+# --bless: each file written, with a short diff; the library gets no sidecar
+sed -i 's/^param spread = 25;/param spread = 30;/' lib/branching.plant
+"$plant" test . >"$tmp/out" 2>&1
+if [ $? -eq 1 ]; then ok; else bad "a changed string passes"; fi
+"$plant" test --bless . >"$tmp/out" 2>&1
+contains "bless names the file" "$tmp/out" "wrote ./bush.txt"
+contains "the old line" "$tmp/out" "    1 - F[+(25)F[+(25)"
+contains "the new line" "$tmp/out" "    1 + F[+(30)F[+(30)"
+contains "the mesh summary too" "$tmp/out" "wrote ./bush.mesh.txt"
+contains "its changed line only" "$tmp/out" "    5 + bounds -2.2408 0.0000"
+lacks "its unchanged lines left out" "$tmp/out" "+ vertices"
+contains "bless counts files" "$tmp/out" "2 files written"
+lacks "no sidecars" "$tmp/out" "sidecar"
+if [ ! -e lib/branching.txt ]; then ok; else bad "--bless wrote a golden file for the library"; fi
+"$plant" test . >"$tmp/out" 2>&1
+if [ $? -eq 0 ]; then ok; else bad "after --bless the project fails"; cat "$tmp/out"; fi
+# named on the command line, a library is run (and fails: it has no axiom)
+"$plant" test lib/branching.plant >"$tmp/out" 2>&1
+if [ $? -eq 1 ]; then ok; else bad "a library named on the command line is not run"; fi
+
+# matching: a wrong message still fails, with or without the position
+mkdir "$tmp/m"
+cd "$tmp/m" || exit 1
+body='param spread = 25;\nmodule X;\naxiom: +(sprad) X;\n'
+t() { printf "# command: check\n# expect error%s\n$body" "$1" >"$2.plant"; }
+t ": unknown name 'sprad'; did you mean 'spread'?" no_position
+t ": unknown name 'sprad'" no_suggestion
+t ": 5:10: unknown name 'sprad'" no_suggestion_placed
+t " contains: 'sprad'" contains
+t ": unknown name 'spread'" wrong_name
+t ": 5:11: unknown name 'sprad'" wrong_column
+t ": unknown name" cut_mid_message
+t " contains: 'sprod'" wrong_contains
+"$plant" test . -v >"$tmp/out" 2>&1
+for f in no_position no_suggestion no_suggestion_placed contains; do contains "$f matches" "$tmp/out" "ok ./$f.plant"; done
+for f in wrong_name wrong_column cut_mid_message wrong_contains; do contains "$f fails" "$tmp/out" "FAIL ./$f.plant"; done
+contains "a contains expectation is shown as one" "$tmp/out" "expected: containing: 'sprod'"
+
+echo "plant_test: $pass passed, $fail failed"
+[ "$fail" -eq 0 ]
