@@ -282,7 +282,7 @@ void setup_run(CLI::App& app, int& exit_code) {
         ->type_name("SIZE");
     cmd->add_option("--max-triangles", c->max_triangles,
                     "Stop before meshing when the mesh is estimated to have more triangles than this "
-                    "(default 50 million, about 6 GB while meshing and a 1.5 GB .glb)")
+                    "(default 20 million, about 3 GB while meshing and a 600 MB .glb)")
         ->check(CLI::Range(1.0, 1e12))
         ->type_name("N");
     auto* nodes = cmd->add_flag("--no-gpu-instancing", c->no_gpu_instancing,

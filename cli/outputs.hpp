@@ -15,7 +15,7 @@
 
 namespace plant::cli {
 
-inline constexpr double kDefaultMaxTriangles = 50e6;
+inline constexpr double kDefaultMaxTriangles = 20e6;
 
 struct OutputOptions {
     int sides = 8;
