@@ -87,7 +87,8 @@ std::string hint(const std::string& text, std::size_t byte, const std::string& m
         return "; there is no power operator: write pow(x, 0.5)";
     if (c == '\'') return "; cpfg's ' (next colour) is written ;(c) here, with the colour index, as in ;(2)";
     if ((c == '{' || c == '.') && message.find("after production") != std::string::npos)
-        return "; cpfg's { . } polygons are written surface leaf = polygon(...); and drawn with ~leaf";
+        return "; cpfg's { . } polygons are written surface leaf = polygon(...); and drawn with ~leaf (a "
+               "production has either '-> successor;' or a '{ }' body, not both)";
     if (c == ',' && message.find("after production") != std::string::npos)
         return "; L-Py's ',' (previous colour) is written ;(c) here, with the colour index";
     return {};

@@ -227,6 +227,12 @@ class Lowering {
                 fmt::format("this '[' is never closed in the {}; add the ']' that ends its branch", what));
     }
 
+    ast::ModuleList checked_list(const Node& n, const char* what) {
+        ast::ModuleList list = module_list(n);
+        check_brackets(list, what);
+        return list;
+    }
+
     std::vector<ast::Stmt> block(const Node& n) {
         std::vector<ast::Stmt> out;
         for (const auto& c : n.children) out.push_back(stmt(*c));
@@ -520,8 +526,7 @@ class Lowering {
         } else if (n.is_type<g::axiom_item>()) {
             ast::Axiom a;
             a.span = span(n);
-            a.successor = module_list(*n.children.at(0));
-            check_brackets(a.successor, "axiom");
+            a.successor = checked_list(*n.children.at(0), "axiom");
             f.axioms.push_back(std::move(a));
         } else if (n.is_type<g::symbol_set_item>()) {
             ast::SymbolSet s;
