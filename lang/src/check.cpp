@@ -4,10 +4,13 @@
 // is compiled, letter runs read as separate letters that mean nothing, productions that can
 // never apply and rule groups never selected.
 #include "compiler_internal.hpp"
+#include "habits.hpp"
 
 #include <fmt/format.h>
 
+#include <cctype>
 #include <set>
+#include <string_view>
 
 namespace plant {
 
@@ -15,6 +18,13 @@ namespace plant {
 void Compiler::check_defines_used() {
     for (const auto& [name, d] : defines_) {
         if (!defines_used_.count(name)) {
+            if (auto c = consts_.find(name); c != consts_.end()) {
+                diags_->error(c->second.span,
+                              fmt::format("-D {}: '{}' is a const, which -D cannot set; declare it as "
+                                          "'param {} = ...;' to set it from the command line",
+                                          name, name, name));
+                continue;
+            }
             std::vector<std::string> params;
             for (const auto& g : P_.globals)
                 if (g.kind == GlobalKind::Param) params.push_back(g.name);
@@ -123,6 +133,31 @@ void Compiler::check_shadowed(const ast::Production& p, const Production& cp, co
     }
 }
 
+namespace {
+
+// `F leaf F` with leaf undeclared reads l e a f, and the 'f' moves the turtle: a word that looks
+// like a name and splits into letters of which some mean something and some nothing is named.
+void warn_name_split(const Program& P_, Diagnostics* diags_, const RawRun& run,
+                     const std::vector<bool>& has_rule, std::set<std::string>& words) {
+    if (run.letters.size() != run.text.size() || !habits::looks_like_a_name(run.text)) return;
+    std::vector<std::string> meaning, idle;
+    for (const auto& l : run.letters) {
+        auto id = P_.symbols.find(l);
+        bool means = id && (has_rule[*id] || P_.symbols[*id].turtle || P_.symbols[*id].declared);
+        (means ? meaning : idle).push_back(l);
+    }
+    if (idle.empty() || !words.insert(run.text).second) return;
+    std::string list;
+    for (const auto& l : meaning) list += (list.empty() ? "'" : ", '") + l + "'";
+    diags_->warning(run.span,
+                    fmt::format("'{}' is not a declared module and is read as {} separate letters, of "
+                                "which {} {} a rule or a turtle meaning; declare it with 'module {};'",
+                                run.text, run.letters.size(), list, meaning.size() == 1 ? "has" : "have",
+                                run.text));
+}
+
+} // namespace
+
 void Compiler::check_raw_runs() {
     std::vector<bool> has_rule(P_.symbols.size(), false);
     auto mark = [&](const RuleSet& rs) {
@@ -137,6 +172,7 @@ void Compiler::check_raw_runs() {
     for (const auto& s : P_.symbols.all())
         if (s.declared && s.arity >= 0) declared.push_back(s.name);
     std::set<std::pair<std::uint32_t, std::uint32_t>> reported;
+    std::set<std::string> words; // name-like words already warned about, once each
     for (const auto& run : raw_runs_) {
         bool meaningful = false;
         for (const auto& l : run.letters) {
@@ -144,7 +180,11 @@ void Compiler::check_raw_runs() {
             if (id && (has_rule[*id] || P_.symbols[*id].turtle || P_.symbols[*id].declared))
                 meaningful = true;
         }
-        if (meaningful || !reported.insert({run.span.file, run.span.begin}).second) continue;
+        if (meaningful) {
+            warn_name_split(P_, diags_, run, has_rule, words);
+            continue;
+        }
+        if (!reported.insert({run.span.file, run.span.begin}).second) continue;
         std::string near = nearest_name(run.text, declared);
         diags_->warning(
             run.span,
@@ -161,12 +201,15 @@ void Compiler::check_raw_runs() {
 void Compiler::check_never_applying() {
     auto check = [&](const RuleSet& rs) {
         for (const auto& p : rs.productions) {
-            SymbolId s = p.strict[0].sym;
-            if (!produced_.count(s)) {
+            // every module of the predecessor must be produced by something (the first that is
+            // not is named)
+            for (const auto& m : p.strict) {
+                if (produced_.count(m.sym)) continue;
                 diags_->warning(p.span,
                                 fmt::format("this production can never apply: neither the axiom nor any "
                                             "successor produces '{}'",
-                                            P_.symbols[s].name));
+                                            P_.symbols[m.sym].name));
+                break;
             }
         }
     };
@@ -174,6 +217,16 @@ void Compiler::check_never_applying() {
     for (const auto& g : P_.groups) check(g);
     check(P_.decompose);
     check(P_.interpret);
+    // rules with no `derive N;` derive 0 steps unless the command line says how many
+    // (only for rules of the main file: the REPL's session imports the grammar and steps itself)
+    if (P_.setting(ast::SettingKey::Derive).empty() && !P_.rules.productions.empty() &&
+        P_.rules.productions[0].span.file == current_file_ && sm_.file(current_file_).name() != "<session>")
+        // a note, not a warning: grammars meant for `-n` (and their tests) stay warning-free
+        diags_->add({Severity::Note,
+                     P_.rules.productions[0].span,
+                     "the grammar has rules but no 'derive N;': it derives 0 steps unless given -n; "
+                     "add a line such as 'derive 5;'",
+                     {}});
     for (const auto& [name, span] : group_decls_) {
         if (!used_groups_.count(name))
             diags_->warning(

@@ -92,8 +92,17 @@ void Compiler::declare_values(const LoadedFile& lf) {
         P_.globals.push_back(std::move(g));
     }
     for (const auto& [name, ov] : lf.overrides) {
-        if (!value_spans_.count(name) || value_spans_[name].file != f.source)
-            diags_->error(ov.second, fmt::format("the imported file has no param '{}'", name));
+        if (!value_spans_.count(name) || value_spans_[name].file != f.source) {
+            std::vector<std::string> names; // the file's own values, for "did you mean"
+            for (const auto& v : f.values)
+                if (v.kind == ast::DeclKind::Param) names.push_back(v.name);
+            std::string near = nearest_name(name, names);
+            diags_->error(
+                ov.second,
+                near.empty()
+                    ? fmt::format("the imported file has no param '{}'", name)
+                    : fmt::format("the imported file has no param '{}'; did you mean '{}'?", name, near));
+        }
     }
 }
 

@@ -2,6 +2,7 @@
 // bodies), successors and letter runs split into modules, and the successor templates that let
 // the engine apply an arrow-form production without running its code module by module.
 #include "compiler_internal.hpp"
+#include "habits.hpp"
 #include "plant/vm.hpp"
 
 #include <fmt/format.h>
@@ -10,6 +11,27 @@
 #include <cmath>
 
 namespace plant {
+
+namespace {
+
+// ?P, ?H, ?U and ?L are filled with three numbers (cpfg's two-slot 2-D form is not read)
+std::string query_arity_message(const std::string& name, std::size_t given) {
+    return fmt::format("'{}' has three slots, filled with x, y, z: write {}(x, y, z), or {}(p) for one vec3; "
+                       "given {}",
+                       name, name, name, given);
+}
+
+// "leaf" as "l e a f"
+std::string spaced(const std::string& s) {
+    std::string out;
+    for (char c : s) {
+        if (!out.empty()) out += ' ';
+        out += c;
+    }
+    return out;
+}
+
+} // namespace
 
 void Compiler::compile_rules(const ast::File& f) {
     for (const auto& rb : f.rule_blocks) {
@@ -207,6 +229,8 @@ void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list) {
                 }
                 width += value_width(t);
             }
+            if (info.query && info.turtle_op != TurtleOp::Communicate && nargs > 0 && width != 3)
+                diags_->error(m.span, query_arity_message(info.name, static_cast<std::size_t>(width)));
             if (width > 255) {
                 diags_->error(m.span, "a module can carry at most 255 numbers");
                 width = 0;
@@ -227,6 +251,14 @@ std::vector<PatternModule> Compiler::compile_pattern(Ctx& c, const ast::ModuleLi
     std::vector<PatternModule> out;
     for (const auto& m : list) {
         auto parts = split_run(m);
+        if (role == PatternRole::Strict && parts.size() == m.name.size() && parts.size() > 1 &&
+            habits::looks_like_a_name(m.name))
+            // ABOP's `plant -> internode ...` typed with the words undeclared
+            diags_->warning(
+                m.name_span,
+                fmt::format("'{}' is not a declared module, so this predecessor is the {} modules "
+                            "{} in a row; declare it with 'module {};'",
+                            m.name, parts.size(), spaced(m.name), m.name));
         for (std::size_t k = 0; k < parts.size(); ++k) {
             PatternModule pm;
             pm.sym = module_symbol(parts[k].first);
@@ -248,6 +280,9 @@ std::vector<PatternModule> Compiler::compile_pattern(Ctx& c, const ast::ModuleLi
                                 info.instance >= 0 ? " and an optional scale" : "", nargs,
                                 where(info.decl_span)));
             }
+            if (info.query && info.turtle_op != TurtleOp::Communicate && nargs != 0 && nargs != 1 &&
+                nargs != 3)
+                diags_->error(m.span, query_arity_message(info.name, nargs));
             for (std::size_t i = 0; i < nargs; ++i) {
                 const ast::Expr& a = *m.args[i];
                 PatternArg pa;

@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <vector>
+
 namespace plant {
 
 void Diagnostics::add(Diagnostic d) {
@@ -26,12 +29,32 @@ const char* severity_name(Severity s) {
     return "error";
 }
 
-// Replaces control and non-ASCII bytes so that binary garbage in a source line cannot mangle
-// the terminal; tabs become a space so the caret lines up.
-std::string printable(std::string_view s) {
+std::size_t utf8_length(std::string_view s, std::size_t i);
+
+// Replaces control bytes and bytes that are not UTF-8 so that binary garbage in a source line
+// cannot mangle the terminal; tabs become a space so the caret lines up. A well-formed UTF-8
+// character (a '→' or 'ω' typed from a book) is kept. `cols` receives, for each byte, the
+// column it is shown at.
+std::string printable(std::string_view s, std::vector<std::size_t>& cols) {
     std::string out;
     out.reserve(s.size());
-    for (unsigned char c : s) out += (c == '\t') ? ' ' : (c < 0x20 || c >= 0x7f) ? '?' : static_cast<char>(c);
+    cols.clear();
+    std::size_t col = 0;
+    for (std::size_t i = 0; i < s.size();) {
+        const auto c = static_cast<unsigned char>(s[i]);
+        std::size_t n = c >= 0x80 ? utf8_length(s, i) : 0;
+        if (n > 0) {
+            out.append(s.substr(i, n));
+            cols.insert(cols.end(), n, col);
+            i += n;
+        } else {
+            out += (c == '\t') ? ' ' : (c < 0x20 || c >= 0x7f) ? '?' : static_cast<char>(c);
+            cols.push_back(col);
+            ++i;
+        }
+        ++col;
+    }
+    cols.push_back(col);
     return out;
 }
 
@@ -75,15 +98,19 @@ void render_one(std::string& out, Severity sev, Span span, const std::string& me
     LineCol lc = f.line_col(span.begin);
     out += fmt::format("{}:{}:{}: {}{}:{} {}\n", escape_controls(f.name()), lc.line, lc.col, on,
                        severity_name(sev), off, escape_controls(message, true));
-    std::string line = printable(f.line_text(lc.line));
-    if (line.size() > 200) line = line.substr(0, 200);
+    std::vector<std::size_t> cols;
+    std::string_view raw = f.line_text(lc.line);
+    if (raw.size() > 200) raw = raw.substr(0, 200);
+    const std::string line = printable(raw, cols);
+    const std::size_t width = cols.back(); // the line's length in shown columns
     out += fmt::format("{:5} | {}\n", lc.line, line);
-    std::size_t col = lc.col - 1;
+    auto shown = [&](std::size_t byte_col) { return cols[std::min(byte_col, cols.size() - 1)]; };
+    std::size_t col = shown(lc.col - 1);
     std::size_t len = 1;
     LineCol ec = f.line_col(span.end > span.begin ? span.end - 1 : span.begin);
-    if (ec.line == lc.line && span.end > span.begin) len = ec.col - lc.col + 1;
-    if (col > line.size()) col = line.size();
-    if (col + len > line.size() + 1) len = line.size() + 1 - col;
+    if (ec.line == lc.line && span.end > span.begin) len = shown(ec.col - 1) - col + 1;
+    if (col > width) col = width;
+    if (col + len > width + 1) len = width + 1 - col;
     if (len == 0) len = 1;
     out += fmt::format("      | {}{}^{}{}\n", std::string(col, ' '), on, std::string(len - 1, '~'), off);
 }

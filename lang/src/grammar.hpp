@@ -111,7 +111,14 @@ struct unary : sor<unary_expr, postfix> {};
 struct operand : seq<unary> {};
 struct mul_op : sor<one<'*'>, seq<one<'/'>, not_at<one<'*'>>>, one<'%'>> {};
 struct mul : seq<unary, star<pad<mul_op>, must<operand>>> {};
-struct add_op : sor<one<'+'>, seq<one<'-'>, not_at<one<'>'>>>> {};
+// ABOP's stochastic arrow -(0.33)-> : a '-' with a number in parentheses right before '->' or
+// '-->' is the arrow, never a '-' operator or module (docs/language.md, ABOP, cpfg and L-Py)
+struct long_arrow : string<'-', '-', '>'> {};
+struct stoch_prob : seq<ws, number, ws> {};
+struct stoch_arrow : seq<one<'-'>, one<'('>, stoch_prob, one<')'>, sor<long_arrow, string<'-', '>'>>, ws> {};
+// '-' is subtraction unless it starts an arrow: '->', '-->' (L-Py) or -(p)->
+struct minus_sign : seq<not_at<stoch_arrow>, not_at<long_arrow>, one<'-'>, not_at<one<'>'>>> {};
+struct add_op : sor<one<'+'>, minus_sign> {};
 struct add : seq<mul, star<pad<add_op>, must<mul>>> {};
 struct rel_op : sor<string<'<', '='>, string<'>', '='>, seq<one<'<'>, not_at<one<'<'>>>,
                     seq<one<'>'>, not_at<one<'>'>>>> {};
@@ -140,8 +147,8 @@ struct at_name : seq<one<'@'>, identifier> {};
 struct query_name : seq<one<'?'>, identifier> {};
 struct tilde_name : seq<one<'~'>, opt<identifier>> {};
 struct semi_sym : seq<one<';'>, at<one<'('>>> {}; // ';' is a module only with arguments
-struct punct_sym : sor<one<'+'>, seq<one<'-'>, not_at<one<'>'>>>, one<'&'>, one<'^'>, one<'\\'>,
-                       seq<one<'/'>, not_at<one<'*'>>>, one<'|'>, one<'$'>, one<'!'>, one<'%'>> {};
+struct punct_sym : sor<one<'+'>, minus_sign, one<'&'>, one<'^'>, one<'\\'>, seq<one<'/'>, not_at<one<'*'>>>,
+                       one<'|'>, one<'$'>, one<'!'>, one<'%'>> {};
 struct word : identifier {};
 struct module_name : sor<at_name, query_name, tilde_name, semi_sym, punct_sym, word> {};
 struct module_args : if_must<open_paren, arg_list, close_paren> {};
@@ -152,18 +159,24 @@ struct wildcard : pad<one<'*'>> {};
 // successor <- ('[' | ']' | module)*
 struct successor : star<sor<bracket_open, bracket_close, module_ref>> {};
 // pattern <- ('[' | ']' | '*' | module)+
-struct pattern : plus<sor<bracket_open, bracket_close, wildcard, module_ref>> {};
+struct pattern_elem : seq<not_at<stoch_arrow>, sor<bracket_open, bracket_close, wildcard, module_ref>> {};
+struct pattern : plus<pattern_elem> {};
 
 // production <- pattern (ctx_op pattern)* (':' expr)? ('->' successor (':' expr)? ';' | block)
 struct ctx_op : sor<string<'<', '<'>, one<'<'>, string<'>', '>'>, seq<one<'>'>, not_at<one<'='>>>> {};
 struct ctx_part : seq<pad<ctx_op>, must<pattern>> {};
-struct condition : if_must<colon, expr> {};
+// '->', L-Py's '-->' and the arrow character U+2192 (as ABOP prints it) are one arrow
+struct utf8_arrow : string<'\xe2', '\x86', '\x92'> {};
+struct arrow : pad<sor<long_arrow, string<'-', '>'>, utf8_arrow>> {};
+// cpfg's ': *' (no condition) before the arrow
+struct any_condition : seq<pad<one<'*'>>, at<sor<arrow, stoch_arrow, one<'{'>>>> {};
+struct condition : sor<seq<colon, any_condition>, if_must<colon, expr>> {};
 struct weight : if_must<colon, expr> {};
-struct arrow : pad<string<'-', '>'>> {};
 struct production_end : semi {};
 struct arrow_form : if_must<arrow, successor, opt<weight>, production_end> {};
+struct stoch_form : if_must<stoch_arrow, successor, production_end> {};
 struct block;
-struct production_tail : sor<arrow_form, block> {};
+struct production_tail : sor<arrow_form, stoch_form, block> {};
 struct production : seq<pattern, star<ctx_part>, opt<condition>, must<production_tail>> {};
 struct rules_body : if_must<open_brace, star<production>, close_brace> {};
 
@@ -216,7 +229,9 @@ struct instance_body : if_must<open_brace, star<item>, close_brace> {};
 struct instance_item : if_must<kw_instance, name, opt<param_list>, instance_body> {};
 struct setting_key : sor<kw_derive, kw_angle, kw_step, kw_width, kw_seed, kw_width_scale> {};
 struct setting_item : if_must<setting_key, expr, semi> {};
-struct axiom_item : if_must<kw_axiom, colon, successor, semi> {};
+// 'axiom:' or ABOP's 'ω:'
+struct omega : seq<string<'\xcf', '\x89'>, ws> {};
+struct axiom_item : if_must<sor<kw_axiom, omega>, colon, successor, semi> {};
 struct symbol_set_kind : sor<kw_ignore, kw_consider> {};
 struct symbol_set_item : if_must<symbol_set_kind, colon, opt<pattern>, semi> {};
 struct group_name : name {};

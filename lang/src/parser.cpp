@@ -4,6 +4,7 @@
 
 #include "grammar.hpp"
 #include "grammar_errors.hpp"
+#include "habits.hpp"
 
 #include <fmt/format.h>
 #include <tao/pegtl/contrib/parse_tree.hpp>
@@ -25,16 +26,16 @@ using selector = pt::selector<
         g::name_ref, g::paren_expr, g::member, g::unary_expr, g::unary_op, g::mul_op, g::add_op, g::rel_op,
         g::eq_op, g::and_op, g::or_op, g::module_ref, g::module_name, g::module_args, g::bracket_open,
         g::bracket_close, g::wildcard, g::successor, g::pattern, g::production, g::ctx_part, g::ctx_op,
-        g::condition, g::arrow_form, g::weight, g::block, g::let_stmt, g::assign_stmt, g::assign_op,
-        g::if_stmt, g::else_part, g::for_stmt, g::produce_stmt, g::nproduce_stmt, g::use_stmt, g::stop_stmt,
-        g::return_stmt, g::expr_stmt, g::param_item, g::const_item, g::var_item, g::module_item,
-        g::module_decl, g::param_list, g::param_decl, g::bound_clause, g::fn_item, g::fn_expr_body,
-        g::curve_item, g::surface_item, g::texture_item, g::shape_kind, g::env_item, g::key_args, g::key_arg,
-        g::instance_item, g::instance_body, g::setting_item, g::setting_key, g::axiom_item,
-        g::symbol_set_item, g::symbol_set_kind, g::rules_item, g::group_name, g::rules_body,
-        g::decompose_item, g::interpret_item, g::max_depth_clause, g::hook_item, g::hook_name, g::import_item,
-        g::import_target, g::with_clause, g::override_block, g::override_item, g::graph_item, g::match_clause,
-        g::graph_body, g::graph_param, g::edits_item, g::edits_target>,
+        g::condition, g::arrow_form, g::stoch_form, g::stoch_arrow, g::weight, g::block, g::let_stmt,
+        g::assign_stmt, g::assign_op, g::if_stmt, g::else_part, g::for_stmt, g::produce_stmt,
+        g::nproduce_stmt, g::use_stmt, g::stop_stmt, g::return_stmt, g::expr_stmt, g::param_item,
+        g::const_item, g::var_item, g::module_item, g::module_decl, g::param_list, g::param_decl,
+        g::bound_clause, g::fn_item, g::fn_expr_body, g::curve_item, g::surface_item, g::texture_item,
+        g::shape_kind, g::env_item, g::key_args, g::key_arg, g::instance_item, g::instance_body,
+        g::setting_item, g::setting_key, g::axiom_item, g::symbol_set_item, g::symbol_set_kind, g::rules_item,
+        g::group_name, g::rules_body, g::decompose_item, g::interpret_item, g::max_depth_clause, g::hook_item,
+        g::hook_name, g::import_item, g::import_target, g::with_clause, g::override_block, g::override_item,
+        g::graph_item, g::match_clause, g::graph_body, g::graph_param, g::edits_item, g::edits_target>,
     // (ternary_then and ternary_else are selected only so that their nesting is counted: the tree
     // builder calls the grammar's control for selected rules alone; each has one child, which
     // fold_one puts in its place)
@@ -202,6 +203,36 @@ class Lowering {
         return out;
     }
 
+    // A '[' without its ']' (or a ']' with no '[') in an axiom or an arrow-form successor is
+    // almost always a typo; the branch would run to the end of the string (docs/language.md).
+    void check_brackets(const ast::ModuleList& list, const char* what) {
+        std::vector<const ast::ModuleRef*> open;
+        for (const auto& m : list) {
+            if (m.name == "[") {
+                open.push_back(&m);
+            } else if (m.name == "]") {
+                if (open.empty()) {
+                    diags_.warning(m.span,
+                                   fmt::format("this ']' closes no '[' of the {}; remove it or add the "
+                                               "'[' that opens its branch",
+                                               what));
+                    return;
+                }
+                open.pop_back();
+            }
+        }
+        if (!open.empty())
+            diags_.warning(
+                open.back()->span,
+                fmt::format("this '[' is never closed in the {}; add the ']' that ends its branch", what));
+    }
+
+    ast::ModuleList checked_list(const Node& n, const char* what) {
+        ast::ModuleList list = module_list(n);
+        check_brackets(list, what);
+        return list;
+    }
+
     std::vector<ast::Stmt> block(const Node& n) {
         std::vector<ast::Stmt> out;
         for (const auto& c : n.children) out.push_back(stmt(*c));
@@ -266,6 +297,14 @@ class Lowering {
         std::vector<Part> parts;
         std::size_t i = 0;
         parts.push_back({"", n.children.at(i++).get()});
+        if (const auto& first = parts[0].pat->children;
+            first.size() > 1 && first.front()->begin().line != first.back()->begin().line)
+            // `A -> F ; G` then a new line: L-Py's colour ';' ended the production and G began the next
+            diags_.warning(
+                span(*first.front()),
+                fmt::format("this predecessor runs from line {} to line {}; if the ';' before it was "
+                            "meant as L-Py's colour step, write ;(c) with the colour index",
+                            first.front()->begin().line, first.back()->begin().line));
         while (i < n.children.size() && n.children[i]->is_type<g::ctx_part>()) {
             const Node& cp = *n.children[i++];
             parts.push_back({trimmed(*cp.children.at(0)), cp.children.at(1).get()});
@@ -321,12 +360,24 @@ class Lowering {
         for (; i < n.children.size(); ++i) {
             const Node& c = *n.children[i];
             if (c.is_type<g::condition>()) {
-                p.condition = expr(*c.children.at(0));
+                if (!c.children.empty()) p.condition = expr(*c.children.at(0)); // none for cpfg's ': *'
             } else if (c.is_type<g::arrow_form>()) {
+                // '->' is two bytes; '-->' and U+2192 three
+                const std::size_t len = c.string_view().substr(0, 2) == "->" ? 2 : 3;
                 p.arrow_span = {file_, static_cast<std::uint32_t>(c.begin().byte),
-                                static_cast<std::uint32_t>(c.begin().byte + 2)};
+                                static_cast<std::uint32_t>(c.begin().byte + len)};
                 p.successor = module_list(*c.children.at(0));
+                check_brackets(p.successor, "successor");
                 if (c.children.size() > 1) p.weight = expr(*c.children[1]->children.at(0));
+            } else if (c.is_type<g::stoch_form>()) {
+                // ABOP's -(p)-> : the probability is the production's weight
+                const Node& a = *c.children.at(0);
+                p.arrow_span = span(a);
+                p.arrow_span.end =
+                    p.arrow_span.begin + static_cast<std::uint32_t>(a.string_view().find('>') + 1);
+                p.weight = expr(*a.children.at(0));
+                p.successor = module_list(*c.children.at(1));
+                check_brackets(p.successor, "successor");
             } else if (c.is_type<g::block>()) {
                 p.body_form = true;
                 p.body = block(c);
@@ -475,7 +526,7 @@ class Lowering {
         } else if (n.is_type<g::axiom_item>()) {
             ast::Axiom a;
             a.span = span(n);
-            a.successor = module_list(*n.children.at(0));
+            a.successor = checked_list(*n.children.at(0), "axiom");
             f.axioms.push_back(std::move(a));
         } else if (n.is_type<g::symbol_set_item>()) {
             ast::SymbolSet s;
@@ -545,6 +596,13 @@ std::string describe_found(const std::string& text, std::size_t byte) {
         return fmt::format("'{}'", text.substr(byte, e - byte));
     }
     if (c == '\n' || c == '\r') return "end of line";
+    if (std::size_t n = habits::utf8_length(text, byte); n > 0) {
+        // a character typed from a book, shown as itself with its code point
+        std::uint32_t cp = c & (0xff >> (n + 1));
+        for (std::size_t k = 1; k < n; ++k)
+            cp = (cp << 6) | (static_cast<unsigned char>(text[byte + k]) & 0x3f);
+        return fmt::format("'{}' (U+{:04X})", text.substr(byte, n), cp);
+    }
     if (c < 0x20 || c >= 0x7f) return fmt::format("byte 0x{:02x}", c);
     return fmt::format("'{}'", static_cast<char>(c));
 }
@@ -562,7 +620,7 @@ void report(const g::GrammarError& e, const SourceFile& src, std::uint32_t file_
         }
         msg.replace(p, 4, at);
     }
-    msg += ", found " + describe_found(src.text(), e.byte);
+    msg += ", found " + describe_found(src.text(), e.byte) + habits::hint(src.text(), e.byte, msg);
     auto b = static_cast<std::uint32_t>(e.byte);
     diags.error({file_id, b, b + 1}, msg);
 }
@@ -600,6 +658,7 @@ std::unique_ptr<ast::File> parse_file(const SourceManager& sources, std::uint32_
     auto file = std::make_unique<ast::File>();
     file->source = file_id;
     Lowering lower(file_id, diags);
+    habits::check_cpfg_lines(src, file_id, diags);
     std::size_t offset = 0;
     std::size_t errors = 0;
     while (offset <= text.size()) {

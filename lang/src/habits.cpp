@@ -1,0 +1,138 @@
+// Habits from ABOP, cpfg and L-Py: hints appended to parse errors, and cpfg's preprocessor lines
+// reported instead of read as comments. Each decision is recorded in docs/language.md (coming
+// from ABOP, cpfg or L-Py).
+#include "habits.hpp"
+
+#include <fmt/format.h>
+
+#include <array>
+#include <cctype>
+#include <utility>
+
+namespace plant::habits {
+
+std::size_t utf8_length(std::string_view s, std::size_t i) {
+    const auto at = [&](std::size_t k) { return static_cast<unsigned char>(s[k]); };
+    const unsigned char c = at(i);
+    std::size_t n = 0;
+    unsigned char lo = 0x80, hi = 0xbf; // the second byte's range (RFC 3629)
+    if (c >= 0xc2 && c <= 0xdf) {
+        n = 2;
+    } else if (c >= 0xe0 && c <= 0xef) {
+        n = 3;
+        if (c == 0xe0) lo = 0xa0;
+        if (c == 0xed) hi = 0x9f;
+    } else if (c >= 0xf0 && c <= 0xf4) {
+        n = 4;
+        if (c == 0xf0) lo = 0x90;
+        if (c == 0xf4) hi = 0x8f;
+    } else {
+        return 0;
+    }
+    if (i + n > s.size() || at(i + 1) < lo || at(i + 1) > hi) return 0;
+    for (std::size_t k = 2; k < n; ++k)
+        if (at(i + k) < 0x80 || at(i + k) > 0xbf) return 0;
+    return n;
+}
+
+bool looks_like_a_name(std::string_view run) {
+    if (run.size() < 3) return false;
+    bool vowel = false, consonant = false;
+    for (std::size_t i = 0; i < run.size(); ++i) {
+        const auto c = static_cast<unsigned char>(run[i]);
+        if (!std::islower(c)) return false; // Xab, FbFb: capitals are modules of their own
+        (std::string_view("aeiouy").find(static_cast<char>(std::tolower(c))) != std::string_view::npos
+             ? vowel
+             : consonant) = true;
+    }
+    return vowel && consonant;
+}
+
+namespace {
+
+// Words that open a section in cpfg's or L-Py's files, and what plant writes instead.
+constexpr std::array<std::pair<std::string_view, std::string_view>, 14> kSectionWords{{
+    {"production", "productions go in a block: rules { A -> F A; }"},
+    {"productions", "productions go in a block: rules { A -> F A; }"},
+    {"Production", "productions go in a block: rules { A -> F A; }"},
+    {"Productions", "productions go in a block: rules { A -> F A; }"},
+    {"Axiom", "the axiom is written axiom: F A; (lower case, ':' and ';')"},
+    {"AXIOM", "the axiom is written axiom: F A; (lower case, ':' and ';')"},
+    {"decomposition", "decomposition rules go in a block: decompose { A -> B C; }"},
+    {"Decomposition", "decomposition rules go in a block: decompose { A -> B C; }"},
+    {"homomorphism", "interpretation rules go in a block: interpret { A -> F; }"},
+    {"interpretation", "interpretation rules go in a block: interpret { A -> F; }"},
+    {"derivation", "the number of steps is written derive 5;"},
+    {"Lsystem", "a plant file has no L-system header: write axiom:, rules { } and derive N; directly"},
+    {"lsystem", "a plant file has no L-system header: write axiom:, rules { } and derive N; directly"},
+    {"endlsystem", "a plant file has no L-system footer: leave it out"},
+}};
+
+std::string_view word_at(const std::string& text, std::size_t byte) {
+    std::size_t e = byte;
+    while (e < text.size() && (std::isalnum(static_cast<unsigned char>(text[e])) || text[e] == '_')) ++e;
+    return std::string_view(text).substr(byte, e - byte);
+}
+
+} // namespace
+
+std::string hint(const std::string& text, std::size_t byte, const std::string& message) {
+    if (byte >= text.size()) return {};
+    const char c = text[byte];
+    const std::string_view word = word_at(text, byte);
+    for (const auto& [w, fix] : kSectionWords)
+        if (word == w) return fmt::format("; {}", fix);
+    if (word == "maximum") return "; the depth bound is written decompose max_depth 8 { ... }";
+    if (c == '^' || (c == '*' && byte > 0 && text[byte - 1] == '*'))
+        return "; there is no power operator: write pow(x, 0.5)";
+    if (c == '\'') return "; cpfg's ' (next colour) is written ;(c) here, with the colour index, as in ;(2)";
+    if ((c == '{' || c == '.') && message.find("after production") != std::string::npos)
+        return "; cpfg's { . } polygons are written surface leaf = polygon(...); and drawn with ~leaf (a "
+               "production has either '-> successor;' or a '{ }' body, not both)";
+    if (c == ',' && message.find("after production") != std::string::npos)
+        return "; L-Py's ',' (previous colour) is written ;(c) here, with the colour index";
+    return {};
+}
+
+void check_cpfg_lines(const SourceFile& src, std::uint32_t file_id, Diagnostics& diags) {
+    const std::string& text = src.text();
+    std::size_t b = 0;
+    while (b < text.size()) {
+        std::size_t nl = text.find('\n', b);
+        std::size_t e = nl == std::string::npos ? text.size() : nl;
+        std::string_view line = std::string_view(text).substr(b, e - b);
+        while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.remove_suffix(1);
+        auto after = [&](std::string_view directive) {
+            std::string_view rest = line.substr(directive.size());
+            while (!rest.empty() && (rest.front() == ' ' || rest.front() == '\t')) rest.remove_prefix(1);
+            return std::string(rest.substr(0, 80));
+        };
+        auto at = [&](std::size_t len) {
+            return Span{file_id, static_cast<std::uint32_t>(b), static_cast<std::uint32_t>(b + len)};
+        };
+        if (line.rfind("#define ", 0) == 0) {
+            std::string rest = after("#define");
+            std::size_t sp = rest.find_first_of(" \t");
+            std::string fix = sp == std::string::npos
+                                  ? fmt::format("const {} = 1;", rest)
+                                  : fmt::format("const {} = {};", rest.substr(0, sp),
+                                                rest.substr(rest.find_first_not_of(" \t", sp)));
+            diags.error(at(7), fmt::format("cpfg's #define is a comment in plant ('#' starts a comment); "
+                                           "write {}",
+                                           fix));
+        } else if (line.rfind("#ignore:", 0) == 0 || line.rfind("#consider:", 0) == 0) {
+            const bool ignore = line[1] == 'i';
+            const std::string_view kw = ignore ? "ignore:" : "consider:";
+            diags.error(at(kw.size() + 1),
+                        fmt::format("cpfg's #{} is a comment in plant ('#' starts a comment); write {} {};",
+                                    kw, kw, after(line.substr(0, kw.size() + 1))));
+        } else if (line.rfind("#include ", 0) == 0) {
+            diags.error(at(8), fmt::format("cpfg's #include is a comment in plant; write import \"{}\";",
+                                           after("#include")));
+        }
+        if (nl == std::string::npos) break;
+        b = nl + 1;
+    }
+}
+
+} // namespace plant::habits
