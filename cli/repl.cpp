@@ -155,6 +155,7 @@ int Session::load(const std::string& path) {
     edits_.clear();
     graph_lines_.clear();
     graph_undo_.clear();
+    default_edits_unreadable_ = false;
     if (!rebuild(0) || (read_default_edits() && !rebuild(0))) {
         std::tie(file_, file_text_, axiom_, extra_rules_, params_, seed_, uses_, edits_, graph_lines_) =
             saved;
@@ -398,6 +399,8 @@ void Session::evaluate(const std::string& expr) {
 
 bool Session::back_to(int k) {
     history_.resize(std::min(history_.size(), static_cast<std::size_t>(k) + 1));
+    // a graph edit made after step k can no longer be the last thing done (the edit itself stays)
+    std::erase_if(graph_undo_, [&](const auto& u) { return u.first > history_.size(); });
     // what was chosen or done after step k belongs to the steps undone
     std::erase_if(uses_, [&](const auto& u) { return u.first > k; });
     std::size_t before = edits_.size();

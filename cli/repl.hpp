@@ -153,6 +153,7 @@ class Session {
     std::vector<std::string> graph_lines_;
     std::shared_ptr<const GraphEdits> graph_edits_;
     std::vector<std::pair<std::size_t, std::vector<std::string>>> graph_undo_;
+    bool default_edits_unreadable_ = false; // the grammar's edits file exists but could not be read
 
     std::unique_ptr<SourceManager> sources_;
     std::unique_ptr<Program> program_;

@@ -11,6 +11,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
 namespace plant::cli {
 
 const DecompositionGraph* Session::graph() {
@@ -56,7 +58,16 @@ bool Session::parse_graph_lines(const Program& program, SourceManager& sources) 
 bool Session::read_default_edits() {
     if (!program_ || program_->graph.edits_path.empty()) return false;
     std::string text;
-    if (read_input_file(program_->graph.edits_path, text) != ReadFailure::None) return false;
+    const ReadFailure f = read_input_file(program_->graph.edits_path, text);
+    if (f == ReadFailure::Missing) return false; // a default not written yet: no edits
+    if (f != ReadFailure::None) {
+        // as plant run refuses it; :save will not overwrite a file the session could not read
+        error() << fmt::format("plant: cannot read the edits file '{}': {}; the session has none of "
+                               "its edits, and :save needs a file name\n",
+                               escape_controls(program_->graph.edits_path), describe(f));
+        default_edits_unreadable_ = true;
+        return false;
+    }
     std::size_t b = 0;
     while (b < text.size()) {
         std::size_t e = text.find('\n', b);
@@ -90,6 +101,12 @@ bool Session::drop_orphaned_edits(int steps) {
         if (is_edit) ++edit;
     }
     if (dropped == 0) return true;
+    // lost for good, as in the paper: :back cannot bring a dropped edit back either
+    for (auto& [size, lines] : graph_undo_)
+        std::erase_if(lines, [&](const std::string& l) {
+            return std::find(kept.begin(), kept.end(), l) == kept.end() &&
+                   std::find(graph_lines_.begin(), graph_lines_.end(), l) != graph_lines_.end();
+        });
     graph_lines_ = std::move(kept);
     return rebuild(steps);
 }
@@ -134,15 +151,23 @@ void Session::graph_edit(const std::string& command, const std::string& rest) {
 }
 
 bool Session::undo_graph_edit() {
+    // an edit that single matching has dropped since leaves nothing to undo: :back undoes a step
+    while (!graph_undo_.empty() && graph_undo_.back().first == history_.size() &&
+           graph_undo_.back().second == graph_lines_)
+        graph_undo_.pop_back();
     if (graph_undo_.empty() || graph_undo_.back().first != history_.size()) return false;
     const std::vector<std::string> before = graph_lines_;
     graph_lines_ = graph_undo_.back().second;
     graph_undo_.pop_back();
+    // the line undone: the last one the session has now and did not have then
+    std::string undone;
+    for (auto it = before.rbegin(); it != before.rend() && undone.empty(); ++it)
+        if (std::find(graph_lines_.begin(), graph_lines_.end(), *it) == graph_lines_.end()) undone = *it;
     if (!rebuild(current().steps_done())) {
         graph_lines_ = before;
         return true;
     }
-    out_ << fmt::format("undid the edit '{}'\n", escape_controls(before.back()));
+    out_ << fmt::format("undid the edit '{}'\n", escape_controls(undone));
     return true;
 }
 
@@ -165,6 +190,12 @@ void Session::list_graph_edits() {
 void Session::save_edits(const std::string& rest) {
     if (!need_derivation()) return;
     const std::string path = rest.empty() && program_ ? program_->graph.edits_path : rest;
+    if (rest.empty() && default_edits_unreadable_) {
+        error() << fmt::format("':save' will not overwrite '{}', which the session could not read: "
+                               "give a file name, as in :save new.edits\n",
+                               escape_controls(path));
+        return;
+    }
     if (path.empty()) {
         error() << "':save' expects a file name (the grammar names no edits file)\n";
         return;
