@@ -98,7 +98,7 @@ int view_main(ViewCmd& c) {
         std::lock_guard lock(stopper_mutex);
         if (stopper) stopper();
     });
-    model.rebuild();
+    events.publish(model.rebuild());
     std::thread watcher([&] { watch_files(model, events, stop); });
     ViewServerOptions so;
     so.port = c.port;

@@ -46,6 +46,7 @@ struct ViewModel::Built {
     std::vector<std::pair<std::string, double>> params;
     std::uint64_t seed = 0;
     std::size_t instances = 0; // instance declarations (the page checks InstancedMesh against it)
+    std::uint64_t version = 0; // the version that made it; a failed rebuild after it keeps it
 };
 
 ViewModel::ViewModel(GrammarOptions options, OutputOptions output, std::string scratch_dir)
@@ -145,6 +146,7 @@ std::uint64_t ViewModel::rebuild() {
     watched_.insert(files.begin(), files.end());
     error_ = b->program ? std::string() : (messages.empty() ? "plant: the grammar failed" : messages);
     if (b->program) {
+        b->version = version_ + 1;
         good_ = std::move(b);
         derive_ms_ = ms;
     }
@@ -175,6 +177,7 @@ std::string ViewModel::state_json() const {
     j["error"] = error_.empty() ? nlohmann::json() : nlohmann::json(error_);
     j["three"] = kViewThreeVersion;
     if (good_) {
+        j["plant"] = good_->version;
         j["modules"] = good_->modules;
         nlohmann::json kept = nlohmann::json::array();
         for (const auto& s : good_->steps) kept.push_back(s != nullptr);
@@ -229,7 +232,7 @@ void ViewEvents::publish(std::uint64_t version) {
 std::uint64_t ViewEvents::wait(std::uint64_t seen, int ms) {
     std::unique_lock lock(mutex_);
     cv_.wait_for(lock, std::chrono::milliseconds(ms), [&] { return stopped_ || version_ > seen; });
-    return stopped_ ? seen : version_;
+    return stopped_ ? seen : std::max(seen, version_);
 }
 
 void ViewEvents::stop() {
