@@ -78,9 +78,12 @@ int view_main(ViewCmd& c) {
         std::cerr << fmt::format("plant: cannot read '{}': no such file\n", escape_controls(c.g.file));
         return kNoInput;
     }
-    char scratch[] = "/tmp/plant-view-XXXXXX";
-    if (!mkdtemp(scratch)) {
-        std::cerr << "plant: cannot create a scratch folder in /tmp\n";
+    // the scratch folder the GLB export writes into, under $TMPDIR (else /tmp)
+    const char* tmpdir = std::getenv("TMPDIR");
+    std::string scratch = std::string(tmpdir && *tmpdir ? tmpdir : "/tmp") + "/plant-view-XXXXXX";
+    if (!mkdtemp(scratch.data())) {
+        std::cerr << fmt::format("plant: cannot create a scratch folder in '{}'\n",
+                                 escape_controls(tmpdir && *tmpdir ? tmpdir : "/tmp"));
         return kCantCreate;
     }
     OutputOptions oo;
@@ -131,8 +134,8 @@ int view_main(ViewCmd& c) {
 void setup_view(CLI::App& app, int& exit_code) {
     auto c = std::make_shared<ViewCmd>();
     auto* cmd = app.add_subcommand(
-        "view", "Show the plant in a web browser, derived again on every save of the grammar or a file it "
-                "reads, with its params, seed and steps as controls (docs/view.md)");
+        "view", "Show the plant live in a web browser: redrawn on every save, with params, seed and steps "
+                "as controls (docs/view.md)");
     add_grammar_options(*cmd, c->g, true);
     cmd->add_option("--port", c->port, "The port on 127.0.0.1 to serve on (0: any free port)")
         ->check(CLI::Range(0, 65535))

@@ -90,10 +90,15 @@ static void derive_steps(ViewModel::Built& b, const DeriveOptions& options) {
         b.steps.push_back(std::move(copy));
     };
     keep(std::make_unique<Derivation>(*d));
-    while (d->step()) {
+    for (;;) {
+        // step() says false after the last step too: a step was made when the count moved
+        const int before = d->steps_done();
+        const bool more = d->step();
+        if (d->steps_done() == before) break;
         kept += d->string().size();
         keep(kept <= kKeptModules ? std::make_unique<Derivation>(*d) : nullptr);
         b.modules.back() = d->string().size();
+        if (!more) break;
     }
     d->finish();
     b.modules.back() = d->string().size();

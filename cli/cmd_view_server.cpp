@@ -123,6 +123,12 @@ void stream_events(ViewModel& model, ViewEvents& events, httplib::Response& res)
 int serve_view(ViewModel& model, ViewEvents& events, const ViewServerOptions& options,
                std::function<void(std::function<void()>)> set_stopper) {
     httplib::Server server;
+    // SO_REUSEADDR only: httplib's default adds SO_REUSEPORT, which would let a second server
+    // (another `plant view`, or any program of the same user) share the port and half the requests
+    server.set_socket_options([](int sock) {
+        int yes = 1;
+        setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+    });
     int port = options.port;
     if (port == 0) {
         port = server.bind_to_any_port("127.0.0.1");
@@ -130,6 +136,7 @@ int serve_view(ViewModel& model, ViewEvents& events, const ViewServerOptions& op
     } else if (!server.bind_to_port("127.0.0.1", port)) {
         return -1;
     }
+    server.set_payload_max_length(64 * 1024); // the controls' JSON is far smaller
     server.set_pre_routing_handler(
         [port](const httplib::Request& req, httplib::Response& res) { return screen(req, res, port); });
     server.Get("/api/state", [&](const httplib::Request&, httplib::Response& res) {
