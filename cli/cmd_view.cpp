@@ -11,6 +11,7 @@
 #include <iostream>
 #include <pthread.h>
 #include <spawn.h>
+#include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
 
@@ -32,8 +33,11 @@ struct ViewCmd {
 void open_browser(const std::string& url) {
     pid_t pid = 0;
     const char* argv[] = {"xdg-open", url.c_str(), nullptr};
-    if (posix_spawnp(&pid, "xdg-open", nullptr, nullptr, const_cast<char* const*>(argv), environ) != 0)
+    if (posix_spawnp(&pid, "xdg-open", nullptr, nullptr, const_cast<char* const*>(argv), environ) != 0) {
         std::cerr << "plant: could not run xdg-open; open " << url << " yourself\n";
+        return;
+    }
+    std::thread([pid] { waitpid(pid, nullptr, 0); }).detach(); // reaped, not left a zombie
 }
 
 // SIGINT and SIGTERM are taken by one thread (sigwait) that stops the server; every other thread
