@@ -57,6 +57,7 @@ const state = {
     return out;
   },
   screenBox: () => screenBox(),
+  names: () => { const out = []; if (plant) plant.traverse((o) => { if (o.name) out.push(o.name); }); return out; },
   showGrid: (on) => { if (grid) grid.visible = on; renderer.render(scene, camera); },
 };
 window.plantView = state;
@@ -266,6 +267,36 @@ $('step').addEventListener('input', () => {
   }
   if (server) show(Number(slider.value));
 });
+// Stepping and playing through the kept steps: a climber's growth along its wall, a plant's
+// development. Play shows each step once the one before is on screen, at most 5 a second.
+function goToStep(k) {
+  const slider = $('step');
+  const last = Number(slider.max);
+  slider.value = String(Math.max(0, Math.min(last, k)));
+  slider.dispatchEvent(new Event('input'));
+}
+let playing = null;
+function stopPlaying() {
+  if (playing) clearTimeout(playing);
+  playing = null;
+  $('play').textContent = 'play';
+}
+async function playNext() {
+  const slider = $('step');
+  if (Number(slider.value) >= Number(slider.max)) { stopPlaying(); return; }
+  goToStep(Number(slider.value) + 1);
+  await showing;
+  if (playing) playing = setTimeout(playNext, 200);
+}
+$('play').addEventListener('click', () => {
+  if (playing) { stopPlaying(); return; }
+  const slider = $('step');
+  if (Number(slider.value) >= Number(slider.max)) goToStep(0);
+  $('play').textContent = 'pause';
+  playing = setTimeout(playNext, 0);
+});
+$('step-back').addEventListener('click', () => { stopPlaying(); goToStep(Number($('step').value) - 1); });
+$('step-forward').addEventListener('click', () => { stopPlaying(); goToStep(Number($('step').value) + 1); });
 $('seed').addEventListener('change', () => {
   const s = $('seed').value.trim();
   if (!/^\d+$/.test(s)) { showError('the seed is a whole number'); return; }

@@ -183,6 +183,18 @@ async function roseChecks(browser) {
   await page.evaluate(() => { const e = document.getElementById('step'); e.value = '3'; e.dispatchEvent(new Event('input')); });
   await waitFor(page, () => window.plantView.step === 3);
   check(Date.now() - t0 < 1000, 'moving back to a kept step is quick', `${Date.now() - t0} ms`);
+  await page.click('#step-forward');
+  await waitFor(page, () => window.plantView.step === 4);
+  await page.click('#step-back');
+  await waitFor(page, () => window.plantView.step === 3);
+  check(true, 'the step buttons move one step on and back');
+  await page.click('#play');
+  await waitFor(page, () => window.plantView.step >= 6);
+  await page.click('#play'); // pause
+  const paused = await page.evaluate(() => window.plantView.step);
+  await new Promise((r) => setTimeout(r, 600));
+  const later = await page.evaluate(() => window.plantView.step);
+  check(later <= paused + 1 && later < state.modules.length - 1, 'play shows the steps in turn and pause stops', `paused at ${paused}, then ${later}`);
   check(errors.length === 0, 'no console error', errors.join(' | '));
   await page.close();
 }
@@ -191,6 +203,16 @@ async function roseChecks(browser) {
 function glbJson(bytes) {
   const length = bytes.readUInt32LE(12);
   return JSON.parse(bytes.subarray(20, 20 + length).toString('utf8'));
+}
+
+async function climberChecks(browser) {
+  const { url } = await startView(path.join(sourceDir, 'grammars/climbers/fig01_column.plant'));
+  const errors = [];
+  const page = await openPage(browser, url, errors);
+  const names = await page.evaluate(() => window.plantView.names());
+  check(names.some((n) => n.includes('obstacles')), 'a climber\'s obstacles are drawn', names.slice(0, 6).join(', '));
+  check(errors.length === 0, 'no console error (climber)', errors.join(' | '));
+  await page.close();
 }
 
 async function instanceChecks(browser) {
@@ -230,6 +252,7 @@ try {
   } else {
     await roseChecks(browser);
     await instanceChecks(browser);
+    await climberChecks(browser);
     const rose = await latency(browser, path.join(sourceDir, 'grammars/rose/fig12c.plant'), (t) => t.replace('N_S = 5', 'N_S = 4'), 4);
     check(rose.median_ms <= 300, 'the rose\'s save-to-pixels latency is at most 300 ms', `median ${rose.median_ms.toFixed(0)} ms`);
   }
