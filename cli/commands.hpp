@@ -70,6 +70,7 @@ void setup_check(CLI::App& app, int& exit_code);
 void setup_test(CLI::App& app, int& exit_code);
 void setup_run(CLI::App& app, int& exit_code);
 void setup_repl(CLI::App& app, int& exit_code);
+void setup_view(CLI::App& app, int& exit_code);
 void setup_help(CLI::App& app, int& exit_code);
 void setup_graph(CLI::App& app, int& exit_code);
 

@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
     setup_graph(app, exit_code);
     setup_test(app, exit_code);
     setup_repl(app, exit_code);
+    setup_view(app, exit_code);
     setup_help(app, exit_code);
     try {
         app.parse(argc, argv);

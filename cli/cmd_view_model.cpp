@@ -1,0 +1,251 @@
+// plant view's model: compile, derive keeping every step's state, export GLB on demand.
+#include "cmd_view.hpp"
+
+#include "plant/environment_phase.hpp"
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace plant::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Intermediate steps are kept (for the step slider) while their strings hold at most this many
+// modules in all; past it only the last step is kept.
+constexpr std::size_t kKeptModules = 20'000'000;
+
+std::string absolute(const std::string& path) {
+    std::error_code ec;
+    fs::path p = fs::weakly_canonical(fs::absolute(path, ec), ec);
+    return p.string();
+}
+
+std::string number_text(double v) {
+    return fmt::format("{}", v);
+}
+
+} // namespace
+
+// A compiled program and its derivation at every kept step (index: the step number; null when
+// that step was not kept).
+struct ViewModel::Built {
+    std::unique_ptr<SourceManager> sources;
+    std::unique_ptr<Program> program;
+    std::unique_ptr<TurtleEnvironmentPhase> phase;
+    std::vector<std::unique_ptr<Derivation>> steps;
+    std::vector<std::size_t> modules; // per step
+    std::map<int, std::string> glb;   // exported steps
+    std::vector<std::pair<std::string, double>> params;
+    std::uint64_t seed = 0;
+    std::size_t instances = 0; // instance declarations (the page checks InstancedMesh against it)
+    std::uint64_t version = 0; // the version that made it; a failed rebuild after it keeps it
+};
+
+ViewModel::ViewModel(GrammarOptions options, OutputOptions output, std::string scratch_dir)
+    : options_(std::move(options)), output_(output), scratch_(std::move(scratch_dir)) {
+    watched_.insert(absolute(options_.file));
+}
+
+ViewModel::~ViewModel() = default;
+
+std::uint64_t ViewModel::version() const {
+    std::lock_guard lock(mutex_);
+    return version_;
+}
+
+std::set<std::string> ViewModel::watched_files() const {
+    std::lock_guard lock(mutex_);
+    return watched_;
+}
+
+static void collect_files(const SourceManager& sources, const Program* program, std::set<std::string>& out) {
+    for (std::size_t k = 0; k < sources.size(); ++k) {
+        const std::string& name = sources.file(static_cast<std::uint32_t>(k)).name();
+        if (!name.empty() && name[0] != '<') out.insert(absolute(name));
+    }
+    if (!program) return;
+    for (const auto& s : program->surfaces)
+        if (s.kind == SurfaceKind::Load) out.insert(absolute(s.path));
+    for (const auto& t : program->textures) out.insert(absolute(t.path));
+    for (const auto& e : program->environments)
+        for (const auto& a : e.args)
+            if (a.type == ValueType::String && !a.text.empty()) out.insert(absolute(a.text));
+}
+
+// Derives `program`, keeping a copy of the derivation after every step while they fit.
+static void derive_steps(ViewModel::Built& b, const DeriveOptions& options) {
+    auto d = std::make_unique<Derivation>(*b.program, options);
+    d->start();
+    std::size_t kept = d->string().size();
+    auto keep = [&](std::unique_ptr<Derivation> copy) {
+        b.modules.push_back(copy ? copy->string().size() : 0);
+        b.steps.push_back(std::move(copy));
+    };
+    keep(std::make_unique<Derivation>(*d));
+    for (;;) {
+        // step() says false after the last step too: a step was made when the count moved
+        const int before = d->steps_done();
+        const bool more = d->step();
+        if (d->steps_done() == before) break;
+        kept += d->string().size();
+        keep(kept <= kKeptModules ? std::make_unique<Derivation>(*d) : nullptr);
+        b.modules.back() = d->string().size();
+        if (!more) break;
+    }
+    d->finish();
+    b.modules.back() = d->string().size();
+    b.steps.back() = std::move(d);
+}
+
+std::uint64_t ViewModel::rebuild() {
+    std::lock_guard build(build_mutex_);
+    GrammarOptions g = options_;
+    {
+        std::lock_guard lock(mutex_);
+        for (const auto& [name, value] : controls_.params)
+            g.defines.push_back(name + "=" + number_text(value));
+        if (controls_.seed) g.seed = controls_.seed;
+    }
+    g.color = false;
+    const auto t0 = std::chrono::steady_clock::now();
+    auto b = std::make_unique<Built>();
+    b->sources = std::make_unique<SourceManager>();
+    std::string messages;
+    int exit_code = kOk;
+    b->program = load_program(g, *b->sources, exit_code, &messages);
+    std::set<std::string> files;
+    collect_files(*b->sources, b->program.get(), files);
+    if (b->program) {
+        DeriveOptions opt = derive_options(g);
+        b->phase = std::make_unique<TurtleEnvironmentPhase>();
+        opt.environment_phase = b->phase.get();
+        opt.on_print = [](const std::string&) {};
+        try {
+            derive_steps(*b, opt);
+        } catch (const RuntimeError& e) {
+            messages += render(Diagnostic{Severity::Error, e.span, e.message, {}}, *b->sources, false);
+            b->program.reset();
+        } catch (const std::bad_alloc&) {
+            messages += "plant: out of memory (lower --max-modules or the derivation length)\n";
+            b->program.reset();
+        }
+    }
+    if (b->program) {
+        for (const Global& gl : b->program->globals)
+            if (gl.kind == GlobalKind::Param && gl.type == ValueType::Number)
+                b->params.emplace_back(gl.name, b->program->global_values[gl.slot]);
+        b->seed = b->steps.back()->seed();
+        b->instances = b->program->instances ? b->program->instances->size() : 0;
+    }
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    std::lock_guard lock(mutex_);
+    watched_.insert(files.begin(), files.end());
+    error_ = b->program ? std::string() : (messages.empty() ? "plant: the grammar failed" : messages);
+    if (b->program) {
+        b->version = version_ + 1;
+        good_ = std::move(b);
+        derive_ms_ = ms;
+    }
+    return ++version_;
+}
+
+std::string ViewModel::set_controls(const ViewControls& controls) {
+    {
+        std::lock_guard lock(mutex_);
+        for (const auto& [name, value] : controls.params) {
+            bool known = false;
+            if (good_)
+                for (const auto& p : good_->params) known = known || p.first == name;
+            if (!known) return fmt::format("'{}' is not a param of the grammar", name);
+            if (!std::isfinite(value)) return fmt::format("the value of '{}' is not a finite number", name);
+        }
+        controls_ = controls;
+    }
+    rebuild();
+    return {};
+}
+
+std::string ViewModel::state_json() const {
+    std::lock_guard lock(mutex_);
+    nlohmann::json j;
+    j["version"] = version_;
+    j["file"] = options_.file;
+    j["error"] = error_.empty() ? nlohmann::json() : nlohmann::json(error_);
+    j["three"] = kViewThreeVersion;
+    if (good_) {
+        j["plant"] = good_->version;
+        j["modules"] = good_->modules;
+        nlohmann::json kept = nlohmann::json::array();
+        for (const auto& s : good_->steps) kept.push_back(s != nullptr);
+        j["kept"] = kept;
+        j["seed"] = std::to_string(good_->seed);
+        nlohmann::json params = nlohmann::json::array();
+        for (const auto& [name, value] : good_->params) params.push_back({{"name", name}, {"value", value}});
+        j["params"] = params;
+        j["instances"] = good_->instances;
+        j["derive_ms"] = derive_ms_;
+    }
+    // the command line that grows what is shown
+    std::string cmd = "plant run " + options_.file;
+    for (const auto& d : options_.defines) cmd += " -D " + d;
+    for (const auto& [name, value] : controls_.params) cmd += " -D " + name + "=" + number_text(value);
+    if (controls_.seed)
+        cmd += fmt::format(" --seed {}", *controls_.seed);
+    else if (options_.seed)
+        cmd += fmt::format(" --seed {}", *options_.seed);
+    if (options_.steps) cmd += fmt::format(" -n {}", *options_.steps);
+    j["command"] = cmd;
+    return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+std::optional<std::string> ViewModel::glb(int step) {
+    std::lock_guard lock(mutex_);
+    if (!good_) return std::nullopt;
+    const int last = static_cast<int>(good_->steps.size()) - 1;
+    if (step < 0 || step > last) step = last;
+    if (auto it = good_->glb.find(step); it != good_->glb.end()) return it->second;
+    const Derivation* d = good_->steps[static_cast<std::size_t>(step)].get();
+    if (!d) return std::nullopt;
+    // the export `plant run -o x.glb` does, into the scratch folder, read back
+    const std::string path = scratch_ + "/model.glb";
+    write_outputs(*good_->program, *d, {path}, output_);
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream bytes;
+    bytes << in.rdbuf();
+    fs::remove(path);
+    if (good_->glb.size() > 64) good_->glb.clear(); // bounded: a few dozen steps exported at most
+    return good_->glb[step] = bytes.str();
+}
+
+void ViewEvents::publish(std::uint64_t version) {
+    {
+        std::lock_guard lock(mutex_);
+        version_ = std::max(version_, version);
+    }
+    cv_.notify_all();
+}
+
+std::uint64_t ViewEvents::wait(std::uint64_t seen, int ms) {
+    std::unique_lock lock(mutex_);
+    cv_.wait_for(lock, std::chrono::milliseconds(ms), [&] { return stopped_ || version_ > seen; });
+    return stopped_ ? seen : std::max(seen, version_);
+}
+
+void ViewEvents::stop() {
+    {
+        std::lock_guard lock(mutex_);
+        stopped_ = true;
+    }
+    cv_.notify_all();
+}
+
+} // namespace plant::cli

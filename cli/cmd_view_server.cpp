@@ -1,0 +1,160 @@
+// plant view's HTTP server (cpp-httplib): a fixed route table on 127.0.0.1. No part of a request
+// names a file: the page's files are built into the program and the model is made in memory.
+// Requests whose Host or Origin is not this loopback address and port are refused (a web page
+// elsewhere could otherwise reach the server through DNS rebinding); the page can change params
+// and the seed, which derives again, and nothing else.
+#include "cmd_view.hpp"
+
+#include <httplib.h>
+#include <nlohmann/json.hpp>
+
+#include <charconv>
+#include <cstring>
+
+namespace plant::cli {
+
+namespace {
+
+bool allowed_host(const std::string& host, int port) {
+    return host == "127.0.0.1:" + std::to_string(port) || host == "localhost:" + std::to_string(port);
+}
+
+bool allowed_origin(const httplib::Request& req, int port) {
+    if (!req.has_header("Origin")) return true; // same-origin GETs and tools send none
+    const std::string origin = req.get_header_value("Origin");
+    return origin.rfind("http://", 0) == 0 && allowed_host(origin.substr(7), port);
+}
+
+void refuse(httplib::Response& res, int status, const std::string& why) {
+    res.status = status;
+    res.set_content(why + "\n", "text/plain; charset=utf-8");
+}
+
+// The checks every request passes before any route sees it.
+httplib::Server::HandlerResponse screen(const httplib::Request& req, httplib::Response& res, int port) {
+    res.set_header("X-Content-Type-Options", "nosniff");
+    res.set_header("Cache-Control", "no-store");
+    if (!allowed_host(req.get_header_value("Host"), port) || !allowed_origin(req, port)) {
+        refuse(res, 403, "plant view answers only requests for 127.0.0.1:" + std::to_string(port));
+        return httplib::Server::HandlerResponse::Handled;
+    }
+    if (req.path.empty() || req.path[0] != '/' || req.path.find("..") != std::string::npos ||
+        req.target.find("..") != std::string::npos || req.path.find('\\') != std::string::npos ||
+        req.path.find("//") != std::string::npos) {
+        refuse(res, 400, "plant view serves only its own routes");
+        return httplib::Server::HandlerResponse::Handled;
+    }
+    return httplib::Server::HandlerResponse::Unhandled;
+}
+
+void serve_asset(const httplib::Request& req, httplib::Response& res) {
+    for (const ViewAsset* a = kViewAssets; a->route; ++a) {
+        if (req.path != a->route) continue;
+        res.set_content(a->begin, static_cast<std::size_t>(a->end - a->begin), a->mime);
+        res.set_header("Content-Security-Policy",
+                       "default-src 'self'; img-src 'self' blob: data:; connect-src 'self' blob: data:; "
+                       "style-src 'self' 'unsafe-inline'");
+        return;
+    }
+    refuse(res, 404, "no such page");
+}
+
+void serve_model(ViewModel& model, const httplib::Request& req, httplib::Response& res) {
+    int step = -1;
+    if (req.has_param("step")) {
+        const std::string s = req.get_param_value("step");
+        auto r = std::from_chars(s.data(), s.data() + s.size(), step);
+        if (r.ec != std::errc() || r.ptr != s.data() + s.size())
+            return refuse(res, 400, "step: a whole number");
+    }
+    try {
+        auto bytes = model.glb(step);
+        if (!bytes) return refuse(res, 404, "no plant (the grammar has an error) or that step was not kept");
+        res.set_content(std::move(*bytes), "model/gltf-binary");
+    } catch (const RuntimeError& e) {
+        refuse(res, 500, e.message);
+    } catch (const std::exception& e) {
+        refuse(res, 500, e.what());
+    }
+}
+
+// POST /api/controls {"params": {"name": number}, "seed": "digits" or null}
+void set_controls(ViewModel& model, ViewEvents& events, const httplib::Request& req, httplib::Response& res) {
+    ViewControls c;
+    try {
+        const auto j = nlohmann::json::parse(req.body);
+        if (j.contains("params"))
+            for (const auto& [name, value] : j.at("params").items()) c.params[name] = value.get<double>();
+        if (j.contains("seed") && !j.at("seed").is_null()) {
+            const std::string s = j.at("seed").get<std::string>();
+            std::uint64_t v = 0;
+            auto r = std::from_chars(s.data(), s.data() + s.size(), v);
+            if (s.empty() || r.ec != std::errc() || r.ptr != s.data() + s.size())
+                return refuse(res, 400, "the seed is a whole number from 0 to 2^64 - 1");
+            c.seed = v;
+        }
+    } catch (const std::exception&) {
+        return refuse(res, 400, "expected {\"params\": {\"name\": number}, \"seed\": \"digits\"}");
+    }
+    if (std::string why = model.set_controls(c); !why.empty()) return refuse(res, 400, why);
+    events.publish(model.version());
+    res.set_content(model.state_json(), "application/json");
+}
+
+// GET /api/events: Server-Sent Events, one `model` event (the state) per new version.
+void stream_events(ViewModel& model, ViewEvents& events, httplib::Response& res) {
+    auto seen = std::make_shared<std::uint64_t>(0);
+    res.set_chunked_content_provider(
+        "text/event-stream", [&model, &events, seen](std::size_t, httplib::DataSink& sink) {
+            if (events.stopped()) return false;
+            const std::uint64_t now = *seen == 0 ? model.version() : events.wait(*seen, 1000);
+            if (events.stopped()) return false;
+            std::string message = ": waiting\n\n"; // also finds out when the page has gone
+            if (now != *seen) {
+                *seen = now;
+                message = "event: model\ndata: " + model.state_json() + "\n\n";
+            }
+            return sink.write(message.data(), message.size());
+        });
+}
+
+} // namespace
+
+int serve_view(ViewModel& model, ViewEvents& events, const ViewServerOptions& options,
+               std::function<void(std::function<void()>)> set_stopper) {
+    httplib::Server server;
+    // SO_REUSEADDR only: httplib's default adds SO_REUSEPORT, which would let a second server
+    // (another `plant view`, or any program of the same user) share the port and half the requests
+    server.set_socket_options([](int sock) {
+        int yes = 1;
+        setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+    });
+    int port = options.port;
+    if (port == 0) {
+        port = server.bind_to_any_port("127.0.0.1");
+        if (port < 0) return -1;
+    } else if (!server.bind_to_port("127.0.0.1", port)) {
+        return -1;
+    }
+    server.set_payload_max_length(64 * 1024); // the controls' JSON is far smaller
+    server.set_pre_routing_handler(
+        [port](const httplib::Request& req, httplib::Response& res) { return screen(req, res, port); });
+    server.Get("/api/state", [&](const httplib::Request&, httplib::Response& res) {
+        res.set_content(model.state_json(), "application/json");
+    });
+    server.Get("/api/model.glb",
+               [&](const httplib::Request& req, httplib::Response& res) { serve_model(model, req, res); });
+    server.Get("/api/events",
+               [&](const httplib::Request&, httplib::Response& res) { stream_events(model, events, res); });
+    server.Post("/api/controls", [&](const httplib::Request& req, httplib::Response& res) {
+        set_controls(model, events, req, res);
+    });
+    server.Get(".*", [](const httplib::Request& req, httplib::Response& res) { serve_asset(req, res); });
+    set_stopper([&server] { server.stop(); });
+    if (options.on_listening) options.on_listening(port);
+    server.listen_after_bind();
+    set_stopper(nullptr);
+    return port;
+}
+
+} // namespace plant::cli

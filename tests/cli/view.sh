@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# plant view without a browser (docs/view.md): usage, the server's routes and refusals with curl,
+# a save seen through /api/state, Ctrl-C ending it cleanly, a port already taken.
+#   tests/cli/view.sh PLANT
+set -uo pipefail
+plant="$1"
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+tmp=$(mktemp -d)
+pids=()
+trap 'for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done; rm -rf "$tmp"' EXIT
+fail=0
+check() { # check NAME COND...
+    local name="$1"; shift
+    if "$@"; then echo "ok - $name"; else echo "not ok - $name"; fail=1; fi
+}
+
+"$plant" view --help > "$tmp/help" 2>&1
+check "--help lists --port and --open" grep -q -- "--open" "$tmp/help"
+"$plant" view "$tmp/missing.plant" --port 0 > /dev/null 2> "$tmp/err"; code=$?
+check "a missing grammar is exit 66" test "$code" = 66
+
+cp "$root/grammars/abop/fig1_24a.plant" "$tmp/g.plant"
+mkdir "$tmp/scratch"
+TMPDIR="$tmp/scratch" "$plant" view "$tmp/g.plant" --port 0 > "$tmp/out" 2>&1 &
+pid=$!; pids+=("$pid")
+for _ in $(seq 50); do grep -q "http://" "$tmp/out" && break; sleep 0.1; done
+url=$(grep -o 'http://127.0.0.1:[0-9]*/' "$tmp/out")
+port=${url#http://127.0.0.1:}; port=${port%/}
+check "prints the URL on 127.0.0.1" test -n "$url"
+status() { curl -s -o /dev/null -w '%{http_code}' "$@"; }
+check "serves the page" test "$(status "$url")" = 200
+check "the page loads its script" grep -q 'src="/viewer.js"' <(curl -s "$url")
+check "serves three.js" test "$(status "${url}three/three.module.js")" = 200
+check "serves the model as GLB" test "$(curl -s "${url}api/model.glb" | head -c 4)" = glTF
+check "a foreign Host is refused" test "$(status -H "Host: attacker.example:$port" "$url")" = 403
+check "a foreign Origin is refused" test "$(status -H "Origin: http://attacker.example" "${url}api/state")" = 403
+check "a path with .. is refused" test "$(status --path-as-is "${url}../../etc/passwd")" = 400
+check "an encoded .. is refused" test "$(status --path-as-is "${url}%2e%2e/%2e%2e/etc/passwd")" = 400
+check "a file system path is not served" test "$(status "${url}etc/passwd")" = 404
+check "only declared params may be set" test "$(status -X POST -d '{"params":{"nope":1}}' "${url}api/controls")" = 400
+check "a malformed request is refused" test "$(status -X POST -d 'run rm -rf /' "${url}api/controls")" = 400
+check "the seed must be digits" test "$(status -X POST -d '{"seed":"1;ls"}' "${url}api/controls")" = 400
+check "a huge request is refused" test "$(head -c 200000 /dev/zero | tr '\0' 'x' | curl -s -o /dev/null -w '%{http_code}' -X POST --data-binary @- "${url}api/controls")" = 413
+v0=$(curl -s "${url}api/state" | grep -o '"version":[0-9]*')
+m0=$(curl -s "${url}api/state" | grep -o '"modules":\[[0-9,]*\]')
+sed -i 's/derive 5;/derive 3;/; s/^derive .*/derive 3;/' "$tmp/g.plant"
+seen=""
+for _ in $(seq 40); do
+    m=$(curl -s "${url}api/state" | grep -o '"modules":\[[0-9,]*\]')
+    [ "$m" != "$m0" ] && { seen=1; break; }
+    sleep 0.05
+done
+check "a save derives again within 2 s ($v0; $m0 -> $m)" test -n "$seen"
+check "the seed set on the page derives again" test "$(status -X POST -d '{"params":{},"seed":"7"}' "${url}api/controls")" = 200
+check "the export's scratch folder is under TMPDIR" test "$(ls "$tmp/scratch" | wc -l)" = 1
+"$plant" view "$tmp/g.plant" --port "$port" > /dev/null 2> "$tmp/err2"; code=$?
+check "a port in use is exit 70 with advice" test "$code" = 70 -a -n "$(grep -- '--port 0' "$tmp/err2")"
+kill -INT "$pid"
+for _ in $(seq 40); do kill -0 "$pid" 2>/dev/null || break; sleep 0.05; done
+wait "$pid"; code=$?
+check "Ctrl-C stops it cleanly (exit 0)" test "$code" = 0
+check "and removes its scratch folder" test "$(ls "$tmp/scratch" | wc -l)" = 0
+exit $fail

@@ -1,0 +1,266 @@
+// Browser tests of `plant view` (docs/view.md): headless Debian chromium driven by puppeteer-core.
+//   node view.mjs PLANT SOURCE_DIR [--bench]
+// Each check prints "ok - ..." or "not ok - ..." and the run exits 1 when any failed. With --bench
+// it measures save-to-pixels latency only (bench/view-latency).
+import { spawn } from 'node:child_process';
+import fs from 'node:fs';
+import http from 'node:http';
+import os from 'node:os';
+import path from 'node:path';
+import puppeteer from 'puppeteer-core';
+
+const [plant, sourceDir, mode] = process.argv.slice(2);
+const bench = mode === '--bench';
+const tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'plant-view-test-'));
+const servers = [];
+let failures = 0;
+
+function check(ok, what, detail = '') {
+  console.log(`${ok ? 'ok' : 'not ok'} - ${what}${detail ? ` (${detail})` : ''}`);
+  if (!ok) failures += 1;
+}
+
+// Starts `plant view FILE --port 0` and resolves to its URL.
+function startView(file, extra = []) {
+  return new Promise((resolve, reject) => {
+    const child = spawn(plant, ['view', file, '--port', '0', ...extra], { stdio: ['ignore', 'pipe', 'inherit'] });
+    servers.push(child);
+    let out = '';
+    child.stdout.on('data', (d) => {
+      out += d;
+      const m = out.match(/http:\/\/127\.0\.0\.1:\d+\//);
+      if (m) resolve({ url: m[0], child });
+    });
+    child.on('exit', (code) => reject(new Error(`plant view exited with ${code}: ${out}`)));
+  });
+}
+
+// A raw request (no path normalisation, any Host header).
+function request(url, requestPath, headers = {}) {
+  const u = new URL(url);
+  return new Promise((resolve, reject) => {
+    const req = http.request({ host: u.hostname, port: u.port, path: requestPath, headers }, (res) => {
+      const chunks = [];
+      res.on('data', (c) => chunks.push(c));
+      res.on('end', () => resolve({ status: res.statusCode, body: Buffer.concat(chunks) }));
+    });
+    req.on('error', reject);
+    req.end();
+  });
+}
+
+async function waitFor(page, fn, arg, timeout = 5000) {
+  await page.waitForFunction(fn, { timeout, polling: 10 }, arg);
+}
+
+// Pixels in the plant's screen box that differ from the background (the grid hidden).
+function paintedPixels(page) {
+  return page.evaluate(() => {
+    window.plantView.showGrid(false);
+    const c = document.querySelector('#view canvas');
+    const b = window.plantView.screenBox();
+    const r = c.getBoundingClientRect();
+    const s = c.width / r.width;
+    const tmpCanvas = document.createElement('canvas');
+    tmpCanvas.width = c.width; tmpCanvas.height = c.height;
+    const ctx = tmpCanvas.getContext('2d');
+    ctx.drawImage(c, 0, 0);
+    const w = Math.max(1, Math.floor(b.width * s)), h = Math.max(1, Math.floor(b.height * s));
+    const d = ctx.getImageData(Math.floor((b.x - r.left) * s), Math.floor((b.y - r.top) * s), w, h).data;
+    let n = 0;
+    for (let k = 0; k < d.length; k += 4)
+      if (Math.abs(d[k] - 0x1d) + Math.abs(d[k + 1] - 0x21) + Math.abs(d[k + 2] - 0x26) > 12) n += 1;
+    window.plantView.showGrid(true);
+    return { painted: n, total: w * h };
+  });
+}
+
+// Writes `text` to `file` and resolves to the milliseconds from the write to the new model's
+// first frame, with the module count then shown.
+async function saveAndWait(page, file, text) {
+  const before = await page.evaluate(() => window.plantView.loads);
+  const t0 = Date.now();
+  fs.writeFileSync(file, text);
+  await waitFor(page, (n) => window.plantView.loads > n, before);
+  const r = await page.evaluate((t) => ({ ms: window.plantView.drawnAt - t, event: window.plantView.eventAt - t, modules: window.plantView.modules, timing: window.plantView.timing }), t0);
+  if (process.env.VIEW_TIMING) console.error(JSON.stringify(r));
+  return r;
+}
+
+async function openPage(browser, url, errors) {
+  const page = await browser.newPage();
+  await page.setViewport({ width: 1000, height: 700 });
+  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  page.on('pageerror', (e) => errors.push(String(e)));
+  await page.goto(url);
+  await waitFor(page, () => window.plantView && window.plantView.loads > 0, null, 20000);
+  return page;
+}
+
+function median(xs) { const s = [...xs].sort((a, b) => a - b); return s[Math.floor(s.length / 2)]; }
+
+// Save-to-pixels latency of `grammar`: `edits` alternate two versions of the file.
+async function latency(browser, grammar, mutate, rounds) {
+  const file = path.join(tmp, path.basename(grammar));
+  const original = fs.readFileSync(grammar, 'utf8');
+  fs.writeFileSync(file, original);
+  const { url, child } = await startView(file);
+  const errors = [];
+  const page = await openPage(browser, url, errors);
+  const times = [];
+  for (let k = 0; k < rounds; ++k) times.push((await saveAndWait(page, file, k % 2 ? original : mutate(original))).ms);
+  await page.close();
+  child.kill('SIGINT');
+  return { grammar: path.relative(sourceDir, grammar), median_ms: median(times), max_ms: Math.max(...times), rounds };
+}
+
+async function securityChecks(url) {
+  const port = new URL(url).port;
+  const good = await request(url, '/api/state', { Host: `127.0.0.1:${port}` });
+  check(good.status === 200, 'the state is served to a loopback Host', `status ${good.status}`);
+  const foreign = await request(url, '/api/state', { Host: `attacker.example:${port}` });
+  check(foreign.status === 403, 'a foreign Host header is refused', `status ${foreign.status}`);
+  const origin = await request(url, '/api/state', { Host: `127.0.0.1:${port}`, Origin: 'http://attacker.example' });
+  check(origin.status === 403, 'a foreign Origin is refused', `status ${origin.status}`);
+  const dots = await request(url, '/../../etc/passwd', { Host: `127.0.0.1:${port}` });
+  check(dots.status === 400 && !dots.body.toString().includes('root:'), 'a path with .. is refused', `status ${dots.status}`);
+  const abs = await request(url, '/etc/passwd', { Host: `127.0.0.1:${port}` });
+  check(abs.status === 404 && !abs.body.toString().includes('root:'), 'a file system path is not served', `status ${abs.status}`);
+}
+
+async function roseChecks(browser) {
+  const grammar = path.join(sourceDir, 'grammars/rose/fig12c.plant');
+  const file = path.join(tmp, 'fig12c.plant');
+  const original = fs.readFileSync(grammar, 'utf8');
+  fs.writeFileSync(file, original);
+  const { url } = await startView(file);
+  await securityChecks(url);
+  const errors = [];
+  const page = await openPage(browser, url, errors);
+  await page.evaluate(() => { window.notReloaded = true; });
+  const px = await paintedPixels(page);
+  check(px.painted > px.total * 0.02, 'the plant is drawn (pixels differ from the background in its box)', `${px.painted} of ${px.total}`);
+
+  // a save reaches the page
+  const m0 = await page.evaluate(() => window.plantView.modules);
+  const saved = await saveAndWait(page, file, original.replace('N_S = 5', 'N_S = 3'));
+  check(saved.modules !== m0 && saved.ms < 2000, 'a save reaches the page within 2 s', `${m0} -> ${saved.modules} modules in ${saved.ms.toFixed(0)} ms`);
+  check(await page.evaluate(() => window.notReloaded === true), 'without reloading the page');
+  check((await page.$eval('#status', (e) => e.textContent)).includes(`${saved.modules} modules`), 'the page shows the module count');
+
+  // a syntax error shows its diagnostic; the plant stays
+  const shown = await page.evaluate(() => window.plantView.shownVersion);
+  fs.writeFileSync(file, original.replace('seed 12;', 'seed 12 12;'));
+  await waitFor(page, () => window.plantView.error);
+  const error = await page.$eval('#error', (e) => ({ text: e.textContent, shown: getComputedStyle(e).display !== 'none' }));
+  check(error.shown && /fig12c\.plant:\d+:\d+/.test(error.text) && error.text.includes('^'), 'a syntax error shows file:line:col, the line and a caret', JSON.stringify(error.text.split('\n')[0]));
+  check(await page.evaluate((v) => window.plantView.shownVersion === v, shown), 'the last good plant stays');
+  const px2 = await paintedPixels(page);
+  check(px2.painted > px2.total * 0.02, 'and is still drawn');
+  const fixed = await saveAndWait(page, file, original);
+  check(!(await page.evaluate(() => window.plantView.error)) && fixed.modules === m0, 'fixing the error clears it', `${fixed.modules} modules`);
+
+  // a param changed on the page derives again
+  const loads = await page.evaluate(() => window.plantView.loads);
+  await page.$eval('input[data-param="N_S"]', (e) => { e.value = '2'; e.dispatchEvent(new Event('change')); });
+  await waitFor(page, (n) => window.plantView.loads > n, loads);
+  const afterParam = await page.evaluate(() => window.plantView.modules);
+  check(afterParam !== m0, 'changing a param derives again', `${m0} -> ${afterParam} modules`);
+  const line = await page.evaluate(() => { document.getElementById('save-d').click(); return document.getElementById('command-line').textContent; });
+  check(line.includes('-D N_S=2'), '"Save as -D" shows the command line', line);
+
+  // the step slider shows step k
+  const k = 3;
+  const expected = await page.evaluate((s) => { const e = document.getElementById('step'); e.value = String(s); e.dispatchEvent(new Event('input')); return window.plantView.params && null; }, k);
+  void expected;
+  await waitFor(page, (s) => window.plantView.step === s, k);
+  const state = JSON.parse((await request(url, '/api/state', { Host: new URL(url).host })).body);
+  const stepModules = await page.evaluate(() => window.plantView.modules);
+  check(stepModules === state.modules[k] && (await page.$eval('#status', (e) => e.textContent)).includes(`${state.modules[k]} modules, step ${k}`), 'the step slider shows step k\'s module count', `step ${k}: ${stepModules}`);
+  const t0 = Date.now();
+  await page.evaluate(() => { const e = document.getElementById('step'); e.value = e.max; e.dispatchEvent(new Event('input')); });
+  await waitFor(page, (n) => window.plantView.modules === n, state.modules.at(-1));
+  await page.evaluate(() => { const e = document.getElementById('step'); e.value = '3'; e.dispatchEvent(new Event('input')); });
+  await waitFor(page, () => window.plantView.step === 3);
+  check(Date.now() - t0 < 1000, 'moving back to a kept step is quick', `${Date.now() - t0} ms`);
+  await page.click('#step-forward');
+  await waitFor(page, () => window.plantView.step === 4);
+  await page.click('#step-back');
+  await waitFor(page, () => window.plantView.step === 3);
+  check(true, 'the step buttons move one step on and back');
+  await page.click('#play');
+  await waitFor(page, () => window.plantView.step >= 6);
+  await page.click('#play'); // pause
+  const paused = await page.evaluate(() => window.plantView.step);
+  await new Promise((r) => setTimeout(r, 600));
+  const later = await page.evaluate(() => window.plantView.step);
+  check(later <= paused + 1 && later < state.modules.length - 1, 'play shows the steps in turn and pause stops', `paused at ${paused}, then ${later}`);
+  check(errors.length === 0, 'no console error', errors.join(' | '));
+  await page.close();
+}
+
+// The JSON chunk of a GLB.
+function glbJson(bytes) {
+  const length = bytes.readUInt32LE(12);
+  return JSON.parse(bytes.subarray(20, 20 + length).toString('utf8'));
+}
+
+async function climberChecks(browser) {
+  const { url } = await startView(path.join(sourceDir, 'grammars/climbers/fig01_column.plant'));
+  const errors = [];
+  const page = await openPage(browser, url, errors);
+  const names = await page.evaluate(() => window.plantView.names());
+  check(names.some((n) => n.includes('obstacles')), 'a climber\'s obstacles are drawn', names.slice(0, 6).join(', '));
+  check(errors.length === 0, 'no console error (climber)', errors.join(' | '));
+  await page.close();
+}
+
+async function instanceChecks(browser) {
+  const grammar = path.join(sourceDir, 'grammars/willow/fig06a.plant');
+  const { url } = await startView(grammar);
+  const errors = [];
+  const page = await openPage(browser, url, errors);
+  const drawn = (await page.evaluate(() => window.plantView.instanced())).map((m) => m.count).sort((a, b) => a - b);
+  const gltf = glbJson((await request(url, '/api/model.glb', { Host: new URL(url).host })).body);
+  const expected = [];
+  for (const node of gltf.nodes || []) {
+    const ext = node.extensions && node.extensions.EXT_mesh_gpu_instancing;
+    if (!ext || node.mesh === undefined) continue;
+    const count = gltf.accessors[Object.values(ext.attributes)[0]].count;
+    for (let p = 0; p < gltf.meshes[node.mesh].primitives.length; ++p) expected.push(count);
+  }
+  expected.sort((a, b) => a - b);
+  check(expected.length > 0 && JSON.stringify(drawn) === JSON.stringify(expected),
+    'an instanced file is drawn as InstancedMesh with the GLB\'s instance counts',
+    `${drawn.length} InstancedMesh, ${drawn.reduce((a, b) => a + b, 0)} instances; expected ${expected.length}, ${expected.reduce((a, b) => a + b, 0)}`);
+  const px = await paintedPixels(page);
+  check(px.painted > px.total * 0.02, 'the willow is drawn', `${px.painted} of ${px.total}`);
+  check(errors.length === 0, 'no console error (willow)', errors.join(' | '));
+  await page.close();
+}
+
+const browser = await puppeteer.launch({
+  executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
+  headless: true,
+  args: ['--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist'],
+});
+try {
+  if (bench) {
+    const rose = await latency(browser, path.join(sourceDir, 'grammars/rose/fig12c.plant'), (t) => t.replace('N_S = 5', 'N_S = 4'), 10);
+    const abop = await latency(browser, path.join(sourceDir, 'grammars/abop/fig1_9a.plant'), (t) => t + '\n# edited\n', 10);
+    for (const r of [rose, abop]) console.log(JSON.stringify(r));
+  } else {
+    await roseChecks(browser);
+    await instanceChecks(browser);
+    await climberChecks(browser);
+    const rose = await latency(browser, path.join(sourceDir, 'grammars/rose/fig12c.plant'), (t) => t.replace('N_S = 5', 'N_S = 4'), 4);
+    check(rose.median_ms <= 300, 'the rose\'s save-to-pixels latency is at most 300 ms', `median ${rose.median_ms.toFixed(0)} ms`);
+  }
+} catch (e) {
+  check(false, 'the browser test ran to the end', String(e.stack || e));
+} finally {
+  await browser.close();
+  for (const s of servers) s.kill('SIGINT');
+  fs.rmSync(tmp, { recursive: true, force: true });
+}
+process.exit(failures ? 1 : 0);

@@ -1,0 +1,362 @@
+// The page `plant view` serves (docs/view.md): the plant as the GLB `plant run -o x.glb` writes,
+// drawn with three.js; the server's events bring each new derivation, the controls send params,
+// the seed and the step back. Instanced organs arrive as EXT_mesh_gpu_instancing, which three's
+// GLTFLoader turns into InstancedMesh.
+import * as THREE from '/three/three.module.js';
+import { OrbitControls } from '/three/addons/controls/OrbitControls.js';
+import { GLTFLoader } from '/three/addons/loaders/GLTFLoader.js';
+
+const $ = (id) => document.getElementById(id);
+const view = $('view');
+
+// Multisampling, unless WebGL runs on a software rasteriser (SwiftShader, llvmpipe: a machine
+// without a GPU, headless chromium), where it makes every frame several times slower.
+function softwareGL() {
+  const gl = document.createElement('canvas').getContext('webgl2');
+  const info = gl && gl.getExtension('WEBGL_debug_renderer_info');
+  const name = info ? String(gl.getParameter(info.UNMASKED_RENDERER_WEBGL)) : '';
+  if (gl) gl.getExtension('WEBGL_lose_context')?.loseContext();
+  return /swiftshader|llvmpipe|softpipe/i.test(name);
+}
+const renderer = new THREE.WebGLRenderer({ antialias: !softwareGL(), preserveDrawingBuffer: true });
+renderer.setPixelRatio(window.devicePixelRatio);
+renderer.setClearColor(0x1d2126);
+view.appendChild(renderer.domElement);
+
+const scene = new THREE.Scene();
+const camera = new THREE.PerspectiveCamera(40, 1, 0.01, 1000);
+camera.position.set(3, 2, 5);
+const controls = new OrbitControls(camera, renderer.domElement);
+scene.add(new THREE.HemisphereLight(0xeef4ff, 0x4a4030, 1.6));
+const sun = new THREE.DirectionalLight(0xffffff, 2.2);
+sun.position.set(4, 10, 6);
+scene.add(sun);
+scene.add(camera);
+const fill = new THREE.DirectionalLight(0xffffff, 0.6);
+fill.position.set(-0.4, 0.2, 1);
+camera.add(fill); // a light from the viewer's side keeps the front lit while orbiting
+
+let grid = null;     // the ground grid, sized on the first plant
+let plant = null;    // the glTF scene shown
+let framed = false;  // the camera is framed once; later models keep it
+const loader = new GLTFLoader();
+
+// What the tests and the benchmark read (tests/view/view.mjs).
+const state = {
+  version: 0,        // the server's version of the derivation shown (or failed)
+  shownVersion: 0,   // the version whose plant is on screen (a failed version keeps the one before)
+  step: -1,          // the step shown
+  modules: 0,        // its module count
+  error: null,       // the diagnostic shown, if any
+  drawnAt: 0,        // Date-comparable time (ms) when the last model was first rendered
+  loads: 0,          // models put on screen
+  params: [],
+  instanced: () => {
+    const out = [];
+    if (plant) plant.traverse((o) => { if (o.isInstancedMesh) out.push({ name: o.name, count: o.count }); });
+    return out;
+  },
+  screenBox: () => screenBox(),
+  names: () => { const out = []; if (plant) plant.traverse((o) => { if (o.name) out.push(o.name); }); return out; },
+  showGrid: (on) => { if (grid) grid.visible = on; renderer.render(scene, camera); },
+};
+window.plantView = state;
+
+let server = null;           // the last state from the server
+const glbCache = new Map();  // `${version}:${step}` -> ArrayBuffer, so moving the slider back is instant
+const edited = {};           // params changed on the page
+let seedEdited = null;
+let followLast = true;       // the step slider sits on the last step
+
+function resize() {
+  const w = view.clientWidth, h = view.clientHeight;
+  renderer.setSize(w, h, false);
+  camera.aspect = w / Math.max(h, 1);
+  camera.updateProjectionMatrix();
+}
+window.addEventListener('resize', () => { resize(); requestRender(); });
+resize();
+
+// Frames are drawn on demand (the camera moved, a model arrived), not continuously: a page left
+// open costs nothing, and the machine's cores go to deriving.
+let frameWaiters = [];
+let frameQueued = false;
+function requestRender() {
+  if (frameQueued) return;
+  frameQueued = true;
+  requestAnimationFrame(() => {
+    frameQueued = false;
+    renderer.render(scene, camera);
+    const waiters = frameWaiters;
+    frameWaiters = [];
+    for (const w of waiters) w();
+  });
+}
+controls.addEventListener('change', requestRender);
+const nextFrame = () => new Promise((resolve) => { frameWaiters.push(resolve); requestRender(); });
+
+
+function disposeTree(root) {
+  root.traverse((o) => {
+    if (o.geometry) o.geometry.dispose();
+    if (o.material) for (const m of [].concat(o.material)) { for (const v of Object.values(m)) if (v && v.isTexture) v.dispose(); m.dispose(); }
+  });
+}
+
+// The camera looks at the plant's bounding box from the front and a little above; the grid lies
+// under it, a few times its width.
+function frame(box) {
+  const size = box.getSize(new THREE.Vector3());
+  const center = box.getCenter(new THREE.Vector3());
+  const radius = Math.max(size.length() / 2, 1e-3);
+  const dist = radius / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2)) * 1.05;
+  camera.near = dist / 1000;
+  camera.far = dist * 100;
+  camera.position.copy(center).add(new THREE.Vector3(0, size.y * 0.15, dist));
+  camera.updateProjectionMatrix();
+  controls.target.copy(center);
+  controls.update();
+  if (grid) { scene.remove(grid); grid.geometry.dispose(); grid.material.dispose(); }
+  const extent = Math.max(size.x, size.z, size.y) * 3;
+  const cell = Math.pow(10, Math.floor(Math.log10(Math.max(extent / 20, 1e-6))));
+  const cells = Math.min(200, Math.max(2, Math.round(extent / cell)));
+  grid = new THREE.GridHelper(cells * cell, cells, 0x556070, 0x363c44);
+  grid.position.set(center.x, box.min.y, center.z);
+  scene.add(grid);
+}
+
+// The plant's box on the screen, in CSS pixels of the page: what the tests look at.
+function screenBox() {
+  if (!plant) return null;
+  const box = new THREE.Box3().setFromObject(plant);
+  const r = renderer.domElement.getBoundingClientRect();
+  let x0 = Infinity, y0 = Infinity, x1 = -Infinity, y1 = -Infinity;
+  for (let k = 0; k < 8; ++k) {
+    const p = new THREE.Vector3(k & 1 ? box.max.x : box.min.x, k & 2 ? box.max.y : box.min.y, k & 4 ? box.max.z : box.min.z).project(camera);
+    const x = r.left + (p.x + 1) / 2 * r.width, y = r.top + (1 - p.y) / 2 * r.height;
+    x0 = Math.min(x0, x); y0 = Math.min(y0, y); x1 = Math.max(x1, x); y1 = Math.max(y1, y);
+  }
+  return { x: Math.max(x0, r.left), y: Math.max(y0, r.top), width: Math.min(x1, r.right) - Math.max(x0, r.left), height: Math.min(y1, r.bottom) - Math.max(y0, r.top) };
+}
+
+async function fetchModel(version, step) {
+  const key = `${version}:${step}`;
+  if (glbCache.has(key)) return glbCache.get(key);
+  const res = await fetch(`/api/model.glb?step=${step}&v=${version}`);
+  if (!res.ok) throw new Error(await res.text());
+  const bytes = await res.arrayBuffer();
+  for (const k of glbCache.keys()) if (!k.startsWith(`${version}:`)) glbCache.delete(k);
+  glbCache.set(key, bytes);
+  return bytes;
+}
+
+let showing = Promise.resolve();
+// Puts step `step` of the server's current version on screen (one at a time, the newest wins).
+function show(step) {
+  const version = server.plant;
+  showing = showing.then(async () => {
+    if (version !== server.plant) return; // a newer one is on its way
+    const t0 = performance.now();
+    const bytes = await fetchModel(version, step);
+    const t1 = performance.now();
+    const gltf = await loader.parseAsync(bytes, '');
+    const t2 = performance.now();
+    if (version !== server.plant) return;
+    const old = plant;
+    if (old) scene.remove(old);
+    plant = gltf.scene;
+    plant.name = 'plant';
+    scene.add(plant);
+    if (!framed) { frame(new THREE.Box3().setFromObject(plant)); framed = true; }
+    state.shownVersion = version;
+    state.step = step;
+    state.modules = server.modules[step];
+    status();
+    await nextFrame();
+    state.drawnAt = performance.timeOrigin + performance.now();
+    state.timing = { fetch: t1 - t0, parse: t2 - t1, draw: performance.now() - t2 };
+    // disposed only now: the new plant's materials have taken over the old one's shader programs
+    if (old) disposeTree(old);
+    state.loads += 1;
+  }).catch((e) => showError(String(e.message || e)));
+  return showing;
+}
+
+function showError(text) {
+  state.error = text;
+  $('error').textContent = text;
+  $('error').style.display = text ? 'block' : 'none';
+}
+
+function status() {
+  if (!server || !server.modules) { $('status').textContent = 'no plant yet'; return; }
+  const last = server.modules.length - 1;
+  $('status').textContent = `${state.modules} modules, step ${state.step} of ${last}` +
+    (server.derive_ms !== undefined ? ` (derived in ${server.derive_ms.toFixed(0)} ms)` : '');
+  $('step-label').textContent = `${state.step} / ${last}`;
+}
+
+function numberField(name, value) {
+  const label = document.createElement('label');
+  label.textContent = name;
+  const input = document.createElement('input');
+  input.type = 'number';
+  input.step = 'any';
+  input.value = value;
+  input.dataset.param = name;
+  input.addEventListener('change', () => {
+    const v = Number(input.value);
+    if (!Number.isFinite(v) || input.value.trim() === '') return;
+    edited[name] = v;
+    sendControls();
+  });
+  label.appendChild(input);
+  return label;
+}
+
+function updateControls() {
+  const params = server.params || [];
+  state.params = params;
+  const box = $('params');
+  const names = params.map((p) => p.name).join(',');
+  if (box.dataset.names !== names) {
+    box.replaceChildren(...params.map((p) => numberField(p.name, p.value)));
+    box.dataset.names = names;
+    if (!params.length) box.textContent = 'none';
+  } else {
+    for (const p of params) {
+      const input = box.querySelector(`input[data-param="${CSS.escape(p.name)}"]`);
+      if (input && document.activeElement !== input) input.value = p.value;
+    }
+  }
+  if (document.activeElement !== $('seed') && server.seed !== undefined) $('seed').value = server.seed;
+  const slider = $('step');
+  const last = server.modules.length - 1;
+  slider.max = String(last);
+  if (followLast || Number(slider.value) > last) slider.value = String(last);
+  if ($('command-line').style.display === 'block') $('command-line').textContent = server.command;
+}
+
+async function sendControls() {
+  const body = { params: edited, seed: seedEdited };
+  const res = await fetch('/api/controls', { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(body) });
+  if (!res.ok) showError(await res.text());
+  // the new version arrives as an event
+}
+
+// A new state from the server: a new derivation, or a failed one (the last plant stays).
+function onState(next) {
+  if (server && next.version === server.version) return; // sent again: nothing new
+  server = next;
+  state.eventAt = performance.timeOrigin + performance.now();
+  state.version = next.version;
+  $('file').textContent = next.file;
+  showError(next.error || '');
+  if (!next.modules) { status(); return; }
+  updateControls();
+  // a failed derivation keeps the plant shown; a new one replaces it
+  if (next.plant !== state.shownVersion || Number($('step').value) !== state.step) show(Number($('step').value));
+}
+
+$('step').addEventListener('input', () => {
+  const slider = $('step');
+  followLast = Number(slider.value) === Number(slider.max);
+  if (server && server.kept && !server.kept[Number(slider.value)]) {
+    showError(`step ${slider.value} was not kept (the derivation is too large to keep every step)`);
+    return;
+  }
+  if (server) show(Number(slider.value));
+});
+// Stepping and playing through the kept steps: a climber's growth along its wall, a plant's
+// development. Play shows each step once the one before is on screen, at most 5 a second.
+function goToStep(k) {
+  const slider = $('step');
+  const last = Number(slider.max);
+  slider.value = String(Math.max(0, Math.min(last, k)));
+  slider.dispatchEvent(new Event('input'));
+}
+let playing = null;
+function stopPlaying() {
+  if (playing) clearTimeout(playing);
+  playing = null;
+  $('play').textContent = 'play';
+}
+async function playNext() {
+  const slider = $('step');
+  if (Number(slider.value) >= Number(slider.max)) { stopPlaying(); return; }
+  goToStep(Number(slider.value) + 1);
+  await showing;
+  if (playing) playing = setTimeout(playNext, 200);
+}
+$('play').addEventListener('click', () => {
+  if (playing) { stopPlaying(); return; }
+  const slider = $('step');
+  if (Number(slider.value) >= Number(slider.max)) goToStep(0);
+  $('play').textContent = 'pause';
+  playing = setTimeout(playNext, 0);
+});
+$('step-back').addEventListener('click', () => { stopPlaying(); goToStep(Number($('step').value) - 1); });
+$('step-forward').addEventListener('click', () => { stopPlaying(); goToStep(Number($('step').value) + 1); });
+$('seed').addEventListener('change', () => {
+  const s = $('seed').value.trim();
+  if (!/^\d+$/.test(s)) { showError('the seed is a whole number'); return; }
+  seedEdited = s;
+  sendControls();
+});
+$('save-d').addEventListener('click', () => {
+  const line = $('command-line');
+  line.textContent = server ? server.command : '';
+  line.style.display = 'block';
+  if (navigator.clipboard && server) navigator.clipboard.writeText(server.command).catch(() => {});
+});
+
+function download(name, blob) {
+  const a = document.createElement('a');
+  a.href = URL.createObjectURL(blob);
+  a.download = name;
+  a.click();
+  setTimeout(() => URL.revokeObjectURL(a.href), 1000);
+}
+const stem = () => (server ? server.file.replace(/^.*\//, '').replace(/\.plant$/, '') : 'plant');
+$('download-glb').addEventListener('click', async () => {
+  if (!server || state.step < 0) return;
+  download(`${stem()}-step${state.step}.glb`, new Blob([await fetchModel(state.shownVersion, state.step)]));
+});
+$('download-png').addEventListener('click', () => {
+  renderer.render(scene, camera);
+  renderer.domElement.toBlob((blob) => download(`${stem()}-step${state.step}.png`, blob));
+});
+
+// Picking: the clicked mesh (and instance) is outlined by a box and named.
+const raycaster = new THREE.Raycaster();
+let marker = null;
+renderer.domElement.addEventListener('click', (ev) => {
+  if (!plant) return;
+  const r = renderer.domElement.getBoundingClientRect();
+  const ndc = new THREE.Vector2((ev.clientX - r.left) / r.width * 2 - 1, -(ev.clientY - r.top) / r.height * 2 + 1);
+  raycaster.setFromCamera(ndc, camera);
+  const hit = raycaster.intersectObject(plant, true)[0];
+  if (marker) { scene.remove(marker); marker.dispose(); marker = null; }
+  if (!hit) { $('pick').textContent = 'nothing there'; requestRender(); return; }
+  const o = hit.object;
+  const box = new THREE.Box3();
+  if (o.isInstancedMesh && hit.instanceId !== undefined) {
+    const m = new THREE.Matrix4();
+    o.getMatrixAt(hit.instanceId, m);
+    o.geometry.computeBoundingBox();
+    box.copy(o.geometry.boundingBox).applyMatrix4(m.premultiply(o.matrixWorld));
+  } else {
+    box.setFromObject(o);
+  }
+  marker = new THREE.Box3Helper(box, 0xffd040);
+  scene.add(marker);
+  requestRender();
+  const names = [];
+  for (let p = o; p && p !== plant; p = p.parent) if (p.name) names.unshift(p.name);
+  $('pick').textContent = `${names.join(' / ') || '(unnamed)'}` +
+    (o.isInstancedMesh ? `\ninstance ${hit.instanceId} of ${o.count}` : '') +
+    `\nat ${hit.point.toArray().map((v) => v.toFixed(3)).join(', ')}`;
+});
+
+const events = new EventSource('/api/events');
+events.addEventListener('model', (ev) => onState(JSON.parse(ev.data)));
