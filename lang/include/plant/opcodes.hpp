@@ -63,8 +63,9 @@ OPCODE(LoadMulConst, 0, 1, Next, "push frame[a] * consts[b]")
 OPCODE(LoadAddConst, 0, 1, Next, "push frame[a] + consts[b]")
 // ---- shapes and environments ----
 OPCODE(Curve, 1, 1, Next, "replace t on top by curves[a](t)")
-OPCODE(EnvCall, n, 3, Next,
-       "method b of environment a (the run state's), on n numbers; pushes its result (at most a vec3)")
+OPCODE(
+    EnvCall, n, b >> 12, Next,
+    "method (b & 0xfff) of environment a (the run state's), on n numbers; pushes its result, b >> 12 numbers")
 // ---- decomposition graphs (graph_ops.hpp) ----
 OPCODE(GraphCall, n, b, Next, "graph built-in a (root, child, depth, ...) on n numbers, giving b numbers")
 OPCODE(
