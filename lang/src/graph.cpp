@@ -84,10 +84,15 @@ std::uint64_t DecompositionGraph::child_handle(std::uint64_t parent, double posi
     return h <= kRoot ? h + 2 : h;
 }
 
-bool DecompositionGraph::record(std::uint64_t handle, std::uint64_t parent, double position,
-                                int index) const {
+bool DecompositionGraph::record(std::uint64_t handle, std::uint64_t parent, double position, int index,
+                                const NodePlace* place) const {
     std::lock_guard lock(*pending_mutex_);
-    auto [it, added] = pending_.try_emplace(handle, Pending{parent, position, index});
+    Pending fresh{parent, position, index, false, NodePlace{}};
+    if (place) {
+        fresh.placed = true;
+        fresh.place = *place;
+    }
+    auto [it, added] = pending_.try_emplace(handle, fresh);
     if (added) return true;
     const Pending& p = it->second;
     return p.parent == parent && std::fabs(p.position - position) <= kSamePosition && p.index == index;
@@ -155,6 +160,13 @@ void DecompositionGraph::commit() {
                 continue;
             }
             add_node(h, parent, p.position, p.index);
+            if (p.placed) { // the first call that made the node places it
+                GraphNode& n = nodes_.back();
+                n.placed = true;
+                n.base = p.place.base;
+                n.dir = p.place.dir;
+                n.span = p.place.span;
+            }
             progress = true;
         }
         fresh = std::move(later);
@@ -224,6 +236,7 @@ struct Local {
     bool is_private = false;
     double number = 0;
     const CurveDef* curve = nullptr;
+    std::shared_ptr<const Silhouette> silhouette;
     int edit = -1;
 };
 
@@ -250,6 +263,7 @@ void apply(Local& l, const GraphEdit& e, int k) {
     }
     l.number = e.number;
     l.curve = e.curve.get();
+    l.silhouette = e.silhouette;
     l.edit = k;
 }
 } // namespace
@@ -261,6 +275,7 @@ void DecompositionGraph::resolve() {
         local[p].status = ValueStatus::Explicit;
         local[p].number = decl_->params[p].number;
         local[p].curve = decl_->params[p].curve.get();
+        local[p].silhouette = decl_->params[p].silhouette;
     }
     const std::size_t E = edits_ ? edits_->edits.size() : 0;
     matches_.assign(E, -1);
@@ -301,6 +316,7 @@ void DecompositionGraph::resolve() {
                 v.from = static_cast<int>(n);
                 v.number = l.number;
                 if (l.curve) v.curve = {CurveTerm{EditOp::Set, l.curve}};
+                v.silhouette = l.silhouette;
                 continue;
             }
             const int from = source[static_cast<std::size_t>(parent) * P + p];
@@ -309,6 +325,7 @@ void DecompositionGraph::resolve() {
             v.from = inherited.status == ValueStatus::Inherited ? inherited.from : from;
             v.number = inherited.number;
             v.curve = inherited.curve;
+            v.silhouette = inherited.silhouette; // (a silhouette is never relative)
             if (l.status == ValueStatus::Offset) {
                 v.number += l.number;
                 if (l.curve) v.curve.push_back({EditOp::Offset, l.curve});
@@ -317,6 +334,31 @@ void DecompositionGraph::resolve() {
                 if (l.curve) v.curve.push_back({EditOp::Fraction, l.curve});
             }
         }
+        place(n);
+    }
+}
+
+// Places node n's silhouettes (Boudon et al. 2003, section 3, Fig. 8): the root's are in world
+// coordinates; a node made by child(n, pos, index, base, dir) has B at base, BT along dir and T on
+// its parent's envelope of the same parameter; any other node keeps its parent's placement.
+void DecompositionGraph::place(std::size_t n) {
+    const std::size_t P = decl_->params.size();
+    const GraphNode& node = nodes_[n];
+    for (std::size_t p = 0; p < P; ++p) {
+        if (decl_->params[p].kind != GraphParamKind::Silhouette) continue;
+        NodeValue& v = values_[n * P + p];
+        if (node.parent < 0 || !v.silhouette) continue; // the identity
+        const NodeValue& up = values_[static_cast<std::size_t>(node.parent) * P + p];
+        if (!node.placed) {
+            v.placement = up.placement;
+            continue;
+        }
+        ChildPlacement c = place_child(*up.silhouette, up.placement, *v.silhouette, node.base, node.dir);
+        if (!c.ok())
+            throw RuntimeError{RuntimeErrorKind::General, node.span,
+                               fmt::format("cannot place silhouette '{}' of {}: {}", decl_->params[p].name,
+                                           path(static_cast<int>(n)), c.error)};
+        v.placement = c.placement;
     }
 }
 

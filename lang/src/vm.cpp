@@ -564,6 +564,22 @@ RunStatus execute(const Code& code, double* frame, EvalEnv& env, double* result)
             st[sp++] = r[0];
             break;
         }
+        case Op::GraphPlace: {
+            sp -= 9;
+            double r[1] = {0};
+            std::string error = graph_place(st + sp, r, env, code.spans[pc]);
+            if (!error.empty()) fail(code, pc, std::move(error));
+            st[sp++] = r[0];
+            break;
+        }
+        case Op::GraphShape: {
+            sp -= I.n;
+            double r[3] = {0, 0, 0};
+            std::string error = graph_shape(I.a, env_call_method(I), st + sp, r, env);
+            if (!error.empty()) fail(code, pc, std::move(error));
+            for (unsigned k = 0; k < (I.b >> kEnvMethodBits); ++k) st[sp++] = r[k];
+            break;
+        }
         }
     }
     if (result && sp > 0)

@@ -71,3 +71,7 @@ OPCODE(GraphCall, n, b, Next, "graph built-in a (root, child, depth, ...) on n n
 OPCODE(
     GraphRead, n, 1, Next,
     "parameter a of a node: pops the node (n = 1), or the node and t for a curve (n = 2); pushes its value")
+OPCODE(GraphPlace, 9, 1, Next, "child(n, pos, index, base, dir): pops those 9 numbers, pushes the child node")
+OPCODE(GraphShape, n, b >> 12, Next,
+       "method (b & 0xfff) of silhouette parameter a of a node: pops the node and its arguments (n numbers), "
+       "pushes b >> 12")
