@@ -6,6 +6,7 @@
 #include "plant/derive.hpp"
 #include "plant/environment_phase.hpp"
 #include "plant/environments.hpp"
+#include "plant/graph.hpp"
 #include "plant/skeleton.hpp"
 #include "plant/turtle.hpp"
 
@@ -44,6 +45,13 @@ struct Bonsai {
         FAIL("no environment " << env);
         return 0;
     }
+    // the plant's silhouette: the graph root's `crown` (placed as written)
+    double crown_level(const glm::dvec3& p) const {
+        const int k = program->graph.find("crown");
+        REQUIRE(k >= 0);
+        return program->graph.params[static_cast<std::size_t>(k)].silhouette->envelope.level(p);
+    }
+    std::unique_ptr<Derivation> derivation;
     const SkeletonAxis& trunk() const {
         REQUIRE(!skeleton.axes.empty());
         REQUIRE(skeleton.axes[0].parent == -1);
@@ -51,7 +59,7 @@ struct Bonsai {
     }
 };
 
-Bonsai grow(const std::string& path) {
+Bonsai grow(const std::string& path, const std::string& edits = "") {
     SourceManager sources;
     Diagnostics diags;
     CompileOptions co;
@@ -63,7 +71,13 @@ Bonsai grow(const std::string& path) {
     TurtleEnvironmentPhase phase;
     DeriveOptions opt;
     opt.environment_phase = &phase;
-    Derivation d(*b.program, opt);
+    if (!edits.empty()) {
+        opt.edits = parse_edits(*b.program, sources, sources.add("test.edits", edits), diags);
+        INFO(render_all(diags, sources));
+        REQUIRE(opt.edits);
+    }
+    b.derivation = std::make_unique<Derivation>(*b.program, opt);
+    Derivation& d = *b.derivation;
     d.run();
     b.skeleton = build_skeleton(*b.program, d.interpreted(d.string()), turtle_options(d));
     return b;
@@ -100,7 +114,7 @@ TEST_CASE("bonsai: every branch point lies inside the crown's envelope", "[bonsa
             ++branches;
             const glm::dvec3 p = axis.points[0].position;
             INFO("branch point " << p.x << " " << p.y << " " << p.z);
-            CHECK(b.ask("crown", "level", p) <= 1 + 1e-9);
+            CHECK(b.crown_level(p) <= 1 + 1e-9);
         }
         CHECK(branches >= 20);
         // the trunk stands in the pot
@@ -128,4 +142,51 @@ TEST_CASE("bonsai: kengai's trunk tip falls below the pot's rim", "[bonsai]") {
     double top = -1;
     for (const auto& p : pts) top = std::max(top, p.position.y);
     CHECK(top > 0.15);
+}
+
+// Fig. 8 in the library: each first-order branch's silhouette is placed with its T on the
+// plant's envelope (|level - 1| < 1e-9), and a branch's length comes from it.
+TEST_CASE("bonsai: each first-order branch's silhouette T lies on the plant's envelope", "[bonsai]") {
+    Bonsai b = grow(kRoot + "/grammars/bonsai/chokkan.plant");
+    const DecompositionGraph& g = *b.derivation->run_state().graph();
+    const int crown = g.decl().find("crown");
+    int first = 0;
+    for (std::size_t k = 1; k < g.size(); ++k) {
+        if (g.node(static_cast<int>(k)).depth != 1) continue;
+        ++first;
+        const PlacedSilhouette s = g.value(static_cast<int>(k), crown).placed();
+        INFO(g.path(static_cast<int>(k)));
+        CHECK(std::fabs(b.crown_level(s.tip()) - 1) < 1e-9);
+        CHECK(b.crown_level(s.base()) <= 1 + 1e-9);
+    }
+    CHECK(first >= 8);
+}
+
+// Per-branch quantities are read through the branch's node: an edit on one branch changes it
+// and no other.
+TEST_CASE("bonsai: an edit changes one branch", "[bonsai]") {
+    Bonsai plain = grow(kRoot + "/grammars/bonsai/chokkan.plant");
+    const DecompositionGraph& g = *plain.derivation->run_state().graph();
+    int target = -1;
+    for (std::size_t k = 1; k < g.size() && target < 0; ++k)
+        if (g.node(static_cast<int>(k)).depth == 1) target = static_cast<int>(k);
+    REQUIRE(target > 0);
+    const std::string path = g.path(target, true);
+    Bonsai edited = grow(kRoot + "/grammars/bonsai/chokkan.plant", path + " fill *= 0.5\n");
+    const DecompositionGraph& h = *edited.derivation->run_state().graph();
+    const int fill = h.decl().find("fill");
+    int changed = 0;
+    for (std::size_t k = 1; k < h.size(); ++k)
+        if (h.node(static_cast<int>(k)).depth == 1 && h.value(static_cast<int>(k), fill).number != 0.85)
+            ++changed;
+    CHECK(changed == 1);
+    CHECK(edited.skeleton.axes.size() <= plain.skeleton.axes.size());
+    double before = 0, after = 0;
+    for (const auto& a : plain.skeleton.axes)
+        for (std::size_t i = 1; i < a.points.size(); ++i)
+            before += glm::length(a.points[i].position - a.points[i - 1].position);
+    for (const auto& a : edited.skeleton.axes)
+        for (std::size_t i = 1; i < a.points.size(); ++i)
+            after += glm::length(a.points[i].position - a.points[i - 1].position);
+    CHECK(after < before);
 }
