@@ -105,7 +105,9 @@ double pot_rim() {
 // the same point).
 TEST_CASE("bonsai: every branch point lies inside the crown's envelope", "[bonsai]") {
     for (const char* file :
-         {"/stdlib/bonsai.plant", "/grammars/bonsai/chokkan.plant", "/grammars/bonsai/kengai.plant"}) {
+         {"/stdlib/bonsai.plant", "/grammars/bonsai/chokkan.plant", "/grammars/bonsai/kengai.plant",
+          "/grammars/bonsai/bunjingi.plant", "/grammars/bonsai/nejikan.plant",
+          "/grammars/bonsai/fukinagashi.plant", "/grammars/bonsai/sankan.plant"}) {
         INFO(file);
         Bonsai b = grow(kRoot + file);
         int branches = 0;
@@ -116,7 +118,8 @@ TEST_CASE("bonsai: every branch point lies inside the crown's envelope", "[bonsa
             INFO("branch point " << p.x << " " << p.y << " " << p.z);
             CHECK(b.crown_level(p) <= 1 + 1e-9);
         }
-        CHECK(branches >= 20);
+        // (bunjingi, the literati style, has a few branches at the top only)
+        CHECK(branches >= (std::string(file).find("bunjingi") != std::string::npos ? 6 : 20));
         // the trunk stands in the pot
         CHECK(b.ask("pot", "inside", b.trunk().points.front().position) == 1);
     }
@@ -189,4 +192,101 @@ TEST_CASE("bonsai: an edit changes one branch", "[bonsai]") {
         for (std::size_t i = 1; i < a.points.size(); ++i)
             after += glm::length(a.points[i].position - a.points[i - 1].position);
     CHECK(after < before);
+}
+
+namespace {
+// the length of an axis's horizontal mean direction from its first point to its last
+glm::dvec3 horizontal(const SkeletonAxis& a) {
+    glm::dvec3 d = a.points.back().position - a.points.front().position;
+    d.y = 0;
+    return d;
+}
+} // namespace
+
+// Sankan: three trunks from one point. In the graph they are the root's children at position 0
+// with indices 0, 1 and 2, placed at the plant's base; in the skeleton, three axes start there
+// and each rises more than 0.3.
+TEST_CASE("bonsai: sankan has three trunks from one point", "[bonsai]") {
+    Bonsai b = grow(kRoot + "/grammars/bonsai/sankan.plant");
+    const DecompositionGraph& g = *b.derivation->run_state().graph();
+    const int crown = g.decl().find("crown");
+    const glm::dvec3 base = g.value(0, crown).placed().base();
+    int trunks = 0;
+    for (int c : g.node(0).children) {
+        CHECK(g.node(c).position == 0);
+        CHECK(g.node(c).index == trunks);
+        CHECK(glm::length(g.value(c, crown).placed().base() - base) < 1e-12);
+        ++trunks;
+    }
+    CHECK(trunks == 3);
+    int drawn = 0;
+    for (const auto& a : b.skeleton.axes) {
+        if (a.points.size() < 2) continue;
+        double top = -1;
+        for (const auto& p : a.points) top = std::max(top, p.position.y);
+        bool from_base = false; // an axis that starts at the base, or a trunk whose first chord does
+        for (std::size_t i = 0; i < std::min<std::size_t>(a.points.size(), 2); ++i)
+            from_base = from_base || glm::length(a.points[i].position - base) < 1e-6;
+        if (from_base && top - base.y > 0.3) ++drawn;
+    }
+    CHECK(drawn == 3);
+}
+
+// Fukinagashi: every first-order branch (an axis whose parent is the trunk) streams to the
+// leeward: its horizontal direction, first point to last, within 60 degrees of the wind (+x).
+TEST_CASE("bonsai: fukinagashi's branches all lie to the leeward", "[bonsai]") {
+    Bonsai b = grow(kRoot + "/grammars/bonsai/fukinagashi.plant");
+    const glm::dvec3 wind{1, 0, 0};
+    int branches = 0;
+    for (const auto& a : b.skeleton.axes) {
+        if (a.parent != 0 || a.points.size() < 2) continue;
+        const glm::dvec3 h = horizontal(a);
+        if (glm::length(h) < 1e-9) continue;
+        ++branches;
+        const double angle = std::acos(glm::dot(glm::normalize(h), wind)) * 180 / std::numbers::pi;
+        INFO("branch from " << a.points[0].position.x << " " << a.points[0].position.y);
+        CHECK(angle < 60);
+    }
+    CHECK(branches >= 6);
+}
+
+// Nejikan: the trunk's frame turns more than 180 degrees about its axis from base to tip. The
+// roll is summed point to point: the previous up vector carried onto the new heading by the
+// smallest rotation, then the signed angle to the new up about the new heading.
+TEST_CASE("bonsai: nejikan's trunk twists more than half a turn", "[bonsai]") {
+    Bonsai b = grow(kRoot + "/grammars/bonsai/nejikan.plant");
+    const auto& pts = b.trunk().points;
+    REQUIRE(pts.size() > 10);
+    double roll = 0;
+    for (std::size_t i = 2; i < pts.size(); ++i) {
+        const glm::dvec3 h0 = glm::normalize(pts[i - 1].heading), h1 = glm::normalize(pts[i].heading);
+        glm::dvec3 u = pts[i - 1].up;
+        const glm::dvec3 k = glm::cross(h0, h1);
+        const double s = glm::length(k), c = glm::dot(h0, h1);
+        if (s > 1e-12) { // Rodrigues: turn u by the angle between h0 and h1 about k
+            const glm::dvec3 n = k / s;
+            u = u * c + glm::cross(n, u) * s + n * (glm::dot(n, u) * (1 - c));
+        }
+        roll += std::atan2(glm::dot(glm::cross(u, pts[i].up), h1), glm::dot(u, pts[i].up));
+    }
+    INFO("roll " << roll * 180 / std::numbers::pi);
+    CHECK(std::fabs(roll) * 180 / std::numbers::pi > 180);
+}
+
+// Bunjingi: a bare trunk, foliage only at the top. Rule: no foliage pad (an organ) has its centre
+// in the lower half of the trunk's height (between its base and its highest point).
+TEST_CASE("bonsai: bunjingi has no foliage on the lower half of its trunk", "[bonsai]") {
+    Bonsai b = grow(kRoot + "/grammars/bonsai/bunjingi.plant");
+    const auto& pts = b.trunk().points;
+    double top = -1;
+    for (const auto& p : pts) top = std::max(top, p.position.y);
+    const double half = pts.front().position.y + 0.5 * (top - pts.front().position.y);
+    int pads = 0;
+    for (const auto& o : b.skeleton.organs) {
+        ++pads;
+        INFO("pad at height " << o.transform[3].y);
+        CHECK(o.transform[3].y > half);
+    }
+    CHECK(pads >= 6);
+    CHECK(top > 0.75); // and the trunk is tall
 }
