@@ -298,8 +298,12 @@ void DecompositionGraph::resolve() {
             if (m >= 0) apply(local[static_cast<std::size_t>(m) * P + p], e, static_cast<int>(k));
         }
     }
-    // parents come before their children in nodes_, so one pass resolves everything
-    values_.assign(N * P, NodeValue{});
+    // parents come before their children in nodes_, so one pass resolves everything; a node whose
+    // silhouettes and parent's placements are as at the last commit keeps its placements
+    std::vector<NodeValue> previous(N * P);
+    previous.swap(values_);
+    const std::size_t before = std::min(previous.size() / std::max<std::size_t>(P, 1), N);
+    std::vector<char> same(N, 0);
     std::vector<int> source(N * P); // the node whose value this node's children inherit
     for (std::size_t n = 0; n < N; ++n) {
         const int parent = nodes_[n].parent;
@@ -334,16 +338,26 @@ void DecompositionGraph::resolve() {
                 if (l.curve) v.curve.push_back({EditOp::Fraction, l.curve});
             }
         }
-        place(n);
+        place(n, previous, before, same);
     }
 }
 
 // Places node n's silhouettes (Boudon et al. 2003, section 3, Fig. 8): the root's are in world
 // coordinates; a node made by child(n, pos, index, base, dir) has B at base, BT along dir and T on
 // its parent's envelope of the same parameter; any other node keeps its parent's placement.
-void DecompositionGraph::place(std::size_t n) {
+void DecompositionGraph::place(std::size_t n, const std::vector<NodeValue>& previous, std::size_t before,
+                               std::vector<char>& same) {
     const std::size_t P = decl_->params.size();
     const GraphNode& node = nodes_[n];
+    // unchanged since the last commit: the same silhouettes here and an unchanged parent
+    bool keep = n < before && (node.parent < 0 || same[static_cast<std::size_t>(node.parent)]);
+    for (std::size_t p = 0; p < P && keep; ++p)
+        keep = previous[n * P + p].silhouette == values_[n * P + p].silhouette;
+    same[n] = keep;
+    if (keep) {
+        for (std::size_t p = 0; p < P; ++p) values_[n * P + p].placement = previous[n * P + p].placement;
+        return;
+    }
     for (std::size_t p = 0; p < P; ++p) {
         if (decl_->params[p].kind != GraphParamKind::Silhouette) continue;
         NodeValue& v = values_[n * P + p];

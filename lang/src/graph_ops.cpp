@@ -68,11 +68,15 @@ std::string make_child(const DecompositionGraph& g, const double* a, bool with_i
         for (std::size_t p = 0; p < g.decl().params.size(); ++p) {
             if (g.decl().params[p].kind != GraphParamKind::Silhouette) continue;
             const NodeValue& v = g.value(up, static_cast<int>(p));
-            // the parent's envelope alone decides whether base and dir can place a child
-            const ChildPlacement c =
-                place_child(*v.silhouette, v.placement, *v.silhouette, place->base, place->dir);
-            if (!c.ok())
-                return fmt::format("cannot place silhouette '{}': {}", g.decl().params[p].name, c.error);
+            // the branching point inside the parent's envelope (the ray's reach is checked when
+            // the node is committed, with this call's span)
+            const double level = v.placed().level(place->base);
+            if (!(level <= 1.0 + 1e-9))
+                return fmt::format(
+                    "cannot place silhouette '{}': the branching point lies outside the parent's "
+                    "envelope (level {:.6g}, at most 1 inside): place branches on the part of the "
+                    "axis inside it",
+                    g.decl().params[p].name, level);
         }
     }
     if (records && !g.record(h, parent, pos, index, place))

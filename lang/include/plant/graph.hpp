@@ -196,7 +196,8 @@ class DecompositionGraph {
     };
     int match(const GraphEdit& e) const;
     void resolve();
-    void place(std::size_t node);
+    void place(std::size_t node, const std::vector<NodeValue>& previous, std::size_t before,
+               std::vector<char>& same);
     void add_node(std::uint64_t handle, int parent, double position, int index);
 
     const GraphDecl* decl_;
