@@ -44,6 +44,20 @@ std::string where(const SourceManager& sources, Span s) {
 
 std::string value_text(const DecompositionGraph& g, int node, int param, bool json) {
     const NodeValue& v = g.value(node, param);
+    if (g.decl().params[static_cast<std::size_t>(param)].kind == GraphParamKind::Silhouette) {
+        // the placed silhouette (Fig. 8): where its base and T are, and its scale
+        const PlacedSilhouette s = v.placed();
+        auto vec = [&](const glm::dvec3& p) {
+            const std::string xyz =
+                format_double(p.x) + ", " + format_double(p.y) + ", " + format_double(p.z);
+            return json ? "[" + xyz + "]" : "(" + xyz + ")";
+        };
+        const std::string scale = format_double(s.placement.scale);
+        if (json)
+            return "{\"base\": " + vec(s.base()) + ", \"tip\": " + vec(s.tip()) + ", \"scale\": " + scale +
+                   "}";
+        return "silhouette base " + vec(s.base()) + " tip " + vec(s.tip()) + " scale " + scale;
+    }
     if (g.decl().params[static_cast<std::size_t>(param)].kind != GraphParamKind::Curve)
         return format_double(v.number);
     std::string out;

@@ -308,6 +308,7 @@ ValueType Compiler::compile_method(Ctx& c, const ast::Expr& e) {
             if (P_.environments[k].name == obj.text && P_.environments[k].kind) env = k;
     if (env < P_.environments.size()) return compile_env_call(c, e, env);
     const bool env_name = obj.kind == K::Name && env_names_.count(obj.text);
+    if (ValueType r; !env_name && compile_silhouette_method(c, e, r)) return r;
     if (!env_name && compile_expr(c, obj) == ValueType::Node) return compile_node_read(c, e, &obj);
     if (env_name) {
         diags_->error(
@@ -462,6 +463,7 @@ ValueType Compiler::compile_call(Ctx& c, const ast::Expr& e) {
         emit(c, Op::Curve, static_cast<std::int32_t>(k), 0, e.span);
         return ValueType::Number;
     }
+    if (name == "child" && e.args.size() == 5) return compile_child_placed(c, e);
     // built-ins: first row whose name and argument types fit
     std::vector<ValueType> types;
     for (const auto& a : e.args) types.push_back(compile_expr(c, *a));

@@ -315,7 +315,9 @@ ValueType Compiler::compile_env_call(Ctx& c, const ast::Expr& e, std::size_t env
                                       e.text, value_type_name(method.args[i]), value_type_name(t)));
         width += value_width(t);
     }
-    emit(c, Op::EnvCall, static_cast<std::int32_t>(env), width, e.span, static_cast<std::uint16_t>(m));
+    // the method's index and its result's width share b (program.hpp), so the stack check is exact
+    emit(c, Op::EnvCall, static_cast<std::int32_t>(env), width, e.span,
+         env_call_operand(m, value_width(method.result)));
     return method.result;
 }
 

@@ -170,6 +170,9 @@ class Compiler {
     void compile_graph_param(const ast::GraphParam& p);
     ValueType compile_node_read(Ctx& c, const ast::Expr& e, const ast::Expr* object);
     ValueType compile_graph_call(Ctx& c, const ast::Expr& e, const BuiltinInfo& b, int width);
+    bool compile_silhouette_method(Ctx& c, const ast::Expr& e, ValueType& result);
+    ValueType compile_child_placed(Ctx& c, const ast::Expr& e);
+    std::string silhouette_method_list() const;
     std::optional<CurveDef> make_curve(const std::string& name, const std::string& kind, Span kind_span,
                                        const std::vector<ast::ExprPtr>& args, Span span);
 

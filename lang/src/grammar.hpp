@@ -248,7 +248,9 @@ struct with_clause : if_must<kw_with, override_block> {};
 struct import_item : if_must<kw_import, import_target, opt<with_clause>, semi> {};
 // graph [match range|single] { name = value; ... }   (docs/language.md, decomposition graphs)
 struct match_clause : if_must<kw_match, name> {};
-struct graph_param : seq<name, must<equals, expr, semi>> {};
+// silhouette(axis: polyline(...), top: ..., ...): a silhouette value, keyed like an env's arguments
+struct silhouette_value : seq<TAO_PEGTL_KEYWORD("silhouette"), ws, key_args> {};
+struct graph_param : seq<name, must<equals, sor<silhouette_value, expr>, semi>> {};
 struct graph_body : if_must<open_brace, star<graph_param>, close_brace> {};
 struct graph_item : if_must<kw_graph, opt<match_clause>, graph_body> {};
 // edits "file.edits";

@@ -90,14 +90,19 @@ bool DecompositionGraph::full() const {
     return n > kMaxNodes || n * std::max<std::size_t>(decl_->params.size(), 1) > kMaxValues;
 }
 
-bool DecompositionGraph::record(std::uint64_t handle, std::uint64_t parent, double position,
-                                int index) const {
+bool DecompositionGraph::record(std::uint64_t handle, std::uint64_t parent, double position, int index,
+                                const NodePlace* place) const {
     std::lock_guard lock(*pending_mutex_);
     if (pending_.count(handle) == 0) {
         const std::size_t n = nodes_.size() + pending_.size() + 1;
         if (n > kMaxNodes || n * std::max<std::size_t>(decl_->params.size(), 1) > kMaxValues) return false;
     }
-    auto [it, added] = pending_.try_emplace(handle, Pending{parent, position, index});
+    Pending fresh{parent, position, index, false, NodePlace{}};
+    if (place) {
+        fresh.placed = true;
+        fresh.place = *place;
+    }
+    auto [it, added] = pending_.try_emplace(handle, fresh);
     if (added) return true;
     const Pending& p = it->second;
     return p.parent == parent && std::fabs(p.position - position) <= kSamePosition && p.index == index;
@@ -165,6 +170,13 @@ void DecompositionGraph::commit() {
                 continue;
             }
             add_node(h, parent, p.position, p.index);
+            if (p.placed) { // the first call that made the node places it
+                GraphNode& n = nodes_.back();
+                n.placed = true;
+                n.base = p.place.base;
+                n.dir = p.place.dir;
+                n.span = p.place.span;
+            }
             progress = true;
         }
         fresh = std::move(later);
@@ -253,6 +265,7 @@ struct Local {
     bool is_private = false;
     double number = 0;
     const CurveDef* curve = nullptr;
+    std::shared_ptr<const Silhouette> silhouette;
     int edit = -1;
 };
 
@@ -279,6 +292,7 @@ void apply(Local& l, const GraphEdit& e, int k) {
     }
     l.number = e.number;
     l.curve = e.curve.get();
+    l.silhouette = e.silhouette;
     l.edit = k;
 }
 } // namespace
@@ -290,6 +304,7 @@ void DecompositionGraph::resolve() {
         local[p].status = ValueStatus::Explicit;
         local[p].number = decl_->params[p].number;
         local[p].curve = decl_->params[p].curve.get();
+        local[p].silhouette = decl_->params[p].silhouette;
     }
     const std::size_t E = edits_ ? edits_->edits.size() : 0;
     matches_.assign(E, -1);
@@ -312,8 +327,12 @@ void DecompositionGraph::resolve() {
             if (m >= 0) apply(local[static_cast<std::size_t>(m) * P + p], e, static_cast<int>(k));
         }
     }
-    // parents come before their children in nodes_, so one pass resolves everything
-    values_.assign(N * P, NodeValue{});
+    // parents come before their children in nodes_, so one pass resolves everything; a node whose
+    // silhouettes and parent's placements are as at the last commit keeps its placements
+    std::vector<NodeValue> previous(N * P);
+    previous.swap(values_);
+    const std::size_t before = std::min(previous.size() / std::max<std::size_t>(P, 1), N);
+    std::vector<char> same(N, 0);
     std::vector<int> source(N * P); // the node whose value this node's children inherit
     for (std::size_t n = 0; n < N; ++n) {
         const int parent = nodes_[n].parent;
@@ -330,6 +349,7 @@ void DecompositionGraph::resolve() {
                 v.from = static_cast<int>(n);
                 v.number = l.number;
                 if (l.curve) v.curve = {CurveTerm{EditOp::Set, l.curve}};
+                v.silhouette = l.silhouette;
                 continue;
             }
             const int from = source[static_cast<std::size_t>(parent) * P + p];
@@ -338,6 +358,7 @@ void DecompositionGraph::resolve() {
             v.from = inherited.status == ValueStatus::Inherited ? inherited.from : from;
             v.number = inherited.number;
             v.curve = inherited.curve;
+            v.silhouette = inherited.silhouette; // (a silhouette is never relative)
             if (l.status == ValueStatus::Offset) {
                 v.number += l.number;
                 if (l.curve) v.curve.push_back({EditOp::Offset, l.curve});
@@ -346,6 +367,41 @@ void DecompositionGraph::resolve() {
                 if (l.curve) v.curve.push_back({EditOp::Fraction, l.curve});
             }
         }
+        place(n, previous, before, same);
+    }
+}
+
+// Places node n's silhouettes (Boudon et al. 2003, section 3, Fig. 8): the root's are in world
+// coordinates; a node made by child(n, pos, index, base, dir) has B at base, BT along dir and T on
+// its parent's envelope of the same parameter; any other node keeps its parent's placement.
+void DecompositionGraph::place(std::size_t n, const std::vector<NodeValue>& previous, std::size_t before,
+                               std::vector<char>& same) {
+    const std::size_t P = decl_->params.size();
+    const GraphNode& node = nodes_[n];
+    // unchanged since the last commit: the same silhouettes here and an unchanged parent
+    bool keep = n < before && (node.parent < 0 || same[static_cast<std::size_t>(node.parent)]);
+    for (std::size_t p = 0; p < P && keep; ++p)
+        keep = previous[n * P + p].silhouette == values_[n * P + p].silhouette;
+    same[n] = keep;
+    if (keep) {
+        for (std::size_t p = 0; p < P; ++p) values_[n * P + p].placement = previous[n * P + p].placement;
+        return;
+    }
+    for (std::size_t p = 0; p < P; ++p) {
+        if (decl_->params[p].kind != GraphParamKind::Silhouette) continue;
+        NodeValue& v = values_[n * P + p];
+        if (node.parent < 0 || !v.silhouette) continue; // the identity
+        const NodeValue& up = values_[static_cast<std::size_t>(node.parent) * P + p];
+        if (!node.placed) {
+            v.placement = up.placement;
+            continue;
+        }
+        ChildPlacement c = place_child(*up.silhouette, up.placement, *v.silhouette, node.base, node.dir);
+        if (!c.ok())
+            throw RuntimeError{RuntimeErrorKind::General, node.span,
+                               fmt::format("cannot place silhouette '{}' of {}: {}", decl_->params[p].name,
+                                           path(static_cast<int>(n)), c.error)};
+        v.placement = c.placement;
     }
 }
 

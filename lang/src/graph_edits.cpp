@@ -6,6 +6,7 @@
 // read into GraphEdits with every error at its line and column. Values are evaluated here, with
 // the program's params and consts: numbers, arithmetic, and linear(...) / bezier(...) curves.
 #include "compiler_internal.hpp"
+#include "graph_silhouette.hpp"
 #include "plant/derive.hpp"
 #include "plant/graph.hpp"
 #include "plant/parser.hpp"
@@ -219,14 +220,20 @@ class LineReader {
         }
         const bool is_curve =
             expr->kind == ast::ExprKind::Call && (expr->text == "linear" || expr->text == "bezier");
-        if (expr->kind == ast::ExprKind::Call && expr->text == "silhouette")
-            fail(expr->span.begin, expr->span.end, "silhouette values are not supported yet");
+        const bool is_silhouette = expr->kind == ast::ExprKind::Call && expr->text == "silhouette";
+        if (is_silhouette != (p.kind == GraphParamKind::Silhouette))
+            fail(
+                expr->span.begin, expr->span.end,
+                is_silhouette
+                    ? fmt::format("'{}' is a {}, found a silhouette", p.name, graph_param_kind_name(p.kind))
+                    : fmt::format("'{}' is a silhouette: give silhouette(axis: ..., top: ..., ...)", p.name));
+        if (p.kind == GraphParamKind::Silhouette) {
+            edit.silhouette = silhouette(*expr);
+            return;
+        }
         if (p.kind == GraphParamKind::Number && is_curve)
             fail(expr->span.begin, expr->span.end,
                  fmt::format("'{}' is a number, found a curve: give a number expression", p.name));
-        if (p.kind == GraphParamKind::Silhouette)
-            fail(expr->span.begin, expr->span.end,
-                 fmt::format("'{}' is a silhouette, which is not supported yet", p.name));
         if (p.kind == GraphParamKind::Number) {
             edit.number = eval(*expr);
             return;
@@ -242,6 +249,32 @@ class LineReader {
             curve(*expr, c);
         }
         edit.curve = std::make_shared<const CurveDef>(std::move(c));
+    }
+
+    std::shared_ptr<const Silhouette> silhouette(const ast::Expr& e) const {
+        SilhouetteEval ev;
+        ev.vec = [&](const ast::Expr& x) -> std::optional<glm::dvec3> { return point(x); };
+        ev.number = [&](const ast::Expr& x) -> std::optional<double> { return eval(x); };
+        ev.error = [&](Span s, std::string m) { fail(s.begin, s.end, std::move(m)); };
+        return build_silhouette(e, ev);
+    }
+
+    // vec3(x, y, z) of number expressions, or a vec3 param or const
+    glm::dvec3 point(const ast::Expr& e) const {
+        if (e.kind == ast::ExprKind::Call && e.text == "vec3" && e.args.size() == 3)
+            return {eval(*e.args[0]), eval(*e.args[1]), eval(*e.args[2])};
+        if (e.kind == ast::ExprKind::Name) {
+            if (auto it = prog_.global_index.find(e.text); it != prog_.global_index.end()) {
+                const Global& g = prog_.globals[it->second];
+                if (g.type == ValueType::Vec3)
+                    return {prog_.global_values[g.slot], prog_.global_values[g.slot + 1],
+                            prog_.global_values[g.slot + 2]};
+            }
+            for (const auto& c : prog_.constants)
+                if (c.name == e.text && c.type == ValueType::Vec3) return {c.v[0], c.v[1], c.v[2]};
+        }
+        fail(e.span.begin, e.span.end,
+             "a silhouette's point is vec3(x, y, z) of numbers, or a vec3 param or const");
     }
 
     void curve(const ast::Expr& e, CurveDef& c) const {

@@ -35,8 +35,8 @@ std::string committed(const DecompositionGraph& g, double v, int& node) {
     return fmt::format("{} is not a node of the decomposition graph", format_double(v));
 }
 
-std::string make_child(const DecompositionGraph& g, const double* a, bool with_index, bool records,
-                       double& r) {
+std::string make_child(const DecompositionGraph& g, const double* a, bool with_index, bool records, double& r,
+                       const NodePlace* place = nullptr) {
     std::uint64_t parent = 0;
     const bool parent_ok = as_handle(a[0], parent) && (g.find(parent) >= 0 || g.is_pending(parent));
     if (!parent_ok) return fmt::format("{} is not a node of the decomposition graph", format_double(a[0]));
@@ -60,7 +60,26 @@ std::string make_child(const DecompositionGraph& g, const double* a, bool with_i
                            "{} of another node",
                            g.path(known), format_double(pos));
     }
-    if (records && !g.record(h, parent, pos, index))
+    if (place) { // the parent's silhouettes must be there to place the child's in (Fig. 8)
+        const int up = g.find(parent);
+        if (up < 0)
+            return "the parent node was made in the current pass: place its children from the next step "
+                   "(nodes are committed when a pass ends)";
+        for (std::size_t p = 0; p < g.decl().params.size(); ++p) {
+            if (g.decl().params[p].kind != GraphParamKind::Silhouette) continue;
+            const NodeValue& v = g.value(up, static_cast<int>(p));
+            // the branching point inside the parent's envelope (the ray's reach is checked when
+            // the node is committed, with this call's span)
+            const double level = v.placed().level(place->base);
+            if (!(level <= 1.0 + 1e-9))
+                return fmt::format(
+                    "cannot place silhouette '{}': the branching point lies outside the parent's "
+                    "envelope (level {:.6g}, at most 1 inside): place branches on the part of the "
+                    "axis inside it",
+                    g.decl().params[p].name, level);
+        }
+    }
+    if (records && !g.record(h, parent, pos, index, place))
         return g.full() ? fmt::format("the decomposition graph would have more than {} nodes (or {} values: "
                                       "nodes times parameters)",
                                       DecompositionGraph::kMaxNodes, DecompositionGraph::kMaxValues)
@@ -93,6 +112,82 @@ std::string graph_builtin(BuiltinId id, const double* a, double* r, const EvalEn
     default:
         return "not a graph built-in";
     }
+}
+
+std::string graph_place(const double* a, double* r, const EvalEnv& env, Span span) {
+    const DecompositionGraph* g = env.run ? env.run->graph() : nullptr;
+    if (!g) return "the decomposition graph exists only while the plant is derived";
+    NodePlace place;
+    place.base = {a[3], a[4], a[5]};
+    place.dir = {a[6], a[7], a[8]};
+    place.span = span;
+    return make_child(*g, a, true, env.graph_records, r[0], &place);
+}
+
+namespace {
+constexpr ValueType N = ValueType::Number, V = ValueType::Vec3, B = ValueType::Bool, X = ValueType::Void;
+constexpr SilhouetteMethodInfo kMethods[] = {
+    {"level", SilhouetteMethod::Level, 1, {V, X}, N, "how far out p is: below 1 inside, 1 on the envelope"},
+    {"contains", SilhouetteMethod::Contains, 1, {V, X}, B, "p inside the envelope"},
+    {"reach",
+     SilhouetteMethod::Reach,
+     2,
+     {V, V},
+     N,
+     "the distance from p along the unit d to the envelope, 0 when p is outside"},
+    {"axis", SilhouetteMethod::Axis, 1, {N, X}, V, "the point at t of the placed axis"},
+    {"heading", SilhouetteMethod::Heading, 1, {N, X}, V, "the unit tangent at t of the placed axis"},
+    {"base", SilhouetteMethod::Base, 0, {X, X}, V, "the placed base B"},
+    {"tip", SilhouetteMethod::Tip, 0, {X, X}, V, "the placed control point T"},
+    {"scale", SilhouetteMethod::Scale, 0, {X, X}, N, "the placement's scale"},
+};
+} // namespace
+
+std::span<const SilhouetteMethodInfo> silhouette_methods() {
+    return kMethods;
+}
+
+std::string graph_shape(int param, std::size_t method, const double* a, double* r, const EvalEnv& env) {
+    const DecompositionGraph* g = env.run ? env.run->graph() : nullptr;
+    if (!g) return "the decomposition graph exists only while the plant is derived";
+    int node = -1;
+    if (std::string e = committed(*g, a[0], node); !e.empty()) return e;
+    const PlacedSilhouette s = g->value(node, param).placed();
+    const glm::dvec3 p{a[1], a[2], a[3]};
+    auto put = [&](const glm::dvec3& v) {
+        r[0] = v.x;
+        r[1] = v.y;
+        r[2] = v.z;
+    };
+    switch (kMethods[method].id) {
+    case SilhouetteMethod::Level:
+        r[0] = s.level(p);
+        break;
+    case SilhouetteMethod::Contains:
+        r[0] = s.contains(p) ? 1 : 0;
+        break;
+    case SilhouetteMethod::Reach: {
+        const glm::dvec3 d{a[4], a[5], a[6]};
+        r[0] = s.reach(p, d);
+        break;
+    }
+    case SilhouetteMethod::Axis:
+        put(s.axis(a[1]));
+        break;
+    case SilhouetteMethod::Heading:
+        put(s.heading(a[1]));
+        break;
+    case SilhouetteMethod::Base:
+        put(s.base());
+        break;
+    case SilhouetteMethod::Tip:
+        put(s.tip());
+        break;
+    case SilhouetteMethod::Scale:
+        r[0] = s.placement.scale;
+        break;
+    }
+    return {};
 }
 
 std::string graph_read(int param, bool curve, const double* a, double* r, const EvalEnv& env) {

@@ -35,7 +35,8 @@ using selector = pt::selector<
         g::setting_item, g::setting_key, g::axiom_item, g::symbol_set_item, g::symbol_set_kind, g::rules_item,
         g::group_name, g::rules_body, g::decompose_item, g::interpret_item, g::max_depth_clause, g::hook_item,
         g::hook_name, g::import_item, g::import_target, g::with_clause, g::override_block, g::override_item,
-        g::graph_item, g::match_clause, g::graph_body, g::graph_param, g::edits_item, g::edits_target>,
+        g::graph_item, g::match_clause, g::graph_body, g::graph_param, g::silhouette_value, g::edits_item,
+        g::edits_target>,
     // (ternary_then and ternary_else are selected only so that their nesting is counted: the tree
     // builder calls the grammar's control for selected rules alone; each has one child, which
     // fold_one puts in its place)
@@ -94,6 +95,15 @@ class Lowering {
             e->kind = ast::ExprKind::Call;
             e->text = n.children.at(0)->string();
             for (const auto& a : n.children.at(1)->children) e->args.push_back(expr(*a));
+        } else if (n.is_type<g::silhouette_value>()) { // keyed arguments (a graph's silhouette)
+            e->kind = ast::ExprKind::Call;
+            e->text = "silhouette";
+            for (const auto& a : n.children.at(0)->children) {
+                const bool keyed = a->children.size() == 2;
+                e->keys.push_back(keyed ? a->children[0]->string() : std::string());
+                e->key_spans.push_back(span(*a->children[0]));
+                e->args.push_back(expr(*a->children.back()));
+            }
         } else if (n.is_type<g::unary_expr>()) {
             e->kind = ast::ExprKind::Unary;
             e->unary = spelled(ast::kUnaryOps, *n.children.at(0));
@@ -713,8 +723,9 @@ ast::ExprPtr parse_expression(const SourceManager& sources, std::uint32_t file_i
     tao::pegtl::memory_input<> in(text.data() + begin, text.data() + end, src.name(), begin, lc.line, lc.col);
     g::ParseState state;
     try {
-        auto root = pt::parse<tao::pegtl::seq<g::ws, g::expr, tao::pegtl::eof>, selector, tao::pegtl::nothing,
-                              g::control>(in, state);
+        auto root =
+            pt::parse<tao::pegtl::seq<g::ws, tao::pegtl::sor<g::silhouette_value, g::expr>, tao::pegtl::eof>,
+                      selector, tao::pegtl::nothing, g::control>(in, state);
         if (!root || root->children.empty()) {
             diags.error({file_id, begin, end}, "expected an expression");
             return nullptr;

@@ -538,16 +538,17 @@ RunStatus execute(const Code& code, double* frame, EvalEnv& env, double* result)
         case Op::EnvCall: {
             const auto e = static_cast<std::size_t>(I.a);
             const EnvironmentDecl& decl = env.prog->environments[e];
-            const EnvMethod& method = decl.kind->methods[I.b];
+            const std::size_t m = env_call_method(I);
+            const EnvMethod& method = decl.kind->methods[m];
             sp -= I.n;
             double r[3] = {0, 0, 0};
             if (method.access == EnvAccess::Edit) {
                 // the compiler allows edits in hooks only, and only hooks run with hook_run set
                 if (!env.hook_run) fail(code, pc, "an environment can be changed only in hooks");
-                env.hook_run->environment(e)->edit(I.b, st + sp);
+                env.hook_run->environment(e)->edit(m, st + sp);
             } else {
                 const Environment* object = env.run ? env.run->environment(e) : decl.initial.get();
-                object->query(I.b, st + sp, r);
+                object->query(m, st + sp, r);
             }
             for (int k = 0; k < value_width(method.result); ++k) st[sp++] = r[k];
             break;
@@ -561,6 +562,22 @@ RunStatus execute(const Code& code, double* frame, EvalEnv& env, double* result)
                                     : graph_read(I.a, I.n == 2, st + sp, r, env);
             if (!error.empty()) fail(code, pc, std::move(error));
             st[sp++] = r[0];
+            break;
+        }
+        case Op::GraphPlace: {
+            sp -= 9;
+            double r[1] = {0};
+            std::string error = graph_place(st + sp, r, env, code.spans[pc]);
+            if (!error.empty()) fail(code, pc, std::move(error));
+            st[sp++] = r[0];
+            break;
+        }
+        case Op::GraphShape: {
+            sp -= I.n;
+            double r[3] = {0, 0, 0};
+            std::string error = graph_shape(I.a, env_call_method(I), st + sp, r, env);
+            if (!error.empty()) fail(code, pc, std::move(error));
+            for (unsigned k = 0; k < (I.b >> kEnvMethodBits); ++k) st[sp++] = r[k];
             break;
         }
         }

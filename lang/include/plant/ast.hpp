@@ -135,6 +135,9 @@ struct Expr {
     BinaryOp binary = BinaryOp::Add; // Binary
     UnaryOp unary = UnaryOp::Neg;    // Unary
     std::vector<ExprPtr> args;
+    // silhouette(key: value, ...) only: each argument's key ("" when none) and its span
+    std::vector<std::string> keys;
+    std::vector<Span> key_spans;
 };
 
 // One module as written in a successor or pattern. `raw` is a letter run not yet split into

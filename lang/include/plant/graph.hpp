@@ -8,6 +8,7 @@
 #pragma once
 
 #include "plant/diagnostics.hpp"
+#include "plant/silhouette.hpp"
 #include "plant/source.hpp"
 
 #include <cstdint>
@@ -22,8 +23,8 @@ namespace plant {
 struct CurveDef;
 struct Program;
 
-// What a graph parameter holds. Silhouettes are declared by the grammar but their geometry is
-// not wired in yet: a `silhouette(...)` value is a compile error saying so.
+// What a graph parameter holds: a number, a curve (a function of t) or a silhouette (an axis, an
+// envelope and the control point T, placed in each node by child(n, pos, index, base, dir)).
 enum class GraphParamKind : std::uint8_t { Number, Curve, Silhouette };
 const char* graph_param_kind_name(GraphParamKind k);
 
@@ -34,8 +35,9 @@ enum class GraphMatch : std::uint8_t { Range, Single };
 struct GraphParamDecl {
     std::string name;
     GraphParamKind kind = GraphParamKind::Number;
-    double number = 0;                     // the root's default (Number)
-    std::shared_ptr<const CurveDef> curve; // the root's default (Curve)
+    double number = 0;                            // the root's default (Number)
+    std::shared_ptr<const CurveDef> curve;        // the root's default (Curve)
+    std::shared_ptr<const Silhouette> silhouette; // the root's default (Silhouette)
     Span span;
 };
 
@@ -76,6 +78,7 @@ struct GraphEdit {
     EditOp op = EditOp::Set;
     double number = 0;
     std::shared_ptr<const CurveDef> curve;
+    std::shared_ptr<const Silhouette> silhouette;
     std::string value_text; // the value as written (for listings)
 };
 
@@ -101,6 +104,17 @@ struct GraphNode {
     int index = 0;
     int depth = 0;
     std::vector<int> children; // by position, then index
+    // child(n, pos, index, base, dir): where the branch starts and which way it points, for the
+    // placement of the node's silhouettes (Fig. 8); the call's span for errors
+    bool placed = false;
+    glm::dvec3 base{0.0}, dir{0.0};
+    Span span;
+};
+
+// Where child(n, pos, index, base, dir) puts a new node's silhouettes.
+struct NodePlace {
+    glm::dvec3 base{0.0}, dir{0.0};
+    Span span;
 };
 
 // How a node's value of a parameter came about.
@@ -120,7 +134,10 @@ struct NodeValue {
     int edit = -1; // the edit that set the status or value, -1: none
     double number = 0;
     std::vector<CurveTerm> curve;
+    std::shared_ptr<const Silhouette> silhouette; // own coordinates (explicit or inherited)
+    Placement placement;                          // own coordinates to world (Fig. 8)
     double at(double t) const;
+    PlacedSilhouette placed() const { return {silhouette.get(), placement}; }
 };
 
 class DecompositionGraph {
@@ -147,14 +164,16 @@ class DecompositionGraph {
     }
     // Records a child made during a pass (from any thread); committed by commit(). False when
     // the handle is already recorded for another path (a hash collision).
-    bool record(std::uint64_t handle, std::uint64_t parent, double position, int index) const;
+    bool record(std::uint64_t handle, std::uint64_t parent, double position, int index,
+                const NodePlace* place = nullptr) const;
     // Whether `handle` was recorded in this pass and is not committed yet.
     bool is_pending(std::uint64_t handle) const;
     // Whether one more node would pass kMaxNodes or kMaxValues (record() then refuses it).
     bool full() const;
     // Commits the nodes recorded since the last commit (sorted by path, so the result does not
-    // depend on the threads), then matches the edits and resolves every value. Throws
-    // RuntimeError (kind General) on a hash collision or too many nodes.
+    // depend on the threads), then matches the edits, resolves every value and places every
+    // silhouette. Throws RuntimeError (kind General) on a hash collision, too many nodes or a
+    // silhouette that cannot be placed (at the child() call that made the node).
     void commit();
 
     std::size_t size() const { return nodes_.size(); }
@@ -180,9 +199,13 @@ class DecompositionGraph {
         std::uint64_t parent;
         double position;
         int index;
+        bool placed = false;
+        NodePlace place;
     };
     int match(const GraphEdit& e) const;
     void resolve();
+    void place(std::size_t node, const std::vector<NodeValue>& previous, std::size_t before,
+               std::vector<char>& same);
     void add_node(std::uint64_t handle, int parent, double position, int index);
 
     const GraphDecl* decl_;

@@ -63,10 +63,15 @@ OPCODE(LoadMulConst, 0, 1, Next, "push frame[a] * consts[b]")
 OPCODE(LoadAddConst, 0, 1, Next, "push frame[a] + consts[b]")
 // ---- shapes and environments ----
 OPCODE(Curve, 1, 1, Next, "replace t on top by curves[a](t)")
-OPCODE(EnvCall, n, 3, Next,
-       "method b of environment a (the run state's), on n numbers; pushes its result (at most a vec3)")
+OPCODE(
+    EnvCall, n, b >> 12, Next,
+    "method (b & 0xfff) of environment a (the run state's), on n numbers; pushes its result, b >> 12 numbers")
 // ---- decomposition graphs (graph_ops.hpp) ----
 OPCODE(GraphCall, n, b, Next, "graph built-in a (root, child, depth, ...) on n numbers, giving b numbers")
 OPCODE(
     GraphRead, n, 1, Next,
     "parameter a of a node: pops the node (n = 1), or the node and t for a curve (n = 2); pushes its value")
+OPCODE(GraphPlace, 9, 1, Next, "child(n, pos, index, base, dir): pops those 9 numbers, pushes the child node")
+OPCODE(GraphShape, n, b >> 12, Next,
+       "method (b & 0xfff) of silhouette parameter a of a node: pops the node and its arguments (n numbers), "
+       "pushes b >> 12")

@@ -105,6 +105,16 @@ struct Instr {
     std::int32_t a = 0;  // primary operand
 };
 
+// EnvCall's b holds the method's index in its low 12 bits and the width of its result (0, 1 or
+// 3 numbers) above them, so that the opcode table's stack effect is exact for every method.
+inline constexpr unsigned kEnvMethodBits = 12;
+inline constexpr std::uint16_t env_call_operand(std::size_t method, int result_width) {
+    return static_cast<std::uint16_t>(method | (static_cast<unsigned>(result_width) << kEnvMethodBits));
+}
+inline constexpr std::size_t env_call_method(const Instr& I) {
+    return I.b & ((1u << kEnvMethodBits) - 1);
+}
+
 // How many numbers an instruction pops, then pushes (opcodes.hpp).
 struct StackEffect {
     int pops = 0, pushes = 0;

@@ -239,11 +239,142 @@ rules { A(n) -> F(n.lenght) F(n.bend) F(n.length(1)); }
     CHECK(msg.find("'bend' is a curve: read it at a t from 0 to 1") != std::string::npos);
     CHECK(msg.find("'length' is a number: read it as n.length") != std::string::npos);
     auto s = test::compile("graph { crown = silhouette(); }\naxiom: F;\n");
-    CHECK(s->rendered().find("silhouette parameters are not supported yet") != std::string::npos);
+    CHECK(s->rendered().find("a silhouette needs 'axis:'") != std::string::npos);
     auto n = test::compile("module A(n: node);\naxiom: A(3);\n");
     CHECK(n->rendered().find("parameter 'n' of 'A' is a node, found a number") != std::string::npos);
     auto g = test::compile("axiom: F(depth(root()));\n");
     CHECK(g->rendered().find("'root' needs a decomposition graph") != std::string::npos);
+}
+
+// ---- silhouettes (Boudon et al. 2003, sections 2.4 and 3, Fig. 8) ---------------------------
+
+namespace {
+
+// A small bonsai-like graph: the root's crown, a trunk along its axis bearing six branches
+// (phyllotaxis 137.5 degrees, rising with height), each bearing three twigs along its own placed
+// axis, all placed by child(n, pos, index, base, dir).
+const char* kCrowns = R"(
+graph {
+  crown = silhouette(axis: bezier(vec3(0, 0, 0), vec3(0.1, 4, 0), vec3(-0.1, 7, 0), vec3(0, 10, 0)),
+                     top: vec3(0, 10, 0), bottom: vec3(0, 1, 0), px: vec3(4, 4, 0), pz: vec3(0, 5, 3.5),
+                     nx: vec3(-3, 4.5, 0), nz: vec3(0, 3.5, -3), top_shape: 1.5, bottom_shape: 2.5,
+                     tip: vec3(0, 10, 0));
+  rise = 70;
+}
+module Axis(n: node, o);
+derive 3;
+axiom: Axis(root(), 0);
+fn dir(h: vec3, i, a) {
+  let side = normalize(cross(h, vec3(cos(rad(137.5 * i)), 0, sin(rad(137.5 * i)))));
+  return normalize(h * cos(rad(a)) + side * sin(rad(a)));
+}
+rules {
+  Axis(n, o) : o < 2 {
+    let kids = o == 0 ? 6 : 3;
+    for i in 1..kids + 1 {
+      let t = (o == 0 ? 0.2 : 0.1) + 0.7 * i / (kids + 1);
+      let p = n.crown.axis(t);
+      nproduce [ Axis(child(n, t, 0, p, dir(n.crown.heading(t), i, n.rise)), o + 1) ];
+    }
+    produce F(n.crown.scale());
+  }
+}
+)";
+
+} // namespace
+
+TEST_CASE("graph: every placed child's T lies on its parent's envelope, every branch point inside it") {
+    Run r = derive(kCrowns, "");
+    const int crown = r.g().decl().find("crown");
+    REQUIRE(r.g().size() == 1 + 6 + 18);
+    int checked = 0;
+    for (std::size_t k = 1; k < r.g().size(); ++k) {
+        const GraphNode& n = r.g().node(static_cast<int>(k));
+        const PlacedSilhouette child = r.g().value(static_cast<int>(k), crown).placed();
+        const PlacedSilhouette parent = r.g().value(n.parent, crown).placed();
+        INFO(r.g().path(static_cast<int>(k)));
+        REQUIRE(n.placed);
+        // T on the parent's envelope (Fig. 8): the placement solves for it, so only rounding
+        CHECK(std::fabs(parent.level(child.tip()) - 1) < 1e-9);
+        // the branch point inside the parent's envelope: it lies on the parent's placed axis,
+        // which the envelope holds; 1e-9 absorbs rounding only
+        CHECK(parent.level(child.base()) <= 1 + 1e-9);
+        CHECK(glm::length(child.base() - n.base) < 1e-9);
+        // BT along the branch direction
+        CHECK(glm::dot(glm::normalize(child.tip() - child.base()), glm::normalize(n.dir)) > 1 - 1e-9);
+        ++checked;
+    }
+    CHECK(checked == 24);
+    // a twig is smaller than its branch, a branch than the plant
+    CHECK(r.value("/0.3", "crown").placement.scale < 1);
+    CHECK(r.value("/0.3/0.275", "crown").placement.scale < r.value("/0.3", "crown").placement.scale);
+}
+
+TEST_CASE("graph: silhouettes are explicit or inherited in edits, never relative") {
+    const std::string sil =
+        "silhouette(axis: polyline(vec3(0, 0, 0), vec3(0, 2, 0)), top: vec3(0, 2, 0), "
+        "bottom: vec3(0, 0, 0), px: vec3(1, 1, 0), pz: vec3(0, 1, 1), nx: vec3(-1, 1, 0), "
+        "nz: vec3(0, 1, -1), tip: vec3(0, 2, 0))";
+    Run r = derive(kCrowns, "/0.3[0.2..0.4] crown = " + sil + "\n/0.4 rise = 20\n");
+    const NodeValue& own = r.value("/0.3", "crown");
+    CHECK(own.status == ValueStatus::Explicit);
+    CHECK(own.silhouette->envelope.top.y == 2);
+    // its twigs inherit the edited silhouette, placed inside it
+    const NodeValue& twig = r.value("/0.3/0.275", "crown");
+    CHECK(twig.status == ValueStatus::Inherited);
+    CHECK(twig.silhouette == own.silhouette);
+    CHECK(std::fabs(own.placed().level(twig.placed().tip()) - 1) < 1e-9);
+    // a sibling keeps the root's
+    CHECK(r.value("/0.6", "crown").silhouette == r.value("/", "crown").silhouette);
+    auto c = test::compile(kCrowns);
+    REQUIRE(c->program);
+    const std::uint32_t id =
+        c->sources.add("bad.edits", "/0.3 crown *= 2\n/0.5 crown = 3\n/0.6 rise = " + sil + "\n");
+    CHECK(!parse_edits(*c->program, c->sources, id, c->diags));
+    const std::string msg = c->rendered();
+    CHECK(msg.find("bad.edits:1:12: error: a silhouette can be explicit or inherited, not relative") !=
+          std::string::npos);
+    CHECK(msg.find("bad.edits:2:14: error: 'crown' is a silhouette: give silhouette(") != std::string::npos);
+    CHECK(msg.find("bad.edits:3:13: error: 'rise' is a number, found a silhouette") != std::string::npos);
+}
+
+TEST_CASE("graph: silhouette errors, at compile time and at the child() call") {
+    auto c = test::compile(R"(
+graph { crown = silhouette(axis: polyline(vec3(0, 0, 0), vec3(0, 1, 0)), top: vec3(0, 1, 0), bottom: vec3(0, 0, 0),
+                           px: vec3(1, 0.5, 0), pz: vec3(0, 0.5, 1), nx: vec3(-1, 0.5, 0), nz: vec3(0, 0.5, -1)); }
+module A(n: node);
+axiom: A(root());
+rules { A(n) -> F(n.crown.levle(vec3(0, 0, 0))) F(n.crown) F(n.crown.reach(vec3(0, 0, 0))); }
+)");
+    CHECK(!c->program);
+    const std::string msg = c->rendered();
+    CHECK(msg.find("6:19: error: a silhouette has no method 'levle'; did you mean 'level'?") !=
+          std::string::npos);
+    CHECK(msg.find("'crown' is a silhouette: call one of its methods") != std::string::npos);
+    CHECK(msg.find("'crown.reach' takes 2 arguments, given 1") != std::string::npos);
+    auto k =
+        test::compile("graph { crown = silhouette(axis: polyline(vec3(0, 0, 0), vec3(0, 1, 0)), topp: 1); }\n"
+                      "axiom: F;\n");
+    CHECK(k->rendered().find("a silhouette has no argument 'topp'; did you mean 'top'?") !=
+          std::string::npos);
+    // a branch point outside the parent's envelope: a runtime error at the call
+    auto out = test::compile(R"(
+graph { crown = silhouette(axis: polyline(vec3(0, 0, 0), vec3(0, 1, 0)), top: vec3(0, 1, 0), bottom: vec3(0, 0, 0),
+                           px: vec3(1, 0.5, 0), pz: vec3(0, 0.5, 1), nx: vec3(-1, 0.5, 0), nz: vec3(0, 0.5, -1)); }
+module A(n: node);
+derive 1;
+axiom: A(root());
+rules { A(n) -> A(child(n, 0.5, 0, vec3(5, 0.5, 0), vec3(1, 0, 0))); }
+)");
+    REQUIRE(out->program);
+    Derivation d(*out->program, {});
+    try {
+        d.run();
+        FAIL("expected a runtime error");
+    } catch (const RuntimeError& e) {
+        CHECK(e.message.find("the branching point lies outside the parent's envelope") != std::string::npos);
+        CHECK(e.span.begin > 0);
+    }
 }
 
 } // namespace plant

@@ -51,6 +51,33 @@ TEST_CASE("the opcode table names every opcode once and knows which ones jump", 
     CHECK(stack_effect(Instr{Op::Builtin, 2, 3, 0}).pushes == 3);
 }
 
+TEST_CASE("an environment call pushes exactly its method's result width", "[vm]") {
+    // b holds the method and the result's width (program.hpp)
+    const Instr number{Op::EnvCall, 3, env_call_operand(5, 1), 0};
+    CHECK(env_call_method(number) == 5);
+    CHECK(stack_effect(number).pops == 3);
+    CHECK(stack_effect(number).pushes == 1);
+    CHECK(stack_effect(Instr{Op::EnvCall, 3, env_call_operand(2, 3), 0}).pushes == 3);
+    CHECK(stack_effect(Instr{Op::EnvCall, 3, env_call_operand(2, 0), 0}).pushes == 0);
+    // a number-returning method called in a loop: counted as a vec3, the loop's depth would
+    // seem to grow on every turn and the check would fail
+    CompileOptions opts;
+    opts.environments = runtime_environments();
+    auto c = test::compile(
+        "env box = ellipsoid(center: vec3(0, 0, 0), radii: vec3(1, 1, 1));\n"
+        "fn total(n) {\n  let s = 0;\n"
+        "  for k in 0..n { s += box.level(vec3(k, 0, 0)); if box.contains(vec3(0, k, 0)) { s += 1; } }\n"
+        "  return s;\n}\naxiom: F(total(3));\n",
+        opts);
+    INFO(c->rendered());
+    REQUIRE(c->program);
+    for (const auto& [name, code] : all_code(*c->program)) {
+        const StackCheck r = check_stack(*code);
+        INFO(name << ": " << r.error << "\n" << disassemble(*code));
+        CHECK(r.ok);
+    }
+}
+
 TEST_CASE("check_stack finds code that pops more than the stack holds", "[vm]") {
     Code bad;
     bad.instrs = {Instr{Op::Const, 0, 0, 0}, Instr{Op::Add, 0, 0, 0}, Instr{Op::Halt, 1, 0, 0}};
