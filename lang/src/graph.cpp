@@ -12,6 +12,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <unordered_map>
 
 namespace plant {
 
@@ -104,8 +106,17 @@ bool DecompositionGraph::record(std::uint64_t handle, std::uint64_t parent, doub
     }
     auto [it, added] = pending_.try_emplace(handle, fresh);
     if (added) return true;
-    const Pending& p = it->second;
-    return p.parent == parent && std::fabs(p.position - position) <= kSamePosition && p.index == index;
+    Pending& p = it->second;
+    if (p.parent != parent || std::fabs(p.position - position) > kSamePosition || p.index != index)
+        return false;
+    // one node named twice with positions a rounding error apart: keep the lower position (and its
+    // placement), whichever thread came first, so the graph is the same for every --threads
+    if (position < p.position) {
+        p.position = position;
+        p.placed = fresh.placed;
+        p.place = fresh.place;
+    }
+    return true;
 }
 
 bool DecompositionGraph::is_pending(std::uint64_t handle) const {
@@ -123,13 +134,8 @@ void DecompositionGraph::add_node(std::uint64_t handle, int parent, double posit
     const int k = static_cast<int>(nodes_.size());
     by_handle_[handle] = k;
     nodes_.push_back(std::move(n));
-    if (parent < 0) return;
-    auto& siblings = nodes_[static_cast<std::size_t>(parent)].children;
-    auto before = [&](int a, int b) {
-        const GraphNode &x = nodes_[static_cast<std::size_t>(a)], &y = nodes_[static_cast<std::size_t>(b)];
-        return x.position != y.position ? x.position < y.position : x.index < y.index;
-    };
-    siblings.insert(std::upper_bound(siblings.begin(), siblings.end(), k, before), k);
+    // (commit sorts each parent's children once, after adding a pass's nodes)
+    if (parent >= 0) nodes_[static_cast<std::size_t>(parent)].children.push_back(k);
 }
 
 void DecompositionGraph::commit() {
@@ -143,8 +149,43 @@ void DecompositionGraph::commit() {
     if (nodes_.size() + fresh.size() > kMaxNodes)
         throw RuntimeError{RuntimeErrorKind::General, Span{},
                            fmt::format("the decomposition graph would have more than {} nodes", kMaxNodes)};
-    // by handle, then parents before children: the same nodes in the same order on any threads
+    // parents before children (by the depth among the new nodes), then by handle: the same nodes
+    // in the same order on any threads, in one pass however deep the new part is
     std::sort(fresh.begin(), fresh.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    {
+        std::unordered_map<std::uint64_t, std::size_t> at;
+        at.reserve(fresh.size());
+        for (std::size_t i = 0; i < fresh.size(); ++i) at.emplace(fresh[i].first, i);
+        std::vector<std::size_t> depth(fresh.size(), SIZE_MAX);
+        std::vector<std::size_t> chain;
+        for (std::size_t i = 0; i < fresh.size(); ++i) {
+            // walk up through new parents until one of known depth or an old parent, then unwind
+            // (a cycle, which only colliding handles could make, is cut by the length bound)
+            std::size_t k = i, base = 0;
+            chain.clear();
+            while (depth[k] == SIZE_MAX && chain.size() <= fresh.size()) {
+                chain.push_back(k);
+                auto up = at.find(fresh[k].second.parent);
+                if (up == at.end()) break;
+                if (depth[up->second] != SIZE_MAX) {
+                    base = depth[up->second] + 1;
+                    break;
+                }
+                k = up->second;
+            }
+            for (std::size_t j = 0; j < chain.size(); ++j) // chain[0] is i, the last the highest
+                depth[chain[j]] = std::min(depth[chain[j]], base + (chain.size() - 1 - j));
+        }
+        std::vector<std::size_t> order(fresh.size());
+        for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+        std::stable_sort(order.begin(), order.end(),
+                         [&](std::size_t a, std::size_t b) { return depth[a] < depth[b]; });
+        std::vector<std::pair<std::uint64_t, Pending>> sorted;
+        sorted.reserve(fresh.size());
+        for (std::size_t i : order) sorted.push_back(std::move(fresh[i]));
+        fresh = std::move(sorted);
+    }
+    std::vector<int> touched; // parents that got children
     bool progress = true;
     while (!fresh.empty() && progress) {
         progress = false;
@@ -170,6 +211,7 @@ void DecompositionGraph::commit() {
                 continue;
             }
             add_node(h, parent, p.position, p.index);
+            touched.push_back(parent);
             if (p.placed) { // the first call that made the node places it
                 GraphNode& n = nodes_.back();
                 n.placed = true;
@@ -182,6 +224,16 @@ void DecompositionGraph::commit() {
         fresh = std::move(later);
     }
     // (a parent that is never committed cannot happen: child() checks that it is a node)
+    std::sort(touched.begin(), touched.end());
+    touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+    for (int t : touched) {
+        auto& siblings = nodes_[static_cast<std::size_t>(t)].children;
+        std::sort(siblings.begin(), siblings.end(), [&](int a, int b) {
+            const GraphNode &x = nodes_[static_cast<std::size_t>(a)],
+                            &y = nodes_[static_cast<std::size_t>(b)];
+            return x.position != y.position ? x.position < y.position : x.index < y.index;
+        });
+    }
     resolve();
 }
 
@@ -366,6 +418,12 @@ void DecompositionGraph::resolve() {
                 v.number *= l.number;
                 if (l.curve) v.curve.push_back({EditOp::Fraction, l.curve});
             }
+            if (!std::isfinite(v.number)) // e.g. `length *= 1e200` on a node that inherits another
+                throw RuntimeError{
+                    RuntimeErrorKind::Arithmetic,
+                    l.edit >= 0 ? edits_->edits[static_cast<std::size_t>(l.edit)].span : Span{},
+                    fmt::format("'{}' at {} is not a finite number ({}) after this edit",
+                                decl_->params[p].name, path(static_cast<int>(n)), format_double(v.number))};
         }
         place(n, previous, before, same);
     }

@@ -25,6 +25,7 @@ namespace {
 constexpr std::size_t kMaxEdits = 100'000;
 constexpr std::size_t kMaxPathSteps = 1000;
 constexpr int kMaxShareLevel = 1000;
+constexpr std::size_t kMaxBezierPoints = 256;
 
 bool blank(char c) {
     return c == ' ' || c == '\t' || c == '\r';
@@ -279,6 +280,12 @@ class LineReader {
 
     void curve(const ast::Expr& e, CurveDef& c) const {
         c.bezier = e.text == "bezier";
+        // a Bezier curve costs the square of its control points at every t: bound what a file asks
+        if (c.bezier && e.args.size() > kMaxBezierPoints)
+            fail(e.span.begin, e.span.end,
+                 fmt::format("a bezier(...) curve takes at most {} control values here, given {}: use "
+                             "linear(...) for more",
+                             kMaxBezierPoints, e.args.size()));
         bool points = false;
         for (std::size_t i = 0; i < e.args.size(); ++i) {
             const ast::Expr& a = *e.args[i];

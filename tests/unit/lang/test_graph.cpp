@@ -377,4 +377,46 @@ rules { A(n) -> A(child(n, 0.5, 0, vec3(5, 0.5, 0), vec3(1, 0, 0))); }
     }
 }
 
+TEST_CASE("graph: one child named at positions a rounding error apart is the same node in any order") {
+    // whichever call comes first (string order here, thread timing in a parallel step), the node
+    // keeps the lower position, so its path and the values read through it never depend on timing
+    const char* grammar = R"(
+graph { length = 10; }
+module A(n: node, p), B(n: node);
+derive 1;
+axiom: %s;
+rules { A(n, p) -> B(child(n, p)); }
+)";
+    for (const char* axiom :
+         {"A(root(), 0.5 + 1e-12) A(root(), 0.5)", "A(root(), 0.5) A(root(), 0.5 + 1e-12)"}) {
+        char buf[512];
+        std::snprintf(buf, sizeof buf, grammar, axiom);
+        Run r = derive(buf, "");
+        INFO(axiom);
+        CHECK(r.g().size() == 2);
+        CHECK(r.g().node(1).position == 0.5);
+        CHECK(r.g().path(1) == "/0.5");
+    }
+}
+
+TEST_CASE("graph: a relative edit that overflows stops at the edit, not at a module parameter") {
+    Run r;
+    r.c = test::compile(kTree);
+    REQUIRE(r.c->program);
+    const std::uint32_t id =
+        r.c->sources.add("big.edits", "/0.5 length *= 1e200\n/0.5/0.5 length *= 1e200\n");
+    DeriveOptions opt;
+    opt.edits = parse_edits(*r.c->program, r.c->sources, id, r.c->diags);
+    REQUIRE(opt.edits);
+    Derivation d(*r.c->program, opt);
+    try {
+        d.run();
+        FAIL("expected an error");
+    } catch (const RuntimeError& e) {
+        CHECK(e.message.find("not a finite number") != std::string::npos);
+        CHECK(e.span.file == id);
+        CHECK(r.c->sources.file(id).line_col(e.span.begin).line == 2);
+    }
+}
+
 } // namespace plant
