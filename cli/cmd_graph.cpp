@@ -65,36 +65,52 @@ std::string value_text(const DecompositionGraph& g, int node, int param, bool js
     return json ? "[" + out + "]" : out;
 }
 
-void tree(const DecompositionGraph& g, int node, std::string& out, bool children = true) {
-    const GraphNode& n = g.node(node);
-    const std::string pad(static_cast<std::size_t>(2 * n.depth), ' ');
-    out += pad + g.path(node) + "\n";
-    for (std::size_t p = 0; p < g.decl().params.size(); ++p) {
-        const GraphParamDecl& decl = g.decl().params[p];
-        const NodeValue& v = g.value(node, static_cast<int>(p));
-        out += fmt::format("{}  {}{} = {}  ({}, {}, from {})\n", pad, decl.name,
-                           decl.kind == GraphParamKind::Curve ? "(0..1)" : "",
-                           value_text(g, node, static_cast<int>(p), false), value_status_name(v.status),
-                           v.is_private ? "private" : "public", g.path(v.from));
+// Calls visit(node) for node and, with children, every node below it in tree order: an explicit
+// stack, so a graph as deep as the node limit allows cannot overflow the call stack.
+template <typename Visit> void preorder(const DecompositionGraph& g, int node, bool children, Visit visit) {
+    std::vector<int> stack{node};
+    while (!stack.empty()) {
+        const int k = stack.back();
+        stack.pop_back();
+        visit(k);
+        if (!children) continue;
+        const auto& below = g.node(k).children;
+        stack.insert(stack.end(), below.rbegin(), below.rend());
     }
-    if (children)
-        for (int c : n.children) tree(g, c, out);
 }
 
-void json_nodes(const DecompositionGraph& g, int node, std::string& out) {
-    const GraphNode& n = g.node(node);
-    if (out.back() == '}') out += ",\n";
-    out += fmt::format("    {{\"path\": {}, \"depth\": {}, \"position\": {}, \"index\": {}, \"params\": {{",
-                       json_string(g.path(node)), n.depth, format_double(n.position), n.index);
-    for (std::size_t p = 0; p < g.decl().params.size(); ++p) {
-        const NodeValue& v = g.value(node, static_cast<int>(p));
-        out += fmt::format("{}{}: {{\"value\": {}, \"status\": \"{}\", \"private\": {}, \"from\": {}}}",
-                           p ? ", " : "", json_string(g.decl().params[p].name),
-                           value_text(g, node, static_cast<int>(p), true), value_status_name(v.status),
-                           v.is_private ? "true" : "false", json_string(g.path(v.from)));
-    }
-    out += "}}";
-    for (int c : n.children) json_nodes(g, c, out);
+void tree(const DecompositionGraph& g, int root, std::string& out, bool children = true) {
+    preorder(g, root, children, [&](int node) {
+        const GraphNode& n = g.node(node);
+        const std::string pad(static_cast<std::size_t>(2 * n.depth), ' ');
+        out += pad + g.path(node) + "\n";
+        for (std::size_t p = 0; p < g.decl().params.size(); ++p) {
+            const GraphParamDecl& decl = g.decl().params[p];
+            const NodeValue& v = g.value(node, static_cast<int>(p));
+            out += fmt::format("{}  {}{} = {}  ({}, {}, from {})\n", pad, decl.name,
+                               decl.kind == GraphParamKind::Curve ? "(0..1)" : "",
+                               value_text(g, node, static_cast<int>(p), false), value_status_name(v.status),
+                               v.is_private ? "private" : "public", g.path(v.from));
+        }
+    });
+}
+
+void json_nodes(const DecompositionGraph& g, int root, std::string& out) {
+    preorder(g, root, true, [&](int node) {
+        const GraphNode& n = g.node(node);
+        if (out.back() == '}') out += ",\n";
+        out +=
+            fmt::format("    {{\"path\": {}, \"depth\": {}, \"position\": {}, \"index\": {}, \"params\": {{",
+                        json_string(g.path(node)), n.depth, format_double(n.position), n.index);
+        for (std::size_t p = 0; p < g.decl().params.size(); ++p) {
+            const NodeValue& v = g.value(node, static_cast<int>(p));
+            out += fmt::format("{}{}: {{\"value\": {}, \"status\": \"{}\", \"private\": {}, \"from\": {}}}",
+                               p ? ", " : "", json_string(g.decl().params[p].name),
+                               value_text(g, node, static_cast<int>(p), true), value_status_name(v.status),
+                               v.is_private ? "true" : "false", json_string(g.path(v.from)));
+        }
+        out += "}}";
+    });
 }
 
 std::string edits_text(const DecompositionGraph& g, const SourceManager& sources, bool json) {
