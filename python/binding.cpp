@@ -15,18 +15,6 @@ namespace plant::python {
 
 namespace {
 
-const char* severity_name(Severity s) {
-    switch (s) {
-    case Severity::Note:
-        return "note";
-    case Severity::Warning:
-        return "warning";
-    case Severity::Error:
-        return "error";
-    }
-    return "error";
-}
-
 py::object errors_module() {
     return py::module_::import("plant._errors");
 }

@@ -15,8 +15,6 @@ void Diagnostics::add(Diagnostic d) {
     items_.push_back(std::move(d));
 }
 
-namespace {
-
 const char* severity_name(Severity s) {
     switch (s) {
     case Severity::Note:
@@ -29,7 +27,32 @@ const char* severity_name(Severity s) {
     return "error";
 }
 
-std::size_t utf8_length(std::string_view s, std::size_t i);
+// The length of the UTF-8 sequence at s[i], or 0 when it is not one (RFC 3629: no overlong
+// forms, no surrogates, nothing past U+10FFFF).
+std::size_t utf8_length(std::string_view s, std::size_t i) {
+    const auto at = [&](std::size_t k) { return static_cast<unsigned char>(s[k]); };
+    const unsigned char c = at(i);
+    std::size_t n = 0;
+    unsigned char lo = 0x80, hi = 0xbf; // the second byte's range
+    if (c >= 0xc2 && c <= 0xdf)
+        n = 2;
+    else if (c >= 0xe0 && c <= 0xef) {
+        n = 3;
+        if (c == 0xe0) lo = 0xa0;
+        if (c == 0xed) hi = 0x9f;
+    } else if (c >= 0xf0 && c <= 0xf4) {
+        n = 4;
+        if (c == 0xf0) lo = 0x90;
+        if (c == 0xf4) hi = 0x8f;
+    } else
+        return 0;
+    if (i + n > s.size() || at(i + 1) < lo || at(i + 1) > hi) return 0;
+    for (std::size_t k = 2; k < n; ++k)
+        if (at(i + k) < 0x80 || at(i + k) > 0xbf) return 0;
+    return n;
+}
+
+namespace {
 
 // Replaces control bytes and bytes that are not UTF-8 so that binary garbage in a source line
 // cannot mangle the terminal; tabs become a space so the caret lines up. A well-formed UTF-8
@@ -56,31 +79,6 @@ std::string printable(std::string_view s, std::vector<std::size_t>& cols) {
     }
     cols.push_back(col);
     return out;
-}
-
-// The length of the UTF-8 sequence at s[i], or 0 when it is not one (RFC 3629: no overlong
-// forms, no surrogates, nothing past U+10FFFF).
-std::size_t utf8_length(std::string_view s, std::size_t i) {
-    const auto at = [&](std::size_t k) { return static_cast<unsigned char>(s[k]); };
-    const unsigned char c = at(i);
-    std::size_t n = 0;
-    unsigned char lo = 0x80, hi = 0xbf; // the second byte's range
-    if (c >= 0xc2 && c <= 0xdf)
-        n = 2;
-    else if (c >= 0xe0 && c <= 0xef) {
-        n = 3;
-        if (c == 0xe0) lo = 0xa0;
-        if (c == 0xed) hi = 0x9f;
-    } else if (c >= 0xf0 && c <= 0xf4) {
-        n = 4;
-        if (c == 0xf0) lo = 0x90;
-        if (c == 0xf4) hi = 0x8f;
-    } else
-        return 0;
-    if (i + n > s.size() || at(i + 1) < lo || at(i + 1) > hi) return 0;
-    for (std::size_t k = 2; k < n; ++k)
-        if (at(i + k) < 0x80 || at(i + k) > 0xbf) return 0;
-    return n;
 }
 
 void render_one(std::string& out, Severity sev, Span span, const std::string& message,

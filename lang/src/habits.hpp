@@ -11,9 +11,6 @@
 
 namespace plant::habits {
 
-// The length of the UTF-8 sequence at s[i], or 0 when it is not a valid one.
-std::size_t utf8_length(std::string_view s, std::size_t i);
-
 // For a parse error `message` at `byte` of `text`: a sentence that names the plant form of what
 // the user probably meant ("; write ..."), or an empty string.
 std::string hint(const std::string& text, std::size_t byte, const std::string& message);

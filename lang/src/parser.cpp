@@ -606,7 +606,7 @@ std::string describe_found(const std::string& text, std::size_t byte) {
         return fmt::format("'{}'", text.substr(byte, e - byte));
     }
     if (c == '\n' || c == '\r') return "end of line";
-    if (std::size_t n = habits::utf8_length(text, byte); n > 0) {
+    if (std::size_t n = utf8_length(text, byte); n > 0) {
         // a character typed from a book, shown as itself with its code point
         std::uint32_t cp = c & (0xff >> (n + 1));
         for (std::size_t k = 1; k < n; ++k)

@@ -5,34 +5,7 @@
 set -u
 plant=$(realpath "${1:?usage: graph.sh PLANT}")
 root=$(cd "$(dirname "$0")/../.." && pwd)
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-pass=0
-fail=0
-check() { # check NAME EXPECTED_EXIT COMMAND...; output in $tmp/stdout and $tmp/stderr
-  local name=$1 want=$2
-  shift 2
-  "$@" >"$tmp/stdout" 2>"$tmp/stderr"
-  local got=$?
-  if [ "$got" -eq "$want" ]; then pass=$((pass + 1)); else
-    fail=$((fail + 1))
-    echo "FAIL $name: exit $got, expected $want"
-    sed 's/^/  /' "$tmp/stderr" | head -5
-  fi
-}
-contains() { # contains NAME FILE TEXT
-  if grep -qF -- "$3" "$2"; then pass=$((pass + 1)); else
-    fail=$((fail + 1))
-    echo "FAIL $1: '$3' not in output"
-    sed 's/^/  /' "$2" | head -12
-  fi
-}
-lacks() { # lacks NAME FILE TEXT
-  if ! grep -qF -- "$3" "$2"; then pass=$((pass + 1)); else
-    fail=$((fail + 1))
-    echo "FAIL $1: '$3' in output"
-  fi
-}
+. "$(dirname "$0")/checks.sh"
 range=$root/grammars/bonsai/fig10_range.plant
 single=$root/grammars/bonsai/fig10_single.plant
 curved="bend(0..1) = 0 0.2 0.4 0.6000000000000001 0.8  (explicit, public, from"

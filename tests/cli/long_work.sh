@@ -5,14 +5,7 @@
 set -u
 plant=$(realpath "${1:?usage: long_work.sh PLANT}")
 src=$(cd "$(dirname "$0")/../.." && pwd)
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-pass=0
-fail=0
-ok() { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL $*"; }
-contains() { if grep -qF -- "$3" "$2"; then ok; else bad "$1: '$3' not in $2"; sed 's/^/  /' "$2" | head -5; fi; }
-lacks() { if ! grep -qF -- "$3" "$2"; then ok; else bad "$1: '$3' in $2"; fi; }
+. "$(dirname "$0")/checks.sh"
 g=$src/grammars/abop/fig1_24a.plant
 
 # on a terminal (script(1) gives the run one), the stages show

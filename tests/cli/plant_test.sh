@@ -5,14 +5,7 @@
 set -u
 plant=$(realpath "${1:?usage: plant_test.sh PLANT}")
 src=$(cd "$(dirname "$0")/../.." && pwd)
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-pass=0
-fail=0
-ok() { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL $*"; }
-contains() { if grep -qF -- "$3" "$2"; then ok; else bad "$1: '$3' not in output"; sed 's/^/  /' "$2" | head -8; fi; }
-lacks() { if ! grep -qF -- "$3" "$2"; then ok; else bad "$1: '$3' in output"; fi; }
+. "$(dirname "$0")/checks.sh"
 
 cp -r "$src/examples/testing" "$tmp/project"
 cd "$tmp/project" || exit 1

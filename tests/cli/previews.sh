@@ -5,24 +5,7 @@
 set -u
 plant=$(realpath "${1:?usage: previews.sh PLANT}")
 src=$(cd "$(dirname "$0")/../.." && pwd)
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-pass=0
-fail=0
-ok() { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL $*"; }
-check() { # check NAME EXPECTED_EXIT COMMAND...
-  local name=$1 want=$2
-  shift 2
-  "$@" >"$tmp/stdout" 2>"$tmp/stderr"
-  local got=$?
-  if [ "$got" -eq "$want" ]; then ok; else
-    bad "$name: exit $got, expected $want"
-    sed 's/^/  /' "$tmp/stderr" | head -5
-  fi
-}
-contains() { if grep -qF -- "$3" "$2"; then ok; else bad "$1: '$3' not in $2"; fi; }
-lacks() { if ! grep -qF -- "$3" "$2"; then ok; else bad "$1: '$3' in $2"; fi; }
+. "$(dirname "$0")/checks.sh"
 abop=$src/grammars/abop
 
 # width: the grammar's width_scale, and --width-scale over it

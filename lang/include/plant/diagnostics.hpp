@@ -14,6 +14,13 @@ namespace plant {
 
 enum class Severity { Note, Warning, Error };
 
+// "note", "warning" or "error", as diagnostics are printed.
+const char* severity_name(Severity s);
+
+// The length of the UTF-8 sequence at s[i], or 0 when it is not one (RFC 3629: no overlong
+// forms, no surrogates, nothing past U+10FFFF).
+std::size_t utf8_length(std::string_view s, std::size_t i);
+
 struct Diagnostic {
     Severity severity = Severity::Error;
     Span span;
