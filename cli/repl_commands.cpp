@@ -235,6 +235,11 @@ bool Session::typed_setting(const std::string& line) {
     if (std::none_of(ast::kSettings.begin(), ast::kSettings.end(),
                      [&](const auto& s) { return key == s.spelling; }))
         return false;
+    // a grammar may name a param `width`: then `width * 2` is an expression
+    if (program_ && (std::any_of(program_->globals.begin(), program_->globals.end(),
+                                 [&](const Global& g) { return g.name == key; }) ||
+                     file_consts().count(key) > 0))
+        return false;
     std::string value = trim(line.substr(sp));
     if (!value.empty() && value.back() == ';') value = trim(value.substr(0, value.size() - 1));
     if (value.empty()) return false;
