@@ -127,6 +127,9 @@ bool Session::rebuild(int steps, const std::string* extra_fn) {
         }
     } catch (const RuntimeError& e) {
         error() << render(Diagnostic{Severity::Error, e.span, e.message, {}}, *sources, color_);
+        if (e.kind == RuntimeErrorKind::ModuleLimit && !history_.empty() && !extra_fn)
+            error() << fmt::format("not changed; still at step {}: {}\n", current().steps_done(),
+                                   modules(current().string().size()));
         last_error_runtime_ = true;
         return false;
     }
