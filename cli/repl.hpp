@@ -88,6 +88,7 @@ class Session {
     // The loaded file's consts (name: the value's byte range), which :set may replace.
     std::map<std::string, std::pair<std::uint32_t, std::uint32_t>> file_consts() const;
     std::string file_text_with_consts() const;
+    bool parses_as_expression(const std::string& name, const std::string& text); // else says why
     void use(const std::string& rest);
     void export_command(const std::string& rest);
     const ReplCommand* find_command(const std::string& name) const;

@@ -192,6 +192,8 @@ void Session::set_param(const std::string& rest) {
         error() << "':set' expects NAME VALUE, as in :set r1 0.8\n";
     } else if (program_ && !is_const && !is_param()) {
         error() << fmt::format("no param '{}'; :params lists them\n", pname);
+    } else if (is_const && !parses_as_expression(":set " + pname, value)) {
+        return; // said why, on the value as typed
     } else {
         auto saved = std::pair{params_, consts_};
         (is_const ? consts_ : params_)[pname] = value;
@@ -202,6 +204,14 @@ void Session::set_param(const std::string& rest) {
         else
             std::tie(params_, consts_) = saved;
     }
+}
+
+bool Session::parses_as_expression(const std::string& name, const std::string& text) {
+    SourceManager sources;
+    Diagnostics diags;
+    if (parse_expression(sources, sources.add(name, text), diags) && !diags.has_errors()) return true;
+    error() << render_all(diags, sources, color_);
+    return false;
 }
 
 std::map<std::string, std::pair<std::uint32_t, std::uint32_t>> Session::file_consts() const {
