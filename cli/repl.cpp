@@ -31,6 +31,7 @@ DeriveOptions Session::options() const {
     o.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     o.interrupt = interrupt_;
     o.max_steps = max_steps_;
+    if (max_modules_ > 0) o.max_modules = max_modules_;
     static TurtleEnvironmentPhase phase;
     o.environment_phase = &phase;
     std::ostream* out = &out_;
@@ -43,6 +44,8 @@ std::string Session::session_source(const std::string* extra_fn) const {
     std::string s;
     if (!file_.empty()) s += fmt::format("import \"{}\";\n", file_);
     if (axiom_) s += "axiom: " + *axiom_ + ";\n";
+    // typed settings: the session's file comes after the import, so its settings win
+    for (const auto& [key, value] : settings_) s += fmt::format("{} {};\n", key, value);
     if (!extra_rules_.empty()) {
         s += "rules {\n";
         for (const auto& r : extra_rules_) s += r + "\n";
@@ -63,7 +66,7 @@ CompileOptions Session::compile_options() const {
     CompileOptions co;
     co.max_steps = max_steps_;
     for (const auto& [name, value] : params_) co.defines.emplace_back(name, value);
-    if (!file_.empty()) co.file_texts[file_] = file_text_; // the file as :load or :reload read it
+    if (!file_.empty()) co.file_texts[file_] = file_text_with_consts(); // as read, with :set consts
     // the session's source is "<session>": the loaded grammar's folder is its own
     co.confine_reads = true;
     co.allow_read = allow_read_;
@@ -124,6 +127,9 @@ bool Session::rebuild(int steps, const std::string* extra_fn) {
         }
     } catch (const RuntimeError& e) {
         error() << render(Diagnostic{Severity::Error, e.span, e.message, {}}, *sources, color_);
+        if (e.kind == RuntimeErrorKind::ModuleLimit && !history_.empty() && !extra_fn)
+            error() << fmt::format("not changed; still at step {}: {}\n", current().steps_done(),
+                                   modules(current().string().size()));
         last_error_runtime_ = true;
         return false;
     }
@@ -143,13 +149,15 @@ int Session::load(const std::string& path) {
         return 66;
     }
     // a new grammar starts a new session; a grammar that does not build leaves the old one as it was
-    auto saved =
-        std::tuple{file_, file_text_, axiom_, extra_rules_, params_, seed_, uses_, edits_, graph_lines_};
+    auto saved = std::tuple{file_,     file_text_, axiom_, extra_rules_, params_,     consts_,
+                            settings_, seed_,      uses_,  edits_,       graph_lines_};
     file_ = fs::path(path).lexically_normal().string(); // as given: messages stay short and portable
     read_file(file_, file_text_);
     axiom_.reset();
     extra_rules_.clear();
     params_.clear();
+    consts_.clear();
+    settings_.clear();
     seed_.reset();
     uses_.clear();
     edits_.clear();
@@ -157,8 +165,8 @@ int Session::load(const std::string& path) {
     graph_undo_.clear();
     default_edits_unreadable_ = false;
     if (!rebuild(0) || (read_default_edits() && !rebuild(0))) {
-        std::tie(file_, file_text_, axiom_, extra_rules_, params_, seed_, uses_, edits_, graph_lines_) =
-            saved;
+        std::tie(file_, file_text_, axiom_, extra_rules_, params_, consts_, settings_, seed_, uses_, edits_,
+                 graph_lines_) = saved;
         graph_undo_.clear();
         return last_error_runtime_ ? 70 : last_error_input_ ? 66 : 65;
     }
@@ -185,6 +193,9 @@ bool Session::step(int n) {
             error() << render(Diagnostic{Severity::Error, e.span, e.message, {}}, *sources_, color_);
             if (e.kind == RuntimeErrorKind::Interrupted)
                 error() << fmt::format("interrupted; still at step {}\n", current().steps_done());
+            else if (e.kind == RuntimeErrorKind::ModuleLimit)
+                error() << fmt::format("still at step {}: {}\n", current().steps_done(),
+                                       modules(current().string().size()));
             return false;
         }
         last_step_ms_ =
@@ -361,8 +372,21 @@ void Session::evaluate(const std::string& expr) {
     CompileOptions co = compile_options();
     Diagnostics diags;
     std::string text = history_.empty() ? fn + "\naxiom: ;\n" : session_source(&fn);
-    auto program = compile_source(*sources, sources->add("<session>", text), co, diags);
-    err_ << render_all(news(diags, *sources), *sources, color_);
+    const std::uint32_t id = sources->add("<session>", text);
+    auto program = compile_source(*sources, id, co, diags);
+    // An error past the typed expression (at the `;` the session added on the next line) is
+    // shown at the end of what was typed, on the line the user typed.
+    const std::size_t typed_end = text.find(fn) + fn.size() - 2; // before "\n;"
+    Diagnostics placed;
+    for (Diagnostic d : diags.all()) {
+        if (d.span.valid() && d.span.file == id && d.span.begin > typed_end) {
+            d.span = Span{id, static_cast<std::uint32_t>(typed_end), static_cast<std::uint32_t>(typed_end)};
+            if (auto at = d.message.rfind("found ';'"); at != std::string::npos)
+                d.message.replace(at, 9, "found the end of the line");
+        }
+        placed.add(std::move(d));
+    }
+    err_ << render_all(news(placed, *sources), *sources, color_);
     if (!program) {
         failed_ = true;
         return;
@@ -452,11 +476,21 @@ bool Session::is_edit(const std::string& line) const {
 
 void Session::export_files(const std::vector<std::string>& paths, const OutputOptions& options) {
     if (!need_derivation()) return;
+    OutputOptions o = options;
+    if (const std::atomic<bool>* flag = interrupt_) // Ctrl-C: checked at each stage (interpreting,
+        o.progress = [flag](const std::string&) {   // meshing, writing each file)
+            if (flag->load()) throw RuntimeError{RuntimeErrorKind::Interrupted, Span{}, "interrupted"};
+        };
     try {
-        OutputSummary s = write_outputs(*program_, current(), paths, options);
+        OutputSummary s = write_outputs(*program_, current(), paths, o);
         for (const auto& p : paths) out_ << "wrote " << escape_controls(p) << "\n";
         out_ << fmt::format("{} triangles, {} organs\n", s.triangles, s.organs);
     } catch (const RuntimeError& e) {
+        if (e.kind == RuntimeErrorKind::Interrupted) { // the files are written whole or not at all
+            error() << fmt::format("interrupted; nothing written, still at step {}\n",
+                                   current().steps_done());
+            return;
+        }
         error() << render(Diagnostic{Severity::Error, e.span, e.message, {}}, *sources_, color_);
     } catch (const ExportError& e) {
         error() << "plant: " << escape_controls(e.what(), true) << "\n";
@@ -511,6 +545,7 @@ bool Session::execute(const std::string& raw) {
             axiom_ = saved;
         return true;
     }
+    if (typed_setting(line)) return true;
     bool production =
         line.find("->") != std::string::npos || (line.back() == '}' && line.find('{') != std::string::npos);
     if (production) {

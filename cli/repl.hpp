@@ -62,7 +62,8 @@ class Session {
     void set_interrupt(const std::atomic<bool>* flag) { interrupt_ = flag; }
     // --allow-read: folders the grammar may read besides its own (file_access.hpp)
     void allow_read(std::vector<std::string> dirs) { allow_read_ = std::move(dirs); }
-    void set_max_steps(std::uint64_t n) { max_steps_ = n; } // --max-steps
+    void set_max_steps(std::uint64_t n) { max_steps_ = n; }   // --max-steps
+    void set_max_modules(std::size_t n) { max_modules_ = n; } // --max-modules; 0: the default
     int load(const std::string& path); // :load; 0, or the exit code of the failure (65, 66, 70)
     // Whether some line since the last call reported an error (scripts exit 1 when one did).
     bool take_failed() {
@@ -82,6 +83,12 @@ class Session {
     void reset_command();
     void set_param(const std::string& rest);
     void set_seed(const std::string& rest);
+    // `angle 30;`, `derive 5;`, ... typed at the prompt: the session's own setting (repl_commands.cpp)
+    bool typed_setting(const std::string& line);
+    // The loaded file's consts (name: the value's byte range), which :set may replace.
+    std::map<std::string, std::pair<std::uint32_t, std::uint32_t>> file_consts() const;
+    std::string file_text_with_consts() const;
+    bool parses_as_expression(const std::string& name, const std::string& text); // else says why
     void use(const std::string& rest);
     void export_command(const std::string& rest);
     const ReplCommand* find_command(const std::string& name) const;
@@ -129,6 +136,7 @@ class Session {
     bool color_;
     const std::atomic<bool>* interrupt_ = nullptr;
     std::uint64_t max_steps_ = kDefaultMaxSteps;
+    std::size_t max_modules_ = 0;
 
     std::vector<std::string> allow_read_;       // --allow-read
     std::string file_;                          // the loaded grammar's path, as given
@@ -137,6 +145,8 @@ class Session {
     std::vector<std::string> extra_rules_;      // typed productions
     std::map<std::string, std::string> params_; // :set NAME VALUE
     std::optional<std::uint64_t> seed_;
+    std::map<std::string, std::string> settings_;   // typed `angle 30;` and the like: key, value
+    std::map<std::string, std::string> consts_;     // :set NAME VALUE on a const of the loaded file
     std::vector<std::pair<int, std::string>> uses_; // :use GROUP at step N, replayed by rebuilds
     // Edits (:do, or a hook-only call such as ivy.cut(12) typed at the prompt): statements run
     // by an `on before_step` hook at step N, that is before the step that follows N.
@@ -162,6 +172,6 @@ class Session {
 };
 
 int repl_main(const std::string& file, bool color, const std::vector<std::string>& allow_read = {},
-              std::uint64_t max_steps = kDefaultMaxSteps);
+              std::uint64_t max_steps = kDefaultMaxSteps, std::size_t max_modules = 0);
 
 } // namespace plant::cli

@@ -3,10 +3,14 @@
 #include "repl.hpp"
 #include "repl_text.hpp"
 
+#include "plant/parser.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <sstream>
+#include <tuple>
 
 namespace plant::cli {
 
@@ -47,7 +51,7 @@ std::span<const ReplCommand> Session::commands() {
          "identities",
          C::Modules},
         {"set", "", [](S& s, A, A rest) { s.set_param(rest); }, ":set NAME VALUE",
-         "change a param (VALUE is an expression) and replay", C::Params},
+         "change a param or a const of the loaded file (VALUE is an expression) and replay", C::Params},
         {"params", "", [](S& s, A, A) { s.params(); }, ":params",
          "list the params and vars with their current values", C::Nothing},
         {"seed", "", [](S& s, A, A rest) { s.set_seed(rest); }, ":seed S",
@@ -92,7 +96,7 @@ std::span<const ReplCommand> Session::commands() {
          ":time", "the time of the last step", C::Nothing},
         {"export", "", [](S& s, A, A rest) { s.export_command(rest); }, ":export [OPTION]... FILE...",
          "write files as plant run does (.glb .png .obj .svg .txt .skel.json ...); options "
-         "--flatten, --no-gpu-instancing, --camera X,Y,Z, --look-at X,Y,Z",
+         "--flatten, --no-gpu-instancing, --camera X,Y,Z, --look-at X,Y,Z, --size WxH (PNG and SVG)",
          C::Files},
         {"render", "",
          [](S& s, A, A rest) { s.export_files({rest.empty() ? std::string("out/repl.png") : rest}); },
@@ -178,23 +182,111 @@ void Session::set_param(const std::string& rest) {
     std::string value;
     std::getline(in, value);
     value = trim(value);
+    const auto is_param = [&] {
+        return std::any_of(program_->globals.begin(), program_->globals.end(),
+                           [&](const Global& g) { return g.kind == GlobalKind::Param && g.name == pname; });
+    };
+    // a const of the loaded file is set by replacing its value in the session's copy of the file
+    const bool is_const = program_ && !is_param() && file_consts().count(pname) > 0;
     if (pname.empty() || value.empty()) {
         error() << "':set' expects NAME VALUE, as in :set r1 0.8\n";
-    } else if (program_ &&
-               std::none_of(program_->globals.begin(), program_->globals.end(), [&](const Global& g) {
-                   return g.kind == GlobalKind::Param && g.name == pname;
-               })) {
+    } else if (program_ && !is_const && !is_param()) {
         error() << fmt::format("no param '{}'; :params lists them\n", pname);
+    } else if (is_const && !parses_as_expression(":set " + pname, value)) {
+        return; // said why, on the value as typed
     } else {
-        auto saved = params_;
-        params_[pname] = value;
+        auto saved = std::pair{params_, consts_};
+        (is_const ? consts_ : params_)[pname] = value;
         int steps = history_.empty() ? 0 : current().steps_done();
         if (rebuild(steps))
             out_ << fmt::format("{} = {}; step {}: {}\n", pname, value, current().steps_done(),
                                 modules(current().string().size()));
         else
-            params_ = saved;
+            std::tie(params_, consts_) = saved;
     }
+}
+
+bool Session::parses_as_expression(const std::string& name, const std::string& text) {
+    SourceManager sources;
+    Diagnostics diags;
+    if (parse_expression(sources, sources.add(name, text), diags) && !diags.has_errors()) return true;
+    error() << render_all(diags, sources, color_);
+    return false;
+}
+
+std::map<std::string, std::pair<std::uint32_t, std::uint32_t>> Session::file_consts() const {
+    std::map<std::string, std::pair<std::uint32_t, std::uint32_t>> out;
+    if (file_.empty()) return out;
+    SourceManager sources;
+    Diagnostics diags;
+    auto ast = parse_file(sources, sources.add(file_, file_text_), diags);
+    if (!ast) return out;
+    for (const auto& v : ast->values)
+        if (v.kind == ast::DeclKind::Const && v.value) out[v.name] = {v.value->span.begin, v.value->span.end};
+    return out;
+}
+
+std::string Session::file_text_with_consts() const {
+    if (consts_.empty()) return file_text_;
+    std::vector<std::pair<std::pair<std::uint32_t, std::uint32_t>, std::string>> edits;
+    const auto found = file_consts();
+    for (const auto& [name, value] : consts_)
+        if (auto it = found.find(name); it != found.end()) edits.emplace_back(it->second, "(" + value + ")");
+    std::sort(edits.begin(), edits.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    std::string text = file_text_; // from the end, so that earlier ranges stay where they were
+    for (const auto& [range, value] : edits) text.replace(range.first, range.second - range.first, value);
+    return text;
+}
+
+bool Session::typed_setting(const std::string& line) {
+    std::size_t sp = line.find_first_of(" \t");
+    if (sp == std::string::npos) return false;
+    const std::string key = line.substr(0, sp);
+    if (std::none_of(ast::kSettings.begin(), ast::kSettings.end(),
+                     [&](const auto& s) { return key == s.spelling; }))
+        return false;
+    // a grammar may name a param `width`: then `width * 2` is an expression
+    if (program_ && (std::any_of(program_->globals.begin(), program_->globals.end(),
+                                 [&](const Global& g) { return g.name == key; }) ||
+                     file_consts().count(key) > 0))
+        return false;
+    std::string value = trim(line.substr(sp));
+    if (!value.empty() && value.back() == ';') value = trim(value.substr(0, value.size() - 1));
+    if (value.empty()) return false;
+    if (!need_derivation()) return true;
+    if (key == "seed") { // the session's seed, as :seed sets it
+        auto seed = whole_number(value);
+        if (!seed) {
+            error() << fmt::format("'seed' expects a whole number, found '{}'\n", value);
+            return true;
+        }
+        auto saved = seed_;
+        seed_ = *seed;
+        if (rebuild(current().steps_done()))
+            out_ << fmt::format("seed = {}; step {}: {}\n", *seed_, current().steps_done(),
+                                modules(current().string().size()));
+        else
+            seed_ = saved;
+        return true;
+    }
+    auto saved = settings_;
+    settings_[key] = value;
+    int steps = current().steps_done();
+    if (key == "derive") { // the session derives that many steps from the axiom
+        auto n = whole_number(value);
+        if (!n || *n > 1000000) {
+            error() << fmt::format("'derive' expects a whole number from 0 to 1000000, found '{}'\n", value);
+            settings_ = saved;
+            return true;
+        }
+        steps = static_cast<int>(*n);
+    }
+    if (rebuild(steps))
+        out_ << fmt::format("{} = {}; step {}: {}\n", key, value, current().steps_done(),
+                            modules(current().string().size()));
+    else
+        settings_ = saved;
+    return true;
 }
 
 void Session::set_seed(const std::string& rest) {
@@ -245,6 +337,23 @@ void Session::export_command(const std::string& rest) {
             }
             (w == "--camera" ? options.camera : options.look_at) = *point;
             ++k;
+        } else if (w == "--size") {
+            int width = 0, height = 0;
+            char end = 0; // nothing may follow the height
+            const std::string size = k + 1 < words.size() ? words[k + 1] : std::string();
+            if (std::sscanf(size.c_str(), "%dx%d%c", &width, &height, &end) != 2 || width < 16 ||
+                height < 16 || width > 16384 || height > 16384 ||
+                static_cast<long long>(width) * height > 64LL * 1000 * 1000) {
+                error() << fmt::format(
+                    "':export --size' expects WIDTHxHEIGHT after it, each from 16 to 16384 "
+                    "and at most 64 million pixels, such as --size 200x200; found '{}'\n",
+                    escape_controls(size));
+                return;
+            }
+            options.width = width;
+            options.height = height;
+            options.size_given = true;
+            ++k;
         } else if (w.size() > 1 && w[0] == '-' && w[1] == '-') {
             error() << fmt::format("':export' has no option '{}': it takes --flatten, --no-gpu-instancing, "
                                    "--camera X,Y,Z and --look-at X,Y,Z before the file names\n",
@@ -289,6 +398,8 @@ std::vector<std::string> Session::completions(const std::string& before) const {
         const bool all = kind == ReplCompletion::Names;
         for (const auto& g : program_->globals)
             if (all || (kind == ReplCompletion::Params && g.kind == GlobalKind::Param)) out.push_back(g.name);
+        if (all || kind == ReplCompletion::Params) // consts, which :set may change too
+            for (const auto& [name, range] : file_consts()) out.push_back(name);
         if (all || kind == ReplCompletion::Modules)
             for (const auto& s : program_->symbols.all())
                 if (s.arity >= 0 && !s.name.empty()) out.push_back(s.name);

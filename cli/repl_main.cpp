@@ -58,11 +58,12 @@ std::string history_path() {
 } // namespace
 
 int repl_main(const std::string& file, bool color, const std::vector<std::string>& allow_read,
-              std::uint64_t max_steps) {
+              std::uint64_t max_steps, std::size_t max_modules) {
     const bool interactive = isatty(0) != 0;
     Session session(std::cout, std::cerr, color && interactive);
     session.allow_read(allow_read);
     session.set_max_steps(max_steps);
+    session.set_max_modules(max_modules);
     // (before the grammar is loaded: the derivation made then keeps the flag for its steps)
     if (interactive) session.set_interrupt(&g_interrupt);
     g_session = &session;
@@ -119,6 +120,7 @@ int repl_main(const std::string& file, bool color, const std::vector<std::string
 void setup_repl(CLI::App& app, int& exit_code) {
     auto file = std::make_shared<std::string>();
     auto max_steps = std::make_shared<std::uint64_t>(kDefaultMaxSteps);
+    auto max_modules = std::make_shared<std::size_t>(0);
     CLI::App* cmd =
         app.add_subcommand("repl", "An interactive session: step a derivation, inspect the string, change "
                                    "rules and params, look at the plant");
@@ -132,10 +134,15 @@ void setup_repl(CLI::App& app, int& exit_code) {
                        "after this many instructions (default {})",
                        kDefaultMaxSteps))
         ->type_name("N");
+    cmd->add_option("--max-modules", *max_modules,
+                    "Stop a step with an error when the string grows past this many modules (the session "
+                    "stays at the step before)")
+        ->check(CLI::PositiveNumber);
     cmd->footer("Reads commands from standard input without a prompt when it is not a terminal:\n"
                 "  plant repl grammar.plant < script");
-    cmd->callback([file, allow, max_steps, &exit_code] {
-        exit_code = repl_main(*file, isatty(2) != 0 && !std::getenv("NO_COLOR"), *allow, *max_steps);
+    cmd->callback([file, allow, max_steps, max_modules, &exit_code] {
+        exit_code =
+            repl_main(*file, isatty(2) != 0 && !std::getenv("NO_COLOR"), *allow, *max_steps, *max_modules);
     });
 }
 

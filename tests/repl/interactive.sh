@@ -23,9 +23,10 @@ work=$tmp/work
 mkdir -p "$home" "$work"
 cat >"$work/g.plant" <<'EOF'
 param branch_length = 2;
+const growth = 2;
 module A(x);
 axiom: A(1);
-rules { A(x) -> F(branch_length) [ + A(x + 1) ] A(x * 2); }
+rules { A(x) -> F(branch_length) [ + A(x + 1) ] A(x * growth); }
 EOF
 timeout=10 # seconds for any one wait
 pass=0
@@ -117,6 +118,33 @@ type_text "* 10 + 0.5"
 keys Enter
 expect_text "the completed expression is evaluated" "20.5"
 
+# Tab completion by context: params and consts after :set, commands after :help, file names
+# after :load, :render and :export
+type_text ":set gro"
+keys Tab
+expect_line "Tab after :set completes a const" "plant> :set growth"
+keys C-u
+type_text ":set br"
+keys Tab
+expect_line "Tab after :set completes a param" "plant> :set branch_length"
+keys C-u
+type_text ":help rel"
+keys Tab
+expect_line "Tab after :help completes a command's name" "plant> :help reload"
+keys C-u
+type_text ":load g.pl"
+keys Tab
+expect_line "Tab after :load completes a file name" "plant> :load g.plant"
+keys C-u
+type_text ":render g.pl"
+keys Tab
+expect_line "Tab after :render completes a file name" "plant> :render g.plant"
+keys C-u
+type_text ":help gro"
+keys Tab
+expect_line "Tab after :help offers no param" "plant> :help gro"
+keys C-u
+
 type_text ":quit"
 keys Enter
 expect_line ":quit returns to the shell" 'shell$'
@@ -167,6 +195,21 @@ keys Enter
 sleep 0.3
 keys C-c
 expect_text "Ctrl-C stops a runaway hook" "interrupted; still at step 0"
+# Ctrl-C stops :render while it meshes (an instance whose derivation runs for hours), and
+# nothing is written
+cat >"$work/s.plant" <<'EOF'
+instance Slow() { var k = 0; derive 1; axiom: F; on before_step { for i in 0..1e7 { for j in 0..1e7 { k += 1; } } } }
+axiom: F Slow;
+EOF
+type_text ":load s.plant"
+keys Enter
+expect_text "a grammar with a slow instance loads" "loaded s.plant"
+type_text ":render s.png"
+keys Enter
+sleep 0.3
+keys C-c
+expect_text "Ctrl-C stops :render" "interrupted; nothing written, still at step 0"
+if [ -e "$work/s.png" ]; then ko ":render wrote s.png after Ctrl-C"; else ok "no s.png after Ctrl-C"; fi
 type_text ":quit"
 keys Enter
 expect_line "the session goes on after both and quits" 'shell$'

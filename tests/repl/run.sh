@@ -11,6 +11,7 @@
 #   - a line starting with `!` is not sent to the REPL: the rest of the line is run by bash in
 #     the working directory, between the previous command and the next one (to edit a grammar
 #     before `:reload`, or to look at an exported file). Its output goes into the transcript.
+#   - an optional line `# args: ARG...` gives plant repl more arguments (--max-modules 100).
 #   - every other line is sent to the REPL as typed.
 #
 # Every transcript runs in its own temporary copy of tests/repl, so `!` edits, :export and
@@ -85,6 +86,9 @@ for in in "$here"/*.in; do
   args=(repl)
   file=$(sed -n '1s/^# file: *//p' "$in")
   [ -n "$file" ] && args+=("$file")
+  # an optional `# args: ...` line: more arguments for plant repl (split on spaces)
+  read -r -a extra <<<"$(sed -n 's/^# args: *//p' "$in" | head -1)"
+  args+=("${extra[@]}")
   : >"$raw"
   if grep -q '^!' "$in"; then
     run_fifo "$in" "$work" "$raw" "${args[@]}"
