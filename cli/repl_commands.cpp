@@ -294,8 +294,11 @@ void Session::set_seed(const std::string& rest) {
         auto saved = seed_;
         seed_ = *v;
         int steps = history_.empty() ? 0 : current().steps_done();
-        if (history_.empty() || rebuild(steps))
+        if (history_.empty())
             out_ << fmt::format("seed {}\n", *seed_);
+        else if (rebuild(steps)) // reported as :set reports a param
+            out_ << fmt::format("seed = {}; step {}: {}\n", *seed_, current().steps_done(),
+                                modules(current().string().size()));
         else
             seed_ = saved;
     } else {
