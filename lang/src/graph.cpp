@@ -255,8 +255,15 @@ std::string DecompositionGraph::path(int node, bool with_ranges) const {
             if (o.position < n.position) lo = std::max(lo, (o.position + n.position) / 2);
             if (o.position > n.position) hi = std::min(hi, (o.position + n.position) / 2);
         }
-        auto rounded = [](double x) { return std::round(x * 1e9) / 1e9; }; // 0.3, not 0.30000000000000004
-        out += "[" + format_double(rounded(lo)) + ".." + format_double(rounded(hi)) + "]";
+        // to 9 decimals (0.3, not 0.30000000000000004), but never narrower than the range by more
+        // than rounding noise: the written range must still hold the node's own position
+        auto outward = [](double x, bool up) {
+            const double r = std::round(x * 1e9) / 1e9;
+            if (up ? r < x - 1e-12 : r > x + 1e-12)
+                return (up ? std::ceil(x * 1e9) : std::floor(x * 1e9)) / 1e9;
+            return r;
+        };
+        out += "[" + format_double(outward(lo, false)) + ".." + format_double(outward(hi, true)) + "]";
     }
     return out;
 }

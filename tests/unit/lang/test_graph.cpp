@@ -419,4 +419,26 @@ TEST_CASE("graph: a relative edit that overflows stops at the edit, not at a mod
     }
 }
 
+TEST_CASE("graph: the range written for a node always holds the node's own position") {
+    // two siblings 2e-10 apart: the midpoint rounds past the upper one at 9 decimals, so the
+    // written range is widened instead (the REPL's :edit writes this range into the edits line)
+    Run r = derive(R"(
+graph { length = 10; }
+module A(n: node, p), B(n: node);
+derive 1;
+axiom: A(root(), 0.1234567894) A(root(), 0.1234567896);
+rules { A(n, p) -> B(child(n, p)); }
+)",
+                   "");
+    REQUIRE(r.g().size() == 3);
+    for (int k = 1; k <= 2; ++k) {
+        const std::string path = r.g().path(k, true);
+        INFO(path);
+        const double lo = std::stod(path.substr(path.find('[') + 1));
+        const double hi = std::stod(path.substr(path.find("..") + 2));
+        CHECK(lo <= r.g().node(k).position);
+        CHECK(r.g().node(k).position <= hi);
+    }
+}
+
 } // namespace plant
