@@ -10,7 +10,10 @@ set(PLANT_PYTHON AUTO CACHE STRING "Build the Python module: AUTO (when pybind11
 set_property(CACHE PLANT_PYTHON PROPERTY STRINGS AUTO ON OFF)
 set(PLANT_PYTHON_BUILT OFF)
 
-if(NOT PLANT_PYTHON STREQUAL "OFF")
+# (not in the sanitizer builds: an extension built with ASan cannot load into Debian's python3)
+if(PLANT_SANITIZE)
+  message(STATUS "Python module: not built in a sanitizer build")
+elseif(NOT PLANT_PYTHON STREQUAL "OFF")
   if(NOT Python_EXECUTABLE)
     find_program(plant_path_python3 NAMES python3 NO_CACHE)
     foreach(candidate ${plant_path_python3} /usr/bin/python3)
