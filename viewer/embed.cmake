@@ -3,6 +3,18 @@
 # viewer/install.sh has installed them), each included whole by the assembler (.incbin) under a
 # fixed route. Run at every build; OUT is only rewritten when a file's contents changed (its
 # SHA-256 is in OUT, so ccache sees the change too). Arguments: -DVIEWER=dir -DOUT=file.
+# Writes text to path unless path already holds exactly that (so its time stamp, and what is
+# built from it, change only when its contents do).
+function(write_if_changed path text)
+  set(old "")
+  if(EXISTS ${path})
+    file(READ ${path} old)
+  endif()
+  if(NOT old STREQUAL text)
+    file(WRITE ${path} "${text}")
+  endif()
+endfunction()
+
 set(routes "")
 set(files "")
 file(GLOB page RELATIVE ${VIEWER} ${VIEWER}/*.html ${VIEWER}/*.js ${VIEWER}/*.css)
@@ -43,13 +55,7 @@ if(have_three)
       string(REPLACE "from 'three';" "from '/three/three.module.js';" js "${js}")
       get_filename_component(name ${f} NAME)
       set(copy ${addons}/${name})
-      set(old_js "")
-      if(EXISTS ${copy})
-        file(READ ${copy} old_js)
-      endif()
-      if(NOT old_js STREQUAL js)
-        file(WRITE ${copy} "${js}")
-      endif()
+      write_if_changed(${copy} "${js}")
       list(APPEND files "${copy}")
     else()
       list(APPEND files "${three}/${f}")
@@ -92,10 +98,4 @@ ${table}    {nullptr, nullptr, nullptr, nullptr},
 const char* const kViewThreeVersion = \"${three_version}\";
 } // namespace plant::cli
 ")
-set(old "")
-if(EXISTS ${OUT})
-  file(READ ${OUT} old)
-endif()
-if(NOT old STREQUAL text)
-  file(WRITE ${OUT} "${text}")
-endif()
+write_if_changed(${OUT} "${text}")
