@@ -94,14 +94,6 @@ Outcome run_self(const std::vector<std::string>& args, const fs::path& dir) {
     return o;
 }
 
-std::vector<std::string> lines_of(const std::string& s) {
-    std::vector<std::string> out;
-    std::string line;
-    std::istringstream in(s);
-    while (std::getline(in, line)) out.push_back(line);
-    return out;
-}
-
 struct Expectations {
     bool script = false;
     std::string command = "derive";

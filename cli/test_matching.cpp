@@ -14,15 +14,15 @@ namespace plant::cli {
 
 namespace fs = std::filesystem;
 
-namespace {
-
-std::vector<std::string> split_lines(const std::string& s) {
+std::vector<std::string> lines_of(const std::string& s) {
     std::vector<std::string> out;
     std::string line;
     std::istringstream in(s);
     while (std::getline(in, line)) out.push_back(line);
     return out;
 }
+
+namespace {
 
 // "12:5: message" -> "message"; anything else as it is.
 std::string without_position(const std::string& s) {
@@ -67,7 +67,7 @@ std::string compare_diagnostics(const char* what, const std::vector<ExpectedDiag
 }
 
 std::string short_diff(const std::string& before, const std::string& after, std::size_t max_lines) {
-    const std::vector<std::string> a = split_lines(before), b = split_lines(after);
+    const std::vector<std::string> a = lines_of(before), b = lines_of(after);
     std::size_t head = 0;
     while (head < a.size() && head < b.size() && a[head] == b[head]) ++head;
     std::size_t ta = a.size(), tb = b.size(); // the common tail is left out too
@@ -103,7 +103,7 @@ std::vector<fs::path> library_files(const std::vector<fs::path>& files) {
         sidecar.replace_extension(".txt");
         std::error_code ec;
         bool test = fs::exists(sidecar, ec);
-        for (const std::string& line : split_lines(text)) {
+        for (const std::string& line : lines_of(text)) {
             test = test || directive(line);
             std::smatch m;
             if (std::regex_search(line, m, import_line))

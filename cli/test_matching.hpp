@@ -7,6 +7,9 @@
 
 namespace plant::cli {
 
+// The lines of `s`, without their line ends (a last line without one counts).
+std::vector<std::string> lines_of(const std::string& s);
+
 // An expected diagnostic: `text` as written after `# expect error:` (or `warning:`), or after
 // `# expect error contains:` with `contains` set.
 struct ExpectedDiagnostic {

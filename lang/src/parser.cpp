@@ -694,15 +694,18 @@ std::unique_ptr<ast::File> parse_file(const SourceManager& sources, std::uint32_
     return file;
 }
 
-ast::ExprPtr parse_expression(const SourceManager& sources, std::uint32_t file_id, Diagnostics& diags) {
-    const SourceFile& src = sources.file(file_id);
-    tao::pegtl::memory_input<> in(src.text(), src.name());
+namespace {
+// One expression (by `Rule`, with the blanks before it) and nothing after it, lowered; `whole` is
+// the place named when there is none.
+template <typename Rule>
+ast::ExprPtr parse_one(tao::pegtl::memory_input<>& in, const SourceFile& src, std::uint32_t file_id,
+                       Span whole, Diagnostics& diags) {
     g::ParseState state;
     try {
-        auto root = pt::parse<tao::pegtl::seq<g::ws, g::expr, tao::pegtl::eof>, selector, tao::pegtl::nothing,
+        auto root = pt::parse<tao::pegtl::seq<g::ws, Rule, tao::pegtl::eof>, selector, tao::pegtl::nothing,
                               g::control>(in, state);
         if (!root || root->children.empty()) {
-            diags.error({file_id, 0, 1}, "expected an expression");
+            diags.error(whole, "expected an expression");
             return nullptr;
         }
         Lowering lower(file_id, diags);
@@ -712,7 +715,15 @@ ast::ExprPtr parse_expression(const SourceManager& sources, std::uint32_t file_i
         return nullptr;
     }
 }
+} // namespace
 
+ast::ExprPtr parse_expression(const SourceManager& sources, std::uint32_t file_id, Diagnostics& diags) {
+    const SourceFile& src = sources.file(file_id);
+    tao::pegtl::memory_input<> in(src.text(), src.name());
+    return parse_one<g::expr>(in, src, file_id, {file_id, 0, 1}, diags);
+}
+
+// (the edits files' values: an expression or a silhouette(...))
 ast::ExprPtr parse_expression(const SourceManager& sources, std::uint32_t file_id, std::uint32_t begin,
                               std::uint32_t end, Diagnostics& diags) {
     const SourceFile& src = sources.file(file_id);
@@ -721,21 +732,8 @@ ast::ExprPtr parse_expression(const SourceManager& sources, std::uint32_t file_i
     begin = std::min(begin, end);
     LineCol lc = src.line_col(begin);
     tao::pegtl::memory_input<> in(text.data() + begin, text.data() + end, src.name(), begin, lc.line, lc.col);
-    g::ParseState state;
-    try {
-        auto root =
-            pt::parse<tao::pegtl::seq<g::ws, tao::pegtl::sor<g::silhouette_value, g::expr>, tao::pegtl::eof>,
-                      selector, tao::pegtl::nothing, g::control>(in, state);
-        if (!root || root->children.empty()) {
-            diags.error({file_id, begin, end}, "expected an expression");
-            return nullptr;
-        }
-        Lowering lower(file_id, diags);
-        return lower.expr(*root->children.at(0));
-    } catch (const g::GrammarError& e) {
-        report(e, src, file_id, diags);
-        return nullptr;
-    }
+    return parse_one<tao::pegtl::sor<g::silhouette_value, g::expr>>(in, src, file_id, {file_id, begin, end},
+                                                                    diags);
 }
 
 std::string ast::hook_list(std::string_view prefix, std::string_view last_separator) {

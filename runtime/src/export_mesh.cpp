@@ -1,5 +1,6 @@
 // .obj, .ply and .off export through OpenMesh: the tubes and every placed prototype flattened into
 // one triangle mesh with vertex normals (and texture coordinates for .obj and .ply).
+#include "geometry.hpp"
 #include "plant/export.hpp"
 
 #include "openmesh.hpp"
@@ -29,12 +30,6 @@ using Mesh = OpenMeshTriangles;
 
 std::string quoted(const std::string& s) {
     return "'" + s + "'";
-}
-
-glm::vec3 unit_or_up(glm::vec3 n) {
-    const float len = glm::length(n);
-    if (!(len > 1e-20f) || !std::isfinite(len)) return {0.0f, 1.0f, 0.0f};
-    return n / len;
 }
 
 class Flattener {

@@ -2,6 +2,7 @@
 // colours (plant/export.hpp, obj_file_bytes).
 #include "plant/export.hpp"
 
+#include "geometry.hpp"
 #include "texture_image.hpp"
 
 #include <fmt/format.h>
@@ -21,12 +22,6 @@ std::string obj_name(const std::string& name, const std::string& fallback) {
     std::string out;
     for (const char c : name) out += std::isgraph(static_cast<unsigned char>(c)) ? c : '_';
     return out.empty() ? fallback : out;
-}
-
-glm::vec3 unit_or_up(glm::vec3 n) {
-    const float len = glm::length(n);
-    if (!(len > 1e-20f) || !std::isfinite(len)) return {0.0f, 1.0f, 0.0f};
-    return n / len;
 }
 
 class ObjWriter {

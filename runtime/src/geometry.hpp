@@ -20,6 +20,14 @@ inline glm::dvec3 rotate(const glm::dvec3& v, const glm::dvec3& k, double phi) {
 }
 
 // The three numbers at a (module parameters, method arguments) as a vector.
+// n made unit length, or up (0, 1, 0) when it has none (zero, tiny or not finite): a normal a
+// mesh file can always carry.
+inline glm::vec3 unit_or_up(glm::vec3 n) {
+    const float len = glm::length(n);
+    if (!(len > 1e-20f) || !std::isfinite(len)) return {0.0f, 1.0f, 0.0f};
+    return n / len;
+}
+
 inline glm::dvec3 vec(const double* a) {
     return {a[0], a[1], a[2]};
 }
