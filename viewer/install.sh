@@ -5,6 +5,10 @@
 # into the program (docs/view.md); tests/view/run runs it for its own folder too.
 set -euo pipefail
 dir="$(cd "${1:-$(dirname "${BASH_SOURCE[0]}")}" && pwd)"
+# Tests run in parallel and several install into the same folder: one at a time (npm ci removes
+# node_modules first, so a second npm ci or a check running beside it would see half a tree).
+exec 9>"$dir/.install.lock"
+flock 9
 stale="$(node -e '
   const dir = process.argv[1];
   const lock = require(dir + "/package-lock.json").packages;
