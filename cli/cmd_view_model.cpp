@@ -43,7 +43,8 @@ struct ViewModel::Built {
     std::vector<std::unique_ptr<Derivation>> steps;
     std::vector<std::size_t> modules; // per step
     std::map<int, std::string> glb;   // exported steps
-    std::vector<std::pair<std::string, double>> params;
+    std::vector<Global> params;       // the number params; their values are read from `values`
+    std::vector<double> values;
     std::uint64_t seed = 0;
     std::size_t instances = 0; // instance declarations (the page checks InstancedMesh against it)
     std::uint64_t version = 0; // the version that made it; a failed rebuild after it keeps it
@@ -140,8 +141,10 @@ std::uint64_t ViewModel::rebuild() {
     }
     if (b->program) {
         for (const Global& gl : b->program->globals)
-            if (gl.kind == GlobalKind::Param && gl.type == ValueType::Number)
-                b->params.emplace_back(gl.name, b->program->global_values[gl.slot]);
+            if (gl.kind == GlobalKind::Param && gl.type == ValueType::Number) {
+                b->params.push_back(gl);
+                b->values.push_back(b->program->global_values[gl.slot]);
+            }
         b->seed = b->steps.back()->seed();
         b->instances = b->program->instances ? b->program->instances->size() : 0;
     }
@@ -164,7 +167,7 @@ std::string ViewModel::set_controls(const ViewControls& controls) {
         for (const auto& [name, value] : controls.params) {
             bool known = false;
             if (good_)
-                for (const auto& p : good_->params) known = known || p.first == name;
+                for (const auto& p : good_->params) known = known || p.name == name;
             if (!known) return fmt::format("'{}' is not a param of the grammar", name);
             if (!std::isfinite(value)) return fmt::format("the value of '{}' is not a finite number", name);
         }
@@ -189,7 +192,15 @@ std::string ViewModel::state_json() const {
         j["kept"] = kept;
         j["seed"] = std::to_string(good_->seed);
         nlohmann::json params = nlohmann::json::array();
-        for (const auto& [name, value] : good_->params) params.push_back({{"name", name}, {"value", value}});
+        for (std::size_t k = 0; k < good_->params.size(); ++k) {
+            const Global& p = good_->params[k];
+            nlohmann::json one = {{"name", p.name}, {"value", good_->values[k]}};
+            if (p.has_range) { // `param r = 0.9 in 0.5 .. 1.0;`: the page draws a slider
+                one["low"] = p.low;
+                one["high"] = p.high;
+            }
+            params.push_back(std::move(one));
+        }
         j["params"] = params;
         j["instances"] = good_->instances;
         j["derive_ms"] = derive_ms_;

@@ -196,37 +196,78 @@ function status() {
   $('step-label').textContent = `${state.step} / ${last}`;
 }
 
-function numberField(name, value) {
+// A numeric field for a param and, when the grammar gives it a range (`param r = 0.9 in 0.5 ..
+// 1.0;`), a slider over the range beside it; both carry data-param and are kept in step.
+function paramControl(p) {
   const label = document.createElement('label');
-  label.textContent = name;
+  label.textContent = p.name;
   const input = document.createElement('input');
   input.type = 'number';
   input.step = 'any';
-  input.value = value;
-  input.dataset.param = name;
+  input.value = p.value;
+  input.dataset.param = p.name;
+  let slider = null;
+  if (p.low !== undefined && p.high !== undefined) {
+    input.min = String(p.low);
+    input.max = String(p.high);
+    slider = document.createElement('input');
+    slider.type = 'range';
+    slider.min = String(p.low);
+    slider.max = String(p.high);
+    slider.step = 'any'; // no snapping: the value is the grammar's, not a multiple of a step
+    slider.value = String(p.value);
+    slider.dataset.param = p.name;
+    slider.addEventListener('input', () => {
+      input.value = slider.value;
+      edited[p.name] = Number(slider.value);
+      sendControlsSoon();
+    });
+    label.appendChild(slider);
+  }
   input.addEventListener('change', () => {
     const v = Number(input.value);
     if (!Number.isFinite(v) || input.value.trim() === '') return;
-    edited[name] = v;
+    if (slider) slider.value = String(v);
+    edited[p.name] = v;
     sendControls();
   });
   label.appendChild(input);
   return label;
 }
 
+// While a slider is dragged: one request in flight at a time, the latest value sent after it.
+let controlsInFlight = false;
+let controlsPending = false;
+async function sendControlsSoon() {
+  if (controlsInFlight) {
+    controlsPending = true;
+    return;
+  }
+  controlsInFlight = true;
+  try {
+    await sendControls();
+  } finally {
+    controlsInFlight = false;
+    if (controlsPending) {
+      controlsPending = false;
+      sendControlsSoon();
+    }
+  }
+}
+
 function updateControls() {
   const params = server.params || [];
   state.params = params;
   const box = $('params');
-  const names = params.map((p) => p.name).join(',');
+  const names = params.map((p) => `${p.name}:${p.low ?? ''}:${p.high ?? ''}`).join(',');
   if (box.dataset.names !== names) {
-    box.replaceChildren(...params.map((p) => numberField(p.name, p.value)));
+    box.replaceChildren(...params.map(paramControl));
     box.dataset.names = names;
     if (!params.length) box.textContent = 'none';
   } else {
     for (const p of params) {
-      const input = box.querySelector(`input[data-param="${CSS.escape(p.name)}"]`);
-      if (input && document.activeElement !== input) input.value = p.value;
+      for (const input of box.querySelectorAll(`input[data-param="${CSS.escape(p.name)}"]`))
+        if (document.activeElement !== input) input.value = p.value;
     }
   }
   if (document.activeElement !== $('seed') && server.seed !== undefined) $('seed').value = server.seed;

@@ -87,6 +87,7 @@ void Compiler::declare_values(const LoadedFile& lf) {
         g.type = cv->type;
         g.slot = static_cast<std::uint32_t>(P_.global_values.size());
         g.span = v.name_span;
+        if (v.range_low) check_param_range(v, *value, *cv, g);
         for (int k = 0; k < value_width(cv->type); ++k) P_.global_values.push_back(cv->v[k]);
         P_.global_index[g.name] = static_cast<std::uint32_t>(P_.globals.size());
         P_.globals.push_back(std::move(g));
@@ -103,6 +104,46 @@ void Compiler::declare_values(const LoadedFile& lf) {
                     ? fmt::format("the imported file has no param '{}'", name)
                     : fmt::format("the imported file has no param '{}'; did you mean '{}'?", name, near));
         }
+    }
+}
+
+// `param r = 0.9 in 0.5 .. 1.0;`: constant numeric bounds, low below high, and the param's value
+// (its default, a -D value or an import's override, whichever applies) inside them.
+void Compiler::check_param_range(const ast::ValueDecl& v, const ast::Expr& value, const ConstVal& cv,
+                                 Global& g) {
+    auto low = eval_const(*v.range_low, "a param's range");
+    auto high = eval_const(*v.range_high, "a param's range");
+    if (!low || !high) return;
+    for (const ConstVal* b : {&*low, &*high})
+        if (b->type != ValueType::Number) {
+            diags_->error(b == &*low ? v.range_low->span : v.range_high->span,
+                          "a param's range takes two numbers: write `in LOW .. HIGH`");
+            return;
+        }
+    if (!(low->v[0] < high->v[0])) {
+        diags_->error(v.range_span,
+                      fmt::format("the range of '{}' is empty: its low bound {} is not below its "
+                                  "high bound {}; write `in LOW .. HIGH` with LOW < HIGH",
+                                  v.name, low->v[0], high->v[0]));
+        return;
+    }
+    if (cv.type != ValueType::Number) {
+        diags_->error(v.range_span, fmt::format("'{}' is not a number, so it cannot have a range", v.name));
+        return;
+    }
+    g.has_range = true;
+    g.low = low->v[0];
+    g.high = high->v[0];
+    if (cv.v[0] < g.low || cv.v[0] > g.high) {
+        Diagnostic d{Severity::Error,
+                     value.span,
+                     fmt::format("'{}' = {} is outside its range {} .. {}; give a value in the range or "
+                                 "widen the range",
+                                 v.name, cv.v[0], g.low, g.high),
+                     {}};
+        if (&value != v.value.get()) // a -D value or an import's override: show the declaration too
+            d.notes.emplace_back(v.range_span, "the range is declared here");
+        diags_->add(std::move(d));
     }
 }
 

@@ -204,7 +204,10 @@ struct statement : sor<let_stmt, if_stmt, for_stmt, produce_stmt, nproduce_stmt,
 
 // ---- top-level items (docs/language.md, top-level items) ------------------------------------
 
-struct param_item : if_must<kw_param, name, equals, expr, semi> {};
+// param r = 0.9 in 0.5 .. 1.0;  (the range: values given at compile time are checked against it,
+// and `plant view` draws a slider over it)
+struct param_range : if_must<kw_in, expr, range_dots, expr> {};
+struct param_item : if_must<kw_param, name, equals, expr, opt<param_range>, semi> {};
 struct const_item : if_must<kw_const, name, equals, expr, semi> {};
 struct var_item : if_must<kw_var, name, equals, expr, semi> {};
 // module Name(a, b: vec3) [bound env];

@@ -29,14 +29,14 @@ using selector = pt::selector<
         g::condition, g::arrow_form, g::stoch_form, g::stoch_arrow, g::weight, g::block, g::let_stmt,
         g::assign_stmt, g::assign_op, g::if_stmt, g::else_part, g::for_stmt, g::produce_stmt,
         g::nproduce_stmt, g::use_stmt, g::stop_stmt, g::return_stmt, g::expr_stmt, g::param_item,
-        g::const_item, g::var_item, g::module_item, g::module_decl, g::param_list, g::param_decl,
-        g::bound_clause, g::fn_item, g::fn_expr_body, g::curve_item, g::surface_item, g::texture_item,
-        g::shape_kind, g::env_item, g::key_args, g::key_arg, g::instance_item, g::instance_body,
-        g::setting_item, g::setting_key, g::axiom_item, g::symbol_set_item, g::symbol_set_kind, g::rules_item,
-        g::group_name, g::rules_body, g::decompose_item, g::interpret_item, g::max_depth_clause, g::hook_item,
-        g::hook_name, g::import_item, g::import_target, g::with_clause, g::override_block, g::override_item,
-        g::graph_item, g::match_clause, g::graph_body, g::graph_param, g::silhouette_value, g::edits_item,
-        g::edits_target>,
+        g::param_range, g::const_item, g::var_item, g::module_item, g::module_decl, g::param_list,
+        g::param_decl, g::bound_clause, g::fn_item, g::fn_expr_body, g::curve_item, g::surface_item,
+        g::texture_item, g::shape_kind, g::env_item, g::key_args, g::key_arg, g::instance_item,
+        g::instance_body, g::setting_item, g::setting_key, g::axiom_item, g::symbol_set_item,
+        g::symbol_set_kind, g::rules_item, g::group_name, g::rules_body, g::decompose_item, g::interpret_item,
+        g::max_depth_clause, g::hook_item, g::hook_name, g::import_item, g::import_target, g::with_clause,
+        g::override_block, g::override_item, g::graph_item, g::match_clause, g::graph_body, g::graph_param,
+        g::silhouette_value, g::edits_item, g::edits_target>,
     // (ternary_then and ternary_else are selected only so that their nesting is counted: the tree
     // builder calls the grammar's control for selected rules alone; each has one child, which
     // fold_one puts in its place)
@@ -469,17 +469,28 @@ class Lowering {
         f.rule_blocks.push_back(std::move(rb));
     }
 
+    // param / const / var NAME = EXPR [in LOW .. HIGH];
+    ast::ValueDecl value_decl(const Node& n) {
+        ast::ValueDecl v;
+        v.kind = n.is_type<g::param_item>()   ? ast::DeclKind::Param
+                 : n.is_type<g::const_item>() ? ast::DeclKind::Const
+                                              : ast::DeclKind::Var;
+        v.span = span(n);
+        v.name = n.children.at(0)->string();
+        v.name_span = span(*n.children.at(0));
+        v.value = expr(*n.children.at(1));
+        if (n.children.size() > 2 && n.children[2]->is_type<g::param_range>()) {
+            const Node& r = *n.children[2];
+            v.range_span = span(r);
+            v.range_low = expr(*r.children.at(0));
+            v.range_high = expr(*r.children.at(1));
+        }
+        return v;
+    }
+
     void item(const Node& n, ast::File& f) {
         if (n.is_type<g::param_item>() || n.is_type<g::const_item>() || n.is_type<g::var_item>()) {
-            ast::ValueDecl v;
-            v.kind = n.is_type<g::param_item>()   ? ast::DeclKind::Param
-                     : n.is_type<g::const_item>() ? ast::DeclKind::Const
-                                                  : ast::DeclKind::Var;
-            v.span = span(n);
-            v.name = n.children.at(0)->string();
-            v.name_span = span(*n.children.at(0));
-            v.value = expr(*n.children.at(1));
-            f.values.push_back(std::move(v));
+            f.values.push_back(value_decl(n));
         } else if (n.is_type<g::module_item>()) {
             for (const auto& d : n.children) {
                 ast::ModuleDecl m;

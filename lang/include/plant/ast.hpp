@@ -198,6 +198,9 @@ struct ValueDecl {
     Span name_span;
     std::string name;
     ExprPtr value;
+    // `param r = 0.9 in 0.5 .. 1.0;`: the range's bounds (both null without one)
+    ExprPtr range_low, range_high;
+    Span range_span;
 };
 
 struct ParamName {

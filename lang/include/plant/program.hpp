@@ -211,6 +211,10 @@ struct Global {
     ValueType type = ValueType::Number;
     std::uint32_t slot = 0;
     Span span;
+    // A param's declared range (`param r = 0.9 in 0.5 .. 1.0;`, docs/language.md), checked
+    // against its value at compile time; has_range is false without one.
+    bool has_range = false;
+    double low = 0, high = 0;
 };
 
 struct Function {
