@@ -37,6 +37,18 @@ struct ViewControls {
     std::optional<std::uint64_t> seed;
 };
 
+// A click on the page (docs/view.md, picking), in the plant's own coordinates: the point hit,
+// and for an organ or instance the origin of the placement hit.
+struct ViewPick {
+    enum Kind { Tube, Organ } kind = Tube;
+    glm::dvec3 point{0.0}, origin{0.0};
+};
+struct ViewPickData; // a step's interpreted string and skeleton (cmd_view_pick.cpp)
+// The answer to a pick at `step` of derivation `d`, as JSON; `data` is made on first use and
+// kept by the caller for the next pick at that step.
+std::string view_pick_json(const Program& program, const Derivation& d, int step,
+                           std::shared_ptr<const ViewPickData>& data, const ViewPick& q);
+
 // The grammar, derived with the command line's options and the page's controls; the last good
 // derivation stays when the grammar stops compiling. Thread-safe.
 class ViewModel {
@@ -52,6 +64,10 @@ class ViewModel {
     std::string state_json() const;
     // The GLB of kept step k (the last step when k < 0); none when there is no plant or k is not kept.
     std::optional<std::string> glb(int step);
+    // What was hit at kept step k (the last when k < 0), as JSON: the segment or organ, the
+    // module that drew it (name, identity, parameters) and its graph node if a parameter names
+    // one; none when there is no plant or k is not kept.
+    std::optional<std::string> pick(int step, const ViewPick& q);
     // Every file the grammar read, for the watcher (absolute paths).
     std::set<std::string> watched_files() const;
     std::uint64_t version() const;

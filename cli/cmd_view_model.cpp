@@ -41,9 +41,10 @@ struct ViewModel::Built {
     std::unique_ptr<Program> program;
     std::unique_ptr<TurtleEnvironmentPhase> phase;
     std::vector<std::unique_ptr<Derivation>> steps;
-    std::vector<std::size_t> modules; // per step
-    std::map<int, std::string> glb;   // exported steps
-    std::vector<Global> params;       // the number params; their values are read from `values`
+    std::vector<std::size_t> modules;                         // per step
+    std::map<int, std::string> glb;                           // exported steps
+    std::map<int, std::shared_ptr<const ViewPickData>> picks; // steps picked in (cmd_view_pick.cpp)
+    std::vector<Global> params; // the number params; their values are read from `values`
     std::vector<double> values;
     std::uint64_t seed = 0;
     std::size_t instances = 0; // instance declarations (the page checks InstancedMesh against it)
@@ -235,6 +236,17 @@ std::optional<std::string> ViewModel::glb(int step) {
     fs::remove(path);
     if (good_->glb.size() > 64) good_->glb.clear(); // bounded: a few dozen steps exported at most
     return good_->glb[step] = bytes.str();
+}
+
+std::optional<std::string> ViewModel::pick(int step, const ViewPick& q) {
+    std::lock_guard lock(mutex_);
+    if (!good_) return std::nullopt;
+    const int last = static_cast<int>(good_->steps.size()) - 1;
+    if (step < 0 || step > last) step = last;
+    const Derivation* d = good_->steps[static_cast<std::size_t>(step)].get();
+    if (!d) return std::nullopt;
+    if (good_->picks.size() > 8 && !good_->picks.count(step)) good_->picks.clear(); // a few steps' skeletons
+    return view_pick_json(*good_->program, *d, step, good_->picks[step], q);
 }
 
 void ViewEvents::publish(std::uint64_t version) {

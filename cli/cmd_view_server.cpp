@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include <charconv>
+#include <cmath>
 #include <cstring>
 
 namespace plant::cli {
@@ -71,6 +72,38 @@ void serve_model(ViewModel& model, const httplib::Request& req, httplib::Respons
         auto bytes = model.glb(step);
         if (!bytes) return refuse(res, 404, "no plant (the grammar has an error) or that step was not kept");
         res.set_content(std::move(*bytes), "model/gltf-binary");
+    } catch (const RuntimeError& e) {
+        refuse(res, 500, e.message);
+    } catch (const std::exception& e) {
+        refuse(res, 500, e.what());
+    }
+}
+
+// GET /api/pick?step=K&kind=tube|organ&x=&y=&z=[&ox=&oy=&oz=]: what the click hit (docs/view.md).
+void serve_pick(ViewModel& model, const httplib::Request& req, httplib::Response& res) {
+    auto number = [&](const char* name, double& out) {
+        if (!req.has_param(name)) return false;
+        const std::string s = req.get_param_value(name);
+        auto r = std::from_chars(s.data(), s.data() + s.size(), out);
+        return r.ec == std::errc() && r.ptr == s.data() + s.size() && std::isfinite(out);
+    };
+    ViewPick q;
+    const std::string kind = req.has_param("kind") ? req.get_param_value("kind") : "tube";
+    if (kind != "tube" && kind != "organ") return refuse(res, 400, "kind: tube or organ");
+    q.kind = kind == "tube" ? ViewPick::Tube : ViewPick::Organ;
+    double step = -1;
+    if ((req.has_param("step") && !number("step", step)) || step != std::floor(step) || std::abs(step) > 1e9)
+        return refuse(res, 400, "step: a whole number");
+    if (!number("x", q.point.x) || !number("y", q.point.y) || !number("z", q.point.z))
+        return refuse(res, 400, "x, y and z: the point hit, three finite numbers");
+    q.origin = q.point;
+    if (q.kind == ViewPick::Organ &&
+        (!number("ox", q.origin.x) || !number("oy", q.origin.y) || !number("oz", q.origin.z)))
+        return refuse(res, 400, "ox, oy and oz: where the organ hit is placed, three finite numbers");
+    try {
+        auto json = model.pick(static_cast<int>(step), q);
+        if (!json) return refuse(res, 404, "no plant (the grammar has an error) or that step was not kept");
+        res.set_content(std::move(*json), "application/json");
     } catch (const RuntimeError& e) {
         refuse(res, 500, e.message);
     } catch (const std::exception& e) {
@@ -144,6 +177,8 @@ int serve_view(ViewModel& model, ViewEvents& events, const ViewServerOptions& op
     });
     server.Get("/api/model.glb",
                [&](const httplib::Request& req, httplib::Response& res) { serve_model(model, req, res); });
+    server.Get("/api/pick",
+               [&](const httplib::Request& req, httplib::Response& res) { serve_pick(model, req, res); });
     server.Get("/api/events",
                [&](const httplib::Request&, httplib::Response& res) { stream_events(model, events, res); });
     server.Post("/api/controls", [&](const httplib::Request& req, httplib::Response& res) {

@@ -51,6 +51,15 @@ const state = {
   drawnAt: 0,        // Date-comparable time (ms) when the last model was first rendered
   loads: 0,          // models put on screen
   params: [],
+  picked: null,      // the server's answer to the last click (/api/pick), once it arrived
+  // Clicks at a point of the canvas (CSS pixels from its top left) as a user would.
+  clickAt: (x, y) => pickAt(x, y),
+  // The canvas position (CSS pixels) of a point in the plant's own coordinates.
+  screenOf: (p) => {
+    const v = plant.localToWorld(new THREE.Vector3(p[0], p[1], p[2])).project(camera);
+    const r = renderer.domElement.getBoundingClientRect();
+    return { x: (v.x + 1) / 2 * r.width, y: (1 - v.y) / 2 * r.height };
+  },
   instanced: () => {
     const out = [];
     if (plant) plant.traverse((o) => { if (o.isInstancedMesh) out.push({ name: o.name, count: o.count }); });
@@ -368,13 +377,20 @@ $('download-png').addEventListener('click', () => {
   renderer.domElement.toBlob((blob) => download(`${stem()}-step${state.step}.png`, blob));
 });
 
-// Picking: the clicked mesh (and instance) is outlined by a box and named.
+// Picking: the clicked mesh (and instance) is outlined by a box and named; the server says which
+// module drew it (/api/pick: name, identity, parameters, graph node) and its segment is marked.
 const raycaster = new THREE.Raycaster();
 let marker = null;
+let segmentMarker = null;
 renderer.domElement.addEventListener('click', (ev) => {
+  const r = renderer.domElement.getBoundingClientRect();
+  pickAt(ev.clientX - r.left, ev.clientY - r.top);
+});
+
+function pickAt(x, y) {
   if (!plant) return;
   const r = renderer.domElement.getBoundingClientRect();
-  const ndc = new THREE.Vector2((ev.clientX - r.left) / r.width * 2 - 1, -(ev.clientY - r.top) / r.height * 2 + 1);
+  const ndc = new THREE.Vector2(x / r.width * 2 - 1, -y / r.height * 2 + 1);
   raycaster.setFromCamera(ndc, camera);
   const hit = raycaster.intersectObject(plant, true)[0];
   if (marker) { scene.remove(marker); marker.dispose(); marker = null; }
@@ -394,10 +410,55 @@ renderer.domElement.addEventListener('click', (ev) => {
   requestRender();
   const names = [];
   for (let p = o; p && p !== plant; p = p.parent) if (p.name) names.unshift(p.name);
-  $('pick').textContent = `${names.join(' / ') || '(unnamed)'}` +
+  const what = `${names.join(' / ') || '(unnamed)'}` +
     (o.isInstancedMesh ? `\ninstance ${hit.instanceId} of ${o.count}` : '') +
     `\nat ${hit.point.toArray().map((v) => v.toFixed(3)).join(', ')}`;
-});
+  $('pick').textContent = what;
+  if (segmentMarker) { segmentMarker.removeFromParent(); segmentMarker.geometry.dispose(); segmentMarker = null; }
+  state.picked = null;
+  if (names[0] === 'obstacles') return;
+  // in the plant's own coordinates: the point hit and, for a placed organ or instance, where
+  // its placement stands
+  const local = (v) => plant.worldToLocal(v.clone()).toArray();
+  const q = new URLSearchParams({ step: String(state.step) });
+  const p = local(hit.point);
+  q.set('x', p[0]); q.set('y', p[1]); q.set('z', p[2]);
+  if (names.length === 1 && names[0] === 'tubes') {
+    q.set('kind', 'tube');
+  } else {
+    const m = new THREE.Matrix4();
+    if (o.isInstancedMesh && hit.instanceId !== undefined) o.getMatrixAt(hit.instanceId, m);
+    let top = o;
+    while (top.parent && top.parent !== plant) top = top.parent;
+    const placed = o.isInstancedMesh ? m.premultiply(o.matrixWorld) : top.matrixWorld;
+    const origin = local(new THREE.Vector3().setFromMatrixPosition(placed));
+    q.set('kind', 'organ'); q.set('ox', origin[0]); q.set('oy', origin[1]); q.set('oz', origin[2]);
+  }
+  const shown = plant;
+  fetch(`/api/pick?${q}`).then((res) => (res.ok ? res.json() : null)).then((j) => {
+    if (!j || plant !== shown) return;
+    state.picked = j;
+    $('pick').textContent = pickText(j) + '\n\n' + what;
+    if (j.from && j.to) {
+      const g = new THREE.BufferGeometry().setFromPoints([new THREE.Vector3(...j.from), new THREE.Vector3(...j.to)]);
+      segmentMarker = new THREE.Line(g, new THREE.LineBasicMaterial({ color: 0xff5030, depthTest: false }));
+      segmentMarker.renderOrder = 10;
+      plant.add(segmentMarker);
+      requestRender();
+    }
+  }).catch(() => {});
+}
+
+// The server's answer as text: the module with its identity and parameters, then its node.
+function pickText(j) {
+  if (!j.found) return 'no module drew this';
+  const value = (v) => (Array.isArray(v) ? `(${v.map((x) => +x.toPrecision(6)).join(', ')})` : String(+v.toPrecision(6)));
+  const params = (j.params || []).map((p) => (p.name.startsWith('#') ? value(p.value) : `${p.name} = ${value(p.value)}`));
+  let text = `${j.module}${j.id !== undefined ? ' #' + j.id : ''}${params.length ? `(${params.join(', ')})` : ''}`;
+  if (j.interpreted) text += '\n(made by an interpretation rule)';
+  if (j.node) text += `\nnode ${j.node.path}\n` + j.node.text.split('\n').slice(1).map((l) => l.trim()).filter(Boolean).join('\n');
+  return text;
+}
 
 const events = new EventSource('/api/events');
 events.addEventListener('model', (ev) => onState(JSON.parse(ev.data)));

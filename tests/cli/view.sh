@@ -75,4 +75,18 @@ for _ in $(seq 40); do kill -0 "$pid" 2>/dev/null || break; sleep 0.05; done
 wait "$pid"; code=$?
 check "Ctrl-C stops it cleanly (exit 0)" test "$code" = 0
 check "and removes its scratch folder" test "$(ls "$tmp/scratch" | wc -l)" = 0
+
+# picking (/api/pick): a bonsai branch's segment names the branch's graph node, not the root's
+"$plant" view "$root/grammars/bonsai/chokkan.plant" --port 0 > "$tmp/out2" 2>&1 &
+pid=$!; pids+=("$pid")
+for _ in $(seq 100); do grep -q "http://" "$tmp/out2" && break; sleep 0.1; done
+url=$(grep -o 'http://127.0.0.1:[0-9]*/' "$tmp/out2")
+curl -s "${url}api/pick?kind=tube&x=0&y=0.1&z=0" > "$tmp/trunk.json"
+check "a click on the trunk is the root node" grep -q '"node":{"by":"axis","path":"/",' "$tmp/trunk.json"
+curl -s "${url}api/pick?kind=tube&x=0.11&y=0.49&z=0.02" > "$tmp/branch.json"
+check "a click on a branch is the branch's node" grep -q '"node":{"by":"axis","path":"/0\.[0-9]*",' "$tmp/branch.json"
+check "a pick needs three finite numbers" test "$(status "${url}api/pick?x=nan&y=0&z=0")" = 400
+check "an organ pick needs its placement" test "$(status "${url}api/pick?kind=organ&x=0&y=0&z=0")" = 400
+check "a pick's kind is tube or organ" test "$(status "${url}api/pick?kind=file&x=0&y=0&z=0")" = 400
+kill -INT "$pid"; wait "$pid"
 exit $fail
