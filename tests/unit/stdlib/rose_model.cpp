@@ -96,7 +96,9 @@ class Walker {
     }
 
   private:
-    int node_of(int stem) const { return stem < 0 ? -1 : r_.stems[static_cast<std::size_t>(stem)].segments(); }
+    int node_of(int stem) const {
+        return stem < 0 ? -1 : r_.stems[static_cast<std::size_t>(stem)].segments();
+    }
     RoseStem& stem() { return r_.stems[static_cast<std::size_t>(f_.stem)]; }
 
     void step(const std::string& n, const double* a) {
@@ -131,7 +133,8 @@ class Walker {
         } else if (n == "Bloom" && f_.holds == Holds::Peduncle) {
             ++stem().peduncles[static_cast<std::size_t>(f_.item)].blooms;
         } else if (n == "Dormant" && f_.stem >= 0) {
-            stem().buds.push_back(RoseBud{node_of(f_.stem), static_cast<int>(a[0]), glm::dvec3(a[4], a[5], a[6])});
+            stem().buds.push_back(
+                RoseBud{node_of(f_.stem), static_cast<int>(a[0]), glm::dvec3(a[4], a[5], a[6])});
         }
     }
 

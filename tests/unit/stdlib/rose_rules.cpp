@@ -52,19 +52,24 @@ double seg_len(const Ctx& c, int type) {
     return type == RoseTrunk ? c.p("l_trunk") : type == RoseInter ? c.p("l_inter") : c.p("l_term");
 }
 
-// Sec. IV-B: why a trunk or intermediate stem stopped, read off its last node
+// Sec. IV-B: why a trunk or intermediate stem stops at node k: the crown ellipsoid (winter
+// pruning), the trunk ellipsoid (pinching out) or N_D segments (deadheading)
 enum class Stop { Cut, Pinched, Deadheaded, Other };
-Stop stop_of(const Ctx& c, const RoseStem& s) {
-    const glm::dvec3& q = s.pts.back();
+Stop stop_at(const Ctx& c, const RoseStem& s, int k) {
+    const glm::dvec3& q = s.pts[static_cast<std::size_t>(k)];
     if (level(q, c.p("r_crown"), c.p("h_crown")) > 1) return Stop::Cut;
     if (s.type == RoseTrunk && level(q, c.p("r_trunk"), c.p("h_trunk")) > 1) return Stop::Pinched;
-    if (s.type == RoseInter && s.segments() >= c.n("N_D")) return Stop::Deadheaded;
+    if (s.type == RoseInter && k >= c.n("N_D")) return Stop::Deadheaded;
     return Stop::Other;
+}
+Stop stop_of(const Ctx& c, const RoseStem& s) {
+    return stop_at(c, s, s.segments());
 }
 
 std::string name_of(const Ctx& c, int i) {
     const RoseStem& s = c.stem(i);
-    return fmt::format("stem {} (type {} origin {} at node {} of stem {})", i, s.type, s.origin, s.node, s.parent);
+    return fmt::format("stem {} (type {} origin {} at node {} of stem {})", i, s.type, s.origin, s.node,
+                       s.parent);
 }
 
 // Eq. 1-2: every segment direction follows from the one before with theta-hat, and kappa and
@@ -77,16 +82,24 @@ void check_eq2(Ctx& c) {
         const double sigma = wood ? c.p("sigma_inter") : c.p("sigma_term");
         for (int k = 1; k <= s.segments(); ++k) {
             if (std::abs(s.lens[k] - seg_len(c, s.type)) > 1e-9)
-                c.fail("segment length", fmt::format("{} segment {} is {}", name_of(c, int(i)), k, s.lens[k]));
+                c.fail("segment length",
+                       fmt::format("{} segment {} is {}", name_of(c, int(i)), k, s.lens[k]));
             if (k == 1) continue;
             glm::dvec3 want = rose_blend(s.dirs[k - 1], k - 1, c.p("theta"), kappa, sigma);
             if (!same(want, s.dirs[k]))
                 c.fail("Eq. 1-2", fmt::format("{} segment {}: {} where Eq. 2 gives {}", name_of(c, int(i)), k,
                                               str(s.dirs[k]), str(want)));
         }
+        if (woody(s.type))
+            for (int k = 1; k < s.segments(); ++k)
+                if (stop_at(c, s, k) != Stop::Other)
+                    c.fail("stop rule", fmt::format("{} grows on past node {} of {}", name_of(c, int(i)), k,
+                                                    s.segments()));
         if (s.state != 1) c.fail("picking", fmt::format("{} is still a candidate", name_of(c, int(i))));
-        if (s.segments() < 1) c.fail("stems", fmt::format("{} has no segment", name_of(c, int(i))));
-        else if (s.dirs[1].y < -1e-9) c.fail("shoot picking", fmt::format("{} starts downward", name_of(c, int(i))));
+        if (s.segments() < 1)
+            c.fail("stems", fmt::format("{} has no segment", name_of(c, int(i))));
+        else if (s.dirs[1].y < -1e-9)
+            c.fail("shoot picking", fmt::format("{} starts downward", name_of(c, int(i))));
     }
 }
 
@@ -99,12 +112,15 @@ void check_trunks(Ctx& c) {
     for (std::size_t i = 0; i < c.r.stems.size(); ++i) {
         const RoseStem& s = c.r.stems[i];
         if ((s.type == RoseTrunk) != (s.origin == RoseFromRoot) || (s.type == RoseTrunk) != (s.parent < 0))
-            c.fail("trunks", fmt::format("{}: trunks and only trunks grow from the bud union", name_of(c, int(i))));
+            c.fail("trunks",
+                   fmt::format("{}: trunks and only trunks grow from the bud union", name_of(c, int(i))));
         if (s.type != RoseTrunk || s.segments() < 1) continue;
         ++trunks;
         const double pitch = rose_pitch(s.dirs[1]);
-        if (pitch < c.p("trunk_pitch_min") - 1e-9 || pitch > c.p("trunk_pitch_max") + 1e-9 || !same(s.pts[0], {0, 0, 0}))
-            c.fail("trunks", fmt::format("{} starts at {} with pitch {}", name_of(c, int(i)), str(s.pts[0]), pitch));
+        if (pitch < c.p("trunk_pitch_min") - 1e-9 || pitch > c.p("trunk_pitch_max") + 1e-9 ||
+            !same(s.pts[0], {0, 0, 0}))
+            c.fail("trunks",
+                   fmt::format("{} starts at {} with pitch {}", name_of(c, int(i)), str(s.pts[0]), pitch));
         double az = std::atan2(s.dirs[1].z, s.dirs[1].x);
         if (az < 0) az += 2 * kPi;
         const double x = az / (2 * kPi) * N_S;
@@ -126,8 +142,8 @@ void check_branch_kind(Ctx& c, int parent, int type, int origin, const std::stri
         c.fail("branching", fmt::format("{} branches at its tip without having stopped", name_of(c, parent)));
     else if (type != want)
         c.fail("child by stop reason",
-               fmt::format("{} of {} is type {} (-1: a dormant bud), origin {}; want {}", what, name_of(c, parent), type,
-                           origin, want));
+               fmt::format("{} of {} is type {} (-1: a dormant bud), origin {}; want {}", what,
+                           name_of(c, parent), type, origin, want));
 }
 
 // one child of a trunk or intermediate stem: where it grows and which way it points
@@ -156,9 +172,12 @@ void check_woody_child(Ctx& c, int parent, int type, int origin, int node, const
         if (node != N - 1) c.fail("second child", fmt::format("{} at node {} of {}", what, node, N));
         check_branch_kind(c, parent, type, origin, what);
     } else if (origin == RoseFromRandom) {
-        if (node < 1 || node > N - 2) c.fail("random shoots", fmt::format("{} at node {} of {}", what, node, N));
-        if (level(ps.pts[static_cast<std::size_t>(std::max(node, 0))], c.p("r_crown"), c.p("h_crown")) <= c.p("gamma"))
-            c.fail("gamma", fmt::format("{} of {} inside the crown shrunk by gamma", what, name_of(c, parent)));
+        if (node < 1 || node > N - 2)
+            c.fail("random shoots", fmt::format("{} at node {} of {}", what, node, N));
+        if (level(ps.pts[static_cast<std::size_t>(std::max(node, 0))], c.p("r_crown"), c.p("h_crown")) <=
+            c.p("gamma"))
+            c.fail("gamma",
+                   fmt::format("{} of {} inside the crown shrunk by gamma", what, name_of(c, parent)));
         if (c.p("rho_inter") + c.p("rho_term") <= 0) c.fail("random shoots", what + " with rho = 0");
     } else {
         c.fail("origins", fmt::format("{} of {} has origin {}", what, name_of(c, parent), origin));
@@ -242,26 +261,29 @@ std::vector<glm::dvec3> peduncle_dirs(const Ctx& c, const glm::dvec3& p, const g
 void check_peduncles(Ctx& c, int i, int want) {
     const RoseStem& s = c.stem(i);
     if (static_cast<int>(s.peduncles.size()) != want)
-        c.fail("peduncles", fmt::format("{} has {} peduncles, want {}", name_of(c, i), s.peduncles.size(), want));
+        c.fail("peduncles",
+               fmt::format("{} has {} peduncles, want {}", name_of(c, i), s.peduncles.size(), want));
     for (std::size_t j = 0; j < s.peduncles.size(); ++j) {
         const RosePeduncle& pd = s.peduncles[j];
         const std::string what = fmt::format("peduncle {} of {}", j, name_of(c, i));
         double total = 0;
         for (double l : pd.lens) total += l;
         if (pd.node != s.segments() || pd.blooms != 1 || std::abs(total - 1.5 * c.p("l_term")) > 1e-9)
-            c.fail("peduncle length", fmt::format("{}: at node {}, {} blooms, {} long for l_term {}", what, pd.node,
-                                                  pd.blooms, total, c.p("l_term")));
+            c.fail("peduncle length", fmt::format("{}: at node {}, {} blooms, {} long for l_term {}", what,
+                                                  pd.node, pd.blooms, total, c.p("l_term")));
         auto want_dirs = peduncle_dirs(c, s.pts.back(), s.dirs.back(), static_cast<int>(j));
         if (pd.dirs.size() != want_dirs.size()) {
             c.fail("peduncle length", fmt::format("{} has {} segments", what, pd.dirs.size()));
             continue;
         }
         if (std::abs(angle(pd.dirs[0], s.dirs.back()) - (j == 0 ? 0 : kPi / 4)) > 1e-6)
-            c.fail("peduncle angles", fmt::format("{} starts {} rad from the stem", what, angle(pd.dirs[0], s.dirs.back())));
+            c.fail("peduncle angles",
+                   fmt::format("{} starts {} rad from the stem", what, angle(pd.dirs[0], s.dirs.back())));
         for (std::size_t k = 0; k < pd.dirs.size(); ++k)
             if (!same(pd.dirs[k], want_dirs[k]))
                 c.fail(k == 0 ? "peduncle angles" : "peduncle droop",
-                       fmt::format("{} segment {}: {}, want {}", what, k + 1, str(pd.dirs[k]), str(want_dirs[k])));
+                       fmt::format("{} segment {}: {}, want {}", what, k + 1, str(pd.dirs[k]),
+                                   str(want_dirs[k])));
     }
 }
 
@@ -295,8 +317,8 @@ void check_spiral(Ctx& c, int i, const std::vector<std::pair<int, glm::dvec3>>& 
             if (off > 180) off -= 360;
             if (off <= -180) off += 360;
             if (std::abs(off) > 1e-3)
-                c.fail("3/8 phyllotaxis", fmt::format("{} children at nodes {} and {} off by {} degrees", name_of(c, i),
-                                                      k0, k, off));
+                c.fail("3/8 phyllotaxis", fmt::format("{} children at nodes {} and {} off by {} degrees",
+                                                      name_of(c, i), k0, k, off));
         }
         have = true;
         k0 = k;
@@ -326,19 +348,23 @@ void check_leaves(Ctx& c, int i, std::vector<glm::dvec3>& leaf_at) {
             glm::dvec3 want = rose_tip_ideal(s.pts.back(), d, c.p("phi_leaf"));
             if (japanese) want = rose_upward(want, d);
             if (!same(lf.dir, want))
-                c.fail("tip leaf", fmt::format("{}: tip leaf {}, want {}", name_of(c, i), str(lf.dir), str(want)));
+                c.fail("tip leaf",
+                       fmt::format("{}: tip leaf {}, want {}", name_of(c, i), str(lf.dir), str(want)));
             if (angle(lf.dir, d) < c.p("phi_leaf") - 1e-6)
-                c.fail("tip leaf", fmt::format("{}: tip leaf {} rad from the stem", name_of(c, i), angle(lf.dir, d)));
+                c.fail("tip leaf",
+                       fmt::format("{}: tip leaf {} rad from the stem", name_of(c, i), angle(lf.dir, d)));
             if (japanese) spiral.emplace_back(lf.node, lf.dir);
         } else {
             if (std::abs(glm::dot(lf.dir, d)) > 1e-6)
-                c.fail("perpendicular children", fmt::format("{}: leaf at node {} not perpendicular", name_of(c, i), lf.node));
+                c.fail("perpendicular children",
+                       fmt::format("{}: leaf at node {} not perpendicular", name_of(c, i), lf.node));
             spiral.emplace_back(lf.node, lf.dir);
         }
     }
     for (int k = 1; k <= N; ++k)
         if (count[static_cast<std::size_t>(k)] != 1)
-            c.fail("leaves", fmt::format("{}: {} leaves at node {}", name_of(c, i), count[static_cast<std::size_t>(k)], k));
+            c.fail("leaves", fmt::format("{}: {} leaves at node {}", name_of(c, i),
+                                         count[static_cast<std::size_t>(k)], k));
     std::sort(spiral.begin(), spiral.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
     check_spiral(c, i, spiral);
 }
@@ -350,7 +376,8 @@ void check_terminal(Ctx& c, int i) {
     const int N = s.segments(), N_T = c.n("N_T");
     if (N != N_T) c.fail("N_T segments", fmt::format("{} has {} segments", name_of(c, i), N));
     if (s.parent < 0 || !woody(c.stem(s.parent).type))
-        c.fail("terminal stems", fmt::format("{} does not grow from a trunk or intermediate stem", name_of(c, i)));
+        c.fail("terminal stems",
+               fmt::format("{} does not grow from a trunk or intermediate stem", name_of(c, i)));
     std::vector<glm::dvec3> leaf_at;
     check_leaves(c, i, leaf_at);
     const int nbl = std::min(c.n("N_B"), 9);
@@ -366,7 +393,8 @@ void check_terminal(Ctx& c, int i) {
         const int k = N - back;
         const int extra = back == 2 ? std::min(nbl - 3, 3) : std::min(nbl - 6, 3);
         if (k < 1 || k > N) continue;
-        const glm::dvec3 gb = glm::normalize(leaf_at[static_cast<std::size_t>(k)] + s.dirs[static_cast<std::size_t>(k)]);
+        const glm::dvec3 gb =
+            glm::normalize(leaf_at[static_cast<std::size_t>(k)] + s.dirs[static_cast<std::size_t>(k)]);
         const bool want = extra > 0 && gb.y >= -1e-9;
         auto it = extra_at.find(k);
         if (want != (it != extra_at.end())) {
@@ -377,16 +405,19 @@ void check_terminal(Ctx& c, int i) {
         if (!want) continue;
         const RoseStem& b = c.stem(it->second);
         if (b.segments() != back || !same(b.dirs[1], gb))
-            c.fail("extra bloom stems", fmt::format("{}: {} segments starting {}, want {} starting {}",
-                                                    name_of(c, it->second), b.segments(), str(b.dirs[1]), back, str(gb)));
+            c.fail("extra bloom stems",
+                   fmt::format("{}: {} segments starting {}, want {} starting {}", name_of(c, it->second),
+                               b.segments(), str(b.dirs[1]), back, str(gb)));
         check_peduncles(c, it->second, extra);
         blooms += static_cast<int>(b.peduncles.size());
         extra_at.erase(it);
     }
-    for (const auto& [k, ch] : extra_at) c.fail("extra bloom stems", fmt::format("{} at node {}", name_of(c, ch), k));
+    for (const auto& [k, ch] : extra_at)
+        c.fail("extra bloom stems", fmt::format("{} at node {}", name_of(c, ch), k));
     check_peduncles(c, i, std::min(nbl, 3));
     blooms += static_cast<int>(s.peduncles.size());
-    if (blooms > nbl || blooms < 1) c.fail("blooms", fmt::format("{}: {} blooms, N_B = {}", name_of(c, i), blooms, nbl));
+    if (blooms > nbl || blooms < 1)
+        c.fail("blooms", fmt::format("{}: {} blooms, N_B = {}", name_of(c, i), blooms, nbl));
 }
 
 void check_flowers(Ctx& c) {
@@ -398,10 +429,12 @@ void check_flowers(Ctx& c) {
             check_terminal(c, int(i));
         } else if (t == RoseBloomStem) {
             const int p = c.r.stems[i].parent;
-            if (p < 0 || c.stem(p).type != RoseTerm) c.fail("extra bloom stems", name_of(c, int(i)) + " off a terminal stem");
+            if (p < 0 || c.stem(p).type != RoseTerm)
+                c.fail("extra bloom stems", name_of(c, int(i)) + " off a terminal stem");
         }
     }
-    if (c.p("stage") >= 2 && terminal == 0) c.fail("terminal stems", "a rose in flower without terminal stems");
+    if (c.p("stage") >= 2 && terminal == 0)
+        c.fail("terminal stems", "a rose in flower without terminal stems");
     if (c.p("stage") < 2 && terminal > 0) c.fail("terminal stems", "terminal stems before flowering");
 }
 
@@ -411,8 +444,10 @@ std::vector<std::string> rose_rule_failures(const RoseModel& r) {
     std::vector<std::string> out;
     Ctx c{r, out, {}};
     for (const char* pending : {"Root", "Node", "Grow", "Flower", "Peduncles", "%"})
-        if (r.counts.count(pending)) c.fail("pending", fmt::format("{} {} left at the end", r.counts.at(pending), pending));
-    if (r.params.at("stage") >= 2 && r.counts.count("Dormant")) c.fail("pending", "dormant buds left in flower");
+        if (r.counts.count(pending))
+            c.fail("pending", fmt::format("{} {} left at the end", r.counts.at(pending), pending));
+    if (r.params.at("stage") >= 2 && r.counts.count("Dormant"))
+        c.fail("pending", "dormant buds left in flower");
     if (r.stems.empty()) {
         c.fail("stems", "no stem at all");
         return out;

@@ -17,7 +17,13 @@ namespace plant::test {
 
 // stem types and origins, as stdlib/rose.plant numbers them
 enum RoseType { RoseTrunk = 0, RoseInter = 1, RoseTerm = 2, RoseBloomStem = 3 };
-enum RoseOrigin { RoseFromRoot = 0, RoseFromTip = 1, RoseFromSecond = 2, RoseFromRandom = 3, RoseFromExtra = 4 };
+enum RoseOrigin {
+    RoseFromRoot = 0,
+    RoseFromTip = 1,
+    RoseFromSecond = 2,
+    RoseFromRandom = 3,
+    RoseFromExtra = 4
+};
 
 struct RoseLeaf {
     int node = 0;

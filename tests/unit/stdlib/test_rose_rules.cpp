@@ -76,7 +76,8 @@ TEST_CASE("rose rules: droop_reading 1 droops Fig. 12d's blooms and leaves pi/2 
     std::string error;
     for (std::uint64_t seed : {1, 2}) {
         RoseModel printed = grow_rose_model(kRoseDir + "/fig12d.plant", seed, {}, error);
-        RoseModel caption = grow_rose_model(kRoseDir + "/fig12d.plant", seed, {{"droop_reading", "1"}}, error);
+        RoseModel caption =
+            grow_rose_model(kRoseDir + "/fig12d.plant", seed, {{"droop_reading", "1"}}, error);
         REQUIRE(error.empty());
         const double a = mean_peduncle_end_pitch(printed), b = mean_peduncle_end_pitch(caption);
         INFO(fmt::format("seed {}: mean bloom pitch {} as printed, {} as the caption reads", seed, a, b));
@@ -105,8 +106,8 @@ TEST_CASE("rose rules: tip_leaf_reading 1 turns every tip leaf up", "[rose]") {
                         tips += r == &ja;
                     }
     }
-    INFO(fmt::format("{} tip leaves: {} point down as printed in English, {} in the Japanese reading", tips, down_en,
-                     down_ja));
+    INFO(fmt::format("{} tip leaves: {} point down as printed in English, {} in the Japanese reading", tips,
+                     down_en, down_ja));
     CHECK(tips > 0);
     CHECK(down_en > 0);
     CHECK(down_ja == 0);
