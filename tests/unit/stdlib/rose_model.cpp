@@ -184,7 +184,17 @@ RoseModel grow_rose_model(const std::string& path, std::uint64_t seed, const Ros
     opt.seed = seed;
     opt.environment_phase = &phase;
     Derivation d(*program, opt);
-    d.run();
+    d.start();
+    for (bool more = true; more;) {
+        more = d.step();
+        if (d.steps_done() != 1 || rose.trunk_candidates >= 0) continue;
+        rose.trunk_candidates = 0;
+        const ModuleString& s = d.string();
+        for (std::size_t i = 0; i < s.size(); ++i)
+            if (program->symbols[s.sym[i]].name == "Stem" && static_cast<int>(s.args(i)[0]) == RoseTrunk)
+                ++rose.trunk_candidates;
+    }
+    d.finish();
     for (const auto& g : program->globals)
         if (g.kind == GlobalKind::Param) rose.params[g.name] = d.globals()[g.slot];
     rose.string = format_string(*program, d.string(), false);

@@ -59,7 +59,8 @@ struct RoseModel {
     std::map<std::string, double> params;
     std::map<std::string, int> counts; // modules by name in the final string
     std::vector<RoseStem> stems;
-    std::string string; // the final string, formatted
+    int trunk_candidates = -1; // trunk stems in the string after step 1, before picking
+    std::string string;        // the final string, formatted
 };
 
 using RoseDefines = std::vector<std::pair<std::string, std::string>>;

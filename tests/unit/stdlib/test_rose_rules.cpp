@@ -48,18 +48,18 @@ double mean_peduncle_end_pitch(const RoseModel& r) {
 
 } // namespace
 
-TEST_CASE("rose rules: every figure grammar follows every rule on three seeds", "[rose]") {
+TEST_CASE("rose rules: every figure grammar follows every rule on five seeds", "[rose]") {
     std::vector<std::string> files;
     for (const auto& e : fs::directory_iterator(kRoseDir))
         if (e.path().extension() == ".plant") files.push_back(e.path().filename().string());
     std::sort(files.begin(), files.end());
     REQUIRE(files.size() >= 13);
     for (const auto& f : files)
-        for (std::uint64_t seed : {1, 2, 3}) require_rules(f, seed);
+        for (std::uint64_t seed = 1; seed <= 5; ++seed) require_rules(f, seed);
 }
 
 TEST_CASE("rose rules: parameter sets the figures leave idle follow every rule", "[rose]") {
-    for (std::uint64_t seed : {1, 2, 3, 4}) {
+    for (std::uint64_t seed = 1; seed <= 6; ++seed) {
         require_rules("fig12c.plant", seed, {{"N_B", "9"}});
         require_rules("fig09.plant", seed, {{"N_B", "5"}, {"theta_droop", "0.4"}});
         require_rules("fig12a.plant", seed, {{"gamma", "0.5"}, {"rho_inter", "0.3"}, {"rho_term", "0.5"}});
