@@ -6,6 +6,8 @@
 #include "commands.hpp"
 #include "outputs.hpp"
 
+#include <nlohmann/json.hpp>
+
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
@@ -49,6 +51,20 @@ struct ViewPickData; // a step's interpreted string and skeleton (cmd_view_pick.
 std::string view_pick_json(const Program& program, const Derivation& d, int step,
                            std::shared_ptr<const ViewPickData>& data, const ViewPick& q);
 
+// An edit made on the page to an environment (docs/view.md, editing climbers): one call of an
+// edit method (`ivy.cut(14)`, `ivy.pull(14, vec3(0, 1, 0.2))`), run before step `step + 1` as
+// the REPL's edits are. Arguments: a number each, three for a vec3.
+struct ViewEdit {
+    int step = 0;
+    std::string env, method;
+    std::vector<std::vector<double>> args;
+};
+
+// The `on before_step` hook that runs the edits (empty without any), and the environments'
+// edit methods the page can call, as JSON rows (cmd_view_edit.cpp).
+std::string view_edit_hook(const std::vector<std::pair<int, std::string>>& edits);
+nlohmann::json view_edit_methods(const Program& program);
+
 // The grammar, derived with the command line's options and the page's controls; the last good
 // derivation stays when the grammar stops compiling. Thread-safe.
 class ViewModel {
@@ -60,6 +76,11 @@ class ViewModel {
     // Sets the controls (checked against the params the grammar declares) and rebuilds. Returns
     // an error message, empty on success.
     std::string set_controls(const ViewControls& controls);
+    // Checks an edit against the grammar's environments (an edit method of a declared one, its
+    // arguments' count and types, finite numbers), keeps it and rebuilds. Returns an error
+    // message, empty on success. undo_edit drops the last edit (false when there is none).
+    std::string add_edit(const ViewEdit& edit);
+    bool undo_edit();
     // The state as JSON: version, counts per kept step, params, seed, the error if any.
     std::string state_json() const;
     // The GLB of kept step k (the last step when k < 0); none when there is no plant or k is not kept.
@@ -75,6 +96,7 @@ class ViewModel {
     struct Built; // a compiled program and its kept steps (cmd_view_model.cpp)
 
   private:
+    void update_extra_steps(); // (with mutex_ held)
     GrammarOptions options_;
     OutputOptions output_;
     std::string scratch_;
@@ -82,6 +104,11 @@ class ViewModel {
     std::mutex build_mutex_;      // one rebuild at a time
     std::unique_ptr<Built> good_; // the last good plant
     ViewControls controls_;
+    std::vector<std::pair<int, std::string>> edits_; // (step, statement), in the order made
+    // The steps derived before the first edit; an edit at or past the last of them derives up to
+    // one step more, so that it shows (extra_steps_: the -n that does, none when not needed).
+    int edit_base_steps_ = 0;
+    std::optional<int> extra_steps_;
     std::string error_; // the last rebuild's diagnostics; empty when it succeeded
     double derive_ms_ = 0;
     std::uint64_t version_ = 0;

@@ -1,5 +1,6 @@
 // plant view's model: compile, derive keeping every step's state, export GLB on demand.
 #include "cmd_view.hpp"
+#include "cmd_view_built.hpp"
 
 #include "plant/environment_phase.hpp"
 
@@ -33,23 +34,6 @@ std::string number_text(double v) {
 }
 
 } // namespace
-
-// A compiled program and its derivation at every kept step (index: the step number; null when
-// that step was not kept).
-struct ViewModel::Built {
-    std::unique_ptr<SourceManager> sources;
-    std::unique_ptr<Program> program;
-    std::unique_ptr<TurtleEnvironmentPhase> phase;
-    std::vector<std::unique_ptr<Derivation>> steps;
-    std::vector<std::size_t> modules;                         // per step
-    std::map<int, std::string> glb;                           // exported steps
-    std::map<int, std::shared_ptr<const ViewPickData>> picks; // steps picked in (cmd_view_pick.cpp)
-    std::vector<Global> params; // the number params; their values are read from `values`
-    std::vector<double> values;
-    std::uint64_t seed = 0;
-    std::size_t instances = 0; // instance declarations (the page checks InstancedMesh against it)
-    std::uint64_t version = 0; // the version that made it; a failed rebuild after it keeps it
-};
 
 ViewModel::ViewModel(GrammarOptions options, OutputOptions output, std::string scratch_dir)
     : options_(std::move(options)), output_(output), scratch_(std::move(scratch_dir)) {
@@ -115,6 +99,8 @@ std::uint64_t ViewModel::rebuild() {
         for (const auto& [name, value] : controls_.params)
             g.defines.push_back(name + "=" + number_text(value));
         if (controls_.seed) g.seed = controls_.seed;
+        g.appended = view_edit_hook(edits_);
+        if (extra_steps_) g.steps = extra_steps_;
     }
     g.color = false;
     const auto t0 = std::chrono::steady_clock::now();
@@ -204,6 +190,7 @@ std::string ViewModel::state_json() const {
         }
         j["params"] = params;
         j["instances"] = good_->instances;
+        j["edit_methods"] = view_edit_methods(*good_->program);
         j["derive_ms"] = derive_ms_;
     }
     // the command line that grows what is shown
@@ -214,8 +201,16 @@ std::string ViewModel::state_json() const {
         cmd += fmt::format(" --seed {}", *controls_.seed);
     else if (options_.seed)
         cmd += fmt::format(" --seed {}", *options_.seed);
-    if (options_.steps) cmd += fmt::format(" -n {}", *options_.steps);
+    if (extra_steps_)
+        cmd += fmt::format(" -n {}", *extra_steps_);
+    else if (options_.steps)
+        cmd += fmt::format(" -n {}", *options_.steps);
     j["command"] = cmd;
+    nlohmann::json edits = nlohmann::json::array();
+    for (const auto& [step, statement] : edits_) edits.push_back({{"step", step}, {"call", statement}});
+    j["edits"] = edits;
+    // what to add to the grammar for `plant run` to make the edited plant too
+    j["edit_hook"] = view_edit_hook(edits_);
     return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 

@@ -134,6 +134,42 @@ void set_controls(ViewModel& model, ViewEvents& events, const httplib::Request& 
     res.set_content(model.state_json(), "application/json");
 }
 
+// POST /api/edit {"step": k, "env": "ivy", "method": "cut", "args": [14, [0, 1, 0]]} or
+// {"undo": true}: one edit method call before step k + 1 (docs/view.md, editing climbers).
+void edit(ViewModel& model, ViewEvents& events, const httplib::Request& req, httplib::Response& res) {
+    ViewEdit e;
+    bool undo = false;
+    try {
+        const auto j = nlohmann::json::parse(req.body);
+        undo = j.value("undo", false);
+        if (!undo) {
+            e.step = j.at("step").get<int>();
+            e.env = j.at("env").get<std::string>();
+            e.method = j.at("method").get<std::string>();
+            for (const auto& a : j.at("args")) {
+                std::vector<double> v;
+                if (a.is_array())
+                    for (const auto& x : a) v.push_back(x.get<double>());
+                else
+                    v.push_back(a.get<double>());
+                e.args.push_back(std::move(v));
+            }
+        }
+    } catch (const std::exception&) {
+        return refuse(
+            res, 400,
+            "expected {\"step\": k, \"env\": name, \"method\": name, \"args\": [number or [x, y, z]]} "
+            "or {\"undo\": true}");
+    }
+    if (undo) {
+        if (!model.undo_edit()) return refuse(res, 400, "there is no edit to undo");
+    } else if (std::string why = model.add_edit(e); !why.empty()) {
+        return refuse(res, 400, why);
+    }
+    events.publish(model.version());
+    res.set_content(model.state_json(), "application/json");
+}
+
 // GET /api/events: Server-Sent Events, one `model` event (the state) per new version.
 void stream_events(ViewModel& model, ViewEvents& events, httplib::Response& res) {
     auto seen = std::make_shared<std::uint64_t>(0);
@@ -184,6 +220,8 @@ int serve_view(ViewModel& model, ViewEvents& events, const ViewServerOptions& op
     server.Post("/api/controls", [&](const httplib::Request& req, httplib::Response& res) {
         set_controls(model, events, req, res);
     });
+    server.Post("/api/edit",
+                [&](const httplib::Request& req, httplib::Response& res) { edit(model, events, req, res); });
     server.Get(".*", [](const httplib::Request& req, httplib::Response& res) { serve_asset(req, res); });
     set_stopper([&server] { server.stop(); });
     if (options.on_listening) options.on_listening(port);

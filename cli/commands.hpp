@@ -38,6 +38,9 @@ struct GrammarOptions {
     // --edits FILE: the decomposition graph's edits (docs/language.md, decomposition graphs);
     // empty: the grammar's `edits "file";`, if any.
     std::string edits;
+    // Source text compiled after the file's own, as part of it (plant view's edits, made from
+    // checked parts: an `on before_step` hook); empty: none.
+    std::string appended;
 };
 
 // Reads a whole number from 0 (`lowest`) to 2^64 - 1 written in decimal digits; throws

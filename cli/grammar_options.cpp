@@ -104,6 +104,7 @@ std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& so
         }
         co.defines.emplace_back(d.substr(0, eq), d.substr(eq + 1));
     }
+    if (!o.appended.empty()) text += "\n" + o.appended;
     Diagnostics diags;
     std::uint32_t id = sources.add(o.file, std::move(text));
     auto program = compile_source(sources, id, co, diags);

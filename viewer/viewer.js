@@ -284,8 +284,75 @@ function updateControls() {
   const last = server.modules.length - 1;
   slider.max = String(last);
   if (followLast || Number(slider.value) > last) slider.value = String(last);
-  if ($('command-line').style.display === 'block') $('command-line').textContent = server.command;
+  if ($('command-line').style.display === 'block') $('command-line').textContent = commandText();
+  updateEdits();
 }
+
+// The command line that grows what is shown, and the hook to add for the page's edits.
+function commandText() {
+  if (!server) return '';
+  return server.command + (server.edit_hook ? `\n# with the edits made here, added to the grammar:\n${server.edit_hook}` : '');
+}
+
+// Editing (climbers, docs/view.md): a row per edit method of the grammar's environments, its
+// arguments filled from the pick (a module id, the picked point as a target) and editable; the
+// call runs before the step after the one shown, as the REPL's edits do.
+function updateEdits() {
+  const methods = server.edit_methods || [];
+  $('edit-box').style.display = methods.length ? 'block' : 'none';
+  const key = methods.map((m) => `${m.env}.${m.method}(${m.args})`).join(',');
+  const box = $('edit-methods');
+  if (box.dataset.key !== key) {
+    box.dataset.key = key;
+    box.replaceChildren(...methods.map(editRow));
+  }
+  $('edit-list').textContent = (server.edits || []).map((e) => `before step ${e.step + 1}: ${e.call}`).join('\n') || 'no edits';
+}
+
+function editRow(m) {
+  const row = document.createElement('div');
+  const button = document.createElement('button');
+  button.textContent = `${m.env}.${m.method}`;
+  button.title = m.doc;
+  button.dataset.edit = m.method;
+  row.appendChild(button);
+  const takesId = /module id/.test(m.doc);
+  const inputs = m.args.map((type, k) => {
+    const input = document.createElement('input');
+    input.type = 'text';
+    input.size = type === 'vec3' ? 14 : 6;
+    input.dataset.arg = k === 0 && takesId ? 'id' : type;
+    input.value = type === 'vec3' ? '0, 0, 0' : '0';
+    input.placeholder = k === 0 && takesId ? 'module id' : type === 'vec3' ? 'x, y, z' : 'number';
+    row.appendChild(input);
+    return input;
+  });
+  button.addEventListener('click', async () => {
+    const args = inputs.map((input) => {
+      const xs = input.value.split(',').map((t) => Number(t.trim()));
+      return input.dataset.arg === 'vec3' ? xs : xs[0];
+    });
+    const body = { step: state.step, env: m.env, method: m.method, args };
+    const res = await fetch('/api/edit', { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(body) });
+    if (!res.ok) showError(await res.text());
+  });
+  return row;
+}
+
+// A pick fills the edit rows: its module's identity, and its point as a target (pull).
+function fillEdits(j) {
+  if (!j.found || j.id === undefined) return;
+  for (const input of document.querySelectorAll('#edit-methods input[data-arg="id"]')) input.value = String(j.id);
+  const at = j.to || j.at;
+  if (at) for (const row of document.querySelectorAll('#edit-methods div')) {
+    const vecs = row.querySelectorAll('input[data-arg="vec3"]');
+    if (row.querySelector('input[data-arg="id"]') && vecs.length) vecs[0].value = at.map((v) => +v.toFixed(4)).join(', ');
+  }
+}
+$('edit-undo').addEventListener('click', async () => {
+  const res = await fetch('/api/edit', { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify({ undo: true }) });
+  if (!res.ok) showError(await res.text());
+});
 
 async function sendControls() {
   const body = { params: edited, seed: seedEdited };
@@ -355,9 +422,9 @@ $('seed').addEventListener('change', () => {
 });
 $('save-d').addEventListener('click', () => {
   const line = $('command-line');
-  line.textContent = server ? server.command : '';
+  line.textContent = commandText();
   line.style.display = 'block';
-  if (navigator.clipboard && server) navigator.clipboard.writeText(server.command).catch(() => {});
+  if (navigator.clipboard && server) navigator.clipboard.writeText(commandText()).catch(() => {});
 });
 
 function download(name, blob) {
@@ -438,6 +505,7 @@ function pickAt(x, y) {
   fetch(`/api/pick?${q}`).then((res) => (res.ok ? res.json() : null)).then((j) => {
     if (!j || plant !== shown) return;
     state.picked = j;
+    fillEdits(j);
     $('pick').textContent = pickText(j) + '\n\n' + what;
     if (j.from && j.to) {
       const g = new THREE.BufferGeometry().setFromPoints([new THREE.Vector3(...j.from), new THREE.Vector3(...j.to)]);

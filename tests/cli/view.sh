@@ -67,6 +67,9 @@ for _ in $(seq 40); do
     sleep 0.05
 done
 check "and derives to an error naming the range" test -n "$outside"
+check "an edit names an environment the grammar declares" grep -q "no environment 'ivy'" <(curl -s -X POST -d '{"step":1,"env":"ivy","method":"cut","args":[3]}' "${url}api/edit")
+check "an edit is a call, not source text" test "$(status -X POST -d '{"step":1,"call":"ivy.cut(3); system()"}' "${url}api/edit")" = 400
+check "undo without an edit is refused" test "$(status -X POST -d '{"undo":true}' "${url}api/edit")" = 400
 check "the export's scratch folder is under TMPDIR" test "$(ls "$tmp/scratch" | wc -l)" = 1
 "$plant" view "$tmp/g.plant" --port "$port" > /dev/null 2> "$tmp/err2"; code=$?
 check "a port in use is exit 70 with advice" test "$code" = 70 -a -n "$(grep -- '--port 0' "$tmp/err2")"

@@ -211,6 +211,34 @@ async function climberChecks(browser) {
   const page = await openPage(browser, url, errors);
   const names = await page.evaluate(() => window.plantView.names());
   check(names.some((n) => n.includes('obstacles')), 'a climber\'s obstacles are drawn', names.slice(0, 6).join(', '));
+  // an edit from the page: pick a segment at step 20, cut it, see fewer modules later, undo
+  const host = { Host: new URL(url).host };
+  const stateOf = async () => JSON.parse((await request(url, '/api/state', host)).body);
+  const before = await stateOf();
+  await page.evaluate(() => { const e = document.getElementById('step'); e.value = '20'; e.dispatchEvent(new Event('input')); });
+  await waitFor(page, () => window.plantView.step === 20);
+  let picked = null;
+  for (const y of [0.5, 0.8, 1.1, 0.3, 1.4]) {
+    const seg = JSON.parse((await request(url, `/api/pick?step=20&x=0&y=${y}&z=0.2`, host)).body);
+    const mid = seg.from.map((v, k) => (v + seg.to[k]) / 2);
+    await page.evaluate(() => { window.plantView.picked = null; });
+    await page.evaluate((p) => window.plantView.clickAt(p.x, p.y), await page.evaluate((m) => window.plantView.screenOf(m), mid));
+    try { await waitFor(page, () => window.plantView.picked, null, 2000); } catch { continue; }
+    picked = await page.evaluate(() => window.plantView.picked);
+    if (picked.found && picked.module === 'Seg') break;
+  }
+  check(picked && picked.module === 'Seg' && (await page.$eval('#edit-methods input[data-arg="id"]', (e) => e.value)) === String(picked.id),
+    'clicking a climber\'s segment fills the edit rows with its identity', picked ? `Seg #${picked.id}` : 'nothing picked');
+  // (waits for the edit's state event: moving the step slider above loads a model of its own)
+  await page.click('#edit-methods button[data-edit="cut"]');
+  await waitFor(page, () => document.getElementById('edit-list').textContent.includes('ivy.cut('), null, 20000);
+  const cut = await stateOf();
+  const list = await page.$eval('#edit-list', (e) => e.textContent);
+  check(cut.modules[20] === before.modules[20] && cut.modules.at(-1) < before.modules.at(-1) && list.includes(`before step 21: ivy.cut(${picked && picked.id});`),
+    'the cut button cuts the branch before the next step, and the page lists the edit', `${before.modules.at(-1)} -> ${cut.modules.at(-1)} modules; ${list}`);
+  await page.click('#edit-undo');
+  await waitFor(page, () => document.getElementById('edit-list').textContent === 'no edits', null, 20000);
+  check((await stateOf()).modules.at(-1) === before.modules.at(-1), 'undo edit restores the plant');
   check(errors.length === 0, 'no console error (climber)', errors.join(' | '));
   await page.close();
 }
