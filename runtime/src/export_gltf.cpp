@@ -126,7 +126,7 @@ struct GltfBuilder {
                 sink(piece.bytes, piece.size);
                 continue;
             }
-            constexpr std::size_t kBlock = 4096;
+            constexpr std::size_t kBlock = 1 << 15; // 384 kB a write
             block.resize(kBlock);
             const std::size_t count = piece.size / sizeof(glm::vec3);
             for (std::size_t at = 0; at < count; at += kBlock) {
