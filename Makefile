@@ -42,10 +42,12 @@ FUZZ_SECONDS ?= 60
 fuzz: | deps
 	FUZZ_SECONDS=$(FUZZ_SECONDS) bash scripts/fuzz
 
-# bench/run (the derivation, meshing and end-to-end figures), then bench/run-batch (1,000 roses
-# on 1 and 2 jobs); fails when either misses a target.
+# bench/run (the derivation, meshing and end-to-end figures), bench/run-batch (1,000 roses on 1
+# and 2 jobs), bench/run-peers (against cpfg and lpfg; skipped when they cannot be built) and
+# bench/run-glb (plant run against a hand-written GLB writer); fails when one misses a target.
 bench: build
-	status=0; bash bench/run || status=1; bash bench/run-batch || status=1; exit $$status
+	status=0; bash bench/run || status=1; bash bench/run-batch || status=1; \
+	bash bench/run-peers || status=1; bash bench/run-glb || status=1; exit $$status
 
 # Installing and packaging (docs/install.md): plant, its standard library, docs, man page and
 # the C++ API under PREFIX; the Debian packages plant and plant-dev into $(BUILD)/.

@@ -57,6 +57,9 @@ std::string mesh_summary(const Scene& s) {
 std::string glb_bytes(const OutputSources& from, const std::string& target) {
     return gltf_bytes(from.scene, GltfContainer::Binary, target, from.options.gltf_layout);
 }
+void glb_stream(const OutputSources& from, const std::string& target, const ByteSink& sink) {
+    gltf_to(from.scene, GltfContainer::Binary, target, from.options.gltf_layout, sink);
+}
 std::string gltf_json_bytes(const OutputSources& from, const std::string& target) {
     return gltf_bytes(from.scene, GltfContainer::Json, target, from.options.gltf_layout);
 }
@@ -108,7 +111,8 @@ std::string mesh_summary_bytes(const OutputSources& from, const std::string&) {
 // Adding a format: one row here and its writer above (docs: README.md lists the extensions).
 constexpr OutputFormat kFormats[] = {
     {".glb", OutputNeeds::Scene, glb_bytes,
-     "glTF 2.0, binary; each organ or instance is one mesh, placed by EXT_mesh_gpu_instancing"},
+     "glTF 2.0, binary; each organ or instance is one mesh, placed by EXT_mesh_gpu_instancing", nullptr,
+     nullptr, glb_stream},
     {".gltf", OutputNeeds::Scene, gltf_json_bytes, "glTF 2.0 as JSON, the buffer embedded as a data URI"},
     {".obj", OutputNeeds::Scene, obj_bytes,
      "Wavefront OBJ, one object per organ kind, with its colours in a .mtl file beside it", ".mtl",
@@ -378,7 +382,10 @@ OutputSummary write_outputs(const Program& program, const Derivation& d,
         if (options.progress)
             options.progress(
                 fmt::format("writing {} ({} of {})", escape_controls(paths[k]), k + 1, formats.size()));
-        pending.write(k, formats[k]->bytes(from, paths[k]));
+        if (const auto stream = formats[k]->stream)
+            pending.write_with(k, [&](const ByteSink& sink) { stream(from, paths[k], sink); });
+        else
+            pending.write(k, formats[k]->bytes(from, paths[k]));
     }
     for (std::size_t j = 0; j < sidecar_of.size(); ++j)
         pending.write(paths.size() + j, formats[sidecar_of[j]]->sidecar_bytes(from, paths[sidecar_of[j]]));

@@ -80,6 +80,9 @@ struct OutputFormat {
     // its bytes; written and renamed with the other outputs. Null: none.
     const char* sidecar_extension = nullptr;
     std::string (*sidecar_bytes)(const OutputSources& from, const std::string& target) = nullptr;
+    // When set, what writes the file instead of `bytes`: the bytes handed to the sink as they are
+    // made, so a large file is never held whole in memory (.glb). Same bytes as `bytes`.
+    void (*stream)(const OutputSources& from, const std::string& target, const ByteSink& sink) = nullptr;
 };
 
 // The path of `target`'s sidecar: its extension replaced by `extension` ("a/tree.obj" ->

@@ -99,7 +99,27 @@ PendingFiles::~PendingFiles() {
         if (live_[k].load()) ::unlink(temps_[k].c_str());
 }
 
+namespace {
+
+// Writes all of `size` bytes to `fd`; 0, or the error number.
+int write_all(int fd, const char* data, std::size_t size) {
+    while (size > 0) {
+        const ssize_t n = ::write(fd, data, size);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) return n < 0 ? errno : EIO;
+        data += n;
+        size -= static_cast<std::size_t>(n);
+    }
+    return 0;
+}
+
+} // namespace
+
 void PendingFiles::write(std::size_t k, const std::string& bytes) {
+    write_with(k, [&](const ByteSink& sink) { sink(bytes.data(), bytes.size()); });
+}
+
+void PendingFiles::write_with(std::size_t k, const std::function<void(const ByteSink&)>& produce) {
     const std::string& target = targets_[k];
     const fs::path parent = fs::path(target).parent_path();
     if (fs::path(target).filename().empty())
@@ -115,17 +135,32 @@ void PendingFiles::write(std::size_t k, const std::string& bytes) {
                                       in_quotes(parent.empty() ? std::string(".") : parent.string()),
                                       std::strerror(err)));
     }
-    std::size_t done = 0;
+    // small pieces are gathered in `staged`; large ones go straight to the file
+    constexpr std::size_t kStage = 64 * 1024;
+    std::string staged;
+    staged.reserve(kStage);
     int err = 0;
-    while (done < bytes.size()) {
-        const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) {
-            err = n < 0 ? errno : EIO;
-            break;
+    const ByteSink sink = [&](const void* data, std::size_t size) {
+        if (err != 0) return;
+        const auto* p = static_cast<const char*>(data);
+        if (staged.size() + size <= kStage) {
+            staged.append(p, size);
+            return;
         }
-        done += static_cast<std::size_t>(n);
+        if ((err = write_all(fd, staged.data(), staged.size())) != 0) return;
+        staged.clear();
+        if (size < kStage)
+            staged.append(p, size);
+        else
+            err = write_all(fd, p, size);
+    };
+    try {
+        produce(sink);
+    } catch (...) {
+        ::close(fd);
+        throw;
     }
+    if (err == 0) err = write_all(fd, staged.data(), staged.size());
     if (::close(fd) != 0 && err == 0) err = errno;
     if (err != 0) throw ExportError("cannot write " + in_quotes(target) + ": " + std::strerror(err));
 }

@@ -3,7 +3,10 @@
 // SIGINT or SIGTERM, leaves the earlier files as they were and no temporary file behind.
 #pragma once
 
+#include "plant/export.hpp"
+
 #include <atomic>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -24,6 +27,10 @@ class PendingFiles {
 
     // Writes the k-th file's bytes to its temporary name. Throws ExportError naming the target.
     void write(std::size_t k, const std::string& bytes);
+    // The same, the bytes handed by `produce` to the sink it is given, written as they come (a
+    // little buffering joins small pieces). When `produce` throws, the file is closed and the
+    // exception goes on; the temporary file is removed as an uncommitted one.
+    void write_with(std::size_t k, const std::function<void(const ByteSink&)>& produce);
     // Renames every temporary file onto its target. Throws ExportError naming the target when a
     // rename fails (after checking beforehand what can be checked: a target that is a folder).
     void commit();

@@ -9,6 +9,10 @@
 // Each texture image a material uses is written once, as its file's bytes in a buffer view of its
 // own (padded to 4 bytes like the others), where its material first needs it; every texture
 // shares one sampler (repeat in both directions, linear filtering with mipmaps).
+//
+// The buffer is never gathered in memory for a .glb: the builder keeps a list of pieces (the
+// scene's own arrays, padding, the few arrays made here) and writes them one after another after
+// the JSON; normals are renormalized as they are written, a block at a time.
 #include "plant/export.hpp"
 
 #include "export_placement.hpp"
@@ -20,6 +24,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <map>
 #include <optional>
@@ -50,15 +55,37 @@ double tidy(float f) {
     return d;
 }
 
+// The validator rejects normals that are not unit length: renormalized when written.
+glm::vec3 unit_normal(glm::vec3 n) {
+    const float len = glm::length(n);
+    if (!(len > 1e-20f) || !std::isfinite(len)) return glm::vec3(0.0f, 1.0f, 0.0f);
+    if (std::abs(len - 1.0f) > 1e-5f) n /= len;
+    return n;
+}
+
+// A run of the buffer's bytes: borrowed from the scene (or from GltfBuilder::owned), or normals
+// (vec3 floats) to renormalize on the way out.
+struct Piece {
+    const unsigned char* bytes;
+    std::size_t size;
+    bool normals;
+};
+
+constexpr unsigned char kZeros[4] = {0, 0, 0, 0};
+
 struct GltfBuilder {
     const Scene& scene;
     const std::vector<detail::NestedGroup>& groups; // scene prototypes kept as nodes
     tinygltf::Model model;
-    std::vector<int> material_index;   // scene material -> glTF material, -1 while unused
-    std::vector<int> texture_index;    // scene texture -> glTF texture, -1 while unused
-    std::vector<std::uint32_t> shared; // prototype -> the first prototype with the same mesh
-    std::vector<int> proto_mesh;       // prototype -> its mesh, -1 while none (or empty)
-    std::vector<bool> meshed;          // prototype -> add_mesh was called for it
+    std::vector<int> material_index;               // scene material -> glTF material, -1 while unused
+    std::vector<int> texture_index;                // scene texture -> glTF texture, -1 while unused
+    std::vector<std::uint32_t> shared;             // prototype -> the first prototype with the same mesh
+    std::vector<int> proto_mesh;                   // prototype -> its mesh, -1 while none (or empty)
+    std::vector<bool> meshed;                      // prototype -> add_mesh was called for it
+    std::vector<Piece> pieces;                     // the buffer, in order
+    std::size_t length = 0;                        // the buffer's length: the pieces' sizes added up
+    std::vector<std::vector<unsigned char>> owned; // bytes made here that pieces point into
+    MeshPart baked;                                // the --flatten mesh, which pieces point into
 
     GltfBuilder(const Scene& s, const std::vector<detail::NestedGroup>& g) : scene(s), groups(g) {
         model.asset.version = "2.0";
@@ -67,24 +94,48 @@ struct GltfBuilder {
         texture_index.assign(scene.textures.size(), -1);
     }
 
-    std::vector<unsigned char>& data() {
+    // Pads the buffer with zeros to a multiple of 4 bytes.
+    void align() {
         if (model.buffers.empty()) model.buffers.emplace_back();
-        return model.buffers[0].data;
+        if (const std::size_t pad = (4 - length % 4) % 4) {
+            pieces.push_back(Piece{kZeros, pad, false});
+            length += pad;
+        }
     }
 
-    // Appends raw bytes as a new buffer view (4-byte aligned) and returns its index.
-    int add_view(const void* bytes, std::size_t size, int target) {
-        auto& buf = data();
-        while (buf.size() % 4 != 0) buf.push_back(0);
+    // Adds `size` bytes at `bytes` as a new buffer view (4-byte aligned) and returns its index. The
+    // bytes are read when the file is written: they must outlive the builder's write.
+    int add_view(const void* bytes, std::size_t size, int target, bool normals = false) {
+        align();
         tinygltf::BufferView view;
         view.buffer = 0;
-        view.byteOffset = buf.size();
+        view.byteOffset = length;
         view.byteLength = size;
         view.target = target;
-        const auto* p = static_cast<const unsigned char*>(bytes);
-        buf.insert(buf.end(), p, p + size);
+        if (size > 0) pieces.push_back(Piece{static_cast<const unsigned char*>(bytes), size, normals});
+        length += size;
         model.bufferViews.push_back(std::move(view));
         return static_cast<int>(model.bufferViews.size() - 1);
+    }
+
+    // Hands the buffer's bytes to `sink`, normals renormalized a block at a time.
+    void write_buffer(const ByteSink& sink) const {
+        std::vector<glm::vec3> block;
+        for (const Piece& piece : pieces) {
+            if (!piece.normals) {
+                sink(piece.bytes, piece.size);
+                continue;
+            }
+            constexpr std::size_t kBlock = 1 << 15; // 384 kB a write
+            block.resize(kBlock);
+            const std::size_t count = piece.size / sizeof(glm::vec3);
+            for (std::size_t at = 0; at < count; at += kBlock) {
+                const std::size_t n = std::min(kBlock, count - at);
+                std::memcpy(block.data(), piece.bytes + at * sizeof(glm::vec3), n * sizeof(glm::vec3));
+                for (std::size_t k = 0; k < n; ++k) block[k] = unit_normal(block[k]);
+                sink(block.data(), n * sizeof(glm::vec3));
+            }
+        }
     }
 
     int add_accessor(int view, std::size_t byte_offset, std::size_t count, int type, int component_type) {
@@ -180,18 +231,10 @@ struct GltfBuilder {
         model.accessors[std::size_t(pos)].minValues = {lo.x, lo.y, lo.z};
         model.accessors[std::size_t(pos)].maxValues = {hi.x, hi.y, hi.z};
 
-        // NORMAL: the validator rejects non-unit normals, so renormalize while copying.
+        // NORMAL: renormalized as they are written (unit_normal)
         int nrm = -1;
         if (!part.normals.empty()) {
-            std::vector<glm::vec3> normals(part.normals);
-            for (glm::vec3& n : normals) {
-                const float len = glm::length(n);
-                if (!(len > 1e-20f) || !std::isfinite(len))
-                    n = glm::vec3(0.0f, 1.0f, 0.0f);
-                else if (std::abs(len - 1.0f) > 1e-5f)
-                    n /= len;
-            }
-            const int view = add_view(normals.data(), nv * sizeof(glm::vec3), array_buffer);
+            const int view = add_view(part.normals.data(), nv * sizeof(glm::vec3), array_buffer, true);
             nrm = add_accessor(view, 0, nv, TINYGLTF_TYPE_VEC3, TINYGLTF_COMPONENT_TYPE_FLOAT);
         }
 
@@ -265,7 +308,9 @@ struct GltfBuilder {
     }
 
     template <class T> int add_instance_accessor(const std::vector<T>& values, int type) {
-        const int view = add_view(values.data(), values.size() * sizeof(T), 0);
+        const auto* p = reinterpret_cast<const unsigned char*>(values.data());
+        const std::vector<unsigned char>& kept = owned.emplace_back(p, p + values.size() * sizeof(T));
+        const int view = add_view(kept.data(), kept.size(), 0);
         return add_accessor(view, 0, values.size(), type, TINYGLTF_COMPONENT_TYPE_FLOAT);
     }
 
@@ -374,7 +419,8 @@ struct GltfBuilder {
         model.defaultScene = 0;
 
         if (layout == GltfLayout::Baked) {
-            const int mesh = add_mesh(detail::bake(scene, "glTF export"), "plant");
+            baked = detail::bake(scene, "glTF export");
+            const int mesh = add_mesh(baked, "plant");
             if (mesh >= 0) {
                 tinygltf::Node node;
                 node.name = "plant";
@@ -392,10 +438,47 @@ struct GltfBuilder {
             add_placements(layout);
         }
 
-        if (!model.buffers.empty()) {
-            auto& buf = model.buffers[0].data;
-            while (buf.size() % 4 != 0) buf.push_back(0);
-        }
+        if (!model.buffers.empty()) align();
+    }
+
+    // The JSON of a .glb: tinygltf's, serialized with an empty buffer whose byteLength is then
+    // set. The key cannot occur elsewhere: strings in the JSON have their quotes escaped.
+    std::string glb_json(const std::string& path) const {
+        std::ostringstream out(std::ios::out | std::ios::binary);
+        tinygltf::TinyGLTF gltf;
+        if (!gltf.WriteGltfSceneToStream(&model, out, /*prettyPrint=*/false, /*writeBinary=*/true) || !out)
+            throw ExportError("cannot write " + quoted(path) + ": glTF serialization failed");
+        const std::string glb = std::move(out).str();
+        std::uint32_t chunk = 0; // after the 12-byte header: the JSON chunk's length, then its type
+        if (glb.size() >= 20) std::memcpy(&chunk, glb.data() + 12, 4);
+        std::string json = glb.substr(std::min<std::size_t>(20, glb.size()), chunk);
+        while (!json.empty() && json.back() == ' ') json.pop_back(); // the chunk's padding
+        if (model.buffers.empty()) return json;
+        const std::string empty = R"("buffers":[{"byteLength":0}])";
+        const std::size_t at = json.find(empty);
+        if (at == std::string::npos)
+            throw ExportError("cannot write " + quoted(path) + ": glTF serialization gave no buffer");
+        json.replace(at, empty.size(), R"("buffers":[{"byteLength":)" + std::to_string(length) + "}]");
+        return json;
+    }
+
+    // A .glb: header, JSON chunk (padded with spaces), binary chunk (when the buffer has bytes).
+    void write_glb(const std::string& path, const ByteSink& sink) const {
+        std::string json = glb_json(path);
+        json.append((4 - json.size() % 4) % 4, ' ');
+        const std::uint64_t total = 12 + 8 + json.size() + (length > 0 ? 8 + length : 0);
+        if (total > std::numeric_limits<std::uint32_t>::max())
+            throw ExportError("cannot write " + quoted(path) +
+                              ": the scene is too large for a .glb file (over 4 GB)");
+        // little-endian, as the format is (the machines plant builds on are)
+        const std::uint32_t head[5] = {0x46546C67, 2, std::uint32_t(total), std::uint32_t(json.size()),
+                                       0x4E4F534A};
+        sink(head, sizeof head);
+        sink(json.data(), json.size());
+        if (length == 0) return;
+        const std::uint32_t bin[2] = {std::uint32_t(length), 0x004E4942};
+        sink(bin, sizeof bin);
+        write_buffer(sink);
     }
 
     // The placed prototypes, each distinct one meshed once, and their placements.
@@ -423,10 +506,8 @@ struct GltfBuilder {
 
 } // namespace
 
-std::string gltf_bytes(const Scene& scene, GltfContainer container, const std::string& path,
-                       GltfLayout layout) {
-    const bool binary = container == GltfContainer::Binary;
-
+void gltf_to(const Scene& scene, GltfContainer container, const std::string& path, GltfLayout layout,
+             const ByteSink& sink) {
     // With GPU instancing, scene prototypes holding many parts stay nodes (export_placement.hpp);
     // the other layouts draw everything into one level.
     Scene flat, storage;
@@ -438,20 +519,35 @@ std::string gltf_bytes(const Scene& scene, GltfContainer container, const std::s
     }
     GltfBuilder builder(exported_scene(*drawn, storage, "glTF export"), groups);
     builder.build(layout);
-    if (binary && !builder.model.buffers.empty() &&
-        builder.model.buffers[0].data.size() > std::numeric_limits<std::uint32_t>::max() - 1024)
-        throw ExportError("cannot write " + quoted(path) +
-                          ": the scene is too large for a .glb file (over 4 GB)");
-
+    if (container == GltfContainer::Binary) {
+        builder.write_glb(path, sink);
+        return;
+    }
+    // .gltf: the buffer is embedded in the JSON as a data URI, so it is gathered first
+    if (!builder.model.buffers.empty()) {
+        auto& data = builder.model.buffers[0].data;
+        data.reserve(builder.length);
+        builder.write_buffer([&](const void* bytes, std::size_t size) {
+            const auto* p = static_cast<const unsigned char*>(bytes);
+            data.insert(data.end(), p, p + size);
+        });
+    }
     std::ostringstream out(std::ios::out | std::ios::binary);
     tinygltf::TinyGLTF gltf;
-    if (!gltf.WriteGltfSceneToStream(&builder.model, out, /*prettyPrint=*/!binary,
-                                     /*writeBinary=*/binary) ||
+    if (!gltf.WriteGltfSceneToStream(&builder.model, out, /*prettyPrint=*/true, /*writeBinary=*/false) ||
         !out)
         throw ExportError("cannot write " + quoted(path) + ": glTF serialization failed");
-    // Free the model's copy of the buffer before the file copy is made.
     builder.model = tinygltf::Model{};
-    return std::move(out).str();
+    const std::string text = std::move(out).str();
+    sink(text.data(), text.size());
+}
+
+std::string gltf_bytes(const Scene& scene, GltfContainer container, const std::string& path,
+                       GltfLayout layout) {
+    std::string bytes;
+    gltf_to(scene, container, path, layout,
+            [&](const void* data, std::size_t size) { bytes.append(static_cast<const char*>(data), size); });
+    return bytes;
 }
 
 void write_gltf(const Scene& scene, const std::string& path, GltfContainer container, GltfLayout layout) {

@@ -334,20 +334,36 @@ Scene mesh_skeleton(const Program& program, const Skeleton& skeleton, const Mesh
     std::vector<std::vector<std::uint32_t>> by_material;
     const std::vector<TubePath> tubes = tube_paths(skeleton, options);
     {
-        std::size_t points = 0;
-        for (const auto& t : tubes) points += t.size();
-        const std::size_t vertices = points * static_cast<std::size_t>(std::max(3, options.sides) + 1);
+        // sized from the counts: a ring a point (sharp joints add a few more), 6 indices a side
+        // between two rings; the first material's list is sized for every triangle, since most
+        // plants have one colour of bark (pages never written are never touched)
+        std::size_t points = 0, segments = 0;
+        for (const auto& t : tubes) {
+            points += t.size();
+            segments += t.empty() ? 0 : t.size() - 1;
+        }
+        const auto sides = static_cast<std::size_t>(std::max(3, options.sides));
+        const std::size_t vertices = points * (sides + 1);
         scene.tubes.positions.reserve(vertices);
         scene.tubes.normals.reserve(vertices);
         scene.tubes.uvs.reserve(vertices);
+        by_material.emplace_back().reserve(segments * 6 * sides);
     }
     for (const auto& t : tubes) mesh_tube(t, options, scene.tubes, by_material, material_of);
+    std::size_t used = 0;
+    for (const auto& list : by_material) used += list.empty() ? 0 : 1;
     for (std::uint32_t m = 0; m < by_material.size(); ++m) {
         if (by_material[m].empty()) continue;
         auto first = static_cast<std::uint32_t>(scene.tubes.indices.size());
-        scene.tubes.indices.insert(scene.tubes.indices.end(), by_material[m].begin(), by_material[m].end());
-        scene.tubes.primitives.push_back(
-            Primitive{first, static_cast<std::uint32_t>(by_material[m].size()), m});
+        const auto count = static_cast<std::uint32_t>(by_material[m].size());
+        // one material: its list becomes the index array, not copied, unless it outgrew the
+        // estimate (sharp joints) and holds much more memory than it uses
+        if (used == 1 && by_material[m].capacity() <= count + count / 8)
+            scene.tubes.indices = std::move(by_material[m]);
+        else
+            scene.tubes.indices.insert(scene.tubes.indices.end(), by_material[m].begin(),
+                                       by_material[m].end());
+        scene.tubes.primitives.push_back(Primitive{first, count, m});
     }
     // organs: one prototype per (shape, color), meshed once
     std::map<std::pair<OrganShape, std::uint32_t>, std::uint32_t> prototype_index;

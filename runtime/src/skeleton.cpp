@@ -9,6 +9,7 @@ void SkeletonBuilder::axis_begin(int axis, int parent, const TurtleState& t) {
         skeleton_.axes.resize(static_cast<std::size_t>(axis) + 1);
     SkeletonAxis& a = skeleton_.axes[static_cast<std::size_t>(axis)];
     a.parent = parent;
+    a.points.reserve(2); // its first point and, nearly always, the end of a segment
     a.points.push_back(
         SkeletonPoint{t.position, t.heading, t.left, t.up, t.width / 2, t.color, 0, {}, t.texture});
 }

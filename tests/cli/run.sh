@@ -181,6 +181,13 @@ if [ -e "$tmp/pop.glb" ] || [ -e "$tmp/pop.png" ]; then fail=$((fail + 1)); echo
 check "one unwritable output of two" 73 "$plant" run "$tmp/plant.plant" -o "$tmp/both.glb" -o /proc/nope/x.png
 if [ -e "$tmp/both.glb" ]; then fail=$((fail + 1)); echo "FAIL both.glb left behind"; else pass=$((pass + 1)); fi
 if ls -a "$tmp" | grep -q plant-tmp; then fail=$((fail + 1)); echo "FAIL temporary files left behind"; else pass=$((pass + 1)); fi
+# a .glb goes to its file piece by piece: a write refused part way (here the file-size limit, 64 kB
+# of a 640 kB file) is an error that leaves neither the file nor a temporary one
+mkdir -p "$tmp/full"
+check "a .glb over the file-size limit" 73 bash -c 'trap "" XFSZ; ulimit -f 64; exec "$0" run "$1" -o "$2"' \
+  "$plant" "$(dirname "$0")/../../grammars/abop/fig2_7a.plant" "$tmp/full/big.glb"
+contains "file too large" "$tmp/stderr" "cannot write '$tmp/full/big.glb': File too large"
+if [ -n "$(ls -A "$tmp/full")" ]; then fail=$((fail + 1)); echo "FAIL a partial .glb left behind"; else pass=$((pass + 1)); fi
 # all or nothing across the run: a folder where the second output goes keeps the first file as it was
 mkdir -p "$tmp/keep" "$tmp/keep/b.skel.json" && echo old >"$tmp/keep/a.txt"
 check "second output is a folder" 73 "$plant" run "$tmp/plant.plant" -o "$tmp/keep/a.txt" -o "$tmp/keep/b.skel.json"

@@ -4,6 +4,8 @@
 
 #include "plant/scene.hpp"
 
+#include <cstddef>
+#include <functional>
 #include <iosfwd>
 #include <optional>
 #include <stdexcept>
@@ -44,6 +46,13 @@ void write_gltf(const Scene& scene, const std::string& path, GltfContainer conta
 // The bytes write_gltf writes; `path` names the file in messages only.
 std::string gltf_bytes(const Scene& scene, GltfContainer container, const std::string& path,
                        GltfLayout layout = GltfLayout::GpuInstancing);
+// Receives a file's bytes in order, piece by piece; a piece is only valid during the call.
+using ByteSink = std::function<void(const void* data, std::size_t size)>;
+// The same bytes handed to `sink` as they are made: a .glb's header, JSON and binary chunk go
+// straight from the scene's arrays to the sink, never gathered into one block of memory. Throws
+// ExportError before the first byte when the scene cannot be written.
+void gltf_to(const Scene& scene, GltfContainer container, const std::string& path, GltfLayout layout,
+             const ByteSink& sink);
 
 // Where a PNG preview is seen from (plant run --camera, --look-at): a perspective camera at `eye`
 // looking at `target` (default: the centre of the scene's bounds), y up.
