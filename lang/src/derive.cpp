@@ -96,9 +96,9 @@ void Derivation::run_hook(HookKind kind) {
 }
 
 void Derivation::start() {
-    run_ = RunState(
-        prog_, opt_.edits ? opt_.edits
-                          : prog_.graph.edits); // the environments as declared: a second start begins afresh
+    // the environments as declared (a second start begins afresh); the graph gets half the
+    // string's budget
+    run_ = RunState(prog_, opt_.edits ? opt_.edits : prog_.graph.edits, opt_.max_bytes / 2);
     EvalEnv env;
     env.prog = &prog_;
     env.run = &run_;

@@ -65,15 +65,16 @@ double NodeValue::at(double t) const {
     return v;
 }
 
-DecompositionGraph::DecompositionGraph(const GraphDecl& decl, std::shared_ptr<const GraphEdits> edits)
-    : decl_(&decl), edits_(std::move(edits)) {
+DecompositionGraph::DecompositionGraph(const GraphDecl& decl, std::shared_ptr<const GraphEdits> edits,
+                                       std::size_t max_bytes)
+    : decl_(&decl), edits_(std::move(edits)), max_bytes_(max_bytes) {
     add_node(kRoot, -1, 0, 0);
     resolve();
 }
 
 DecompositionGraph::DecompositionGraph(const DecompositionGraph& other)
     : decl_(other.decl_), edits_(other.edits_), nodes_(other.nodes_), by_handle_(other.by_handle_),
-      values_(other.values_), matches_(other.matches_) {
+      values_(other.values_), matches_(other.matches_), max_bytes_(other.max_bytes_) {
     std::lock_guard lock(*other.pending_mutex_);
     pending_ = other.pending_;
 }
@@ -86,18 +87,26 @@ std::uint64_t DecompositionGraph::child_handle(std::uint64_t parent, double posi
     return h <= kRoot ? h + 2 : h;
 }
 
+std::size_t DecompositionGraph::node_bytes() const {
+    // the node, its values, its entry in the handle map and a pending record while it is made
+    return sizeof(GraphNode) + decl_->params.size() * sizeof(NodeValue) + sizeof(Pending) + 64;
+}
+
+bool DecompositionGraph::too_many(std::size_t n) const {
+    return n > kMaxNodes || n * std::max<std::size_t>(decl_->params.size(), 1) > kMaxValues ||
+           n * node_bytes() > max_bytes_;
+}
+
 bool DecompositionGraph::full() const {
     std::lock_guard lock(*pending_mutex_);
-    const std::size_t n = nodes_.size() + pending_.size() + 1;
-    return n > kMaxNodes || n * std::max<std::size_t>(decl_->params.size(), 1) > kMaxValues;
+    return too_many(nodes_.size() + pending_.size() + 1);
 }
 
 bool DecompositionGraph::record(std::uint64_t handle, std::uint64_t parent, double position, int index,
                                 const NodePlace* place) const {
     std::lock_guard lock(*pending_mutex_);
     if (pending_.count(handle) == 0) {
-        const std::size_t n = nodes_.size() + pending_.size() + 1;
-        if (n > kMaxNodes || n * std::max<std::size_t>(decl_->params.size(), 1) > kMaxValues) return false;
+        if (too_many(nodes_.size() + pending_.size() + 1)) return false;
     }
     Pending fresh{parent, position, index, false, NodePlace{}};
     if (place) {

@@ -80,9 +80,11 @@ std::string make_child(const DecompositionGraph& g, const double* a, bool with_i
         }
     }
     if (records && !g.record(h, parent, pos, index, place))
-        return g.full() ? fmt::format("the decomposition graph would have more than {} nodes (or {} values: "
-                                      "nodes times parameters)",
-                                      DecompositionGraph::kMaxNodes, DecompositionGraph::kMaxValues)
+        return g.full() ? fmt::format("the decomposition graph would have more than {} nodes, {} values (nodes "
+                                      "times parameters) or {} MB (plant run: raise --max-memory, which "
+                                      "gives the graph a quarter of it)",
+                                      DecompositionGraph::kMaxNodes, DecompositionGraph::kMaxValues,
+                                      g.max_bytes() >> 20)
                         : "two paths of the decomposition graph made in this pass have the same handle";
     return {};
 }

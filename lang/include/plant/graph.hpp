@@ -149,7 +149,13 @@ class DecompositionGraph {
     // A bound on nodes times parameters: the resolved values a graph holds.
     static constexpr std::size_t kMaxValues = 20'000'000;
 
-    DecompositionGraph(const GraphDecl& decl, std::shared_ptr<const GraphEdits> edits);
+    // What one node costs in memory, all its values included (the bound max_bytes applies).
+    std::size_t node_bytes() const;
+
+    // `max_bytes`: the memory the nodes and their values may take (a derivation gives its
+    // graph the string's budget, half of plant run's --max-memory); record() refuses past it.
+    DecompositionGraph(const GraphDecl& decl, std::shared_ptr<const GraphEdits> edits,
+                       std::size_t max_bytes = std::size_t{4} << 30);
     DecompositionGraph(const DecompositionGraph& other);
     DecompositionGraph& operator=(const DecompositionGraph&) = delete;
 
@@ -168,8 +174,10 @@ class DecompositionGraph {
                 const NodePlace* place = nullptr) const;
     // Whether `handle` was recorded in this pass and is not committed yet.
     bool is_pending(std::uint64_t handle) const;
-    // Whether one more node would pass kMaxNodes or kMaxValues (record() then refuses it).
+    // Whether one more node would pass kMaxNodes, kMaxValues or the memory bound (record() then
+    // refuses it); max_bytes() is that bound.
     bool full() const;
+    std::size_t max_bytes() const { return max_bytes_; }
     // Commits the nodes recorded since the last commit (sorted by path, so the result does not
     // depend on the threads), then matches the edits, resolves every value and places every
     // silhouette. Throws RuntimeError (kind General) on a hash collision, too many nodes or a
@@ -214,6 +222,8 @@ class DecompositionGraph {
     std::unordered_map<std::uint64_t, int> by_handle_;
     std::vector<NodeValue> values_; // nodes x params
     std::vector<int> matches_;
+    bool too_many(std::size_t nodes) const; // (with pending_mutex_ held)
+    std::size_t max_bytes_ = std::size_t{4} << 30;
     mutable std::unique_ptr<std::mutex> pending_mutex_ = std::make_unique<std::mutex>();
     mutable std::unordered_map<std::uint64_t, Pending> pending_;
 };

@@ -19,12 +19,14 @@ class RunState {
     // A clone of each declaration's object as declared (null where the program has none: it
     // was compiled without a runtime).
     // With a `graph` block, the decomposition graph's root, with `edits` to match as it grows.
-    explicit RunState(const Program& program, std::shared_ptr<const GraphEdits> edits = nullptr) {
+    // The graph may take `graph_bytes` of memory.
+    explicit RunState(const Program& program, std::shared_ptr<const GraphEdits> edits = nullptr,
+                      std::size_t graph_bytes = std::size_t{4} << 30) {
         environments_.reserve(program.environments.size());
         for (const EnvironmentDecl& d : program.environments)
             environments_.push_back(d.initial ? d.initial->clone() : nullptr);
         if (program.graph.declared)
-            graph_ = std::make_unique<DecompositionGraph>(program.graph, std::move(edits));
+            graph_ = std::make_unique<DecompositionGraph>(program.graph, std::move(edits), graph_bytes);
     }
     RunState(const RunState& other) { *this = other; }
     RunState& operator=(const RunState& other) {
