@@ -196,25 +196,30 @@ void check_stems(const Rose& r) {
         }
         CHECK((flowering || (st.type != Term && st.type != BloomStem)));
     }
-    CHECK(trunks <= static_cast<int>(r.params.at("N_S")));
+    CHECK(trunks == static_cast<int>(r.params.at("N_S"))); // density control never picks a trunk
 }
 
 // Eq. 3: no two stems (trunks, intermediate, terminal) have nodes closer than delta_min, except
-// where one branches from the other (a stem's first point lies on its parent).
+// where one branches from the other (a stem's first point lies on its parent), and except two
+// trunks: density control picks new child stems only, never a trunk (Sec. V-B: the specified
+// number of trunks grow), so trunks may stand closer to each other.
 void check_spacing(const Rose& r) {
     const double delta = r.params.at("delta_min");
     std::vector<std::vector<glm::dvec3>> nodes;
     std::vector<glm::dvec3> base;
+    std::vector<bool> trunk;
     for (const auto& st : r.stems)
         if (st.type != BloomStem) {
             auto p = points(r, st);
             base.push_back(p[0]);
             nodes.emplace_back(p.begin() + 1, p.end());
+            trunk.push_back(st.type == Trunk);
         }
     double closest = 1e300;
     for (std::size_t a = 0; a < nodes.size(); ++a)
         for (std::size_t b = a + 1; b < nodes.size(); ++b)
             for (const auto& x : nodes[a]) {
+                if (trunk[a] && trunk[b]) break;                // trunks are never picked
                 if (glm::distance(x, base[b]) < 1e-9) continue; // b branches from a here
                 for (const auto& y : nodes[b])
                     if (glm::distance(y, base[a]) >= 1e-9) closest = std::min(closest, glm::distance(x, y));

@@ -58,6 +58,8 @@ const std::vector<Mutation> kMutations = {
     {"Sec. IV-A: one trunk whatever N_S", {{"for i in 0..N_S {", "for i in 0..1 {"}}},
     {"Sec. IV-A: trunks at any azimuth",
      {{"let az = 2 * pi * (i + uniform(0.15, 0.85)) / N_S;", "let az = 2 * pi * uniform(0, 1);"}}},
+    {"Sec. V-B: density control picks trunks",
+     {{"s == 0 && t != TRUNK && c < delta_min -> %;", "s == 0 && c < delta_min -> %;"}}},
     {"Sec. IV-A: trunk pitch below its range",
      {{"let pt = uniform(trunk_pitch_min, trunk_pitch_max);", "let pt = uniform(0.02, trunk_pitch_max);"}}},
     {"Sec. IV-F: a leaf dropped",
@@ -100,6 +102,7 @@ const std::vector<Run> kRuns = {
     {"fig12d", 1, {{"droop_reading", "1"}}},
     {"fig09", 4, {{"tip_leaf_reading", "0"}, {"N_B", "5"}}},
     {"fig12c", 2, {}},
+    {"fig09", 1, {{"N_S", "12"}, {"delta_min", "3"}}}, // crowded trunks: picking them loses 4 of 12
 };
 
 std::string read_text(const fs::path& p) {

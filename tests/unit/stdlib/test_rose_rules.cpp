@@ -67,6 +67,7 @@ TEST_CASE("rose rules: parameter sets the figures leave idle follow every rule",
         require_rules("fig10a.plant", seed, {{"kappa_term", "1"}, {"sigma_inter", "1.6"}});
         require_rules("fig12d.plant", seed, {{"droop_reading", "1"}});
         require_rules("fig09.plant", seed, {{"tip_leaf_reading", "0"}, {"N_B", "9"}});
+        require_rules("fig09.plant", seed, {{"N_S", "12"}, {"delta_min", "3"}}); // crowded trunks, all kept
     }
 }
 
