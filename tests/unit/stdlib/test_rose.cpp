@@ -385,3 +385,46 @@ TEST_CASE("rose: stage 1 is the winter-pruned shape, dormant buds where terminal
     CHECK(terminal > 0);
     CHECK(terminal <= dormant); // some buds are picked by density control
 }
+
+// stdlib/rose.plant gives every param a range (plant view's sliders): each figure's values lie in
+// it, and a value outside does not compile, naming the range
+TEST_CASE("rose: every param has a range holding each figure's value, and outside it fails", "[rose]") {
+    for (const auto& f : rose_grammars()) {
+        SourceManager sources;
+        Diagnostics diags;
+        CompileOptions co;
+        co.environments = runtime_environments();
+        auto program = compile_file(sources, f, co, diags);
+        INFO(f << "\n" << render_all(diags, sources));
+        REQUIRE(program);
+        int params = 0;
+        for (const auto& g : program->globals) {
+            if (g.kind != GlobalKind::Param) continue;
+            ++params;
+            INFO(g.name);
+            CHECK(g.has_range);
+            const double v = program->global_values[g.slot];
+            CHECK(g.low <= v);
+            CHECK(v <= g.high);
+        }
+        CHECK(params >= 31);
+    }
+    for (const auto& [name, value] :
+         std::vector<std::pair<std::string, std::string>>{{"N_S", "13"},
+                                                          {"N_S", "0"},
+                                                          {"theta", "pi / 2 + 0.01"},
+                                                          {"droop_reading", "2"},
+                                                          {"N_B", "10"}}) {
+        SourceManager sources;
+        Diagnostics diags;
+        CompileOptions co;
+        co.defines = {{name, value}};
+        co.environments = runtime_environments();
+        auto program = compile_file(sources, kRoseDir + "/fig09.plant", co, diags);
+        const std::string text = render_all(diags, sources);
+        INFO(name << " = " << value << "\n" << text);
+        CHECK(!program);
+        CHECK(text.find("is outside its range") != std::string::npos);
+        CHECK(text.find("rose.plant") != std::string::npos); // the note at the declared range
+    }
+}
