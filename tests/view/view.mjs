@@ -160,9 +160,14 @@ async function roseChecks(browser) {
   const fixed = await saveAndWait(page, file, original);
   check(!(await page.evaluate(() => window.plantView.error)) && fixed.modules === m0, 'fixing the error clears it', `${fixed.modules} modules`);
 
+  // the rose library's params have ranges (stdlib/rose.plant), so they get sliders
+  const roseSliders = await page.$$eval('input[type="range"][data-param]', (es) => Object.fromEntries(es.map((e) => [e.dataset.param, [e.min, e.max]])));
+  check(JSON.stringify(roseSliders.N_S) === '["1","12"]' && roseSliders.theta && Math.abs(Number(roseSliders.theta[1]) - Math.PI / 2) < 1e-9 &&
+    JSON.stringify(roseSliders.droop_reading) === '["0","1"]', 'the rose\'s params get sliders over their ranges', JSON.stringify(roseSliders));
+
   // a param changed on the page derives again
   const loads = await page.evaluate(() => window.plantView.loads);
-  await page.$eval('input[data-param="N_S"]', (e) => { e.value = '2'; e.dispatchEvent(new Event('change')); });
+  await page.$eval('input[type="number"][data-param="N_S"]', (e) => { e.value = '2'; e.dispatchEvent(new Event('change')); });
   await waitFor(page, (n) => window.plantView.loads > n, loads);
   const afterParam = await page.evaluate(() => window.plantView.modules);
   check(afterParam !== m0, 'changing a param derives again', `${m0} -> ${afterParam} modules`);

@@ -129,9 +129,9 @@ void check_trunks(Ctx& c) {
         if (frac < 0.15 - 1e-6 || frac > 0.85 + 1e-6 || !sectors.insert(sector).second)
             c.fail("trunks", fmt::format("{} azimuth {} is not alone in its sector", name_of(c, int(i)), az));
     }
-    // N_S trunks grow at step 1; picking (Eq. 3, applied to trunks too: docs/rose.md) may remove
-    // a crowded one at step 2
-    if (c.r.trunk_candidates != N_S || trunks > N_S)
+    // N_S trunks grow at step 1 and all of them are kept: density control (Eq. 3) picks new child
+    // stems only, and "the specified number of trunks grow" (Sec. V-B)
+    if (c.r.trunk_candidates != N_S || trunks != N_S)
         c.fail("N_S trunks",
                fmt::format("{} trunks grown, {} kept, N_S = {}", c.r.trunk_candidates, trunks, N_S));
 }

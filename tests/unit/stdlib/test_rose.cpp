@@ -196,25 +196,30 @@ void check_stems(const Rose& r) {
         }
         CHECK((flowering || (st.type != Term && st.type != BloomStem)));
     }
-    CHECK(trunks <= static_cast<int>(r.params.at("N_S")));
+    CHECK(trunks == static_cast<int>(r.params.at("N_S"))); // density control never picks a trunk
 }
 
 // Eq. 3: no two stems (trunks, intermediate, terminal) have nodes closer than delta_min, except
-// where one branches from the other (a stem's first point lies on its parent).
+// where one branches from the other (a stem's first point lies on its parent), and except two
+// trunks: density control picks new child stems only, never a trunk (Sec. V-B: the specified
+// number of trunks grow), so trunks may stand closer to each other.
 void check_spacing(const Rose& r) {
     const double delta = r.params.at("delta_min");
     std::vector<std::vector<glm::dvec3>> nodes;
     std::vector<glm::dvec3> base;
+    std::vector<bool> trunk;
     for (const auto& st : r.stems)
         if (st.type != BloomStem) {
             auto p = points(r, st);
             base.push_back(p[0]);
             nodes.emplace_back(p.begin() + 1, p.end());
+            trunk.push_back(st.type == Trunk);
         }
     double closest = 1e300;
     for (std::size_t a = 0; a < nodes.size(); ++a)
         for (std::size_t b = a + 1; b < nodes.size(); ++b)
             for (const auto& x : nodes[a]) {
+                if (trunk[a] && trunk[b]) break;                // trunks are never picked
                 if (glm::distance(x, base[b]) < 1e-9) continue; // b branches from a here
                 for (const auto& y : nodes[b])
                     if (glm::distance(y, base[a]) >= 1e-9) closest = std::min(closest, glm::distance(x, y));
@@ -379,4 +384,47 @@ TEST_CASE("rose: stage 1 is the winter-pruned shape, dormant buds where terminal
     CHECK(woody_winter == woody_summer); // flowering adds to the frame, never changes it
     CHECK(terminal > 0);
     CHECK(terminal <= dormant); // some buds are picked by density control
+}
+
+// stdlib/rose.plant gives every param a range (plant view's sliders): each figure's values lie in
+// it, and a value outside does not compile, naming the range
+TEST_CASE("rose: every param has a range holding each figure's value, and outside it fails", "[rose]") {
+    for (const auto& f : rose_grammars()) {
+        SourceManager sources;
+        Diagnostics diags;
+        CompileOptions co;
+        co.environments = runtime_environments();
+        auto program = compile_file(sources, f, co, diags);
+        INFO(f << "\n" << render_all(diags, sources));
+        REQUIRE(program);
+        int params = 0;
+        for (const auto& g : program->globals) {
+            if (g.kind != GlobalKind::Param) continue;
+            ++params;
+            INFO(g.name);
+            CHECK(g.has_range);
+            const double v = program->global_values[g.slot];
+            CHECK(g.low <= v);
+            CHECK(v <= g.high);
+        }
+        CHECK(params >= 31);
+    }
+    for (const auto& [name, value] :
+         std::vector<std::pair<std::string, std::string>>{{"N_S", "13"},
+                                                          {"N_S", "0"},
+                                                          {"theta", "pi / 2 + 0.01"},
+                                                          {"droop_reading", "2"},
+                                                          {"N_B", "10"}}) {
+        SourceManager sources;
+        Diagnostics diags;
+        CompileOptions co;
+        co.defines = {{name, value}};
+        co.environments = runtime_environments();
+        auto program = compile_file(sources, kRoseDir + "/fig09.plant", co, diags);
+        const std::string text = render_all(diags, sources);
+        INFO(name << " = " << value << "\n" << text);
+        CHECK(!program);
+        CHECK(text.find("is outside its range") != std::string::npos);
+        CHECK(text.find("rose.plant") != std::string::npos); // the note at the declared range
+    }
 }

@@ -58,6 +58,8 @@ const std::vector<Mutation> kMutations = {
     {"Sec. IV-A: one trunk whatever N_S", {{"for i in 0..N_S {", "for i in 0..1 {"}}},
     {"Sec. IV-A: trunks at any azimuth",
      {{"let az = 2 * pi * (i + uniform(0.15, 0.85)) / N_S;", "let az = 2 * pi * uniform(0, 1);"}}},
+    {"Sec. V-B: density control picks trunks",
+     {{"s == 0 && t != TRUNK && c < delta_min -> %;", "s == 0 && c < delta_min -> %;"}}},
     {"Sec. IV-A: trunk pitch below its range",
      {{"let pt = uniform(trunk_pitch_min, trunk_pitch_max);", "let pt = uniform(0.02, trunk_pitch_max);"}}},
     {"Sec. IV-F: a leaf dropped",
@@ -78,6 +80,10 @@ const std::vector<Mutation> kMutations = {
     {"Sec. IV-G: at most three blooms whatever N_B", {{"min(N_B, 9)", "min(N_B, 3)"}}},
     {"droop_reading 1: half the sag", {{"g3 = ideal(g3, pitch(g3) - sag);", "g3 = ideal(g3, pitch(g3) - 0.5 * sag);"}}},
     {"tip_leaf_reading 1: no search", {{"if k == n && tip_leaf_reading >= 1 { g = upward(g, d); }", ""}}},
+    {"tip_leaf_reading 0: the search made anyway",
+     {{"if k == n && tip_leaf_reading >= 1 { g = upward(g, d); }", "if k == n { g = upward(g, d); }"}}},
+    {"tip_leaf_reading 1: the spiral not counted back from the tip leaf",
+     {{"if t == TERM && tip_leaf_reading >= 1 { ph = tip_phase(p0, d0, n); }", ""}}},
 };
 // clang-format on
 
@@ -94,8 +100,9 @@ const std::vector<Run> kRuns = {
     {"fig12a", 1, {{"gamma", "0.5"}, {"rho_inter", "0.3"}, {"rho_term", "0.5"}}},
     {"fig09", 3, {{"stage", "1"}}},
     {"fig12d", 1, {{"droop_reading", "1"}}},
-    {"fig09", 4, {{"tip_leaf_reading", "1"}, {"N_B", "5"}}},
+    {"fig09", 4, {{"tip_leaf_reading", "0"}, {"N_B", "5"}}},
     {"fig12c", 2, {}},
+    {"fig09", 1, {{"N_S", "12"}, {"delta_min", "3"}}}, // crowded trunks: picking them loses 4 of 12
 };
 
 std::string read_text(const fs::path& p) {

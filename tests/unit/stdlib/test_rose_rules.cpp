@@ -66,7 +66,8 @@ TEST_CASE("rose rules: parameter sets the figures leave idle follow every rule",
         require_rules("fig09.plant", seed, {{"stage", "1"}});
         require_rules("fig10a.plant", seed, {{"kappa_term", "1"}, {"sigma_inter", "1.6"}});
         require_rules("fig12d.plant", seed, {{"droop_reading", "1"}});
-        require_rules("fig09.plant", seed, {{"tip_leaf_reading", "1"}, {"N_B", "9"}});
+        require_rules("fig09.plant", seed, {{"tip_leaf_reading", "0"}, {"N_B", "9"}});
+        require_rules("fig09.plant", seed, {{"N_S", "12"}, {"delta_min", "3"}}); // crowded trunks, all kept
     }
 }
 
@@ -90,14 +91,18 @@ TEST_CASE("rose rules: droop_reading 1 droops Fig. 12d's blooms and leaves pi/2 
 }
 
 // docs/rose.md: the Japanese version turns a downward tip leaf up and counts the 3/8 spiral back
-// from it; the English one uses the ideal direction as it is
-TEST_CASE("rose rules: tip_leaf_reading 1 turns every tip leaf up", "[rose]") {
+// from it, and is the default; the English one (tip_leaf_reading = 0) uses the ideal direction as
+// it is
+TEST_CASE("rose rules: tip_leaf_reading 1, the default, turns every tip leaf up", "[rose]") {
     std::string error;
     int down_en = 0, down_ja = 0, tips = 0;
     for (std::uint64_t seed : {1, 2, 3}) {
-        RoseModel en = grow_rose_model(kRoseDir + "/fig09.plant", seed, {}, error);
-        RoseModel ja = grow_rose_model(kRoseDir + "/fig09.plant", seed, {{"tip_leaf_reading", "1"}}, error);
+        RoseModel en = grow_rose_model(kRoseDir + "/fig09.plant", seed, {{"tip_leaf_reading", "0"}}, error);
+        RoseModel ja = grow_rose_model(kRoseDir + "/fig09.plant", seed, {}, error);
+        RoseModel ja1 = grow_rose_model(kRoseDir + "/fig09.plant", seed, {{"tip_leaf_reading", "1"}}, error);
         REQUIRE(error.empty());
+        CHECK(ja.string == ja1.string); // the Japanese reading is the default
+        CHECK(ja.string != en.string);
         for (const auto* r : {&en, &ja})
             for (const auto& s : r->stems)
                 for (const auto& lf : s.leaves)
