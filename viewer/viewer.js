@@ -223,7 +223,10 @@ function paramControl(p) {
     slider.type = 'range';
     slider.min = String(p.low);
     slider.max = String(p.high);
-    slider.step = 'any'; // no snapping: the value is the grammar's, not a multiple of a step
+    // a count (whole bounds and value, as `param N_S = 5 in 1 .. 12;`) moves by whole steps;
+    // anything else does not snap: the value is the grammar's, not a multiple of a step
+    const whole = [p.low, p.high, p.value].every(Number.isInteger);
+    slider.step = whole ? '1' : 'any';
     slider.value = String(p.value);
     slider.dataset.param = p.name;
     slider.addEventListener('input', () => {

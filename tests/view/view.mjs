@@ -161,9 +161,10 @@ async function roseChecks(browser) {
   check(!(await page.evaluate(() => window.plantView.error)) && fixed.modules === m0, 'fixing the error clears it', `${fixed.modules} modules`);
 
   // the rose library's params have ranges (stdlib/rose.plant), so they get sliders
-  const roseSliders = await page.$$eval('input[type="range"][data-param]', (es) => Object.fromEntries(es.map((e) => [e.dataset.param, [e.min, e.max]])));
-  check(JSON.stringify(roseSliders.N_S) === '["1","12"]' && roseSliders.theta && Math.abs(Number(roseSliders.theta[1]) - Math.PI / 2) < 1e-9 &&
-    JSON.stringify(roseSliders.droop_reading) === '["0","1"]', 'the rose\'s params get sliders over their ranges', JSON.stringify(roseSliders));
+  const roseSliders = await page.$$eval('input[type="range"][data-param]', (es) => Object.fromEntries(es.map((e) => [e.dataset.param, [e.min, e.max, e.step]])));
+  check(JSON.stringify(roseSliders.N_S) === '["1","12","1"]' && roseSliders.theta && Math.abs(Number(roseSliders.theta[1]) - Math.PI / 2) < 1e-9 &&
+    roseSliders.theta[2] === 'any' && JSON.stringify(roseSliders.droop_reading) === '["0","1","1"]',
+    'the rose\'s params get sliders over their ranges, counts moving by whole steps', JSON.stringify(roseSliders));
 
   // a param changed on the page derives again
   const loads = await page.evaluate(() => window.plantView.loads);
