@@ -79,8 +79,15 @@ template <typename Visit> void preorder(const DecompositionGraph& g, int node, b
     }
 }
 
-void tree(const DecompositionGraph& g, int root, std::string& out, bool children = true) {
+// With `sink`, what is written goes out whenever it passes 64 KB, so a large graph is not held
+// whole in memory.
+void tree(const DecompositionGraph& g, int root, std::string& out, bool children = true,
+          std::ostream* sink = nullptr) {
     preorder(g, root, children, [&](int node) {
+        if (sink && out.size() > (64 << 10)) {
+            *sink << out;
+            out.clear();
+        }
         const GraphNode& n = g.node(node);
         const std::string pad(static_cast<std::size_t>(2 * n.depth), ' ');
         out += pad + g.path(node) + "\n";
@@ -95,8 +102,13 @@ void tree(const DecompositionGraph& g, int root, std::string& out, bool children
     });
 }
 
-void json_nodes(const DecompositionGraph& g, int root, std::string& out) {
+void json_nodes(const DecompositionGraph& g, int root, std::string& out, std::ostream* sink = nullptr) {
     preorder(g, root, true, [&](int node) {
+        if (sink && out.size() > (64 << 10) && out.back() == '}') {
+            // all but the last '}', which the next node's separator looks at
+            *sink << std::string_view(out).substr(0, out.size() - 1);
+            out.erase(0, out.size() - 1);
+        }
         const GraphNode& n = g.node(node);
         if (out.back() == '}') out += ",\n";
         out +=
@@ -157,10 +169,10 @@ int graph_main(const GraphCmd& c) {
     if (c.json) {
         out = fmt::format("{{\n  \"match\": \"{}\",\n  \"nodes\": [\n",
                           program->graph.match == GraphMatch::Range ? "range" : "single");
-        json_nodes(g, 0, out);
+        json_nodes(g, 0, out, &std::cout);
         out += "\n  ],\n" + edits_text(g, sources, true) + "}\n";
     } else {
-        tree(g, 0, out);
+        tree(g, 0, out, true, &std::cout);
         out += edits_text(g, sources, false);
     }
     std::cout << out << std::flush;
@@ -175,10 +187,29 @@ std::string graph_tree(const DecompositionGraph& g, int node, bool children) {
     return out;
 }
 
+// Walks down from the root, one component of `path` at a time ("/0.25#1/0.5"), comparing each
+// with a child's as path() writes it.
 int graph_node_at(const DecompositionGraph& g, const std::string& path) {
-    for (std::size_t k = 0; k < g.size(); ++k)
-        if (g.path(static_cast<int>(k)) == path) return static_cast<int>(k);
-    return -1;
+    if (path.empty() || path[0] != '/') return -1;
+    int node = 0;
+    std::size_t at = 1;
+    while (at < path.size()) {
+        const std::size_t end = std::min(path.find('/', at), path.size());
+        const std::string_view part(path.data() + at, end - at);
+        int next = -1;
+        for (int c : g.node(node).children) {
+            const GraphNode& n = g.node(c);
+            const std::string text = format_double(n.position) + (n.index ? fmt::format("#{}", n.index) : "");
+            if (text == part) {
+                next = c;
+                break;
+            }
+        }
+        if (next < 0) return -1;
+        node = next;
+        at = end + 1;
+    }
+    return path.size() > 1 && path.back() == '/' ? -1 : node;
 }
 
 int report_dormant_edits(const GrammarOptions& o, const Program& program, const SourceManager& sources) {

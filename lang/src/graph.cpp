@@ -140,6 +140,11 @@ void DecompositionGraph::add_node(std::uint64_t handle, int parent, double posit
     n.position = position;
     n.index = index;
     n.depth = parent < 0 ? 0 : nodes_[static_cast<std::size_t>(parent)].depth + 1;
+    if (n.depth > kMaxDepth)
+        throw RuntimeError{
+            RuntimeErrorKind::General, Span{},
+            fmt::format("the decomposition graph would be deeper than {} levels (a child of {})", kMaxDepth,
+                        excerpt(path(parent), 80))};
     const int k = static_cast<int>(nodes_.size());
     by_handle_[handle] = k;
     nodes_.push_back(std::move(n));

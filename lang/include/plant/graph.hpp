@@ -148,6 +148,9 @@ class DecompositionGraph {
     static constexpr std::size_t kMaxNodes = 1'000'000;
     // A bound on nodes times parameters: the resolved values a graph holds.
     static constexpr std::size_t kMaxValues = 20'000'000;
+    // A bound on the depth (a path's components): a plant's branching orders are a handful, and
+    // listings print every node's path whole.
+    static constexpr int kMaxDepth = 100;
 
     // What one node costs in memory, all its values included (the bound max_bytes applies).
     std::size_t node_bytes() const;
