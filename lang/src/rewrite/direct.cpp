@@ -3,7 +3,77 @@
 // the output once and each thread writes its stretch in place (write_direct).
 #include "rewriter.hpp"
 
+#include "plant/streams.hpp"
+
+#include <algorithm>
+
 namespace plant {
+
+namespace {
+
+bool holds(Op op, double x, double y) {
+    switch (op) {
+    case Op::Lt:
+        return x < y;
+    case Op::Le:
+        return x <= y;
+    case Op::Gt:
+        return x > y;
+    case Op::Ge:
+        return x >= y;
+    case Op::Eq:
+        return x == y;
+    default:
+        return x != y; // Ne
+    }
+}
+
+} // namespace
+
+// The first production whose condition holds applies; when it is weighted, every weighted
+// production from it on whose condition holds is a candidate and one is drawn by weight, with
+// the same arithmetic as Rewriter::choose (general.cpp), so that both routes draw alike.
+const Production* Rewriter::pick_guarded(std::size_t i, const RulePlan::Guarded& g) const {
+    if (in.arity(i) != g.width) return nullptr; // no pattern matches
+    const double* a = in.args(i);
+    const RulePlan::Guard* gs = plan.guards.data() + g.first;
+    auto ok = [&](const RulePlan::Guard& q) {
+        if (q.op == Op::Halt) return true;
+        return q.swapped ? holds(q.op, q.constant, a[q.param]) : holds(q.op, a[q.param], q.constant);
+    };
+    std::uint32_t k = 0;
+    while (k < g.count && !ok(gs[k])) ++k;
+    if (k == g.count) return nullptr;
+    if (gs[k].weight < 0) return gs[k].pr;
+    const RulePlan::Guard* options[64];
+    std::size_t count = 0;
+    double total = 0;
+    for (std::uint32_t j = k; j < g.count; ++j) {
+        if (gs[j].weight < 0 || !ok(gs[j]) || gs[j].weight == 0 || count == 64) continue;
+        options[count++] = &gs[j];
+        total += gs[j].weight;
+    }
+    if (count == 0) return nullptr;
+    double scale = 1;
+    if (!std::isfinite(total)) {
+        double largest = 0;
+        for (std::size_t j = 0; j < count; ++j) largest = std::max(largest, options[j]->weight);
+        scale = 1 / largest;
+        total = 0;
+        for (std::size_t j = 0; j < count; ++j) total += options[j]->weight * scale;
+    }
+    double u = random_unit(random_bits(seed, phase, i, stream::kChoiceDraw)) * total;
+    std::size_t pick = count - 1;
+    for (std::size_t j = 0; j < count; ++j) {
+        const double weight = options[j]->weight * scale;
+        if (u < weight) {
+            pick = j;
+            break;
+        }
+        u -= weight;
+    }
+    return options[pick]->pr;
+}
 
 Rewriter::Counts Rewriter::count_direct(std::size_t b, std::size_t e) const {
     Counts c;
@@ -15,7 +85,15 @@ Rewriter::Counts Rewriter::count_direct(std::size_t b, std::size_t e) const {
             continue;
         }
         const Production* pr = plan.direct[s];
-        if (!pr || in.arity(i) != pr->strict[0].width) {
+        if (!pr) {
+            const RulePlan::Guarded& g = plan.guarded[static_cast<std::size_t>(plan.guarded_at[s])];
+            if (!g.uniform) pr = pick_guarded(i, g);
+            if (!pr) { // copied, or as large as a copy
+                ++c.modules;
+                c.params += in.arity(i);
+                continue;
+            }
+        } else if (in.arity(i) != pr->strict[0].width) {
             c.ok = false;
             return c;
         }
@@ -55,7 +133,10 @@ void Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e, ModuleStrin
             if (w.env.interrupt && w.env.interrupt->load())
                 throw RuntimeError{RuntimeErrorKind::Interrupted, Span{}, "interrupted"};
         }
-        if (!plan.has_prod[in.sym[i]]) { // a run of modules without productions: copy it
+        const Production* prp = plan.direct[in.sym[i]];
+        if (!prp && plan.has_prod[in.sym[i]])
+            prp = pick_guarded(i, plan.guarded[static_cast<std::size_t>(plan.guarded_at[in.sym[i]])]);
+        if (!prp) { // a run of modules without productions (or none that applies): copy it
             std::size_t j = i + 1;
             while (j < e && !plan.has_prod[in.sym[j]]) ++j;
             const std::size_t n = j - i;
@@ -84,7 +165,7 @@ void Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e, ModuleStrin
             i = j;
             continue;
         }
-        const Production& pr = *plan.direct[in.sym[i]];
+        const Production& pr = *prp;
         const SuccessorTemplate& t = pr.tmpl;
         if (!t.holes.empty()) {
             const double* a = in.args(i);

@@ -86,6 +86,8 @@ void Engine::rewrite(const Derivation& d, const ModuleString& in, ModuleString& 
     int threads = std::max(1, d.opt_.threads);
     if (plan.sequential() || n < 20000) threads = 1;
     Rewriter rw(plan, in, &brackets, &kernel_scratch, threads == 1);
+    rw.seed = d.seed_;
+    rw.phase = phase;
     auto setup = [&](Worker& w) {
         w.env.prog = &d.prog_;
         w.env.run = &d.run_;

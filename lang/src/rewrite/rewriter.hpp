@@ -91,6 +91,12 @@ class Rewriter {
     void write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at,
                       std::size_t p_at, ModuleId id_at);
 
+    // The production a guarded symbol's module i gets (see RulePlan::Guarded), decided as
+    // apply() and choose() would decide it; nullptr: none applies, the module is copied.
+    const Production* pick_guarded(std::size_t i, const RulePlan::Guarded& g) const;
+    // The seed and phase of the step's random draws (weighted choice on the direct path).
+    std::uint64_t seed = 0, phase = 0;
+
     // ---- backward processing for `>>` (passes.cpp)
     void run_backward(Worker& w);
     ModuleString assemble_backward(const ModuleString& pieces) const;
