@@ -33,7 +33,7 @@ bool holds(Op op, double x, double y) {
 // The first production whose condition holds applies; when it is weighted, every weighted
 // production from it on whose condition holds is a candidate and one is drawn by weight, with
 // the same arithmetic as Rewriter::choose (general.cpp), so that both routes draw alike.
-const Production* Rewriter::pick_guarded(std::size_t i, const RulePlan::Guarded& g) const {
+const RulePlan::Guard* Rewriter::pick_guarded(std::size_t i, const RulePlan::Guarded& g) const {
     if (in.arity(i) != g.width) return nullptr; // no pattern matches
     const double* a = in.args(i);
     const RulePlan::Guard* gs = plan.guards.data() + g.first;
@@ -44,7 +44,7 @@ const Production* Rewriter::pick_guarded(std::size_t i, const RulePlan::Guarded&
     std::uint32_t k = 0;
     while (k < g.count && !ok(gs[k])) ++k;
     if (k == g.count) return nullptr;
-    if (gs[k].weight < 0) return gs[k].pr;
+    if (gs[k].weight < 0) return &gs[k];
     const RulePlan::Guard* options[64];
     std::size_t count = 0;
     double total = 0;
@@ -72,7 +72,7 @@ const Production* Rewriter::pick_guarded(std::size_t i, const RulePlan::Guarded&
         }
         u -= weight;
     }
-    return options[pick]->pr;
+    return options[pick];
 }
 
 Rewriter::Counts Rewriter::count_direct(std::size_t b, std::size_t e) const {
@@ -87,7 +87,8 @@ Rewriter::Counts Rewriter::count_direct(std::size_t b, std::size_t e) const {
         const Production* pr = plan.direct[s];
         if (!pr) {
             const RulePlan::Guarded& g = plan.guarded[static_cast<std::size_t>(plan.guarded_at[s])];
-            if (!g.uniform) pr = pick_guarded(i, g);
+            if (!g.uniform)
+                if (const RulePlan::Guard* q = pick_guarded(i, g)) pr = q->pr;
             if (!pr) { // copied, or as large as a copy
                 ++c.modules;
                 c.params += in.arity(i);
@@ -108,21 +109,23 @@ Rewriter::Counts Rewriter::count_direct(std::size_t b, std::size_t e) const {
 // arrays are already sized; new identities are numbered from id_at.
 // Identities are written only when `out` keeps them (Ids, a template argument so that the
 // loop has no test for it).
-void Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at,
-                            std::size_t p_at, ModuleId id_at) {
-    if (out.keep_ids)
-        write_direct<true>(w, b, e, out, m_at, p_at, id_at);
-    else
-        write_direct<false>(w, b, e, out, m_at, p_at, id_at);
+Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out,
+                                        std::size_t m_at, std::size_t p_at, ModuleId id_at,
+                                        std::uint64_t* tally) {
+    if (out.keep_ids) return write_direct<true>(w, b, e, out, m_at, p_at, id_at, tally);
+    return write_direct<false>(w, b, e, out, m_at, p_at, id_at, tally);
 }
 template <bool Ids>
-void Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at,
-                            std::size_t p_at, ModuleId id_at) {
+Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out,
+                                        std::size_t m_at, std::size_t p_at, ModuleId id_at,
+                                        std::uint64_t* tally) {
     w.frame.assign(plan.frame_size, 0.0);
     SymbolId* S = out.sym.data() + m_at;
     ModuleId* ID = Ids ? out.ids.data() + m_at : nullptr;
     std::uint32_t* PO = out.poff.data() + m_at + 1; // poff[m_at] is the previous stretch's end
     double* PA = out.params.data() + p_at;
+    const std::uint32_t* at = plan.outcome_at.data();
+    const ModuleId id0 = id_at;
     std::size_t p = p_at;
     double values[256];
     std::size_t i = b;
@@ -133,13 +136,21 @@ void Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e, ModuleStrin
             if (w.env.interrupt && w.env.interrupt->load())
                 throw RuntimeError{RuntimeErrorKind::Interrupted, Span{}, "interrupted"};
         }
-        const Production* prp = plan.direct[in.sym[i]];
-        if (!prp && plan.has_prod[in.sym[i]])
-            prp = pick_guarded(i, plan.guarded[static_cast<std::size_t>(plan.guarded_at[in.sym[i]])]);
+        const SymbolId s = in.sym[i];
+        const Production* prp = plan.direct[s];
+        std::uint32_t outcome = at[s] + 1;
+        if (!prp && plan.has_prod[s]) {
+            const RulePlan::Guarded& g = plan.guarded[static_cast<std::size_t>(plan.guarded_at[s])];
+            if (const RulePlan::Guard* q = pick_guarded(i, g)) {
+                prp = q->pr;
+                outcome += static_cast<std::uint32_t>(q - (plan.guards.data() + g.first));
+            }
+        }
         if (!prp) { // a run of modules without productions (or none that applies): copy it
             std::size_t j = i + 1;
             while (j < e && !plan.has_prod[in.sym[j]]) ++j;
             const std::size_t n = j - i;
+            for (std::size_t k = i; k < j; ++k) ++tally[at[in.sym[k]]];
             const std::uint32_t pb = in.poff[i], pe = in.poff[j];
             const auto shift = static_cast<std::uint32_t>(p - pb); // wraps around on purpose
             if (n <= 8 && pe - pb <= 8) {
@@ -165,6 +176,7 @@ void Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e, ModuleStrin
             i = j;
             continue;
         }
+        ++tally[outcome];
         const Production& pr = *prp;
         const SuccessorTemplate& t = pr.tmpl;
         if (!t.holes.empty()) {
@@ -189,6 +201,11 @@ void Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e, ModuleStrin
         p += t.params.size();
         ++i;
     }
+    Counts c;
+    c.modules = static_cast<std::size_t>(S - (out.sym.data() + m_at));
+    c.params = p - p_at;
+    c.new_ids = id_at - id0;
+    return c;
 }
 
 } // namespace plant

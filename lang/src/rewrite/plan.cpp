@@ -57,6 +57,7 @@ RulePlan::RulePlan(const Program& p, std::vector<const RuleSet*> rule_sets)
     guarded_at.assign(P.symbols.size(), -1);
     for (SymbolId s = 0; s < P.symbols.size(); ++s)
         all_direct = all_direct && (!has_prod[s] || direct[s] || (!multi && build_guards(s)));
+    if (all_direct) build_outcomes();
     if (brackets && !multi && !left_new && !right_new) build_context_table();
     // Whether every symbol with productions is rewritten by a direct template or by the
     // context table: then a step needs no matching beyond a table lookup, and the output of
@@ -159,6 +160,25 @@ bool RulePlan::build_guards(SymbolId sym) {
     guarded.push_back(entry);
     guards.insert(guards.end(), gs.begin(), gs.end());
     return true;
+}
+
+void RulePlan::build_outcomes() {
+    for (SymbolId s = 0; s < P.symbols.size(); ++s) {
+        outcome_at.push_back(static_cast<std::uint32_t>(outcome_tmpl.size()));
+        outcome_tmpl.push_back(nullptr);
+        outcome_sym.push_back(s);
+        if (!has_prod[s]) continue;
+        if (direct[s]) {
+            outcome_tmpl.push_back(&direct[s]->tmpl);
+            outcome_sym.push_back(s);
+            continue;
+        }
+        const Guarded& g = guarded[static_cast<std::size_t>(guarded_at[s])];
+        for (std::uint32_t k = 0; k < g.count; ++k) {
+            outcome_tmpl.push_back(&guards[g.first + k].pr->tmpl);
+            outcome_sym.push_back(s);
+        }
+    }
 }
 
 // The symbol kernel's tables. It needs every rewritten symbol to be parameterless: a direct

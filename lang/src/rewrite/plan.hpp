@@ -76,6 +76,13 @@ struct RulePlan {
     std::vector<std::int32_t> guarded_at; // per symbol: its entry in `guarded`, or -1
     std::vector<Guarded> guarded;
     std::vector<Guard> guards;
+    // The outcomes a module can have on the direct path, which the writer tallies so that the
+    // next step knows its output's size without a counting pass (see Engine::StringCounts):
+    // outcome_at[s] is the copy of a module of symbol s, outcome_at[s] + 1 + k its direct
+    // template (k = 0) or its k-th guard.
+    std::vector<std::uint32_t> outcome_at;
+    std::vector<const SuccessorTemplate*> outcome_tmpl; // nullptr: the copy
+    std::vector<SymbolId> outcome_sym;
     // Whether a step must rewrite on one thread, left to right (or right to left for `>>`).
     bool sequential() const { return multi || left_new || right_new; }
     std::size_t max_modules_out = 1; // the longest template's modules (at least 1: a copy)
@@ -84,6 +91,7 @@ struct RulePlan {
   private:
     void build_symbol_kernel();
     bool build_guards(SymbolId sym);
+    void build_outcomes();
     void build_context_table();
 };
 
