@@ -137,6 +137,7 @@ void Derivation::start() {
     stopped_ = false;
     group_ = -1;
     engine_->next_id = 1;
+    engine_->forget_counts();
     // the axiom: emitted like a successor, then decomposed
     env.seed = seed_;
     env.phase = stream::kAxiom;
@@ -181,8 +182,10 @@ bool Derivation::step() {
     if (stopped_) return false;
     const RulePlan& plan = engine_->step_plan(*this);
     // the environment phase: the plant as it is now meets its environments, query modules are filled
-    if ((plan.queries || !prog_.environments.empty()) && opt_.environment_phase)
+    if ((plan.queries || !prog_.environments.empty()) && opt_.environment_phase) {
+        engine_->forget_counts(); // the phase may edit the string in place
         opt_.environment_phase->run(*this, run_, current_);
+    }
     // (moved rather than swapped: an empty ModuleString would allocate its first offset; a
     // moved-from one is only ever cleared, which restores it)
     ModuleString next(std::move(engine_->spare));

@@ -3,7 +3,77 @@
 // the output once and each thread writes its stretch in place (write_direct).
 #include "rewriter.hpp"
 
+#include "plant/streams.hpp"
+
+#include <algorithm>
+
 namespace plant {
+
+namespace {
+
+bool holds(Op op, double x, double y) {
+    switch (op) {
+    case Op::Lt:
+        return x < y;
+    case Op::Le:
+        return x <= y;
+    case Op::Gt:
+        return x > y;
+    case Op::Ge:
+        return x >= y;
+    case Op::Eq:
+        return x == y;
+    default:
+        return x != y; // Ne
+    }
+}
+
+} // namespace
+
+// The first production whose condition holds applies; when it is weighted, every weighted
+// production from it on whose condition holds is a candidate and one is drawn by weight, with
+// the same arithmetic as Rewriter::choose (general.cpp), so that both routes draw alike.
+const RulePlan::Guard* Rewriter::pick_guarded(std::size_t i, const RulePlan::Guarded& g) const {
+    if (in.arity(i) != g.width) return nullptr; // no pattern matches
+    const double* a = in.args(i);
+    const RulePlan::Guard* gs = plan.guards.data() + g.first;
+    auto ok = [&](const RulePlan::Guard& q) {
+        if (q.op == Op::Halt) return true;
+        return q.swapped ? holds(q.op, q.constant, a[q.param]) : holds(q.op, a[q.param], q.constant);
+    };
+    std::uint32_t k = 0;
+    while (k < g.count && !ok(gs[k])) ++k;
+    if (k == g.count) return nullptr;
+    if (gs[k].weight < 0) return &gs[k];
+    const RulePlan::Guard* options[64];
+    std::size_t count = 0;
+    double total = 0;
+    for (std::uint32_t j = k; j < g.count; ++j) {
+        if (gs[j].weight < 0 || !ok(gs[j]) || gs[j].weight == 0 || count == 64) continue;
+        options[count++] = &gs[j];
+        total += gs[j].weight;
+    }
+    if (count == 0) return nullptr;
+    double scale = 1;
+    if (!std::isfinite(total)) {
+        double largest = 0;
+        for (std::size_t j = 0; j < count; ++j) largest = std::max(largest, options[j]->weight);
+        scale = 1 / largest;
+        total = 0;
+        for (std::size_t j = 0; j < count; ++j) total += options[j]->weight * scale;
+    }
+    double u = random_unit(random_bits(seed, phase, i, stream::kChoiceDraw)) * total;
+    std::size_t pick = count - 1;
+    for (std::size_t j = 0; j < count; ++j) {
+        const double weight = options[j]->weight * scale;
+        if (u < weight) {
+            pick = j;
+            break;
+        }
+        u -= weight;
+    }
+    return options[pick];
+}
 
 Rewriter::Counts Rewriter::count_direct(std::size_t b, std::size_t e) const {
     Counts c;
@@ -15,7 +85,16 @@ Rewriter::Counts Rewriter::count_direct(std::size_t b, std::size_t e) const {
             continue;
         }
         const Production* pr = plan.direct[s];
-        if (!pr || in.arity(i) != pr->strict[0].width) {
+        if (!pr) {
+            const RulePlan::Guarded& g = plan.guarded[static_cast<std::size_t>(plan.guarded_at[s])];
+            if (!g.uniform)
+                if (const RulePlan::Guard* q = pick_guarded(i, g)) pr = q->pr;
+            if (!pr) { // copied, or as large as a copy
+                ++c.modules;
+                c.params += in.arity(i);
+                continue;
+            }
+        } else if (in.arity(i) != pr->strict[0].width) {
             c.ok = false;
             return c;
         }
@@ -30,21 +109,23 @@ Rewriter::Counts Rewriter::count_direct(std::size_t b, std::size_t e) const {
 // arrays are already sized; new identities are numbered from id_at.
 // Identities are written only when `out` keeps them (Ids, a template argument so that the
 // loop has no test for it).
-void Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at,
-                            std::size_t p_at, ModuleId id_at) {
-    if (out.keep_ids)
-        write_direct<true>(w, b, e, out, m_at, p_at, id_at);
-    else
-        write_direct<false>(w, b, e, out, m_at, p_at, id_at);
+Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out,
+                                        std::size_t m_at, std::size_t p_at, ModuleId id_at,
+                                        std::uint64_t* tally) {
+    if (out.keep_ids) return write_direct<true>(w, b, e, out, m_at, p_at, id_at, tally);
+    return write_direct<false>(w, b, e, out, m_at, p_at, id_at, tally);
 }
 template <bool Ids>
-void Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at,
-                            std::size_t p_at, ModuleId id_at) {
+Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out,
+                                        std::size_t m_at, std::size_t p_at, ModuleId id_at,
+                                        std::uint64_t* tally) {
     w.frame.assign(plan.frame_size, 0.0);
     SymbolId* S = out.sym.data() + m_at;
     ModuleId* ID = Ids ? out.ids.data() + m_at : nullptr;
     std::uint32_t* PO = out.poff.data() + m_at + 1; // poff[m_at] is the previous stretch's end
     double* PA = out.params.data() + p_at;
+    const std::uint32_t* at = plan.outcome_at.data();
+    const ModuleId id0 = id_at;
     std::size_t p = p_at;
     double values[256];
     std::size_t i = b;
@@ -55,10 +136,21 @@ void Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e, ModuleStrin
             if (w.env.interrupt && w.env.interrupt->load())
                 throw RuntimeError{RuntimeErrorKind::Interrupted, Span{}, "interrupted"};
         }
-        if (!plan.has_prod[in.sym[i]]) { // a run of modules without productions: copy it
+        const SymbolId s = in.sym[i];
+        const Production* prp = plan.direct[s];
+        std::uint32_t outcome = at[s] + 1;
+        if (!prp && plan.has_prod[s]) {
+            const RulePlan::Guarded& g = plan.guarded[static_cast<std::size_t>(plan.guarded_at[s])];
+            if (const RulePlan::Guard* q = pick_guarded(i, g)) {
+                prp = q->pr;
+                outcome += static_cast<std::uint32_t>(q - (plan.guards.data() + g.first));
+            }
+        }
+        if (!prp) { // a run of modules without productions (or none that applies): copy it
             std::size_t j = i + 1;
             while (j < e && !plan.has_prod[in.sym[j]]) ++j;
             const std::size_t n = j - i;
+            for (std::size_t k = i; k < j; ++k) ++tally[at[in.sym[k]]];
             const std::uint32_t pb = in.poff[i], pe = in.poff[j];
             const auto shift = static_cast<std::uint32_t>(p - pb); // wraps around on purpose
             if (n <= 8 && pe - pb <= 8) {
@@ -84,7 +176,8 @@ void Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e, ModuleStrin
             i = j;
             continue;
         }
-        const Production& pr = *plan.direct[in.sym[i]];
+        ++tally[outcome];
+        const Production& pr = *prp;
         const SuccessorTemplate& t = pr.tmpl;
         if (!t.holes.empty()) {
             const double* a = in.args(i);
@@ -108,6 +201,11 @@ void Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e, ModuleStrin
         p += t.params.size();
         ++i;
     }
+    Counts c;
+    c.modules = static_cast<std::size_t>(S - (out.sym.data() + m_at));
+    c.params = p - p_at;
+    c.new_ids = id_at - id0;
+    return c;
 }
 
 } // namespace plant

@@ -86,6 +86,8 @@ void Engine::rewrite(const Derivation& d, const ModuleString& in, ModuleString& 
     int threads = std::max(1, d.opt_.threads);
     if (plan.sequential() || n < 20000) threads = 1;
     Rewriter rw(plan, in, &brackets, &kernel_scratch, threads == 1);
+    rw.seed = d.seed_;
+    rw.phase = phase;
     auto setup = [&](Worker& w) {
         w.env.prog = &d.prog_;
         w.env.run = &d.run_;
@@ -104,7 +106,11 @@ void Engine::rewrite(const Derivation& d, const ModuleString& in, ModuleString& 
     out.keep_ids = in.keep_ids;
     // The direct path needs every module's successor to be a direct template: a plan with
     // symbols rewritten otherwise would find one in nearly every string, after counting up to it.
-    if (!plan.sequential() && plan.all_direct && rewrite_direct(d, rw, in, out, threads, setup)) {
+    // (interpretation rewrites a copy of the string and leaves the counts to the string itself)
+    const bool counted = !interpreting && counts.of == in.sym.data() && counts.size == n && !in.empty();
+    if (!interpreting) forget_counts();
+    if (!plan.sequential() && plan.all_direct &&
+        rewrite_direct(d, rw, in, out, plan, threads, counted, setup)) {
         // done
     } else if (threads == 1) {
         Worker w(std::move(out)); // writes into the arrays `out` has
@@ -243,13 +249,15 @@ void Engine::rewrite_parallel(const Derivation& d, Rewriter& rw, const ModuleStr
 
 // Tries the direct path (see Rewriter::count_direct): count the output of each thread's stretch,
 // allocate the output once, write the stretches in place. Returns false, having written
-// nothing, when some module needs the general path.
+// nothing, when some module needs the general path. On one thread, a string the last rewrite
+// counted (`counted`, see Engine::counts) is not read to count: its output is sized from the
+// counts, and cut to what was written when that was only a bound.
 template <typename Setup>
 bool Engine::rewrite_direct(const Derivation& d, Rewriter& rw, const ModuleString& in, ModuleString& out,
-                            int threads, const Setup& setup) {
+                            const RulePlan& plan, int threads, bool counted, const Setup& setup) {
     const std::size_t n = in.size();
     const auto T = static_cast<std::size_t>(threads);
-    std::vector<Rewriter::Counts> counts(T);
+    std::vector<Rewriter::Counts> counts_at(T);
     auto bounds = [&](std::size_t t) { return std::pair{n * t / T, n * (t + 1) / T}; };
     auto parallel = [&](auto&& body) {
         if (T == 1) {
@@ -259,17 +267,22 @@ bool Engine::rewrite_direct(const Derivation& d, Rewriter& rw, const ModuleStrin
         std::vector<std::jthread> pool;
         for (std::size_t t = 0; t < T; ++t) pool.emplace_back([&body, t] { body(t); });
     };
-    parallel([&](std::size_t t) {
-        auto [b, e] = bounds(t);
-        counts[t] = rw.count_direct(b, e);
-    });
     std::size_t modules = 0, params = 0;
-    for (const auto& c : counts) {
-        if (!c.ok) return false;
-        modules += c.modules;
-        params += c.params;
+    const bool sized =
+        T == 1 && counted && size_from_counts(plan, in, modules, params) && within_limits(d, modules, params);
+    if (!sized) {
+        modules = params = 0; // (size_from_counts may have left a partial sum)
+        parallel([&](std::size_t t) {
+            auto [b, e] = bounds(t);
+            counts_at[t] = rw.count_direct(b, e);
+        });
+        for (const auto& c : counts_at) {
+            if (!c.ok) return false;
+            modules += c.modules;
+            params += c.params;
+        }
+        check_limits(d, modules, params); // before allocating anything
     }
-    check_limits(d, modules, params); // before allocating anything
     out.sym.resize(modules);
     if (out.keep_ids) out.ids.resize(modules);
     out.poff.resize(modules + 1);
@@ -283,24 +296,102 @@ bool Engine::rewrite_direct(const Derivation& d, Rewriter& rw, const ModuleStrin
         m_at[t] = m;
         p_at[t] = p;
         id_at[t] = ids;
-        m += counts[t].modules;
-        p += counts[t].params;
-        ids += counts[t].new_ids;
+        m += counts_at[t].modules;
+        p += counts_at[t].params;
+        ids += counts_at[t].new_ids;
     }
+    std::vector<std::vector<std::uint64_t>> tallies(T, std::vector<std::uint64_t>(plan.outcome_tmpl.size()));
     parallel([&](std::size_t t) {
         Worker& w = workers[t];
         setup(w);
         auto [b, e] = bounds(t);
         try {
-            rw.write_direct(w, b, e, out, m_at[t], p_at[t], id_at[t]);
+            counts_at[t] = rw.write_direct(w, b, e, out, m_at[t], p_at[t], id_at[t], tallies[t].data());
         } catch (const RuntimeError& err) {
             w.error = err;
         }
     });
     for (auto& w : workers)
         if (w.error) throw *w.error;
+    if (sized) { // the counts were exact or a bound: cut to what was written
+        const Rewriter::Counts& c = counts_at[0];
+        out.sym.resize(c.modules);
+        if (out.keep_ids) out.ids.resize(c.modules);
+        out.poff.resize(c.modules + 1);
+        out.params.resize(c.params);
+        ids = next_id + c.new_ids;
+    }
     next_id = ids;
+    if (!interpreting) count_outcomes(plan, tallies, counted, out);
     return true;
+}
+
+bool Engine::within_limits(const Derivation& d, std::size_t modules, std::size_t params) const {
+    try {
+        check_limits(d, modules, params);
+    } catch (const RuntimeError&) {
+        return false;
+    }
+    return true;
+}
+
+bool Engine::size_from_counts(const RulePlan& plan, const ModuleString& in, std::size_t& modules,
+                              std::size_t& params) const {
+    modules = 0;
+    params = in.params.size();
+    const std::size_t S = plan.has_prod.size();
+    if (counts.modules.size() != S) return false;
+    for (std::size_t s = 0; s < S; ++s) {
+        const std::uint64_t c = counts.modules[s];
+        if (c == 0) continue;
+        if (!plan.has_prod[s]) {
+            modules += c;
+        } else if (const Production* pr = plan.direct[s]) {
+            if (counts.arity[s] != static_cast<std::int32_t>(pr->strict[0].width)) return false;
+            modules += c * pr->tmpl.syms.size();
+            params += c * pr->tmpl.params.size();
+            params -= c * pr->strict[0].width;
+        } else {
+            const RulePlan::Guarded& g = plan.guarded[static_cast<std::size_t>(plan.guarded_at[s])];
+            std::size_t most_m = 1, most_p = 0; // the copy keeps its own parameters, already counted
+            if (!g.uniform)
+                for (std::uint32_t k = 0; k < g.count; ++k) {
+                    const SuccessorTemplate& t = plan.guards[g.first + k].pr->tmpl;
+                    most_m = std::max(most_m, t.syms.size());
+                    most_p = std::max(most_p, t.params.size());
+                }
+            modules += c * most_m;
+            params += c * most_p;
+        }
+    }
+    return true;
+}
+
+void Engine::count_outcomes(const RulePlan& plan, const std::vector<std::vector<std::uint64_t>>& tallies,
+                            bool counted, const ModuleString& out) {
+    const std::size_t S = plan.has_prod.size();
+    std::vector<std::uint64_t> modules(S, 0);
+    std::vector<std::int32_t> arity(S, -2); // -2: no module yet
+    auto merge = [&](std::size_t s, std::int32_t a) { arity[s] = arity[s] == -2 || arity[s] == a ? a : -1; };
+    for (std::size_t o = 0; o < plan.outcome_tmpl.size(); ++o) {
+        std::uint64_t c = 0;
+        for (const auto& t : tallies) c += t[o];
+        if (c == 0) continue;
+        if (const SuccessorTemplate* t = plan.outcome_tmpl[o]) {
+            for (std::size_t j = 0; j < t->syms.size(); ++j) {
+                modules[t->syms[j]] += c;
+                merge(t->syms[j], static_cast<std::int32_t>(t->param_end[j] - (j ? t->param_end[j - 1] : 0)));
+            }
+        } else {
+            const SymbolId s = plan.outcome_sym[o];
+            modules[s] += c;
+            merge(s, counted && counts.arity.size() == S ? counts.arity[s] : -1);
+        }
+    }
+    counts.modules = std::move(modules);
+    counts.arity = std::move(arity);
+    counts.of = out.sym.data();
+    counts.size = out.size();
 }
 
 void Engine::decompose(const Derivation& d, ModuleString& s, int step_for_env) {

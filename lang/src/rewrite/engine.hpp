@@ -57,6 +57,21 @@ struct Engine {
     ModuleString spare;
     static constexpr std::size_t kMaxSpareBytes = std::size_t{1} << 20;
 
+    // What the last rewrite on the direct path learnt of the string it wrote, from the outcomes
+    // its writers tallied: the modules of each symbol and the parameters they all carry. The
+    // next rewrite of that string on one thread sizes its output from them instead of reading
+    // the string once more to count (see rewrite_direct). They describe the string whose
+    // symbols start at `of` and that has `size` modules, as long as nothing else changes it:
+    // every rewrite forgets them first, and so does the derivation before its environment
+    // phase, which edits the string in place.
+    struct StringCounts {
+        std::vector<std::uint64_t> modules; // per symbol
+        std::vector<std::int32_t> arity;    // per symbol: what every module has; -1 they differ or unknown
+        const SymbolId* of = nullptr;
+        std::size_t size = 0;
+    } counts;
+    void forget_counts() { counts.of = nullptr; }
+
   private:
     void rewrite_one_thread(const Derivation& d, Rewriter& rw, const ModuleString& in, Worker& w,
                             const RulePlan& plan);
@@ -65,7 +80,16 @@ struct Engine {
                           int threads, const Setup& setup);
     template <typename Setup>
     bool rewrite_direct(const Derivation& d, Rewriter& rw, const ModuleString& in, ModuleString& out,
-                        int threads, const Setup& setup);
+                        const RulePlan& plan, int threads, bool counted, const Setup& setup);
+    // The size of the output of `in`, a string `counts` describes, on the direct path: exact
+    // unless a guarded symbol may be copied or rewritten, then at most that. False when
+    // unknown (a symbol's modules may not all have the width its template takes).
+    bool size_from_counts(const RulePlan& plan, const ModuleString& in, std::size_t& modules,
+                          std::size_t& params) const;
+    // Makes `counts` describe `out` from the outcomes the writers tallied.
+    void count_outcomes(const RulePlan& plan, const std::vector<std::vector<std::uint64_t>>& tallies,
+                        bool counted, const ModuleString& out);
+    bool within_limits(const Derivation& d, std::size_t modules, std::size_t params) const;
 };
 
 } // namespace plant

@@ -3,6 +3,8 @@
 #include "plan.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <optional>
 #include <utility>
 
 namespace plant {
@@ -51,8 +53,11 @@ RulePlan::RulePlan(const Program& p, std::vector<const RuleSet*> rule_sets)
                 direct[s] = &pr;
             break;
         }
-        all_direct = all_direct && (!has_prod[s] || direct[s]);
     }
+    guarded_at.assign(P.symbols.size(), -1);
+    for (SymbolId s = 0; s < P.symbols.size(); ++s)
+        all_direct = all_direct && (!has_prod[s] || direct[s] || (!multi && build_guards(s)));
+    if (all_direct) build_outcomes();
     if (brackets && !multi && !left_new && !right_new) build_context_table();
     // Whether every symbol with productions is rewritten by a direct template or by the
     // context table: then a step needs no matching beyond a table lookup, and the output of
@@ -75,6 +80,105 @@ RulePlan::RulePlan(const Program& p, std::vector<const RuleSet*> rule_sets)
     }
     if (templated && max_params_out == 0 && max_modules_out <= SymbolSucc::kMax && !ctx_block.empty())
         build_symbol_kernel();
+}
+
+namespace {
+
+// The guard a production's condition and weight make (see RulePlan::Guard), or nothing when
+// they are not of the simple forms.
+std::optional<RulePlan::Guard> guard_of(const Production& pr) {
+    const PatternModule& pm = pr.strict[0];
+    RulePlan::Guard g;
+    g.pr = &pr;
+    const Code& c = pr.condition;
+    if (!c.empty()) {
+        if (c.instrs.size() != 4 || c.instrs[3].op != Op::Halt || c.instrs[3].n != 1) return std::nullopt;
+        const Op op = c.instrs[2].op;
+        if (op != Op::Lt && op != Op::Le && op != Op::Gt && op != Op::Ge && op != Op::Eq && op != Op::Ne)
+            return std::nullopt;
+        const Instr *load = &c.instrs[0], *k = &c.instrs[1];
+        if (load->op == Op::Const) {
+            std::swap(load, k);
+            g.swapped = true;
+        }
+        if (load->op != Op::LoadLocal || load->n != 1 || k->op != Op::Const) return std::nullopt;
+        const auto slot = static_cast<std::uint32_t>(load->a);
+        std::uint32_t at = 0;
+        bool found = false;
+        for (const auto& pa : pm.args) {
+            if (pa.slot <= slot && slot < pa.slot + static_cast<std::uint32_t>(pa.width)) {
+                g.param = at + (slot - pa.slot);
+                found = true;
+                break;
+            }
+            at += pa.width;
+        }
+        if (!found) return std::nullopt;
+        g.op = op;
+        g.constant = c.consts[static_cast<std::size_t>(k->a)];
+    }
+    const Code& w = pr.weight;
+    if (!w.empty()) {
+        if (w.instrs.size() != 2 || w.instrs[0].op != Op::Const || w.instrs[1].op != Op::Halt ||
+            w.instrs[1].n != 1)
+            return std::nullopt;
+        g.weight = w.consts[static_cast<std::size_t>(w.instrs[0].a)];
+        if (!(g.weight >= 0) || !std::isfinite(g.weight)) return std::nullopt; // the general path says why
+    }
+    return g;
+}
+
+} // namespace
+
+// Whether every production of `sym` makes a guard; then they are recorded as its guards.
+bool RulePlan::build_guards(SymbolId sym) {
+    std::vector<Guard> gs;
+    std::uint32_t width = 0;
+    for (const RuleSet* rs : sets)
+        for (std::uint32_t pi : rs->by_symbol[sym]) {
+            const Production& pr = rs->productions[pi];
+            bool binds_all = pr.strict.size() == 1;
+            for (const auto& a : pr.strict[0].args) binds_all = binds_all && a.bind;
+            if (!binds_all || pr.has_context() || pr.has_new_context() || !pr.tmpl.valid) return false;
+            if (!gs.empty() && pr.strict[0].width != width) return false;
+            width = pr.strict[0].width;
+            std::optional<Guard> g = guard_of(pr);
+            if (!g) return false;
+            gs.push_back(*g);
+        }
+    if (gs.empty() || gs.size() > 64) return false;
+    Guarded entry;
+    entry.first = static_cast<std::uint32_t>(guards.size());
+    entry.count = static_cast<std::uint32_t>(gs.size());
+    entry.width = width;
+    entry.uniform = true;
+    for (const Guard& g : gs) {
+        const SuccessorTemplate& t = g.pr->tmpl;
+        entry.uniform = entry.uniform && t.syms.size() == 1 && t.params.size() == width && t.keep == 0;
+    }
+    guarded_at[sym] = static_cast<std::int32_t>(guarded.size());
+    guarded.push_back(entry);
+    guards.insert(guards.end(), gs.begin(), gs.end());
+    return true;
+}
+
+void RulePlan::build_outcomes() {
+    for (SymbolId s = 0; s < P.symbols.size(); ++s) {
+        outcome_at.push_back(static_cast<std::uint32_t>(outcome_tmpl.size()));
+        outcome_tmpl.push_back(nullptr);
+        outcome_sym.push_back(s);
+        if (!has_prod[s]) continue;
+        if (direct[s]) {
+            outcome_tmpl.push_back(&direct[s]->tmpl);
+            outcome_sym.push_back(s);
+            continue;
+        }
+        const Guarded& g = guarded[static_cast<std::size_t>(guarded_at[s])];
+        for (std::uint32_t k = 0; k < g.count; ++k) {
+            outcome_tmpl.push_back(&guards[g.first + k].pr->tmpl);
+            outcome_sym.push_back(s);
+        }
+    }
 }
 
 // The symbol kernel's tables. It needs every rewritten symbol to be parameterless: a direct

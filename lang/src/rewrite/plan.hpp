@@ -54,7 +54,35 @@ struct RulePlan {
     bool brackets = false, multi = false, left_new = false, right_new = false;
     bool queries = false;   // some pattern names a query module: the turtle pass fills them first
     bool templated = false; // see the end of the constructor
-    bool all_direct = true; // every symbol with productions has a direct template
+    bool all_direct = true; // every symbol with productions has a direct template or guards
+
+    // Guarded symbols (see build_guards): every production of the symbol has one predecessor
+    // module that binds all its arguments, a template, no context, a condition `parameter OP
+    // constant` or none, and a constant weight or none. Which production applies (or none, and
+    // the module is copied) is then decided without the stack machine, on the direct path.
+    struct Guard {
+        const Production* pr = nullptr;
+        std::uint32_t param = 0; // the module's parameter the condition compares
+        Op op = Op::Halt;        // Halt: no condition
+        bool swapped = false;    // `constant OP parameter`
+        double constant = 0;
+        double weight = -1; // below 0: not weighted
+    };
+    struct Guarded {
+        std::uint32_t first = 0, count = 0; // its guards, in the order apply() tries them
+        std::uint32_t width = 0;            // the parameters every pattern of the symbol takes
+        bool uniform = false;               // every outcome (a production or the copy) writes as much
+    };
+    std::vector<std::int32_t> guarded_at; // per symbol: its entry in `guarded`, or -1
+    std::vector<Guarded> guarded;
+    std::vector<Guard> guards;
+    // The outcomes a module can have on the direct path, which the writer tallies so that the
+    // next step knows its output's size without a counting pass (see Engine::StringCounts):
+    // outcome_at[s] is the copy of a module of symbol s, outcome_at[s] + 1 + k its direct
+    // template (k = 0) or its k-th guard.
+    std::vector<std::uint32_t> outcome_at;
+    std::vector<const SuccessorTemplate*> outcome_tmpl; // nullptr: the copy
+    std::vector<SymbolId> outcome_sym;
     // Whether a step must rewrite on one thread, left to right (or right to left for `>>`).
     bool sequential() const { return multi || left_new || right_new; }
     std::size_t max_modules_out = 1; // the longest template's modules (at least 1: a copy)
@@ -62,6 +90,8 @@ struct RulePlan {
 
   private:
     void build_symbol_kernel();
+    bool build_guards(SymbolId sym);
+    void build_outcomes();
     void build_context_table();
 };
 

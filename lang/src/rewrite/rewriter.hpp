@@ -87,9 +87,16 @@ class Rewriter {
     };
     Counts count_direct(std::size_t b, std::size_t e) const;
     // Writes the output of modules [b, e) at module m_at and parameter p_at of `out`, whose
-    // arrays are already sized; new identities are numbered from id_at.
-    void write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at,
-                      std::size_t p_at, ModuleId id_at);
+    // arrays are large enough; new identities are numbered from id_at. Adds each module's
+    // outcome to `tally` (indexed as RulePlan::outcome_at). Returns what it wrote.
+    Counts write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at,
+                        std::size_t p_at, ModuleId id_at, std::uint64_t* tally);
+
+    // The production a guarded symbol's module i gets (see RulePlan::Guarded), decided as
+    // apply() and choose() would decide it; nullptr: none applies, the module is copied.
+    const RulePlan::Guard* pick_guarded(std::size_t i, const RulePlan::Guarded& g) const;
+    // The seed and phase of the step's random draws (weighted choice on the direct path).
+    std::uint64_t seed = 0, phase = 0;
 
     // ---- backward processing for `>>` (passes.cpp)
     void run_backward(Worker& w);
@@ -97,8 +104,8 @@ class Rewriter {
 
   private:
     template <bool Ids>
-    void write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at,
-                      std::size_t p_at, ModuleId id_at);
+    Counts write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at,
+                        std::size_t p_at, ModuleId id_at, std::uint64_t* tally);
     template <bool Ids> void run_templates(Worker& w, std::size_t b, std::size_t e);
     template <bool Whole> void run_symbols(Worker& w, std::size_t b, std::size_t e);
 
@@ -147,7 +154,13 @@ class Rewriter {
         }
     }
 
+    // One test for all the numbers: x * 0 is NaN exactly when x is infinite or NaN, and a NaN
+    // makes the sum NaN. Only then are they looked at one by one, to name the first.
     void check_holes(const SuccessorTemplate& t, const double* values) const {
+        double sum = 0;
+        for (std::size_t h = 0; h < t.holes.size(); ++h) sum += values[h] * 0.0;
+        if (sum == sum) [[likely]]
+            return;
         for (std::size_t h = 0; h < t.holes.size(); ++h)
             if (!std::isfinite(values[h])) hole_error(t, h, values[h]);
     }
