@@ -107,6 +107,8 @@ void World::step() {
     match_shapes_passes();
     auto t0 = clock::now();
     if (settings_.collisions) separate_particles();
+    // contacts and obstacles push particles: the links get their lengths back (length.cpp)
+    keep_shape(false, false);
     double collision_ms = ms(clock::now() - t0).count();
     t0 = clock::now();
     integrate();
