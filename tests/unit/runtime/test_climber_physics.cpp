@@ -142,3 +142,82 @@ TEST_CASE("climber: every climber grammar keeps each stem within 10 % of its res
     }
     CHECK(grammars >= 9);
 }
+
+TEST_CASE("climber: a box slid sideways drags the plants anchored to it along (Fig. 9)", "[climber]") {
+    // grammars/climbers/fig09_boxes.plant slides box 2 (the low one on the right) by 0.25 m from
+    // step 24: every particle anchored to it before stays within 2 cm of it
+    std::ifstream in(std::filesystem::path(PLANT_SOURCE_DIR) / "grammars" / "climbers" / "fig09_boxes.plant");
+    std::stringstream text;
+    text << in.rdbuf();
+    CompileOptions opts;
+    opts.environments = runtime_environments();
+    auto compiled = test::compile(text.str(), opts);
+    REQUIRE(compiled->program);
+    TurtleEnvironmentPhase phase;
+    DeriveOptions options;
+    options.environment_phase = &phase;
+    Derivation d(*compiled->program, options);
+    d.start();
+    while (d.steps_done() < 23) REQUIRE(d.step());
+    std::vector<physics::Handle> held;
+    {
+        const physics::World& w = climber_in(d).world();
+        for (std::uint32_t i = 0; i < w.size(); ++i)
+            if (w.alive(w.handle(i)) && w.anchored_to(w.handle(i), 2)) held.push_back(w.handle(i));
+    }
+    const glm::dvec3 box_before = climber_in(d).world().obstacles()[2].a;
+    while (d.step()) {
+    }
+    const physics::World& w = climber_in(d).world();
+    CHECK(w.obstacles()[2].a.x == Approx(box_before.x + 0.25)); // it moved
+    REQUIRE(held.size() >= 5);
+    std::size_t away = 0;
+    double farthest = 0;
+    for (physics::Handle h : held) {
+        if (!w.alive(h)) continue;
+        const glm::dvec3 r = w.radii(h);
+        const double gap = w.obstacles()[2].distance(w.position(h)) - std::min({r.x, r.y, r.z});
+        farthest = std::max(farthest, gap);
+        if (gap > 0.02) ++away;
+    }
+    INFO(held.size() << " anchored to the box before the move; " << away
+                     << " end over 2 cm from it, the farthest " << farthest << " m");
+    CHECK(away == 0);
+}
+
+TEST_CASE("physics: an anchor moves with its obstacle, and a removed support lets its plant fall",
+          "[physics]") {
+    using namespace plant::physics;
+    Settings s;
+    s.fixed_stiffness = 0.5;
+    World w(s);
+    w.add_obstacle({Obstacle::Plane, {0, 0, 0}, {0, 1, 0}});
+    w.add_obstacle({Obstacle::Box, {-1, 0, -0.5}, {1, 0.5, 0}}); // a low wall
+    const glm::dvec3 r(0.006, 0.025, 0.006);
+    // a stem up the wall's face (z = 0) and along its top, anchored all the way
+    Handle prev = w.add_root({0, 0, 0.006}, glm::dquat(1, 0, 0, 0), r);
+    std::vector<Handle> stem;
+    for (int k = 1; k <= 16; ++k) {
+        const glm::dvec3 at =
+            k <= 10 ? glm::dvec3(0, 0.05 * k, 0.006) : glm::dvec3(0, 0.506, -0.05 * (k - 10));
+        prev = w.add_particle(prev, at, glm::dquat(1, 0, 0, 0), r);
+        stem.push_back(prev);
+        w.add_anchor(prev, at, 0.5, 0.3);
+    }
+    CHECK(w.anchored_to(stem.back(), 1));
+    for (int k = 0; k < 20; ++k) w.step();
+    const double resting = w.position(stem.back()).y;
+    CHECK(resting > 0.45); // held on the wall's top
+    // the wall slides 10 cm along x: the anchored top of the stem comes along
+    for (int k = 0; k < 5; ++k) {
+        w.move_obstacle(1, {0.02, 0, 0});
+        w.step();
+    }
+    for (int k = 0; k < 20; ++k) w.step();
+    CHECK(w.position(stem.back()).x > 0.05);
+    // removed: nothing holds the stem's top, which falls to the ground
+    w.remove_obstacle(1);
+    CHECK_FALSE(w.anchored(stem.back()));
+    for (int k = 0; k < 80; ++k) w.step();
+    CHECK(w.position(stem.back()).y < resting - 0.1);
+}

@@ -157,9 +157,16 @@ class World {
 
     // Eq. 5: each step the particle's predicted position moves a fraction phi of the way to the
     // anchor; past `release` from it, the anchor lets go.
+    // The anchor belongs to the obstacle whose surface is nearest the point (within 5 cm): it is
+    // kept in that obstacle's frame, so it moves with the obstacle (Fig. 9); otherwise it is a
+    // fixed point.
     void add_anchor(Handle h, const glm::dvec3& point, double phi, double release);
     bool anchored(Handle h) const;
+    // Whether h is anchored to obstacle k.
+    bool anchored_to(Handle h, std::size_t k) const;
     void add_obstacle(const Obstacle& o) { obstacles_.push_back(o); }
+    // Removes obstacle k (later ones move down one); its anchors let go, so what it held falls.
+    void remove_obstacle(std::size_t k);
     // Moves obstacle k by `delta` (section 5.2: the user moves objects and the plants adapt).
     void move_obstacle(std::size_t k, const glm::dvec3& delta) {
         if (k >= obstacles_.size()) return;
@@ -307,9 +314,16 @@ class World {
     std::vector<std::uint8_t> fixed_, alive_;
     struct Anchor {
         std::uint32_t particle;
-        glm::dvec3 point;
+        glm::dvec3 point; // where it was made
         double phi, release;
+        std::size_t obstacle = ~std::size_t{0}; // none: a fixed point in the world
+        glm::dvec3 origin{0.0};                 // the obstacle's `a` when it was made
     };
+    // where the anchor is now: moved as far as its obstacle has moved since (exactly where it was
+    // made while the obstacle stays put)
+    glm::dvec3 anchor_point(const Anchor& a) const {
+        return a.obstacle < obstacles_.size() ? a.point + (obstacles_[a.obstacle].a - a.origin) : a.point;
+    }
     std::vector<Anchor> anchors_;
     std::vector<Obstacle> obstacles_;
     std::vector<std::pair<std::uint32_t, glm::dvec3>> pulls_;
