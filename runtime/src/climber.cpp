@@ -322,6 +322,10 @@ glm::dvec3 Climber::grow_dir(const glm::dvec3& p, const glm::dvec3& h) const {
     if (config_.adaption > 0) {
         double best = 0;
         nearest = nearest_obstacle(p, config_.adaption_range, best);
+        // a surface the shoot grows away from (more than 30 degrees off it: the ground under a
+        // free shoot) neither draws it back nor turns it flat; Eq. 6 alone would, by the same
+        // angle as a shoot leaning into it (docs/physics.md)
+        if (nearest && glm::dot(f, nearest->normal(p)) > 0.5) nearest = nullptr;
         if (nearest) {
             normal = nearest->normal(p);
             f = physics::surface_adaption(f, -normal, config_.adaption, time);

@@ -43,9 +43,12 @@ Handle World::add_grown(Handle parent, const glm::dvec3& position_in, const glm:
     Handle h = add_particle(parent, position, orientation, radii);
     // Hädrich et al., Eq. 9-10: growth enters the rest state too. The turn taking the parent's
     // current frame to its rest frame carries the new particle's offset and orientation over.
+    // The offset goes back by the parent's turn as the length and bending sweep reads it
+    // (keep_shape(): the segment into the parent), so a new particle starts where the sweep
+    // holds it.
     const std::uint32_t p = parent.index, i = h.index;
     const glm::dquat back = glm::normalize(rest_q_[p] * glm::inverse(q_[p]));
-    rest_x_[i] = rest_x_[p] + back * (position - x_[p]);
+    rest_x_[i] = rest_x_[p] + carried(p, position - x_[p], true);
     rest_q_[i] = glm::normalize(back * orientation);
     return h;
 }

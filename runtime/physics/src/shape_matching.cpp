@@ -182,6 +182,7 @@ void World::refresh_groups() {
     for (std::size_t j = 0; j < n; ++j)
         if (alive_[j]) rest_moments[j] = rest_moment(static_cast<std::uint32_t>(j));
     build_groups(scratch_.groups);
+    build_links();
     groups_stale_ = false;
 }
 
@@ -231,6 +232,7 @@ void World::match_shapes_passes() {
             }
         });
         for (const auto& [i, target] : pulls_) x_[i] = target; // a dragged particle goes where it is dragged
+        keep_shape(it + 1 == passes); // root to tip: bending and rest lengths (length.cpp)
     }
 }
 

@@ -81,7 +81,29 @@ bool World::alive(Handle h) const {
 }
 
 void World::add_anchor(Handle h, const glm::dvec3& point, double phi, double release) {
-    anchors_.push_back({h.index, point, std::clamp(phi, 0.0, 1.0), release});
+    // the obstacle it holds on to: the nearest surface within 5 cm. Obstacles only translate
+    // (move_obstacle), so its frame is its `a`.
+    Anchor a{h.index, point, std::clamp(phi, 0.0, 1.0), release};
+    double best = 0.05;
+    for (std::size_t k = 0; k < obstacles_.size(); ++k) {
+        const double d = std::fabs(obstacles_[k].distance(point));
+        if (d < best) best = d, a.obstacle = k;
+    }
+    if (a.obstacle < obstacles_.size()) a.origin = obstacles_[a.obstacle].a;
+    anchors_.push_back(a);
+}
+
+bool World::anchored_to(Handle h, std::size_t k) const {
+    return std::any_of(anchors_.begin(), anchors_.end(),
+                       [&](const Anchor& a) { return a.particle == h.index && a.obstacle == k; });
+}
+
+void World::remove_obstacle(std::size_t k) {
+    if (k >= obstacles_.size()) return;
+    obstacles_.erase(obstacles_.begin() + static_cast<std::ptrdiff_t>(k));
+    std::erase_if(anchors_, [&](const Anchor& a) { return a.obstacle == k; });
+    for (Anchor& a : anchors_)
+        if (a.obstacle != ~std::size_t{0} && a.obstacle > k) --a.obstacle;
 }
 
 bool World::anchored(Handle h) const {
@@ -107,6 +129,8 @@ void World::step() {
     match_shapes_passes();
     auto t0 = clock::now();
     if (settings_.collisions) separate_particles();
+    // contacts and obstacles push particles: the links get their lengths back (length.cpp)
+    keep_shape(false, false);
     double collision_ms = ms(clock::now() - t0).count();
     t0 = clock::now();
     integrate();
@@ -138,11 +162,12 @@ void World::pull_to_anchors() {
     // Eq. 5: anchors pull their particles in; one too far away lets go
     for (std::size_t k = 0; k < anchors_.size();) {
         Anchor& a = anchors_[k];
-        if (glm::length(x_[a.particle] - a.point) > a.release) {
+        const glm::dvec3 point = anchor_point(a); // where its obstacle has it now
+        if (glm::length(x_[a.particle] - point) > a.release) {
             anchors_.erase(anchors_.begin() + static_cast<std::ptrdiff_t>(k));
             continue;
         }
-        x_[a.particle] += a.phi * (a.point - x_[a.particle]);
+        x_[a.particle] += a.phi * (point - x_[a.particle]);
         ++k;
     }
 }

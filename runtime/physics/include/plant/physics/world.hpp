@@ -12,6 +12,7 @@
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -50,8 +51,12 @@ struct Settings {
     double stiffening_time = 10; // t_m: a particle reaches full stiffness at this age (s = t_l / t_m)
     double fixed_stiffness = -1; // >= 0: every particle has this stiffness instead (tests, tools)
     Growth growth;
-    int iterations = 4; // shape-matching passes per step
-    int threads = 1;    // threads for the shape-matching passes (results do not depend on it)
+    int iterations = 2; // shape-matching passes per step
+    // The root-to-tip sweep after the passes (docs/physics.md, "Length and bending"): each step a
+    // particle moves bending * s of the way to where its parent's turn from rest carries its rest
+    // offset, then to its rest distance from the parent. 0: the passes alone hold the shape.
+    double bending = 0.7;
+    int threads = 1; // threads for the shape-matching passes (results do not depend on it)
     // Rotation-extraction iterations per group and pass. Each pass warm-starts from the last
     // one's rotation, so the iterations add up over a step's passes, as Müller et al. 2016
     // suggest for simulations; a cold solve (goals(), group_rotation()) runs up to 20.
@@ -152,9 +157,16 @@ class World {
 
     // Eq. 5: each step the particle's predicted position moves a fraction phi of the way to the
     // anchor; past `release` from it, the anchor lets go.
+    // The anchor belongs to the obstacle whose surface is nearest the point (within 5 cm): it is
+    // kept in that obstacle's frame, so it moves with the obstacle (Fig. 9); otherwise it is a
+    // fixed point.
     void add_anchor(Handle h, const glm::dvec3& point, double phi, double release);
     bool anchored(Handle h) const;
+    // Whether h is anchored to obstacle k.
+    bool anchored_to(Handle h, std::size_t k) const;
     void add_obstacle(const Obstacle& o) { obstacles_.push_back(o); }
+    // Removes obstacle k (later ones move down one); its anchors let go, so what it held falls.
+    void remove_obstacle(std::size_t k);
     // Moves obstacle k by `delta` (section 5.2: the user moves objects and the plants adapt).
     void move_obstacle(std::size_t k, const glm::dvec3& delta) {
         if (k >= obstacles_.size()) return;
@@ -277,6 +289,17 @@ class World {
     void pull_to_anchors();     // Eq. 5, letting go of anchors too far away
     void refresh_groups();      // rebuilds the groups and rest moments when they are stale
     void match_shapes_passes(); // the shape-matching passes: positions toward their goals, then orientations
+    // root to tip: bending toward the rest shape (with `bend`), then each rest length; with
+    // `orient`, the orientations follow their segments too
+    void keep_shape(bool orient, bool bend = true);
+    void build_links(); // the sweep's rest links, with the groups
+    // pushes x out of every obstacle it is in, r off the surface (across the face its parent
+    // lies on, when given and against the same obstacle); whether any pushed
+    bool outside_obstacles(glm::dvec3& x, double r, const glm::dvec3* parent = nullptr) const;
+    // v (an offset in p's rest frame) turned as p's frame has turned from rest: by the shortest
+    // turn of the segment from p's parent to p, or by p's own rotation when p has no parent;
+    // with `back`, the other way (a current offset to p's rest frame)
+    glm::dvec3 carried(std::uint32_t p, const glm::dvec3& v, bool back = false) const;
     void separate_particles();  // contacts between particles (section 5.2)
     void integrate();           // Eq. 17-18 with damping, and contacts with obstacles
     void break_overstretched(); // connections stretched past the break threshold let go
@@ -291,9 +314,16 @@ class World {
     std::vector<std::uint8_t> fixed_, alive_;
     struct Anchor {
         std::uint32_t particle;
-        glm::dvec3 point;
+        glm::dvec3 point; // where it was made
         double phi, release;
+        std::size_t obstacle = ~std::size_t{0}; // none: a fixed point in the world
+        glm::dvec3 origin{0.0};                 // the obstacle's `a` when it was made
     };
+    // where the anchor is now: moved as far as its obstacle has moved since (exactly where it was
+    // made while the obstacle stays put)
+    glm::dvec3 anchor_point(const Anchor& a) const {
+        return a.obstacle < obstacles_.size() ? a.point + (obstacles_[a.obstacle].a - a.origin) : a.point;
+    }
     std::vector<Anchor> anchors_;
     std::vector<Obstacle> obstacles_;
     std::vector<std::pair<std::uint32_t, glm::dvec3>> pulls_;
@@ -321,6 +351,14 @@ class World {
         std::vector<glm::dvec3> push;
         std::vector<double> stiffness; // each particle's s, during a step
         Groups groups;
+        // the length and bending sweep (length.cpp): each link's rest offset from the parent,
+        // its rest length and unit direction (kept with the groups), and its direction now
+        std::vector<glm::dvec3> rest_link, rest_dir, dir;
+        std::vector<double> rest_length;
+
+        static double thin_of(std::uint32_t i, const std::vector<glm::dvec3>& radii) {
+            return std::min({radii[i].x, radii[i].y, radii[i].z});
+        }
     } scratch_;
 };
 
