@@ -96,7 +96,6 @@ class ViewModel {
     struct Built; // a compiled program and its kept steps (cmd_view_model.cpp)
 
   private:
-    void update_extra_steps(); // (with mutex_ held)
     GrammarOptions options_;
     OutputOptions output_;
     std::string scratch_;
@@ -105,10 +104,6 @@ class ViewModel {
     std::unique_ptr<Built> good_; // the last good plant
     ViewControls controls_;
     std::vector<std::pair<int, std::string>> edits_; // (step, statement), in the order made
-    // The steps derived before the first edit; an edit at or past the last of them derives up to
-    // one step more, so that it shows (extra_steps_: the -n that does, none when not needed).
-    int edit_base_steps_ = 0;
-    std::optional<int> extra_steps_;
     std::string error_; // the last rebuild's diagnostics; empty when it succeeded
     double derive_ms_ = 0;
     std::uint64_t version_ = 0;

@@ -27,6 +27,9 @@ struct ViewModel::Built {
     std::uint64_t seed = 0;
     std::size_t instances = 0; // instance declarations (the page checks InstancedMesh against it)
     std::uint64_t version = 0; // the version that made it; a failed rebuild after it keeps it
+    // An edit at the grammar's last step derives one step more so that it shows: the -n that
+    // did, none when the grammar's own length was enough.
+    std::optional<int> extended;
 };
 
 } // namespace plant::cli

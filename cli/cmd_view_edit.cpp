@@ -88,21 +88,10 @@ std::string ViewModel::add_edit(const ViewEdit& edit) {
         if (edit.step < 0 || edit.step > last) return fmt::format("step: 0 to {}", last);
         std::string s = statement(*good_->program, edit);
         if (!s.empty() && s[0] == '!') return s.substr(1);
-        if (edits_.empty()) edit_base_steps_ = last;
         edits_.emplace_back(edit.step, std::move(s));
-        update_extra_steps();
     }
     rebuild();
     return {};
-}
-
-// An edit runs before the step after the one it was made at: one made at the last step derives
-// one step more.
-void ViewModel::update_extra_steps() {
-    int need = 0;
-    for (const auto& e : edits_) need = std::max(need, e.first + 1);
-    extra_steps_.reset();
-    if (need > edit_base_steps_) extra_steps_ = need;
 }
 
 bool ViewModel::undo_edit() {
@@ -110,7 +99,6 @@ bool ViewModel::undo_edit() {
         std::lock_guard lock(mutex_);
         if (edits_.empty()) return false;
         edits_.pop_back();
-        update_extra_steps();
     }
     rebuild();
     return true;

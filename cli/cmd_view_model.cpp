@@ -3,10 +3,12 @@
 #include "cmd_view_built.hpp"
 
 #include "plant/environment_phase.hpp"
+#include "plant/graph.hpp"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -67,9 +69,16 @@ static void collect_files(const SourceManager& sources, const Program* program, 
 }
 
 // Derives `program`, keeping a copy of the derivation after every step while they fit.
-static void derive_steps(ViewModel::Built& b, const DeriveOptions& options) {
+static void derive_steps(ViewModel::Built& b, const DeriveOptions& options, int min_steps) {
     auto d = std::make_unique<Derivation>(*b.program, options);
     d->start();
+    if (d->target_steps() < min_steps) { // an edit at the last step: one step more shows it
+        DeriveOptions longer = options;
+        longer.steps = min_steps;
+        d = std::make_unique<Derivation>(*b.program, longer);
+        d->start();
+        b.extended = min_steps;
+    }
     std::size_t kept = d->string().size();
     auto keep = [&](std::unique_ptr<Derivation> copy) {
         b.modules.push_back(copy ? copy->string().size() : 0);
@@ -82,6 +91,9 @@ static void derive_steps(ViewModel::Built& b, const DeriveOptions& options) {
         const bool more = d->step();
         if (d->steps_done() == before) break;
         kept += d->string().size();
+        // a decomposition graph is copied with each step: its nodes count too (a node and its
+        // values weigh about what a hundred modules do)
+        if (const DecompositionGraph* graph = d->run_state().graph()) kept += graph->size() * 100;
         keep(kept <= kKeptModules ? std::make_unique<Derivation>(*d) : nullptr);
         b.modules.back() = d->string().size();
         if (!more) break;
@@ -94,13 +106,14 @@ static void derive_steps(ViewModel::Built& b, const DeriveOptions& options) {
 std::uint64_t ViewModel::rebuild() {
     std::lock_guard build(build_mutex_);
     GrammarOptions g = options_;
+    int min_steps = 0; // an edit runs before the step after its own
     {
         std::lock_guard lock(mutex_);
         for (const auto& [name, value] : controls_.params)
             g.defines.push_back(name + "=" + number_text(value));
         if (controls_.seed) g.seed = controls_.seed;
         g.appended = view_edit_hook(edits_);
-        if (extra_steps_) g.steps = extra_steps_;
+        for (const auto& e : edits_) min_steps = std::max(min_steps, e.first + 1);
     }
     g.color = false;
     const auto t0 = std::chrono::steady_clock::now();
@@ -117,7 +130,7 @@ std::uint64_t ViewModel::rebuild() {
         opt.environment_phase = b->phase.get();
         opt.on_print = [](const std::string&) {};
         try {
-            derive_steps(*b, opt);
+            derive_steps(*b, opt, min_steps);
         } catch (const RuntimeError& e) {
             messages += render(Diagnostic{Severity::Error, e.span, e.message, {}}, *b->sources, false);
             b->program.reset();
@@ -185,6 +198,7 @@ std::string ViewModel::state_json() const {
             if (p.has_range) { // `param r = 0.9 in 0.5 .. 1.0;`: the page draws a slider
                 one["low"] = p.low;
                 one["high"] = p.high;
+                one["whole"] = p.whole; // a count: the slider moves by whole steps
             }
             params.push_back(std::move(one));
         }
@@ -201,8 +215,8 @@ std::string ViewModel::state_json() const {
         cmd += fmt::format(" --seed {}", *controls_.seed);
     else if (options_.seed)
         cmd += fmt::format(" --seed {}", *options_.seed);
-    if (extra_steps_)
-        cmd += fmt::format(" -n {}", *extra_steps_);
+    if (good_ && good_->extended)
+        cmd += fmt::format(" -n {}", *good_->extended);
     else if (options_.steps)
         cmd += fmt::format(" -n {}", *options_.steps);
     j["command"] = cmd;

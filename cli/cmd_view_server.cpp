@@ -143,9 +143,14 @@ void edit(ViewModel& model, ViewEvents& events, const httplib::Request& req, htt
         const auto j = nlohmann::json::parse(req.body);
         undo = j.value("undo", false);
         if (!undo) {
-            e.step = j.at("step").get<int>();
+            const auto& step = j.at("step");
+            if (!step.is_number_integer() || step.get<std::int64_t>() < 0 ||
+                step.get<std::int64_t>() > 1'000'000'000)
+                return refuse(res, 400, "step: the whole number of the step shown");
+            e.step = static_cast<int>(step.get<std::int64_t>());
             e.env = j.at("env").get<std::string>();
             e.method = j.at("method").get<std::string>();
+            if (!j.at("args").is_array()) throw std::invalid_argument("args");
             for (const auto& a : j.at("args")) {
                 std::vector<double> v;
                 if (a.is_array())

@@ -217,16 +217,9 @@ function paramControl(p) {
   input.dataset.param = p.name;
   let slider = null;
   if (p.low !== undefined && p.high !== undefined) {
-    input.min = String(p.low);
-    input.max = String(p.high);
     slider = document.createElement('input');
     slider.type = 'range';
-    slider.min = String(p.low);
-    slider.max = String(p.high);
-    // a count (whole bounds and value, as `param N_S = 5 in 1 .. 12;`) moves by whole steps;
-    // anything else does not snap: the value is the grammar's, not a multiple of a step
-    const whole = [p.low, p.high, p.value].every(Number.isInteger);
-    slider.step = whole ? '1' : 'any';
+    setRange(slider, input, p);
     slider.value = String(p.value);
     slider.dataset.param = p.name;
     slider.addEventListener('input', () => {
@@ -245,6 +238,14 @@ function paramControl(p) {
   });
   label.appendChild(input);
   return label;
+}
+
+// A slider's range and step, and its field's: a count (the grammar wrote the default and both
+// bounds as whole numbers, `param N_S = 5 in 1 .. 12;`) moves by whole steps; anything else does
+// not snap (the value is the grammar's, not a multiple of a step).
+function setRange(slider, input, p) {
+  for (const e of [slider, input]) { e.min = String(p.low); e.max = String(p.high); }
+  slider.step = p.whole ? '1' : 'any';
 }
 
 // While a slider is dragged: one request in flight at a time, the latest value sent after it.
@@ -271,15 +272,20 @@ function updateControls() {
   const params = server.params || [];
   state.params = params;
   const box = $('params');
-  const names = params.map((p) => `${p.name}:${p.low ?? ''}:${p.high ?? ''}`).join(',');
+  // rebuilt when the params or which have ranges change; a range whose bounds moved (a bound
+  // reading another param being dragged) is updated in place, so the slider under the pointer stays
+  const names = params.map((p) => `${p.name}:${p.low !== undefined}`).join(',');
   if (box.dataset.names !== names) {
     box.replaceChildren(...params.map(paramControl));
     box.dataset.names = names;
     if (!params.length) box.textContent = 'none';
   } else {
     for (const p of params) {
-      for (const input of box.querySelectorAll(`input[data-param="${CSS.escape(p.name)}"]`))
-        if (document.activeElement !== input) input.value = p.value;
+      const slider = box.querySelector(`input[type="range"][data-param="${CSS.escape(p.name)}"]`);
+      const field = box.querySelector(`input[type="number"][data-param="${CSS.escape(p.name)}"]`);
+      if (slider && field) setRange(slider, field, p);
+      for (const input of [slider, field])
+        if (input && document.activeElement !== input) input.value = p.value;
     }
   }
   if (document.activeElement !== $('seed') && server.seed !== undefined) $('seed').value = server.seed;

@@ -75,6 +75,7 @@ void Compiler::declare_values(const LoadedFile& lf) {
             }
         }
         auto cv = eval_const(*value, v.kind == ast::DeclKind::Const ? "a const" : "the initial value");
+        const bool evaluated = cv.has_value();
         if (!cv) cv = ConstVal{}; // declared all the same, so later uses are not "unknown" too
         if (v.kind == ast::DeclKind::Const) {
             consts_[v.name] = *cv;
@@ -87,7 +88,7 @@ void Compiler::declare_values(const LoadedFile& lf) {
         g.type = cv->type;
         g.slot = static_cast<std::uint32_t>(P_.global_values.size());
         g.span = v.name_span;
-        if (v.range_low) check_param_range(v, *value, *cv, g);
+        if (v.range_low && evaluated) check_param_range(v, *value, *cv, g);
         for (int k = 0; k < value_width(cv->type); ++k) P_.global_values.push_back(cv->v[k]);
         P_.global_index[g.name] = static_cast<std::uint32_t>(P_.globals.size());
         P_.globals.push_back(std::move(g));
@@ -128,12 +129,20 @@ void Compiler::check_param_range(const ast::ValueDecl& v, const ast::Expr& value
         return;
     }
     if (cv.type != ValueType::Number) {
-        diags_->error(v.range_span, fmt::format("'{}' is not a number, so it cannot have a range", v.name));
+        diags_->error(value.span, fmt::format("'{}' has a range, so its value must be a number", v.name));
         return;
     }
     g.has_range = true;
     g.low = low->v[0];
     g.high = high->v[0];
+    // whole numbers as written: digits only, perhaps negated ("5", "-1"; not "5.0" or "1e3")
+    auto whole = [](const ast::Expr* e) {
+        while (e && e->kind == ast::ExprKind::Unary && e->unary == ast::UnaryOp::Neg && !e->args.empty())
+            e = e->args[0].get();
+        return e && e->kind == ast::ExprKind::Number && !e->text.empty() &&
+               e->text.find_first_not_of("0123456789") == std::string::npos;
+    };
+    g.whole = whole(v.value.get()) && whole(v.range_low.get()) && whole(v.range_high.get());
     if (cv.v[0] < g.low || cv.v[0] > g.high) {
         Diagnostic d{Severity::Error,
                      value.span,

@@ -11,6 +11,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -97,8 +98,9 @@ void Derivation::run_hook(HookKind kind) {
 
 void Derivation::start() {
     // the environments as declared (a second start begins afresh); the graph gets half the
-    // string's budget
-    run_ = RunState(prog_, opt_.edits ? opt_.edits : prog_.graph.edits, opt_.max_bytes / 2);
+    // string's budget, at most 1 GiB (a bonsai's graph holds hundreds of nodes, not millions)
+    run_ = RunState(prog_, opt_.edits ? opt_.edits : prog_.graph.edits,
+                    std::min(opt_.max_bytes / 2, std::size_t{1} << 30));
     EvalEnv env;
     env.prog = &prog_;
     env.run = &run_;

@@ -49,6 +49,9 @@ std::string make_child(const DecompositionGraph& g, const double* a, bool with_i
         return fmt::format("a child's branch index is a whole number from 0 to 1000000, found {}",
                            format_double(idx));
     const int index = static_cast<int>(idx);
+    if (const int up = g.find(parent); up >= 0 && g.node(up).depth >= DecompositionGraph::kMaxDepth)
+        return fmt::format("the decomposition graph would be deeper than {} levels (a child of {})",
+                           DecompositionGraph::kMaxDepth, excerpt(g.path(up), 80));
     const std::uint64_t h = DecompositionGraph::child_handle(parent, pos, index);
     r = static_cast<double>(h);
     if (int known = g.find(h); known >= 0) {
@@ -80,12 +83,13 @@ std::string make_child(const DecompositionGraph& g, const double* a, bool with_i
         }
     }
     if (records && !g.record(h, parent, pos, index, place))
-        return g.full() ? fmt::format("the decomposition graph would have more than {} nodes, {} values (nodes "
-                                      "times parameters) or {} MB (plant run: raise --max-memory, which "
-                                      "gives the graph a quarter of it)",
-                                      DecompositionGraph::kMaxNodes, DecompositionGraph::kMaxValues,
-                                      g.max_bytes() >> 20)
-                        : "two paths of the decomposition graph made in this pass have the same handle";
+        return g.full()
+                   ? fmt::format("the decomposition graph would have more than {} nodes, {} values (nodes "
+                                 "times parameters) or {} MB of memory (a quarter of plant run's "
+                                 "--max-memory, at most 1024 MB)",
+                                 DecompositionGraph::kMaxNodes, DecompositionGraph::kMaxValues,
+                                 g.max_bytes() >> 20)
+                   : "two paths of the decomposition graph made in this pass have the same handle";
     return {};
 }
 

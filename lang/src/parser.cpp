@@ -81,6 +81,7 @@ class Lowering {
             auto r = std::from_chars(s.data(), s.data() + s.size(), e->number);
             if (r.ec != std::errc())
                 diags_.error(e->span, fmt::format("number '{}' is out of range", excerpt(s)));
+            e->text = std::move(s); // as written: "5" is a count, "5.0" a measure (param ranges)
         } else if (n.is_type<g::string_lit>()) {
             e->kind = ast::ExprKind::String;
             e->text = unescape(n.string_view());

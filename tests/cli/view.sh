@@ -45,24 +45,24 @@ v0=$(curl -s "${url}api/state" | grep -o '"version":[0-9]*')
 m0=$(curl -s "${url}api/state" | grep -o '"modules":\[[0-9,]*\]')
 sed -i 's/derive 5;/derive 3;/; s/^derive .*/derive 3;/' "$tmp/g.plant"
 seen=""
-for _ in $(seq 40); do
+for _ in $(seq 200); do
     m=$(curl -s "${url}api/state" | grep -o '"modules":\[[0-9,]*\]')
     [ "$m" != "$m0" ] && { seen=1; break; }
     sleep 0.05
 done
-check "a save derives again within 2 s ($v0; $m0 -> $m)" test -n "$seen"
+check "a save derives again (within 10 s here; the browser test holds it to 2 s) ($v0; $m0 -> $m)" test -n "$seen"
 check "the seed set on the page derives again" test "$(status -X POST -d '{"params":{},"seed":"7"}' "${url}api/controls")" = 200
 # a param's range (`param n = 3 in 1 .. 8;`) reaches the page, and a value outside it is an error
 printf 'param n = 3 in 1 .. 8;\naxiom: A(n);\nderive 4;\nrules { A(x) : x > 0 -> F A(x - 1); }\n' > "$tmp/g.plant"
 ranged=""
-for _ in $(seq 40); do
+for _ in $(seq 200); do
     curl -s "${url}api/state" | grep -q '"low":1.0,"name":"n"\|"high":8.0,"low":1.0' && { ranged=1; break; }
     sleep 0.05
 done
 check "a param's range is in the state" test -n "$ranged"
 check "a value outside the range is accepted as a request" test "$(status -X POST -d '{"params":{"n":9}}' "${url}api/controls")" = 200
 outside=""
-for _ in $(seq 40); do
+for _ in $(seq 200); do
     curl -s "${url}api/state" | grep -q "outside its range 1 .. 8" && { outside=1; break; }
     sleep 0.05
 done

@@ -163,7 +163,8 @@ async function roseChecks(browser) {
   // the rose library's params have ranges (stdlib/rose.plant), so they get sliders
   const roseSliders = await page.$$eval('input[type="range"][data-param]', (es) => Object.fromEntries(es.map((e) => [e.dataset.param, [e.min, e.max, e.step]])));
   check(JSON.stringify(roseSliders.N_S) === '["1","12","1"]' && roseSliders.theta && Math.abs(Number(roseSliders.theta[1]) - Math.PI / 2) < 1e-9 &&
-    roseSliders.theta[2] === 'any' && JSON.stringify(roseSliders.droop_reading) === '["0","1","1"]',
+    roseSliders.theta[2] === 'any' && JSON.stringify(roseSliders.droop_reading) === '["0","1","1"]' &&
+    roseSliders.sigma_inter && roseSliders.sigma_inter[2] === 'any',
     'the rose\'s params get sliders over their ranges, counts moving by whole steps', JSON.stringify(roseSliders));
 
   // a param changed on the page derives again
@@ -226,6 +227,7 @@ async function climberChecks(browser) {
   let picked = null;
   for (const y of [0.5, 0.8, 1.1, 0.3, 1.4]) {
     const seg = JSON.parse((await request(url, `/api/pick?step=20&x=0&y=${y}&z=0.2`, host)).body);
+    if (!seg.found) continue;
     const mid = seg.from.map((v, k) => (v + seg.to[k]) / 2);
     await page.evaluate(() => { window.plantView.picked = null; });
     await page.evaluate((p) => window.plantView.clickAt(p.x, p.y), await page.evaluate((m) => window.plantView.screenOf(m), mid));
@@ -253,14 +255,16 @@ async function climberChecks(browser) {
 // dragging it derives again.
 async function rangeChecks(browser) {
   const file = path.join(tmp, 'ranged.plant');
-  fs.writeFileSync(file, 'param n = 3 in 1 .. 8;\nparam free = 2;\naxiom: A(n);\nderive 10;\n' +
+  fs.writeFileSync(file, 'param n = 3 in 1 .. 8;\nparam s = 1.0 in 0 .. 3;\nparam free = 2;\naxiom: A(n);\nderive 10;\n' +
     'rules { A(x) : x > 0 -> F(1) A(x - 1); }\n');
   const { url } = await startView(file);
   const errors = [];
   const page = await openPage(browser, url, errors);
-  const sliders = await page.$$eval('input[type="range"][data-param]', (es) => es.map((e) => ({ name: e.dataset.param, min: e.min, max: e.max, value: e.value })));
-  check(sliders.length === 1 && sliders[0].name === 'n' && sliders[0].min === '1' && sliders[0].max === '8' && sliders[0].value === '3',
+  const sliders = await page.$$eval('input[type="range"][data-param]', (es) => es.map((e) => ({ name: e.dataset.param, min: e.min, max: e.max, value: e.value, step: e.step })));
+  check(sliders.length === 2 && sliders[0].name === 'n' && sliders[0].min === '1' && sliders[0].max === '8' && sliders[0].value === '3',
     'a ranged param gets a slider over its range, an unranged one none', JSON.stringify(sliders));
+  check(sliders[0].step === '1' && sliders[1] && sliders[1].name === 's' && sliders[1].step === 'any',
+    'a count (written whole) moves by whole steps, a measure written 1.0 does not snap', JSON.stringify(sliders));
   const m0 = await page.evaluate(() => window.plantView.modules);
   const loads = await page.evaluate(() => window.plantView.loads);
   await page.$eval('input[type="range"][data-param="n"]', (e) => { e.value = '8'; e.dispatchEvent(new Event('input')); });

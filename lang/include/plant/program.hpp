@@ -215,6 +215,9 @@ struct Global {
     // against its value at compile time; has_range is false without one.
     bool has_range = false;
     double low = 0, high = 0;
+    // The default and both bounds are written as whole numbers (`param N_S = 5 in 1 .. 12;`):
+    // a count, which `plant view`'s slider moves by whole steps.
+    bool whole = false;
 };
 
 struct Function {
