@@ -69,15 +69,15 @@ static void collect_files(const SourceManager& sources, const Program* program, 
 }
 
 // Derives `program`, keeping a copy of the derivation after every step while they fit.
-static void derive_steps(ViewModel::Built& b, const DeriveOptions& options, int min_steps) {
+static void derive_steps(ViewModel::Built& b, const DeriveOptions& options, const std::set<int>& edit_steps) {
     auto d = std::make_unique<Derivation>(*b.program, options);
     d->start();
-    if (d->target_steps() < min_steps) { // an edit at the last step: one step more shows it
+    if (edit_steps.count(d->target_steps())) { // an edit at the last step: one step more shows it
         DeriveOptions longer = options;
-        longer.steps = min_steps;
+        longer.steps = d->target_steps() + 1;
         d = std::make_unique<Derivation>(*b.program, longer);
         d->start();
-        b.extended = min_steps;
+        b.extended = *longer.steps;
     }
     std::size_t kept = d->string().size();
     auto keep = [&](std::unique_ptr<Derivation> copy) {
@@ -106,14 +106,14 @@ static void derive_steps(ViewModel::Built& b, const DeriveOptions& options, int 
 std::uint64_t ViewModel::rebuild() {
     std::lock_guard build(build_mutex_);
     GrammarOptions g = options_;
-    int min_steps = 0; // an edit runs before the step after its own
+    std::set<int> edit_steps; // an edit runs before the step after its own
     {
         std::lock_guard lock(mutex_);
         for (const auto& [name, value] : controls_.params)
             g.defines.push_back(name + "=" + number_text(value));
         if (controls_.seed) g.seed = controls_.seed;
         g.appended = view_edit_hook(edits_);
-        for (const auto& e : edits_) min_steps = std::max(min_steps, e.first + 1);
+        for (const auto& e : edits_) edit_steps.insert(e.first);
     }
     g.color = false;
     const auto t0 = std::chrono::steady_clock::now();
@@ -130,7 +130,7 @@ std::uint64_t ViewModel::rebuild() {
         opt.environment_phase = b->phase.get();
         opt.on_print = [](const std::string&) {};
         try {
-            derive_steps(*b, opt, min_steps);
+            derive_steps(*b, opt, edit_steps);
         } catch (const RuntimeError& e) {
             messages += render(Diagnostic{Severity::Error, e.span, e.message, {}}, *b->sources, false);
             b->program.reset();
