@@ -92,4 +92,27 @@ check "a pick needs three finite numbers" test "$(status "${url}api/pick?x=nan&y
 check "an organ pick needs its placement" test "$(status "${url}api/pick?kind=organ&x=0&y=0&z=0")" = 400
 check "a pick's kind is tube or organ" test "$(status "${url}api/pick?kind=file&x=0&y=0&z=0")" = 400
 kill -INT "$pid"; wait "$pid"
+
+# a climber edit at the last step derives one step more; a shorter grammar then is not lengthened
+cat > "$tmp/cl.plant" <<'EOF2'
+import climber with { N = 1, B = 1, BP = 0, V = 0.2, Ph = 0.5, shoot_length = 40, steps = 6 };
+env ivy = climber(plane_point: vec3(0, 0, 0), plane_normal: vec3(0, 1, 0), anchor: 0.4, anchor_range: 0.03);
+seed 12;
+EOF2
+"$plant" view "$tmp/cl.plant" --port 0 > "$tmp/out3" 2>&1 &
+pid=$!; pids+=("$pid")
+for _ in $(seq 100); do grep -q "http://" "$tmp/out3" && break; sleep 0.1; done
+url=$(grep -o 'http://127.0.0.1:[0-9]*/' "$tmp/out3")
+steps_of() { curl -s "${url}api/state" | python3 -c 'import json, sys; print(len(json.load(sys.stdin)["modules"]) - 1)'; }
+check "the climber derives its 6 steps" test "$(steps_of)" = 6
+curl -s -X POST -d '{"step":6,"env":"ivy","method":"wind","args":[[3, 0, 0]]}' "${url}api/edit" > "$tmp/edit.json"
+check "an edit at the last step derives one step more" grep -q '"command":"plant run [^"]* -n 7"' "$tmp/edit.json"
+check "a step past the last is refused" test "$(status -X POST -d '{"step":9,"env":"ivy","method":"cut","args":[3]}' "${url}api/edit")" = 400
+check "a fractional step is refused" test "$(status -X POST -d '{"step":2.5,"env":"ivy","method":"cut","args":[3]}' "${url}api/edit")" = 400
+check "args must be a list" test "$(status -X POST -d '{"step":2,"env":"ivy","method":"cut","args":{"a":3}}' "${url}api/edit")" = 400
+sed -i 's/steps = 6/steps = 4/' "$tmp/cl.plant"
+shorter=""
+for _ in $(seq 200); do [ "$(steps_of)" = 4 ] && { shorter=1; break; }; sleep 0.05; done
+check "a shorter grammar after it is not lengthened" test -n "$shorter"
+kill -INT "$pid"; wait "$pid"
 exit $fail
