@@ -60,6 +60,19 @@ void serve_asset(const httplib::Request& req, httplib::Response& res) {
     refuse(res, 404, "no such page");
 }
 
+// Sends what `make` returns for a kept step (404 without a plant or step; 500 on an error making it).
+template <typename Make> void answer(httplib::Response& res, const char* mime, Make make) {
+    try {
+        auto body = make();
+        if (!body) return refuse(res, 404, "no plant (the grammar has an error) or that step was not kept");
+        res.set_content(std::move(*body), mime);
+    } catch (const RuntimeError& e) {
+        refuse(res, 500, e.message);
+    } catch (const std::exception& e) {
+        refuse(res, 500, e.what());
+    }
+}
+
 void serve_model(ViewModel& model, const httplib::Request& req, httplib::Response& res) {
     int step = -1;
     if (req.has_param("step")) {
@@ -68,15 +81,7 @@ void serve_model(ViewModel& model, const httplib::Request& req, httplib::Respons
         if (r.ec != std::errc() || r.ptr != s.data() + s.size())
             return refuse(res, 400, "step: a whole number");
     }
-    try {
-        auto bytes = model.glb(step);
-        if (!bytes) return refuse(res, 404, "no plant (the grammar has an error) or that step was not kept");
-        res.set_content(std::move(*bytes), "model/gltf-binary");
-    } catch (const RuntimeError& e) {
-        refuse(res, 500, e.message);
-    } catch (const std::exception& e) {
-        refuse(res, 500, e.what());
-    }
+    answer(res, "model/gltf-binary", [&] { return model.glb(step); });
 }
 
 // GET /api/pick?step=K&kind=tube|organ&x=&y=&z=[&ox=&oy=&oz=]: what the click hit (docs/view.md).
@@ -100,15 +105,7 @@ void serve_pick(ViewModel& model, const httplib::Request& req, httplib::Response
     if (q.kind == ViewPick::Organ &&
         (!number("ox", q.origin.x) || !number("oy", q.origin.y) || !number("oz", q.origin.z)))
         return refuse(res, 400, "ox, oy and oz: where the organ hit is placed, three finite numbers");
-    try {
-        auto json = model.pick(static_cast<int>(step), q);
-        if (!json) return refuse(res, 404, "no plant (the grammar has an error) or that step was not kept");
-        res.set_content(std::move(*json), "application/json");
-    } catch (const RuntimeError& e) {
-        refuse(res, 500, e.message);
-    } catch (const std::exception& e) {
-        refuse(res, 500, e.what());
-    }
+    answer(res, "application/json", [&] { return model.pick(static_cast<int>(step), q); });
 }
 
 // POST /api/controls {"params": {"name": number}, "seed": "digits" or null}

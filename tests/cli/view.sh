@@ -23,11 +23,17 @@ cp "$root/grammars/abop/fig1_24a.plant" "$tmp/g.plant"
 mkdir "$tmp/scratch"
 TMPDIR="$tmp/scratch" "$plant" view "$tmp/g.plant" --port 0 > "$tmp/out" 2>&1 &
 pid=$!; pids+=("$pid")
-for _ in $(seq 50); do grep -q "http://" "$tmp/out" && break; sleep 0.1; done
+for _ in $(seq 50); do grep -qs "http://" "$tmp/out" && break; sleep 0.1; done
 url=$(grep -o 'http://127.0.0.1:[0-9]*/' "$tmp/out")
 port=${url#http://127.0.0.1:}; port=${port%/}
 check "prints the URL on 127.0.0.1" test -n "$url"
 status() { curl -s -o /dev/null -w '%{http_code}' "$@"; }
+# eventually CMD...: whether CMD succeeds within 10 s (tried every 50 ms)
+eventually() {
+    for _ in $(seq 200); do "$@" && return 0; sleep 0.05; done
+    return 1
+}
+state_has() { curl -s "${url}api/state" | grep -q "$@"; }
 check "serves the page" test "$(status "$url")" = 200
 check "the page loads its script" grep -q 'src="/viewer.js"' <(curl -s "$url")
 check "serves three.js" test "$(status "${url}three/three.module.js")" = 200
@@ -54,19 +60,9 @@ check "a save derives again (within 10 s here; the browser test holds it to 2 s)
 check "the seed set on the page derives again" test "$(status -X POST -d '{"params":{},"seed":"7"}' "${url}api/controls")" = 200
 # a param's range (`param n = 3 in 1 .. 8;`) reaches the page, and a value outside it is an error
 printf 'param n = 3 in 1 .. 8;\naxiom: A(n);\nderive 4;\nrules { A(x) : x > 0 -> F A(x - 1); }\n' > "$tmp/g.plant"
-ranged=""
-for _ in $(seq 200); do
-    curl -s "${url}api/state" | grep -q '"low":1.0,"name":"n"\|"high":8.0,"low":1.0' && { ranged=1; break; }
-    sleep 0.05
-done
-check "a param's range is in the state" test -n "$ranged"
+check "a param's range is in the state" eventually state_has '"high":8.0,"low":1.0,"name":"n"\|"low":1.0,"name":"n"'
 check "a value outside the range is accepted as a request" test "$(status -X POST -d '{"params":{"n":9}}' "${url}api/controls")" = 200
-outside=""
-for _ in $(seq 200); do
-    curl -s "${url}api/state" | grep -q "outside its range 1 .. 8" && { outside=1; break; }
-    sleep 0.05
-done
-check "and derives to an error naming the range" test -n "$outside"
+check "and derives to an error naming the range" eventually state_has "outside its range 1 .. 8"
 check "an edit names an environment the grammar declares" grep -q "no environment 'ivy'" <(curl -s -X POST -d '{"step":1,"env":"ivy","method":"cut","args":[3]}' "${url}api/edit")
 check "an edit is a call, not source text" test "$(status -X POST -d '{"step":1,"call":"ivy.cut(3); system()"}' "${url}api/edit")" = 400
 check "undo without an edit is refused" test "$(status -X POST -d '{"undo":true}' "${url}api/edit")" = 400
@@ -82,7 +78,7 @@ check "and removes its scratch folder" test "$(ls "$tmp/scratch" | wc -l)" = 0
 # picking (/api/pick): a bonsai branch's segment names the branch's graph node, not the root's
 "$plant" view "$root/grammars/bonsai/chokkan.plant" --port 0 > "$tmp/out2" 2>&1 &
 pid=$!; pids+=("$pid")
-for _ in $(seq 100); do grep -q "http://" "$tmp/out2" && break; sleep 0.1; done
+for _ in $(seq 100); do grep -qs "http://" "$tmp/out2" && break; sleep 0.1; done
 url=$(grep -o 'http://127.0.0.1:[0-9]*/' "$tmp/out2")
 curl -s "${url}api/pick?kind=tube&x=0&y=0.1&z=0" > "$tmp/trunk.json"
 check "a click on the trunk is the root node" grep -q '"node":{"by":"axis","path":"/",' "$tmp/trunk.json"
@@ -101,7 +97,7 @@ seed 12;
 EOF2
 "$plant" view "$tmp/cl.plant" --port 0 > "$tmp/out3" 2>&1 &
 pid=$!; pids+=("$pid")
-for _ in $(seq 100); do grep -q "http://" "$tmp/out3" && break; sleep 0.1; done
+for _ in $(seq 100); do grep -qs "http://" "$tmp/out3" && break; sleep 0.1; done
 url=$(grep -o 'http://127.0.0.1:[0-9]*/' "$tmp/out3")
 steps_of() { curl -s "${url}api/state" | python3 -c 'import json, sys; print(len(json.load(sys.stdin)["modules"]) - 1)'; }
 check "the climber derives its 6 steps" test "$(steps_of)" = 6
@@ -111,8 +107,7 @@ check "a step past the last is refused" test "$(status -X POST -d '{"step":9,"en
 check "a fractional step is refused" test "$(status -X POST -d '{"step":2.5,"env":"ivy","method":"cut","args":[3]}' "${url}api/edit")" = 400
 check "args must be a list" test "$(status -X POST -d '{"step":2,"env":"ivy","method":"cut","args":{"a":3}}' "${url}api/edit")" = 400
 sed -i 's/steps = 6/steps = 4/' "$tmp/cl.plant"
-shorter=""
-for _ in $(seq 200); do [ "$(steps_of)" = 4 ] && { shorter=1; break; }; sleep 0.05; done
-check "a shorter grammar after it is not lengthened" test -n "$shorter"
+four_steps() { [ "$(steps_of)" = 4 ]; }
+check "a shorter grammar after it is not lengthened" eventually four_steps
 kill -INT "$pid"; wait "$pid"
 exit $fail
