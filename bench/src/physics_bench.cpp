@@ -4,9 +4,9 @@
 //
 // The plant is a trunk of T particles, each carrying a horizontal lateral of L particles
 // (T * (1 + L) = 25,000 by default), grown up against a box-shaped wall and above a ground
-// plane, so the collision stage has contacts to resolve. Every step runs growth (the T + 1 apices
-// lengthen and branch) and then the physics step, which includes the obstacle pass; the two are
-// timed separately.
+// plane, so the collision stage has contacts to resolve; laterals that meet the wall run along
+// it. Every step runs growth (the T + 1 apices lengthen and branch) and then the physics step,
+// which includes the obstacle pass; the two are timed separately.
 // With AIR > 0, that many SPH air particles blow past the plant, coupled both ways (section 5.3),
 // ten 2.5 ms air steps per 25 ms plant step.
 //   plant_physics_bench [PARTICLES] [STEPS] [THREADS] [AIR] [--per-step]
@@ -64,10 +64,19 @@ int main(int argc, char** argv) {
         // a lateral leaving in the golden-angle direction, slightly rising
         const double a = static_cast<double>(t) * 2.39996322972865332;
         const glm::dvec3 dir = glm::normalize(glm::dvec3(std::cos(a), 0.2, std::sin(a)));
-        const glm::dquat q(glm::dvec3(0, 1, 0), dir); // the rotation taking +y to dir
+        // A lateral that reaches the wall turns to run along its face, as growth would have it
+        // (a particle is never placed inside an obstacle): laterals laid straight through the
+        // wall left their middle particles inside it, stacked on its faces by every step's
+        // obstacle pass, which made the collision stage 1.7 times as dear (7.3 ms against 4.3) as
+        // a plant that grew there makes it.
+        constexpr double face = 0.3 - 0.02; // the wall's near face, a lateral's radius and a gap off
+        glm::dvec3 d = dir, at = base;
         Handle lp = trunk_h;
-        for (long k = 1; k <= lateral && static_cast<long>(w.size()) < want; ++k)
-            lp = w.add_particle(lp, base + dir * (0.05 * static_cast<double>(k)), q, r * 0.8);
+        for (long k = 1; k <= lateral && static_cast<long>(w.size()) < want; ++k) {
+            if ((at + d * 0.05).z > face) d = glm::normalize(glm::dvec3(d.x, d.y, 0));
+            at += d * 0.05;
+            lp = w.add_particle(lp, at, glm::dquat(glm::dvec3(0, 1, 0), d), r * 0.8); // +y turned to d
+        }
         prev = trunk_h;
     }
 

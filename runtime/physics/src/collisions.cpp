@@ -2,36 +2,13 @@
 // that keeps particles out of them, and the contacts between particles.
 #include "plant/physics/world.hpp"
 
+#include "obstacle_field.hpp"
 #include "parallel.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 namespace plant::physics {
-
-namespace {
-
-// Obstacle::distance, declared inline: GCC allows a function declared inline a larger inlining
-// budget, and the integration's loop over the obstacles (integrate()) wants it inlined, as it was
-// when the whole step was one file
-inline double signed_distance(const Obstacle& o, const glm::dvec3& p) {
-    const glm::dvec3 &a = o.a, &b = o.b;
-    switch (o.kind) {
-    case Obstacle::Sphere:
-        return glm::length(p - a) - b.x;
-    case Obstacle::Box: {
-        glm::dvec3 c = (a + b) * 0.5, h = (b - a) * 0.5, q = glm::abs(p - c) - h;
-        return glm::length(glm::max(q, glm::dvec3(0.0))) + std::min(std::max(q.x, std::max(q.y, q.z)), 0.0);
-    }
-    case Obstacle::Plane:
-        return glm::dot(p - a, glm::normalize(b));
-    case Obstacle::Grid:
-        return o.grid ? o.grid->sample(p - a) : 1e300;
-    }
-    return 1e300;
-}
-
-} // namespace
 
 double Obstacle::distance(const glm::dvec3& p) const {
     return signed_distance(*this, p);
@@ -58,14 +35,7 @@ double DistanceGrid::sample(const glm::dvec3& p) const {
 }
 
 glm::dvec3 Obstacle::normal(const glm::dvec3& p) const {
-    if (kind == Plane) return glm::normalize(b);
-    // central differences of the distance (over half a cell for a sampled grid)
-    const double e = kind == Grid && grid ? grid->cell / 2 : 1e-6;
-    glm::dvec3 g(distance(p + glm::dvec3(e, 0, 0)) - distance(p - glm::dvec3(e, 0, 0)),
-                 distance(p + glm::dvec3(0, e, 0)) - distance(p - glm::dvec3(0, e, 0)),
-                 distance(p + glm::dvec3(0, 0, e)) - distance(p - glm::dvec3(0, 0, e)));
-    double l = glm::length(g);
-    return l > 0 ? g / l : glm::dvec3(0, 1, 0);
+    return surface_normal(*this, p);
 }
 
 void World::integrate() {
@@ -83,9 +53,9 @@ void World::integrate() {
             if (fixed_[i]) continue;
             const double r = std::min({radii_[i].x, radii_[i].y, radii_[i].z});
             for (const auto& o : obstacles_) {
-                double d = o.distance(x_[i]) - r;
+                double d = signed_distance(o, x_[i]) - r;
                 if (d >= 0) continue;
-                glm::dvec3 nrm = o.normal(x_[i]);
+                glm::dvec3 nrm = surface_normal(o, x_[i]);
                 x_[i] -= nrm * d;
                 double vn = glm::dot(v_[i], nrm);
                 glm::dvec3 tangential = v_[i] - nrm * vn;

@@ -7,6 +7,8 @@
 // distance from the parent (length, always; follow-the-leader as in hair simulation).
 #include "plant/physics/world.hpp"
 
+#include "obstacle_field.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -17,7 +19,7 @@ namespace {
 // v turned by the shortest rotation taking unit a to unit b (Rodrigues' formula with k = a x b
 // unnormalized: v cos + (k x v) + k (k . v) / (1 + cos)); half a turn about an axis across a
 // when b is (nearly) opposite to a
-glm::dvec3 turn_between(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& v) {
+inline glm::dvec3 turn_between(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& v) {
     const double c = glm::dot(a, b);
     if (c < -1 + 1e-9) {
         glm::dvec3 k = glm::cross(a, std::fabs(a.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0));
@@ -75,18 +77,18 @@ bool World::outside_obstacles(glm::dvec3& x, double r, const glm::dvec3* parent)
     // that face instead of being pushed over the rail's edge onto the next face, a stretch away.
     bool moved = false;
     for (const auto& o : obstacles_) {
-        double d = o.distance(x) - r;
+        double d = signed_distance(o, x) - r;
         if (d >= 0) continue;
         moved = true;
-        if (parent && o.distance(*parent) < 2 * r) {
-            const glm::dvec3 n = o.normal(*parent);
+        if (parent && signed_distance(o, *parent) < 2 * r) {
+            const glm::dvec3 n = surface_normal(o, *parent);
             for (int k = 0; k < 8 && d < 0; ++k) { // inside a box the distance is to the nearest face
                 x -= n * d;
-                d = o.distance(x) - r;
+                d = signed_distance(o, x) - r;
             }
             if (d >= 0) continue;
         }
-        x -= o.normal(x) * d;
+        x -= surface_normal(o, x) * d;
     }
     return moved;
 }

@@ -1,0 +1,45 @@
+// An obstacle's signed distance and its normal, inline for the loops that test every particle
+// against every obstacle (integrate() and the length sweep's outside_obstacles()); internal to
+// plant_physics. Obstacle::distance and Obstacle::normal are these.
+#pragma once
+
+#include "plant/physics/world.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace plant::physics {
+
+// declared inline: GCC allows a function declared inline a larger inlining budget, and the
+// loops over the obstacles want it inlined, as it was when the whole step was one file (forced:
+// left to itself, GCC kept it a call in the length sweep)
+[[gnu::always_inline]] inline double signed_distance(const Obstacle& o, const glm::dvec3& p) {
+    const glm::dvec3 &a = o.a, &b = o.b;
+    switch (o.kind) {
+    case Obstacle::Sphere:
+        return glm::length(p - a) - b.x;
+    case Obstacle::Box: {
+        glm::dvec3 c = (a + b) * 0.5, h = (b - a) * 0.5, q = glm::abs(p - c) - h;
+        return glm::length(glm::max(q, glm::dvec3(0.0))) + std::min(std::max(q.x, std::max(q.y, q.z)), 0.0);
+    }
+    case Obstacle::Plane:
+        return glm::dot(p - a, glm::normalize(b));
+    case Obstacle::Grid:
+        return o.grid ? o.grid->sample(p - a) : 1e300;
+    }
+    return 1e300;
+}
+
+inline glm::dvec3 surface_normal(const Obstacle& o, const glm::dvec3& p) {
+    if (o.kind == Obstacle::Plane) return glm::normalize(o.b);
+    // central differences of the distance (over half a cell for a sampled grid)
+    const double e = o.kind == Obstacle::Grid && o.grid ? o.grid->cell / 2 : 1e-6;
+    auto d = [&](const glm::dvec3& q) { return signed_distance(o, q); };
+    glm::dvec3 g(d(p + glm::dvec3(e, 0, 0)) - d(p - glm::dvec3(e, 0, 0)),
+                 d(p + glm::dvec3(0, e, 0)) - d(p - glm::dvec3(0, e, 0)),
+                 d(p + glm::dvec3(0, 0, e)) - d(p - glm::dvec3(0, 0, e)));
+    double l = glm::length(g);
+    return l > 0 ? g / l : glm::dvec3(0, 1, 0);
+}
+
+} // namespace plant::physics
