@@ -57,6 +57,9 @@ SkeletonBuilder::SkeletonBuilder(const Program& program, const ModuleString& str
     skeleton_.axes.reserve(segments);
     const std::size_t expected =
         std::min<std::size_t>(2 * segments * sizeof(SkeletonPoint), std::size_t{256} << 20);
+    // a small skeleton stays on the heap: a fresh 2 MiB page for a few points costs more to
+    // clear than the allocations it saves
+    if (expected < (std::size_t{1} << 20)) return;
     points_ = PointAllocator<SkeletonPoint>(std::make_shared<PointArena>(expected));
 }
 
