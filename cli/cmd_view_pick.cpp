@@ -69,7 +69,7 @@ Found nearest(const Skeleton& s, const ViewPick& q) {
         const auto& pts = s.axes[static_cast<std::size_t>(axis)].points;
         f = {true,
              pts[k].id,
-             pts[k].module,
+             std::string(s.module_name(pts[k])),
              {{"from", vec(pts[k - 1].position)}, {"to", vec(pts[k].position)}, {"distance", best}},
              axis};
         return f;

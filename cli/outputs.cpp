@@ -348,7 +348,13 @@ OutputSummary write_outputs(const Program& program, const Derivation& d,
     Skeleton skeleton;
     Scene scene;
     if (need_skeleton && options.progress) options.progress("interpreting the string");
-    if (need_skeleton) skeleton = build_skeleton(program, d.interpreted(d.string()), turtle_options(d));
+    if (need_skeleton) {
+        // without interpretation rules the turtle reads the string itself, not a copy of it
+        if (program.interpret.empty())
+            skeleton = build_skeleton(program, d.string(), turtle_options(d));
+        else
+            skeleton = build_skeleton(program, d.interpreted(d.string()), turtle_options(d));
+    }
     // .skel.json lists the prototypes of instances: they are made with the scene
     if (need_skeleton && !need_scene && program.instances)
         for (const auto& p : paths) need_scene = need_scene || format_of(p)->bytes == skeleton_json_bytes;

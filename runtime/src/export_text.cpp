@@ -17,7 +17,7 @@ template <class Vec> void json_vec(std::string& out, const Vec& v) {
     fmt::format_to(std::back_inserter(out), "[{},{},{}]", v.x, v.y, v.z);
 }
 
-std::string json_string(const std::string& s) {
+std::string json_string(std::string_view s) {
     std::string out = "\"";
     for (char c : s) {
         if (c == '"' || c == '\\') out += '\\';
@@ -132,8 +132,8 @@ std::string skeleton_json(const Skeleton& sk, const Scene* scene) {
             json_vec(out, p.up);
             fmt::format_to(std::back_inserter(out), ",\"radius\":{},\"color\":", p.radius);
             json_vec(out, p.color);
-            fmt::format_to(std::back_inserter(out), ",\"module\":{},\"id\":{}}}", json_string(p.module),
-                           p.id);
+            fmt::format_to(std::back_inserter(out), ",\"module\":{},\"id\":{}}}",
+                           json_string(sk.module_name(p)), p.id);
         }
         out += "]}";
     }

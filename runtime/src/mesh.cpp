@@ -51,10 +51,23 @@ bool same_point(const glm::dvec3& a, const glm::dvec3& b) {
 // Work space reused from tube to tube, so meshing a tree does not allocate per axis.
 struct Scratch {
     std::vector<const SkeletonPoint*> pts;
+    std::vector<glm::dvec3> dirs; // unit direction of each segment between pts
     std::vector<Ring> rings;
     std::vector<double> cosines, sines; // of 2 pi j / sides
+    std::vector<float> us;              // texture coordinate u of vertex j of a ring: j / sides
     int sides = 0;
+    double sharp = -1, cos_sharp = 0; // the last sharp-bend angle (radians) and its cosine
 };
+
+// Whether a joint whose segments' directions have cosine `cos_theta` bends by at most `sharp`
+// radians, which is acos(cos_theta) <= sharp. acos is only evaluated near the threshold: a cosine
+// 1e-9 past cos(sharp) either way is an angle at least 1e-9 radians from it, far beyond the
+// rounding of either function.
+bool gentle(double cos_theta, double sharp, double cos_sharp) {
+    if (cos_theta > cos_sharp + 1e-9) return true;
+    if (cos_theta < cos_sharp - 1e-9) return false;
+    return std::acos(cos_theta) <= sharp;
+}
 
 // The rings of a tube, with sharp joints rounded; empty when it has fewer than two distinct
 // points.
@@ -68,8 +81,15 @@ void rings_of(const TubePath& path, const MeshOptions& o, Scratch& s) {
         if (pts.empty() || glm::length(p->position - pts.back()->position) > 1e-9) pts.push_back(p);
     if (pts.size() < 2) return;
     const double sharp = o.sharp_bend_deg * kPi / 180.0;
+    if (sharp != s.sharp) {
+        s.sharp = sharp;
+        s.cos_sharp = std::cos(sharp);
+    }
+    const double cos_sharp = s.cos_sharp;
     const std::size_t m = pts.size() - 1;
-    auto dir = [&](std::size_t k) { return glm::normalize(pts[k + 1]->position - pts[k]->position); };
+    s.dirs.resize(m);
+    for (std::size_t k = 0; k < m; ++k) s.dirs[k] = glm::normalize(pts[k + 1]->position - pts[k]->position);
+    auto dir = [&](std::size_t k) { return s.dirs[k]; };
     auto seg_len = [&](std::size_t k) { return glm::length(pts[k + 1]->position - pts[k]->position); };
     for (std::size_t k = 0; k <= m; ++k) {
         const SkeletonPoint& p = *pts[k];
@@ -81,8 +101,7 @@ void rings_of(const TubePath& path, const MeshOptions& o, Scratch& s) {
         }
         glm::dvec3 d0 = dir(k - 1), d1 = dir(k);
         double cos_theta = std::clamp(glm::dot(d0, d1), -1.0, 1.0);
-        double theta = std::acos(cos_theta);
-        if (theta <= sharp) {
+        if (gentle(cos_theta, sharp, cos_sharp)) {
             glm::dvec3 t = glm::normalize(d0 + d1);
             glm::dvec3 bend = d1 - d0;
             bend -= t * glm::dot(bend, t);
@@ -95,6 +114,7 @@ void rings_of(const TubePath& path, const MeshOptions& o, Scratch& s) {
         }
         // round the corner with a circular arc tangent to both segments, of radius 1.5 tube radii
         // where the segments are long enough (a radius below the tube's folds the inner side)
+        const double theta = std::acos(cos_theta);
         const double half = std::min(theta, 3.0) / 2;
         double rho = 1.5 * r;
         double a = rho * std::tan(half);
@@ -209,10 +229,12 @@ void mesh_tube(const TubePath& path, const MeshOptions& o, MeshPart& part,
         s.sides = sides;
         s.cosines.resize(static_cast<std::size_t>(sides) + 1);
         s.sines.resize(static_cast<std::size_t>(sides) + 1);
+        s.us.resize(static_cast<std::size_t>(sides) + 1);
         for (int j = 0; j <= sides; ++j) {
             double phi = 2 * kPi * (j % sides) / sides;
             s.cosines[static_cast<std::size_t>(j)] = std::cos(phi);
             s.sines[static_cast<std::size_t>(j)] = std::sin(phi);
+            s.us[static_cast<std::size_t>(j)] = static_cast<float>(double(j) / sides);
         }
     }
     // the first frame comes from the turtle's left vector, projected onto the first ring's plane
@@ -248,7 +270,7 @@ void mesh_tube(const TubePath& path, const MeshOptions& o, MeshPart& part,
             if (mitered) offset += R.bend * (glm::dot(offset, R.bend) * (R.miter - 1.0));
             *pos++ = glm::vec3(R.center + offset);
             *nrm++ = glm::vec3((radial + along) * tilt);
-            *uv++ = glm::vec2(static_cast<float>(double(j) / sides), static_cast<float>(arc));
+            *uv++ = glm::vec2(s.us[j], static_cast<float>(arc));
         }
     }
     // triangles, grouped by material (looked up only when the colour or texture changes along the

@@ -9,6 +9,7 @@
 #include "scene_build.hpp"
 
 #include <fmt/format.h>
+#include <sys/mman.h>
 
 #include <cmath>
 #include <map>
@@ -27,7 +28,19 @@ void grow_bounds(const Scene& scene, const glm::mat4* placed, glm::vec3& lo, glm
         lo = glm::min(lo, p);
         hi = glm::max(hi, p);
     };
-    for (const auto& p : scene.tubes.positions) add(placed ? glm::vec3(*placed * glm::vec4(p, 1.0f)) : p);
+    if (placed) {
+        for (const auto& p : scene.tubes.positions) add(glm::vec3(*placed * glm::vec4(p, 1.0f)));
+    } else {
+        // the tubes of a whole tree: the same comparisons as glm::min and glm::max (a NaN
+        // coordinate leaves the bound as it was), one coordinate at a time
+        float lx = lo.x, ly = lo.y, lz = lo.z, hx = hi.x, hy = hi.y, hz = hi.z;
+        for (const auto& p : scene.tubes.positions) {
+            lx = p.x < lx ? p.x : lx, ly = p.y < ly ? p.y : ly, lz = p.z < lz ? p.z : lz;
+            hx = hx < p.x ? p.x : hx, hy = hy < p.y ? p.y : hy, hz = hz < p.z ? p.z : hz;
+        }
+        lo = glm::vec3(lx, ly, lz);
+        hi = glm::vec3(hx, hy, hz);
+    }
     for (const auto& inst : scene.instances) {
         const MeshPart& proto = scene.prototypes[inst.prototype];
         const glm::mat4 m = placed ? *placed * inst.transform : inst.transform;
@@ -314,6 +327,37 @@ MeshPart organ_mesh(const Program& program, const OrganShape& shape) {
 
 } // namespace
 
+namespace {
+
+// Maps the whole pages of a vector's reserved storage in one call (MADV_POPULATE_WRITE, Linux
+// 5.14; a no-op before), instead of one page fault per 4 KiB as the mesh is written: on a tree of
+// 260,000 triangles, 2,600 faults whose entry and exit cost more than clearing the pages. Only for
+// storage that will be written (nearly) whole.
+template <typename T> void populate(const std::vector<T>& v) {
+#ifdef MADV_POPULATE_WRITE
+    constexpr std::uintptr_t page = 4096;
+    const auto b = (reinterpret_cast<std::uintptr_t>(v.data()) + page - 1) / page * page;
+    const auto e = reinterpret_cast<std::uintptr_t>(v.data() + v.capacity()) / page * page;
+    if (e > b + 16 * page) ::madvise(reinterpret_cast<void*>(b), e - b, MADV_POPULATE_WRITE);
+#else
+    (void)v;
+#endif
+}
+
+// Whether every point of the skeleton has the first one's colour and texture: then the tubes
+// have one material, and its index list is the whole index array.
+bool one_material(const Skeleton& skeleton) {
+    const SkeletonPoint* first = nullptr;
+    for (const auto& axis : skeleton.axes)
+        for (const auto& p : axis.points) {
+            if (!first) first = &p;
+            if (p.color != first->color || p.texture != first->texture) return false;
+        }
+    return true;
+}
+
+} // namespace
+
 namespace detail {
 
 Scene mesh_skeleton(const Program& program, const Skeleton& skeleton, const MeshOptions& options) {
@@ -348,6 +392,10 @@ Scene mesh_skeleton(const Program& program, const Skeleton& skeleton, const Mesh
         scene.tubes.normals.reserve(vertices);
         scene.tubes.uvs.reserve(vertices);
         by_material.emplace_back().reserve(segments * 6 * sides);
+        populate(scene.tubes.positions);
+        populate(scene.tubes.normals);
+        populate(scene.tubes.uvs);
+        if (one_material(skeleton)) populate(by_material[0]);
     }
     for (const auto& t : tubes) mesh_tube(t, options, scene.tubes, by_material, material_of);
     std::size_t used = 0;

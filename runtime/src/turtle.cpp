@@ -21,10 +21,41 @@ namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 
+// The cosine and sine of the last few angles turned by: a grammar turns by a handful of angles
+// again and again. The same numbers as computing them afresh, only not recomputed.
+class AngleCache {
+  public:
+    void get(double phi, double& c, double& s) {
+        for (const Entry& e : entries_)
+            if (e.phi == phi && e.valid) {
+                c = e.c;
+                s = e.s;
+                return;
+            }
+        c = std::cos(phi);
+        s = std::sin(phi);
+        entries_[next_] = Entry{phi, c, s, true};
+        next_ = (next_ + 1) % kSize;
+    }
+
+  private:
+    static constexpr std::size_t kSize = 4;
+    struct Entry {
+        double phi = 0, c = 1, s = 0;
+        bool valid = false;
+    };
+    Entry entries_[kSize];
+    std::size_t next_ = 0;
+};
+
+void rotate_frame(TurtleState& t, const glm::dvec3& axis, double c, double s) {
+    t.heading = rotate(t.heading, axis, c, s);
+    t.left = rotate(t.left, axis, c, s);
+    t.up = rotate(t.up, axis, c, s);
+}
+
 void rotate_frame(TurtleState& t, const glm::dvec3& axis, double phi) {
-    t.heading = rotate(t.heading, axis, phi);
-    t.left = rotate(t.left, axis, phi);
-    t.up = rotate(t.up, axis, phi);
+    rotate_frame(t, axis, std::cos(phi), std::sin(phi));
 }
 
 // Keeps the frame orthonormal against rounding over long strings.
@@ -201,7 +232,9 @@ class Turtle {
     // a turn of the parameter's degrees (default the grammar's angle) about one of the
     // turtle's own axes, `sign` giving the direction
     void turn(std::size_t i, const glm::dvec3& axis, int sign) {
-        rotate_frame(t_, axis, arg(i, 0, t_.angle) * kDeg * sign);
+        double c, s;
+        angles_.get(arg(i, 0, t_.angle) * kDeg * sign, c, s);
+        rotate_frame(t_, axis, c, s);
     }
 
     void push() {
@@ -282,6 +315,7 @@ class Turtle {
     std::vector<char> bound_;
     std::vector<TurtleOp> ops_;
     std::vector<int> instance_; // per symbol: the instance it places, or -1
+    AngleCache angles_;
 };
 
 // One row of plant/turtle_symbols.hpp each (its doc says what the case does).

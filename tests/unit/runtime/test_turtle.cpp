@@ -174,7 +174,7 @@ TEST_CASE("G draws like F, and colors come from the color module and SetColor", 
     CHECK(pts[3].color == glm::vec3(1, 0, 0)); // 0..255 is scaled to 0..1
     CHECK(pts[4].color == glm::vec3(0, 0.5f, 1));
     near(pts[5].position - pts[4].position, {1, 0, 0}); // @R set the heading to +X
-    CHECK(pts[5].module == "F");
+    CHECK(sk.module_name(pts[5]) == "F");
     CHECK(pts[5].id != 0);
 }
 
@@ -194,4 +194,32 @@ TEST_CASE("every row of the turtle-symbol table is registered with its operation
     CHECK(table[table.intern("~leaf")].turtle_op == TurtleOp::Surface);
     CHECK(table[table.intern("Apex")].turtle_op == TurtleOp::None);
     CHECK(turtle_symbol(TurtleOp::Sphere)->name == "@O");
+}
+
+TEST_CASE("a skeleton's points share one arena, copies go to the heap, names come from symbols",
+          "[turtle][skeleton]") {
+    // 5,000 segments: enough for an arena (a few points stay on the heap)
+    std::string axiom = "F [ + F G ] [ - G ]";
+    for (int k = 0; k < 5000; ++k) axiom += " F";
+    Drawn drawn = skeleton_of("axiom: " + axiom + ";");
+    Skeleton& sk = drawn.skeleton;
+    REQUIRE(sk.axes.size() == 3);
+    const auto arena = sk.axes[0].points.get_allocator().arena;
+    REQUIRE(arena); // sized from the string's segments
+    for (const auto& a : sk.axes) CHECK(a.points.get_allocator().arena == arena);
+    CHECK(sk.module_name(sk.axes[0].points[0]).empty()); // an axis start
+    CHECK(sk.module_name(sk.axes[1].points[1]) == "F");
+    CHECK(sk.module_name(sk.axes[1].points[2]) == "G");
+    CHECK(sk.axes[0].points.size() == 5002); // grown inside the arena, past its first two
+    CHECK_FALSE(skeleton_of("axiom: F [ + F G ] [ - G ] F;").skeleton.axes[0].points.get_allocator().arena);
+    // a copy owns its points on the heap and outlives the original
+    Skeleton copy = sk;
+    CHECK_FALSE(copy.axes[0].points.get_allocator().arena);
+    CHECK(copy.axes[0].points.size() == sk.axes[0].points.size());
+    CHECK(copy.module_name(copy.axes[1].points[2]) == "G");
+    // a moved skeleton keeps the arena alive after the original is gone
+    Skeleton moved = std::move(sk);
+    drawn.skeleton = Skeleton{};
+    CHECK(moved.axes[1].points[2].position == copy.axes[1].points[2].position);
+    CHECK(moved.module_name(moved.axes[1].points[2]) == "G");
 }

@@ -77,7 +77,7 @@ class Walker {
               std::size_t tree) {
         std::map<std::array<double, 3>, std::size_t> tip_of; // cylinder tip (own frame) -> branch
         for (const auto& ax : sk.axes) {
-            if (ax.points.size() < 2 || ax.points[1].module != "G") continue;
+            if (ax.points.size() < 2 || sk.module_name(ax.points[1]) != "G") continue;
             WeepingBranch b;
             b.tree = tree;
             for (const auto& pt : ax.points)
