@@ -7,7 +7,6 @@
 
 #include <fmt/format.h>
 
-#include <charconv>
 #include <cmath>
 
 #include <iostream>
@@ -190,43 +189,25 @@ std::string graph_tree(const DecompositionGraph& g, int node, bool children) {
     return out;
 }
 
-// Walks down from the root, one component of `path` at a time, spelled as in an edits file:
-// POSITION[#INDEX][[LO..HI]] ("/0.25#1/0.5", "/0.250", "/0.25[0..0.5]" as :save writes it); the
-// range is accepted and ignored. The child at that position (within 1e-9) with that index.
+// Walks down from the root, one component of `path` (read as an edits file reads it) at a time:
+// the child at that position (within 1e-9) with that index; a component's range is ignored.
 int graph_node_at(const DecompositionGraph& g, const std::string& path) {
-    if (path.empty() || path[0] != '/') return -1;
+    const auto steps = parse_node_path(path);
+    if (!steps) return -1;
     int node = 0;
-    std::size_t at = 1;
-    while (at < path.size()) {
-        std::size_t end = path.find('/', at);
-        if (end == std::string::npos) end = path.size();
-        std::string_view part(path.data() + at, end - at);
-        if (const std::size_t open = part.find('['); open != std::string_view::npos && part.back() == ']')
-            part = part.substr(0, open);
-        double position = 0;
-        int index = 0;
-        const std::size_t hash = part.find('#');
-        const std::string_view pos_text = part.substr(0, hash);
-        auto r = std::from_chars(pos_text.data(), pos_text.data() + pos_text.size(), position);
-        if (pos_text.empty() || r.ec != std::errc() || r.ptr != pos_text.data() + pos_text.size()) return -1;
-        if (hash != std::string_view::npos) {
-            const std::string_view idx = part.substr(hash + 1);
-            auto q = std::from_chars(idx.data(), idx.data() + idx.size(), index);
-            if (idx.empty() || q.ec != std::errc() || q.ptr != idx.data() + idx.size()) return -1;
-        }
+    for (const EditStep& step : *steps) {
         int next = -1;
         for (int c : g.node(node).children) {
             const GraphNode& n = g.node(c);
-            if (n.index == index && std::fabs(n.position - position) <= 1e-9) {
+            if (n.index == step.index && std::fabs(n.position - step.position) <= 1e-9) {
                 next = c;
                 break;
             }
         }
         if (next < 0) return -1;
         node = next;
-        at = end + 1;
     }
-    return path.size() > 1 && path.back() == '/' ? -1 : node;
+    return node;
 }
 
 int report_dormant_edits(const GrammarOptions& o, const Program& program, const SourceManager& sources) {

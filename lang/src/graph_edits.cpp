@@ -36,60 +36,13 @@ struct Failure {
     std::string message;
 };
 
-// Reads one line; throws Failure at the first problem.
-class LineReader {
-  public:
-    LineReader(const Program& prog, const SourceManager& sm, std::uint32_t file, std::uint32_t b,
-               std::uint32_t e, Diagnostics& diags)
-        : prog_(prog), sm_(sm), file_(file), text_(sm.file(file).text()), pos_(b), end_(e), diags_(diags) {}
+// Reads a node path, POSITION[#INDEX][[LO..HI]] per component ("/0.25#1/0.5[0.4..0.6]"); throws
+// Failure at the first problem, placed in `file` from the path's first byte `at`.
+struct PathReader {
+    std::uint32_t file = 0;
 
-    GraphEdit read() {
-        GraphEdit edit;
-        edit.span = {file_, pos_, end_};
-        const std::uint32_t first = pos_;
-        std::string word = token();
-        if (word == "share") {
-            edit.share = true;
-            skip();
-            const std::uint32_t at = pos_;
-            std::string level = token();
-            int v = -1;
-            auto r = std::from_chars(level.data(), level.data() + level.size(), v);
-            if (level.empty() || r.ec != std::errc{} || r.ptr != level.data() + level.size() || v < 0 ||
-                v > kMaxShareLevel)
-                fail(at, static_cast<std::uint32_t>(at + std::max<std::size_t>(level.size(), 1)),
-                     fmt::format("expected a level (a depth from 0 to {}) after 'share'", kMaxShareLevel));
-            edit.level = v;
-        } else if (!word.empty() && word[0] == '/') {
-            edit.path = path(word, first);
-        } else {
-            fail(first, static_cast<std::uint32_t>(first + std::max<std::size_t>(word.size(), 1)),
-                 fmt::format(
-                     "expected a node path ('/', '/0.25', '/0.5#1[0.4..0.6]') or 'share LEVEL', found '{}'",
-                     word));
-        }
-        skip();
-        parameter(edit);
-        return edit;
-    }
-
-  private:
     [[noreturn]] void fail(std::uint32_t b, std::uint32_t e, std::string message) const {
-        throw Failure{{file_, b, std::max(e, b + 1)}, std::move(message)};
-    }
-    void skip() {
-        while (pos_ < end_ && blank(text_[pos_])) ++pos_;
-    }
-    std::string token() {
-        const std::uint32_t b = pos_;
-        while (pos_ < end_ && !blank(text_[pos_])) ++pos_;
-        return text_.substr(b, pos_ - b);
-    }
-    std::string identifier() {
-        const std::uint32_t b = pos_;
-        while (pos_ < end_ && (std::isalnum(static_cast<unsigned char>(text_[pos_])) || text_[pos_] == '_'))
-            ++pos_;
-        return text_.substr(b, pos_ - b);
+        throw Failure{{file, b, std::max(e, b + 1)}, std::move(message)};
     }
 
     // A number of the path at `s[i]`, advancing i; `at` is the path's first byte.
@@ -148,6 +101,63 @@ class LineReader {
             out.push_back(step);
         }
         return out;
+    }
+};
+
+// Reads one line; throws Failure at the first problem.
+class LineReader {
+  public:
+    LineReader(const Program& prog, const SourceManager& sm, std::uint32_t file, std::uint32_t b,
+               std::uint32_t e, Diagnostics& diags)
+        : prog_(prog), sm_(sm), file_(file), text_(sm.file(file).text()), pos_(b), end_(e), diags_(diags) {}
+
+    GraphEdit read() {
+        GraphEdit edit;
+        edit.span = {file_, pos_, end_};
+        const std::uint32_t first = pos_;
+        std::string word = token();
+        if (word == "share") {
+            edit.share = true;
+            skip();
+            const std::uint32_t at = pos_;
+            std::string level = token();
+            int v = -1;
+            auto r = std::from_chars(level.data(), level.data() + level.size(), v);
+            if (level.empty() || r.ec != std::errc{} || r.ptr != level.data() + level.size() || v < 0 ||
+                v > kMaxShareLevel)
+                fail(at, static_cast<std::uint32_t>(at + std::max<std::size_t>(level.size(), 1)),
+                     fmt::format("expected a level (a depth from 0 to {}) after 'share'", kMaxShareLevel));
+            edit.level = v;
+        } else if (!word.empty() && word[0] == '/') {
+            edit.path = PathReader{file_}.path(word, first);
+        } else {
+            fail(first, static_cast<std::uint32_t>(first + std::max<std::size_t>(word.size(), 1)),
+                 fmt::format(
+                     "expected a node path ('/', '/0.25', '/0.5#1[0.4..0.6]') or 'share LEVEL', found '{}'",
+                     word));
+        }
+        skip();
+        parameter(edit);
+        return edit;
+    }
+
+  private:
+    [[noreturn]] void fail(std::uint32_t b, std::uint32_t e, std::string message) const {
+        throw Failure{{file_, b, std::max(e, b + 1)}, std::move(message)};
+    }
+    void skip() {
+        while (pos_ < end_ && blank(text_[pos_])) ++pos_;
+    }
+    std::string token() {
+        const std::uint32_t b = pos_;
+        while (pos_ < end_ && !blank(text_[pos_])) ++pos_;
+        return text_.substr(b, pos_ - b);
+    }
+    std::string identifier() {
+        const std::uint32_t b = pos_;
+        while (pos_ < end_ && (std::isalnum(static_cast<unsigned char>(text_[pos_])) || text_[pos_] == '_'))
+            ++pos_;
+        return text_.substr(b, pos_ - b);
     }
 
     void parameter(GraphEdit& edit) {
@@ -425,6 +435,14 @@ std::shared_ptr<const GraphEdits> parse_edits(const Program& program, const Sour
     }
     if (diags.error_count() != errors) return nullptr;
     return out;
+}
+
+std::optional<std::vector<EditStep>> parse_node_path(const std::string& text) {
+    try {
+        return PathReader{}.path(text, 0);
+    } catch (const Failure&) {
+        return std::nullopt;
+    }
 }
 
 std::string edit_path_text(const GraphEdit& e) {

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -94,6 +95,10 @@ std::shared_ptr<const GraphEdits> parse_edits(const Program& program, const Sour
 
 // The path of an edit as written in an edits file ("/0.25[0..0.375]/0.5#1").
 std::string edit_path_text(const GraphEdit& e);
+
+// A node path spelled as in an edits file ("/", "/0.25#1/0.5", "/0.25[0..0.5]"); none when it is
+// not one.
+std::optional<std::vector<EditStep>> parse_node_path(const std::string& text);
 
 // ---- the graph -----------------------------------------------------------------------------
 
