@@ -96,6 +96,7 @@ class ViewModel {
     struct Built; // a compiled program and its kept steps (cmd_view_model.cpp)
 
   private:
+    const Derivation* kept_step(int& step) const; // (with mutex_ held)
     GrammarOptions options_;
     OutputOptions output_;
     std::string scratch_;

@@ -228,14 +228,20 @@ std::string ViewModel::state_json() const {
     return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
-std::optional<std::string> ViewModel::glb(int step) {
-    std::lock_guard lock(mutex_);
-    if (!good_) return std::nullopt;
+// Kept step `step` of the last good plant (the last step when `step` is out of range, which
+// `step` is then set to); null without a plant or when that step was not kept.
+const Derivation* ViewModel::kept_step(int& step) const {
+    if (!good_) return nullptr;
     const int last = static_cast<int>(good_->steps.size()) - 1;
     if (step < 0 || step > last) step = last;
-    if (auto it = good_->glb.find(step); it != good_->glb.end()) return it->second;
-    const Derivation* d = good_->steps[static_cast<std::size_t>(step)].get();
+    return good_->steps[static_cast<std::size_t>(step)].get();
+}
+
+std::optional<std::string> ViewModel::glb(int step) {
+    std::lock_guard lock(mutex_);
+    const Derivation* d = kept_step(step);
     if (!d) return std::nullopt;
+    if (auto it = good_->glb.find(step); it != good_->glb.end()) return it->second;
     // the export `plant run -o x.glb` does, into the scratch folder, read back
     const std::string path = scratch_ + "/model.glb";
     write_outputs(*good_->program, *d, {path}, output_);
@@ -249,10 +255,7 @@ std::optional<std::string> ViewModel::glb(int step) {
 
 std::optional<std::string> ViewModel::pick(int step, const ViewPick& q) {
     std::lock_guard lock(mutex_);
-    if (!good_) return std::nullopt;
-    const int last = static_cast<int>(good_->steps.size()) - 1;
-    if (step < 0 || step > last) step = last;
-    const Derivation* d = good_->steps[static_cast<std::size_t>(step)].get();
+    const Derivation* d = kept_step(step);
     if (!d) return std::nullopt;
     if (good_->picks.size() > 8 && !good_->picks.count(step)) good_->picks.clear(); // a few steps' skeletons
     return view_pick_json(*good_->program, *d, step, good_->picks[step], q);
