@@ -11,6 +11,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <type_traits>
 
 namespace plant::cli {
 
@@ -60,6 +61,17 @@ void serve_asset(const httplib::Request& req, httplib::Response& res) {
     refuse(res, 404, "no such page");
 }
 
+// Query parameter `name` read whole as a number of type T (an int, or a finite double); false
+// when it is missing or not that.
+template <typename T> bool query_number(const httplib::Request& req, const char* name, T& out) {
+    if (!req.has_param(name)) return false;
+    const std::string s = req.get_param_value(name);
+    auto r = std::from_chars(s.data(), s.data() + s.size(), out);
+    if (r.ec != std::errc() || r.ptr != s.data() + s.size()) return false;
+    if constexpr (std::is_floating_point_v<T>) return std::isfinite(out);
+    return true;
+}
+
 // Sends what `make` returns for a kept step (404 without a plant or step; 500 on an error making it).
 template <typename Make> void answer(httplib::Response& res, const char* mime, Make make) {
     try {
@@ -75,29 +87,20 @@ template <typename Make> void answer(httplib::Response& res, const char* mime, M
 
 void serve_model(ViewModel& model, const httplib::Request& req, httplib::Response& res) {
     int step = -1;
-    if (req.has_param("step")) {
-        const std::string s = req.get_param_value("step");
-        auto r = std::from_chars(s.data(), s.data() + s.size(), step);
-        if (r.ec != std::errc() || r.ptr != s.data() + s.size())
-            return refuse(res, 400, "step: a whole number");
-    }
+    if (req.has_param("step") && !query_number(req, "step", step))
+        return refuse(res, 400, "step: a whole number");
     answer(res, "model/gltf-binary", [&] { return model.glb(step); });
 }
 
 // GET /api/pick?step=K&kind=tube|organ&x=&y=&z=[&ox=&oy=&oz=]: what the click hit (docs/view.md).
 void serve_pick(ViewModel& model, const httplib::Request& req, httplib::Response& res) {
-    auto number = [&](const char* name, double& out) {
-        if (!req.has_param(name)) return false;
-        const std::string s = req.get_param_value(name);
-        auto r = std::from_chars(s.data(), s.data() + s.size(), out);
-        return r.ec == std::errc() && r.ptr == s.data() + s.size() && std::isfinite(out);
-    };
+    auto number = [&](const char* name, double& out) { return query_number(req, name, out); };
     ViewPick q;
     const std::string kind = req.has_param("kind") ? req.get_param_value("kind") : "tube";
     if (kind != "tube" && kind != "organ") return refuse(res, 400, "kind: tube or organ");
     q.kind = kind == "tube" ? ViewPick::Tube : ViewPick::Organ;
-    double step = -1;
-    if ((req.has_param("step") && !number("step", step)) || step != std::floor(step) || std::abs(step) > 1e9)
+    int step = -1;
+    if (req.has_param("step") && !query_number(req, "step", step))
         return refuse(res, 400, "step: a whole number");
     if (!number("x", q.point.x) || !number("y", q.point.y) || !number("z", q.point.z))
         return refuse(res, 400, "x, y and z: the point hit, three finite numbers");
@@ -105,7 +108,7 @@ void serve_pick(ViewModel& model, const httplib::Request& req, httplib::Response
     if (q.kind == ViewPick::Organ &&
         (!number("ox", q.origin.x) || !number("oy", q.origin.y) || !number("oz", q.origin.z)))
         return refuse(res, 400, "ox, oy and oz: where the organ hit is placed, three finite numbers");
-    answer(res, "application/json", [&] { return model.pick(static_cast<int>(step), q); });
+    answer(res, "application/json", [&] { return model.pick(step, q); });
 }
 
 // POST /api/controls {"params": {"name": number}, "seed": "digits" or null}
