@@ -47,34 +47,35 @@ nlohmann::json view_edit_methods(const Program& program) {
 
 namespace {
 
-// The statement for `edit`, or an error message (starting with "!").
-std::string statement(const Program& program, const ViewEdit& edit) {
+// The statement for `edit` in `out`; an error message when the edit is not one, empty otherwise.
+std::string statement(const Program& program, const ViewEdit& edit, std::string& out) {
     const EnvironmentDecl* env = nullptr;
     for (const EnvironmentDecl& e : program.environments)
         if (e.name == edit.env && e.kind) env = &e;
-    if (!env) return fmt::format("!the grammar has no environment '{}'", edit.env);
+    if (!env) return fmt::format("the grammar has no environment '{}'", edit.env);
     const EnvMethod* m = env->kind->method(edit.method);
     if (!m || m->access != EnvAccess::Edit)
-        return fmt::format("!'{}' is not an edit method of {} ({})", edit.method, edit.env, env->kind->name);
+        return fmt::format("'{}' is not an edit method of {} ({})", edit.method, edit.env, env->kind->name);
     if (edit.args.size() != m->args.size())
-        return fmt::format("!{}.{} takes {} argument{}", edit.env, edit.method, m->args.size(),
+        return fmt::format("{}.{} takes {} argument{}", edit.env, edit.method, m->args.size(),
                            m->args.size() == 1 ? "" : "s");
     std::string call = edit.env + "." + edit.method + "(";
     for (std::size_t k = 0; k < edit.args.size(); ++k) {
         const bool vec = m->args[k] == ValueType::Vec3;
-        if (!vec && m->args[k] != ValueType::Number) return "!the page cannot give this method's arguments";
+        if (!vec && m->args[k] != ValueType::Number) return "the page cannot give this method's arguments";
         const auto& a = edit.args[k];
         if (a.size() != (vec ? 3u : 1u))
-            return fmt::format("!argument {} is {}", k + 1, vec ? "a vec3" : "a number");
+            return fmt::format("argument {} is {}", k + 1, vec ? "a vec3" : "a number");
         for (double x : a)
             if (!std::isfinite(x) || std::abs(x) > 1e15)
-                return fmt::format("!argument {}: a finite number", k + 1);
+                return fmt::format("argument {}: a finite number", k + 1);
         // shortest round-trip text; a negative number in parentheses reads the same in any place
         auto num = [](double x) { return x < 0 ? fmt::format("({})", x) : fmt::format("{}", x); };
         call += (k ? ", " : "") +
                 (vec ? fmt::format("vec3({}, {}, {})", num(a[0]), num(a[1]), num(a[2])) : num(a[0]));
     }
-    return call + ");";
+    out = call + ");";
+    return {};
 }
 
 } // namespace
@@ -86,8 +87,8 @@ std::string ViewModel::add_edit(const ViewEdit& edit) {
         if (edits_.size() >= kMaxViewEdits) return fmt::format("at most {} edits", kMaxViewEdits);
         const int last = static_cast<int>(good_->steps.size()) - 1;
         if (edit.step < 0 || edit.step > last) return fmt::format("step: 0 to {}", last);
-        std::string s = statement(*good_->program, edit);
-        if (!s.empty() && s[0] == '!') return s.substr(1);
+        std::string s;
+        if (std::string why = statement(*good_->program, edit, s); !why.empty()) return why;
         edits_.emplace_back(edit.step, std::move(s));
     }
     rebuild();
