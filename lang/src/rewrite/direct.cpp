@@ -198,7 +198,8 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
             check_holes(t, values);
         }
         const std::size_t m = t.syms.size();
-        put_template<Ids>(t, values, Ids ? in.ids[i] : 0, id_at, S, NA, PA, ID);
+        put_template<Ids>(t, plan.outcome_nargs.data() + plan.outcome_nargs_at[outcome], values,
+                          Ids ? in.ids[i] : 0, id_at, S, NA, PA, ID);
         if constexpr (Ids) ID += m;
         S += m;
         NA += m;

@@ -130,7 +130,7 @@ template <bool Ids> void Rewriter::run_templates(Worker& w, std::size_t b, std::
             check_holes(t, values);
         }
         ModuleId next_new = env.id_base + env.new_count;
-        put_template<Ids>(t, values, Ids ? in.ids[i] : 0, next_new, S + m, NA + m, PA + p,
+        put_template<Ids>(t, nullptr, values, Ids ? in.ids[i] : 0, next_new, S + m, NA + m, PA + p,
                           Ids ? ID + m : nullptr);
         env.new_count = next_new - env.id_base;
         m += t.syms.size();
