@@ -95,9 +95,12 @@ struct ModuleString {
     // After sym, nargs and params were written directly: sizes block_at for size() modules and
     // fills its entries for modules from b on, module b's parameters starting at p. index_range
     // fills those of modules [b, e) only, block_at being sized already (a thread's stretch).
-    void index_from(std::size_t b, std::size_t p) {
-        block_at.resize((size() + kBlock - 1) >> kBlockShift);
-        index_range(b, size(), p);
+    // index_upto sizes block_at for e modules and fills those of [b, e) (a writer whose arrays
+    // are open past e).
+    void index_from(std::size_t b, std::size_t p) { index_upto(b, size(), p); }
+    void index_upto(std::size_t b, std::size_t e, std::size_t p) {
+        block_at.resize((e + kBlock - 1) >> kBlockShift);
+        index_range(b, e, p);
     }
     void index_range(std::size_t b, std::size_t e, std::size_t p);
     // Bytes held by the arrays (capacity, not size: what the process really pays).

@@ -34,10 +34,7 @@ template <bool Ids> void Rewriter::run_templates(Worker& w, std::size_t b, std::
     auto open = [&](std::size_t need_m, std::size_t need_p) {
         mcap = std::max({out.sym.capacity(), need_m, 2 * m});
         pcap = std::max({out.params.capacity(), need_p, 2 * p});
-        if (S) { // open already, grown for room: index what was written since it was opened
-            out.block_at.resize((m + ModuleString::kBlock - 1) >> ModuleString::kBlockShift);
-            out.index_range(m_open, m, p_open);
-        }
+        if (S) out.index_upto(m_open, m, p_open); // open already: index what was written
         m_open = m;
         p_open = p;
         out.resize_arrays(mcap, pcap);
