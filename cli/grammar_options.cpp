@@ -48,6 +48,17 @@ void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation) {
                        "instructions, the functions it calls included (default {})",
                        kDefaultMaxSteps))
         ->type_name("N");
+    // the same param set twice on one command line is a usage error, not "the last one wins"
+    cmd.parse_complete_callback([&o] {
+        for (std::size_t k = 0; k < o.defines.size(); ++k)
+            for (std::size_t j = 0; j < k; ++j) {
+                const std::string name = o.defines[k].substr(0, o.defines[k].find('='));
+                if (!name.empty() && o.defines[j].substr(0, o.defines[j].find('=')) == name)
+                    throw CLI::ValidationError(fmt::format(
+                        "-D sets {} twice, to '{}' and to '{}': keep one of them", escape_controls(name),
+                        escape_controls(o.defines[j]), escape_controls(o.defines[k])));
+            }
+    });
     o.color = isatty(2) != 0 && std::getenv("NO_COLOR") == nullptr;
 }
 
