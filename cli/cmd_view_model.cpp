@@ -165,11 +165,16 @@ std::string ViewModel::set_controls(const ViewControls& controls) {
     {
         std::lock_guard lock(mutex_);
         for (const auto& [name, value] : controls.params) {
-            bool known = false;
+            const Global* param = nullptr;
             if (good_)
-                for (const auto& p : good_->params) known = known || p.name == name;
-            if (!known) return fmt::format("'{}' is not a param of the grammar", name);
+                for (const auto& p : good_->params)
+                    if (p.name == name) param = &p;
+            if (!param) return fmt::format("'{}' is not a param of the grammar", name);
             if (!std::isfinite(value)) return fmt::format("the value of '{}' is not a finite number", name);
+            // refused here, so that only values the grammar takes reach the "Save as -D" line
+            if (param->has_range && (value < param->low || value > param->high))
+                return fmt::format("the value of '{}' must be from {} to {}, found {}", name,
+                                   number_text(param->low), number_text(param->high), number_text(value));
         }
         controls_ = controls;
     }
@@ -209,7 +214,8 @@ std::string ViewModel::state_json() const {
     }
     // the command line that grows what is shown
     std::string cmd = "plant run " + options_.file;
-    for (const auto& d : options_.defines) cmd += " -D " + d;
+    for (const auto& d : options_.defines) // a -D the page's controls override is left out
+        if (!controls_.params.count(d.substr(0, d.find('=')))) cmd += " -D " + d;
     for (const auto& [name, value] : controls_.params) cmd += " -D " + name + "=" + number_text(value);
     if (controls_.seed)
         cmd += fmt::format(" --seed {}", *controls_.seed);
