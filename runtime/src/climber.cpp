@@ -179,7 +179,20 @@ void Climber::segment(const BoundSegment& s) {
     pending_.push_back(s);
 }
 
+std::size_t Climber::air_particles(const physics::FluidSettings& fluid) {
+    const glm::dvec3 cells =
+        glm::max(glm::floor((fluid.domain_hi - fluid.domain_lo) / fluid.spacing + 1e-9), glm::dvec3(1.0));
+    return static_cast<std::size_t>(std::min(cells.x * cells.y * cells.z, 1e12));
+}
+
+void Climber::charge_particles(std::size_t air) {
+    memory::Stage stage("physics");
+    // a new segment may bring a fixed root with it
+    memory_.resize((world_.size() + 2 * pending_.size()) * kBytesPerParticle + air * kBytesPerAirParticle);
+}
+
 void Climber::advance(std::set<ModuleId>& left) {
+    charge_particles(fluid_.size());
     // particles whose modules the grammar removed go too
     for (auto it = particle_of_.begin(); it != particle_of_.end();) {
         if (seen_.count(it->first)) {
