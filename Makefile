@@ -49,8 +49,9 @@ bench: build
 	status=0; bash bench/run || status=1; bash bench/run-batch || status=1; \
 	bash bench/run-peers || status=1; bash bench/run-glb || status=1; exit $$status
 
-# Installing and packaging (docs/install.md): plant, its standard library, docs, man page and
-# the C++ API under PREFIX; the Debian packages plant and plant-dev into $(BUILD)/.
+# Installing and packaging (docs/install.md): plant, plant view's server module (lib/plant/),
+# its standard library, docs, man page and the C++ API under PREFIX; the Debian packages plant
+# and plant-dev into $(BUILD)/.
 PREFIX ?= /usr/local
 install: build
 	cmake --install $(BUILD) --prefix $(PREFIX)

@@ -82,6 +82,14 @@ int view_main(ViewCmd& c) {
         std::cerr << fmt::format("plant: cannot read '{}': no such file\n", escape_controls(c.g.file));
         return kNoInput;
     }
+    // the HTTP server module, before any work: only `plant view` loads it (view_http.hpp)
+    std::string why;
+    bool missing = false;
+    const view_http::ServeFunction serve = view_http::load_view_server(why, missing);
+    if (!serve) {
+        std::cerr << why << "\n";
+        return missing ? kNoInput : kRuntime;
+    }
     // the scratch folder the GLB export writes into, under $TMPDIR (else /tmp)
     const char* tmpdir = std::getenv("TMPDIR");
     std::string scratch = std::string(tmpdir && *tmpdir ? tmpdir : "/tmp") + "/plant-view-XXXXXX";
@@ -114,7 +122,7 @@ int view_main(ViewCmd& c) {
         std::cout << "plant view: " << url << "  (Ctrl-C stops)" << std::endl;
         if (c.open) open_browser(url);
     };
-    const int port = serve_view(model, events, so, [&](std::function<void()> f) {
+    const int port = serve_view(serve, model, events, so, [&](std::function<void()> f) {
         std::lock_guard lock(stopper_mutex);
         stopper = std::move(f);
         if (stopper && stop) stopper(); // a signal came before the server was up

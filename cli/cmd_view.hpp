@@ -5,6 +5,7 @@
 
 #include "commands.hpp"
 #include "outputs.hpp"
+#include "view_http.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -131,14 +132,14 @@ class ViewEvents {
 // `changed` after a burst of events settles. Runs until `stop` is set; started on its own thread.
 void watch_files(ViewModel& model, ViewEvents& events, const std::atomic<bool>& stop);
 
-// Serves the page, the model and the events on 127.0.0.1:port until stopped (serve_view returns
-// then). `port` 0 picks a free port; `on_listening` gets the bound port before serving.
-struct ViewServer;
+// Serves the page, the model and the events on 127.0.0.1:port through the HTTP server module's
+// `serve` (view_http.hpp) until stopped (serve_view returns then: the port, or -1 when it could
+// not bind). `port` 0 picks a free port; `on_listening` gets the bound port before serving.
 struct ViewServerOptions {
     int port = 0;
     std::function<void(int port)> on_listening;
 };
-int serve_view(ViewModel& model, ViewEvents& events, const ViewServerOptions& options,
-               std::function<void(std::function<void()>)> set_stopper);
+int serve_view(view_http::ServeFunction serve, ViewModel& model, ViewEvents& events,
+               const ViewServerOptions& options, std::function<void(std::function<void()>)> set_stopper);
 
 } // namespace plant::cli

@@ -1,11 +1,11 @@
-// plant view's HTTP server (cpp-httplib): a fixed route table on 127.0.0.1. No part of a request
-// names a file: the page's files are built into the program and the model is made in memory.
-// Requests whose Host or Origin is not this loopback address and port are refused (a web page
-// elsewhere could otherwise reach the server through DNS rebinding); the page can change params
-// and the seed, which derives again, and nothing else.
+// plant view's HTTP server: a fixed route table on 127.0.0.1, answered through the HTTP server
+// module (view_http.hpp; cpp-httplib lives there, loaded only by `plant view`). No part of a
+// request names a file: the page's files are built into the program and the model is made in
+// memory. Requests whose Host or Origin is not this loopback address and port are refused (a web
+// page elsewhere could otherwise reach the server through DNS rebinding); the page can change
+// params and the seed, which derives again, and nothing else.
 #include "cmd_view.hpp"
 
-#include <httplib.h>
 #include <nlohmann/json.hpp>
 
 #include <charconv>
@@ -21,38 +21,38 @@ bool allowed_host(const std::string& host, int port) {
     return host == "127.0.0.1:" + std::to_string(port) || host == "localhost:" + std::to_string(port);
 }
 
-bool allowed_origin(const httplib::Request& req, int port) {
+bool allowed_origin(const view_http::Request& req, int port) {
     if (!req.has_header("Origin")) return true; // same-origin GETs and tools send none
-    const std::string origin = req.get_header_value("Origin");
+    const std::string origin = req.header("Origin");
     return origin.rfind("http://", 0) == 0 && allowed_host(origin.substr(7), port);
 }
 
-void refuse(httplib::Response& res, int status, const std::string& why) {
+void refuse(view_http::Response& res, int status, const std::string& why) {
     res.status = status;
     res.set_content(why + "\n", "text/plain; charset=utf-8");
 }
 
-// The checks every request passes before any route sees it.
-httplib::Server::HandlerResponse screen(const httplib::Request& req, httplib::Response& res, int port) {
+// The checks every request passes before any route sees it: true when it is refused (answered).
+bool screen(const view_http::Request& req, view_http::Response& res, int port) {
     res.set_header("X-Content-Type-Options", "nosniff");
     res.set_header("Cache-Control", "no-store");
-    if (!allowed_host(req.get_header_value("Host"), port) || !allowed_origin(req, port)) {
+    if (!allowed_host(req.header("Host"), port) || !allowed_origin(req, port)) {
         refuse(res, 403, "plant view answers only requests for 127.0.0.1:" + std::to_string(port));
-        return httplib::Server::HandlerResponse::Handled;
+        return true;
     }
     if (req.path.empty() || req.path[0] != '/' || req.path.find("..") != std::string::npos ||
         req.target.find("..") != std::string::npos || req.path.find('\\') != std::string::npos ||
         req.path.find("//") != std::string::npos) {
         refuse(res, 400, "plant view serves only its own routes");
-        return httplib::Server::HandlerResponse::Handled;
+        return true;
     }
-    return httplib::Server::HandlerResponse::Unhandled;
+    return false;
 }
 
-void serve_asset(const httplib::Request& req, httplib::Response& res) {
+void serve_asset(const view_http::Request& req, view_http::Response& res) {
     for (const ViewAsset* a = kViewAssets; a->route; ++a) {
         if (req.path != a->route) continue;
-        res.set_content(a->begin, static_cast<std::size_t>(a->end - a->begin), a->mime);
+        res.set_content(std::string(a->begin, a->end), a->mime);
         res.set_header("Content-Security-Policy",
                        "default-src 'self'; img-src 'self' blob: data:; connect-src 'self' blob: data:; "
                        "style-src 'self' 'unsafe-inline'");
@@ -63,9 +63,9 @@ void serve_asset(const httplib::Request& req, httplib::Response& res) {
 
 // Query parameter `name` read whole as a number of type T (an int, or a finite double); false
 // when it is missing or not that.
-template <typename T> bool query_number(const httplib::Request& req, const char* name, T& out) {
+template <typename T> bool query_number(const view_http::Request& req, const char* name, T& out) {
     if (!req.has_param(name)) return false;
-    const std::string s = req.get_param_value(name);
+    const std::string s = req.param(name);
     auto r = std::from_chars(s.data(), s.data() + s.size(), out);
     if (r.ec != std::errc() || r.ptr != s.data() + s.size()) return false;
     if constexpr (std::is_floating_point_v<T>) return std::isfinite(out);
@@ -73,7 +73,7 @@ template <typename T> bool query_number(const httplib::Request& req, const char*
 }
 
 // Sends what `make` returns for a kept step (404 without a plant or step; 500 on an error making it).
-template <typename Make> void answer(httplib::Response& res, const char* mime, Make make) {
+template <typename Make> void answer(view_http::Response& res, const char* mime, Make make) {
     try {
         auto body = make();
         if (!body) return refuse(res, 404, "no plant (the grammar has an error) or that step was not kept");
@@ -85,7 +85,7 @@ template <typename Make> void answer(httplib::Response& res, const char* mime, M
     }
 }
 
-void serve_model(ViewModel& model, const httplib::Request& req, httplib::Response& res) {
+void serve_model(ViewModel& model, const view_http::Request& req, view_http::Response& res) {
     int step = -1;
     if (req.has_param("step") && !query_number(req, "step", step))
         return refuse(res, 400, "step: a whole number");
@@ -93,10 +93,10 @@ void serve_model(ViewModel& model, const httplib::Request& req, httplib::Respons
 }
 
 // GET /api/pick?step=K&kind=tube|organ&x=&y=&z=[&ox=&oy=&oz=]: what the click hit (docs/view.md).
-void serve_pick(ViewModel& model, const httplib::Request& req, httplib::Response& res) {
+void serve_pick(ViewModel& model, const view_http::Request& req, view_http::Response& res) {
     auto number = [&](const char* name, double& out) { return query_number(req, name, out); };
     ViewPick q;
-    const std::string kind = req.has_param("kind") ? req.get_param_value("kind") : "tube";
+    const std::string kind = req.has_param("kind") ? req.param("kind") : "tube";
     if (kind != "tube" && kind != "organ") return refuse(res, 400, "kind: tube or organ");
     q.kind = kind == "tube" ? ViewPick::Tube : ViewPick::Organ;
     int step = -1;
@@ -112,7 +112,8 @@ void serve_pick(ViewModel& model, const httplib::Request& req, httplib::Response
 }
 
 // POST /api/controls {"params": {"name": number}, "seed": "digits" or null}
-void set_controls(ViewModel& model, ViewEvents& events, const httplib::Request& req, httplib::Response& res) {
+void set_controls(ViewModel& model, ViewEvents& events, const view_http::Request& req,
+                  view_http::Response& res) {
     ViewControls c;
     try {
         const auto j = nlohmann::json::parse(req.body);
@@ -136,7 +137,7 @@ void set_controls(ViewModel& model, ViewEvents& events, const httplib::Request& 
 
 // POST /api/edit {"step": k, "env": "ivy", "method": "cut", "args": [14, [0, 1, 0]]} or
 // {"undo": true}: one edit method call before step k + 1 (docs/view.md, editing climbers).
-void edit(ViewModel& model, ViewEvents& events, const httplib::Request& req, httplib::Response& res) {
+void edit(ViewModel& model, ViewEvents& events, const view_http::Request& req, view_http::Response& res) {
     ViewEdit e;
     bool undo = false;
     try {
@@ -176,63 +177,52 @@ void edit(ViewModel& model, ViewEvents& events, const httplib::Request& req, htt
 }
 
 // GET /api/events: Server-Sent Events, one `model` event (the state) per new version.
-void stream_events(ViewModel& model, ViewEvents& events, httplib::Response& res) {
+void stream_events(ViewModel& model, ViewEvents& events, view_http::Response& res) {
     auto seen = std::make_shared<std::uint64_t>(0);
-    res.set_chunked_content_provider(
-        "text/event-stream", [&model, &events, seen](std::size_t, httplib::DataSink& sink) {
-            if (events.stopped()) return false;
-            const std::uint64_t now = *seen == 0 ? model.version() : events.wait(*seen, 1000);
-            if (events.stopped()) return false;
-            std::string message = ": waiting\n\n"; // also finds out when the page has gone
-            if (now != *seen) {
-                *seen = now;
-                message = "event: model\ndata: " + model.state_json() + "\n\n";
-            }
-            return sink.write(message.data(), message.size());
-        });
+    res.stream_type = "text/event-stream";
+    res.stream = [&model, &events, seen](const view_http::Response::Writer& write) {
+        if (events.stopped()) return false;
+        const std::uint64_t now = *seen == 0 ? model.version() : events.wait(*seen, 1000);
+        if (events.stopped()) return false;
+        std::string message = ": waiting\n\n"; // also finds out when the page has gone
+        if (now != *seen) {
+            *seen = now;
+            message = "event: model\ndata: " + model.state_json() + "\n\n";
+        }
+        return write(message.data(), message.size());
+    };
 }
 
 } // namespace
 
-int serve_view(ViewModel& model, ViewEvents& events, const ViewServerOptions& options,
-               std::function<void(std::function<void()>)> set_stopper) {
-    httplib::Server server;
-    // SO_REUSEADDR only: httplib's default adds SO_REUSEPORT, which would let a second server
-    // (another `plant view`, or any program of the same user) share the port and half the requests
-    server.set_socket_options([](int sock) {
-        int yes = 1;
-        setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
-    });
-    int port = options.port;
-    if (port == 0) {
-        port = server.bind_to_any_port("127.0.0.1");
-        if (port < 0) return -1;
-    } else if (!server.bind_to_port("127.0.0.1", port)) {
-        return -1;
-    }
-    server.set_payload_max_length(64 * 1024); // the controls' JSON is far smaller
-    server.set_pre_routing_handler(
-        [port](const httplib::Request& req, httplib::Response& res) { return screen(req, res, port); });
-    server.Get("/api/state", [&](const httplib::Request&, httplib::Response& res) {
-        res.set_content(model.state_json(), "application/json");
-    });
-    server.Get("/api/model.glb",
-               [&](const httplib::Request& req, httplib::Response& res) { serve_model(model, req, res); });
-    server.Get("/api/pick",
-               [&](const httplib::Request& req, httplib::Response& res) { serve_pick(model, req, res); });
-    server.Get("/api/events",
-               [&](const httplib::Request&, httplib::Response& res) { stream_events(model, events, res); });
-    server.Post("/api/controls", [&](const httplib::Request& req, httplib::Response& res) {
-        set_controls(model, events, req, res);
-    });
-    server.Post("/api/edit",
-                [&](const httplib::Request& req, httplib::Response& res) { edit(model, events, req, res); });
-    server.Get(".*", [](const httplib::Request& req, httplib::Response& res) { serve_asset(req, res); });
-    set_stopper([&server] { server.stop(); });
-    if (options.on_listening) options.on_listening(port);
-    server.listen_after_bind();
-    set_stopper(nullptr);
-    return port;
+int serve_view(view_http::ServeFunction serve, ViewModel& model, ViewEvents& events,
+               const ViewServerOptions& options, std::function<void(std::function<void()>)> set_stopper) {
+    using view_http::Request, view_http::Response;
+    view_http::ServeOptions o;
+    o.host = "127.0.0.1";
+    o.port = options.port;
+    o.max_payload = 64 * 1024; // the controls' JSON is far smaller
+    // the port actually bound, for the screen: known once listening (before any request)
+    auto port = std::make_shared<std::atomic<int>>(options.port);
+    o.screen = [port](const Request& req, Response& res) { return screen(req, res, *port); };
+    auto route = [&o](const char* method, const char* pattern, view_http::Handler h) {
+        o.routes.push_back({method, pattern, std::move(h)});
+    };
+    route("GET", "/api/state",
+          [&](const Request&, Response& res) { res.set_content(model.state_json(), "application/json"); });
+    route("GET", "/api/model.glb", [&](const Request& req, Response& res) { serve_model(model, req, res); });
+    route("GET", "/api/pick", [&](const Request& req, Response& res) { serve_pick(model, req, res); });
+    route("GET", "/api/events", [&](const Request&, Response& res) { stream_events(model, events, res); });
+    route("POST", "/api/controls",
+          [&](const Request& req, Response& res) { set_controls(model, events, req, res); });
+    route("POST", "/api/edit", [&](const Request& req, Response& res) { edit(model, events, req, res); });
+    route("GET", ".*", [](const Request& req, Response& res) { serve_asset(req, res); });
+    o.set_stopper = std::move(set_stopper);
+    o.on_listening = [&options, port](int bound) {
+        *port = bound;
+        if (options.on_listening) options.on_listening(bound);
+    };
+    return serve(o);
 }
 
 } // namespace plant::cli

@@ -1,16 +1,23 @@
 // The REPL's front end: libedit line editing, history in ~/.plant_history and tab completion
 // when standard input is a terminal; plain line reading otherwise (scripts and tests).
+// libedit is loaded (dlopen) only then: linked, it and the libraries it needs (libtinfo, libbsd,
+// libmd) would be loaded and relocated by every plant process, about 0.35 ms each
+// (docs/architecture.md, the command line).
 #include "commands.hpp"
 #include "repl.hpp"
 
-#include <editline/readline.h>
+#include "plant/diagnostics.hpp"
+
+#include <editline/readline.h> // its types only: the functions are looked up in the library
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
+#include <dlfcn.h>
 #include <iostream>
+#include <type_traits>
 #include <unistd.h>
 
 namespace plant::cli {
@@ -22,6 +29,45 @@ Session* g_session = nullptr;
 
 extern "C" void on_sigint(int) {
     g_interrupt.store(true);
+}
+
+// The part of libedit's readline interface the REPL uses, looked up in libedit.so.2.
+struct Editline {
+    char* (*readline)(const char*) = nullptr;
+    int (*add_history)(const char*) = nullptr;
+    int (*read_history)(const char*) = nullptr;
+    int (*write_history)(const char*) = nullptr;
+    char** (*completion_matches)(const char*, rl_compentry_func_t*) = nullptr;
+    char** line_buffer = nullptr;                         // rl_line_buffer
+    int* completion_over = nullptr;                       // rl_attempted_completion_over
+    rl_completion_func_t** completion_function = nullptr; // rl_attempted_completion_function
+};
+Editline g_edit;
+
+// Loads libedit into g_edit; false (with the loader's reason in `why`) when it cannot.
+bool load_editline(std::string& why) {
+    void* lib = dlopen("libedit.so.2", RTLD_NOW | RTLD_LOCAL);
+    if (!lib) {
+        const char* e = dlerror();
+        why = e ? e : "cannot load libedit.so.2";
+        return false;
+    }
+    bool found = true;
+    auto get = [&](auto& out, const char* name) {
+        void* sym = dlsym(lib, name);
+        found = found && sym;
+        out = reinterpret_cast<std::remove_reference_t<decltype(out)>>(sym);
+    };
+    get(g_edit.readline, "readline");
+    get(g_edit.add_history, "add_history");
+    get(g_edit.read_history, "read_history");
+    get(g_edit.write_history, "write_history");
+    get(g_edit.completion_matches, "rl_completion_matches");
+    get(g_edit.line_buffer, "rl_line_buffer");
+    get(g_edit.completion_over, "rl_attempted_completion_over");
+    get(g_edit.completion_function, "rl_attempted_completion_function");
+    if (!found) why = "libedit.so.2 lacks part of the readline interface";
+    return found;
 }
 
 std::vector<std::string> g_matches;
@@ -42,17 +88,34 @@ char* completion_generator(const char* text, int state) {
 }
 
 char** complete(const char* text, int start, int) {
-    g_before.assign(rl_line_buffer, static_cast<std::size_t>(std::max(start, 0)));
+    g_before.assign(*g_edit.line_buffer, static_cast<std::size_t>(std::max(start, 0)));
     // file names only where a command takes them (:load, :export)
     const bool files = g_session->completion_kind(g_before) == ReplCompletion::Files;
-    rl_attempted_completion_over = files ? 0 : 1;
+    *g_edit.completion_over = files ? 0 : 1;
     if (files) return nullptr;
-    return rl_completion_matches(text, completion_generator);
+    return g_edit.completion_matches(text, completion_generator);
 }
 
 std::string history_path() {
     const char* home = std::getenv("HOME");
     return home ? std::string(home) + "/.plant_history" : std::string(".plant_history");
+}
+
+// Reads and runs lines from standard input until it ends or :quit: scripts, and a terminal when
+// libedit cannot be loaded (then with a prompt). Exit 1 when some line failed.
+int read_script(Session& session, bool prompt) {
+    std::string line;
+    bool failed = false;
+    for (;;) {
+        if (prompt) std::cout << "plant> " << std::flush;
+        if (!std::getline(std::cin, line)) break;
+        bool go_on = session.execute(line);
+        failed = session.take_failed() || failed;
+        std::cout.flush();
+        std::cerr.flush();
+        if (!go_on) break;
+    }
+    return failed ? kFailed : kOk;
 }
 
 } // namespace
@@ -71,32 +134,27 @@ int repl_main(const std::string& file, bool color, const std::vector<std::string
         int code = session.load(file);
         if (code != 0 && !interactive) return code;
     }
-    if (!interactive) {
-        // scripts: one line at a time, no prompt; exit 1 when some line failed (Ctrl-C ends
-        // the script as usual: no handler is installed)
-        std::string line;
-        bool failed = false;
-        while (std::getline(std::cin, line)) {
-            bool go_on = session.execute(line);
-            failed = session.take_failed() || failed;
-            std::cout.flush();
-            std::cerr.flush();
-            if (!go_on) break;
-        }
-        return failed ? kFailed : kOk;
-    }
+    // scripts: one line at a time, no prompt; exit 1 when some line failed (Ctrl-C ends the
+    // script as usual: no handler is installed)
+    if (!interactive) return read_script(session, false);
     // interactive: Ctrl-C interrupts a long step and returns to the prompt
+    std::string why;
+    if (!load_editline(why)) {
+        std::cerr << "plant: no line editing (" << escape_controls(why) << "); reading lines plainly\n";
+        read_script(session, true);
+        return kOk; // as the editing REPL: a failed line is not the session's failure
+    }
     struct sigaction sa {};
     sa.sa_handler = on_sigint;
     sigemptyset(&sa.sa_mask);
     sigaction(SIGINT, &sa, nullptr);
     std::cout << "plant repl: :help lists the commands, :quit ends; Tab completes names\n";
-    rl_attempted_completion_function = complete;
+    *g_edit.completion_function = complete;
     const std::string hist = history_path();
-    read_history(hist.c_str());
+    g_edit.read_history(hist.c_str());
     for (;;) {
         g_interrupt.store(false);
-        char* raw = readline("plant> ");
+        char* raw = g_edit.readline("plant> ");
         if (!raw && g_interrupt.load()) { // Ctrl-C at the prompt: a fresh line, not the end
             std::cout << "\n";
             continue;
@@ -107,13 +165,13 @@ int repl_main(const std::string& file, bool color, const std::vector<std::string
         }
         std::string line = raw;
         std::free(raw);
-        if (line.find_first_not_of(" \t") != std::string::npos) add_history(line.c_str());
+        if (line.find_first_not_of(" \t") != std::string::npos) g_edit.add_history(line.c_str());
         bool go_on = session.execute(line);
         session.take_failed();
         std::cout.flush();
         if (!go_on) break;
     }
-    write_history(hist.c_str());
+    g_edit.write_history(hist.c_str());
     return kOk;
 }
 

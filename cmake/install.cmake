@@ -1,6 +1,8 @@
 # What `cmake --install build --prefix P` puts where (docs/install.md), in two components: the
 # program (`runtime`: the plant Debian package) and the C++ API (`dev`: plant-dev).
 #   P/bin/plant
+#   P/lib/plant/plant-view-server.so   plant view's HTTP server, which only `plant view` loads; it
+#                                  looks for it as ../lib/plant/ beside bin/ (cli/view_http_load.cpp)
 #   P/share/plant/stdlib/          the standard library; bin/plant finds it as ../share/plant/stdlib
 #                                  (lang/src/file_access.cpp), so these two paths go together
 #   P/share/doc/plant/             README.md and docs/*.md
@@ -14,6 +16,7 @@ set(PLANT_INSTALL_STDLIBDIR share/plant/stdlib)
 set(PLANT_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/plant)
 
 install(TARGETS plant RUNTIME DESTINATION bin COMPONENT runtime)
+install(TARGETS plant_view_server LIBRARY DESTINATION lib/plant COMPONENT runtime)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/stdlib/ DESTINATION ${PLANT_INSTALL_STDLIBDIR} COMPONENT runtime)
 file(GLOB plant_docs CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/docs/*.md)
 install(FILES ${PROJECT_SOURCE_DIR}/README.md ${plant_docs} DESTINATION share/doc/plant COMPONENT runtime)

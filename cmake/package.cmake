@@ -20,6 +20,8 @@ set(CPACK_DEBIAN_PACKAGE_SECTION graphics)
 
 set(CPACK_DEBIAN_RUNTIME_PACKAGE_NAME plant)
 set(CPACK_DEBIAN_RUNTIME_PACKAGE_SHLIBDEPS ON)
+# plant repl loads libedit.so.2 with dlopen (cli/repl_main.cpp), which dpkg-shlibdeps cannot see
+set(CPACK_DEBIAN_RUNTIME_PACKAGE_DEPENDS "libedit2")
 set(CPACK_COMPONENT_RUNTIME_DESCRIPTION
     "interpreter for the .plant L-system language
  plant grows plants from parametric, context-sensitive and stochastic L-system grammars:

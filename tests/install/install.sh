@@ -16,14 +16,15 @@ pydir=${5:-}
 . "$(dirname "$0")/lib.sh"
 golden=$src/grammars/rose/fig12c.mesh.txt
 
-# install, then move the prefix: nothing may depend on where it was installed
+# install, then move the prefix: nothing may depend on where it was installed (plant view's
+# server module included)
 if ! "$cmake" --install "$build" --prefix "$tmp/first" >"$tmp/install.log" 2>&1; then
   cat "$tmp/install.log"
   exit 1
 fi
 mv "$tmp/first" "$tmp/moved"
 p=$tmp/moved
-for f in bin/plant share/plant/stdlib/rose.plant share/plant/stdlib/textures/bark.png \
+for f in bin/plant lib/plant/plant-view-server.so share/plant/stdlib/rose.plant share/plant/stdlib/textures/bark.png \
   share/doc/plant/README.md share/doc/plant/install.md share/doc/plant/api.md share/man/man1/plant.1 \
   include/plant/compiler.hpp include/plant/derive.hpp include/plant/scene.hpp include/plant/export.hpp \
   include/plant/random.hpp include/plant/physics/world.hpp lib/libplant_lang.a lib/libplant_runtime.a \
@@ -42,6 +43,19 @@ cp "$src/grammars/rose/fig12c.plant" "$tmp/work/"
 cd "$tmp/work" || exit 1
 check "moved install runs a rose" 0 "$p/bin/plant" run fig12c.plant -o rose.glb -o rose.mesh.txt
 same "moved install's rose matches the golden" rose.mesh.txt "$golden"
+
+# plant view from the moved install: it loads the server module from lib/plant/ and serves
+"$p/bin/plant" view fig12c.plant --port 0 >view.out 2>view.err &
+view_pid=$!
+for _ in $(seq 100); do grep -qs "http://" view.out && break; sleep 0.1; done
+url=$(grep -o 'http://127.0.0.1:[0-9]*/' view.out)
+if [ -n "$url" ] && curl -s "${url}api/state" | grep -q '"version"'; then pass=$((pass + 1)); else
+  fail=$((fail + 1))
+  echo "FAIL the moved install's plant view serves"
+  sed 's/^/  /' view.err | head -5
+fi
+kill -INT "$view_pid" 2>/dev/null
+wait "$view_pid"
 
 # the search for a library: -I, then PLANT_PATH, then the install's stdlib, never the source tree
 printf 'import nosuchlib;\naxiom: F;\n' >missing.plant

@@ -29,7 +29,7 @@ contains "package name" "$control" "Package: plant"
 contains "package version" "$control" "Version: $version"
 contains "maintainer" "$control" "Maintainer: "
 contains "description" "$control" "Description: interpreter for the .plant L-system language"
-for lib in libc6 libstdc++6 libfmt9 libedit2 libopenmesh libstb0 libtinygltf; do
+for lib in libc6 libstdc++6 libfmt9 libedit2 libopenmesh libstb0 libtinygltf libcpp-httplib; do
   contains "plant depends on $lib" "$control" "$lib"
 done
 check "dpkg-deb reads plant-dev's control" 0 dpkg-deb -f "$dev" Package Depends
@@ -40,7 +40,7 @@ contains "plant-dev depends on the -dev packages" "$tmp/control-dev.txt" "libfmt
 root=$tmp/root
 check "dpkg -x plant" 0 dpkg -x "$deb" "$root"
 check "dpkg -x plant-dev" 0 dpkg -x "$dev" "$root"
-for f in usr/bin/plant usr/share/plant/stdlib/rose.plant usr/share/plant/stdlib/textures/bark.png \
+for f in usr/bin/plant usr/lib/plant/plant-view-server.so usr/share/plant/stdlib/rose.plant usr/share/plant/stdlib/textures/bark.png \
   usr/share/doc/plant/README.md usr/share/man/man1/plant.1 usr/include/plant/compiler.hpp \
   usr/lib/libplant_runtime.a usr/lib/cmake/plant/plantConfig.cmake; do
   exists "the packages hold $f" "$root/$f"
