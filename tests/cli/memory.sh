@@ -62,6 +62,11 @@ for out in t.svg t.skel.json t.obj; do
   fi
   echo "memory: run -o $out peaked at $((kb / 1024)) MB under --max-memory 256M (exit $rc)"
 done
+# repl: a step past the budget fails, and the session stays at the step before it
+printf ':s 30\n:stats\n' >"$tmp/steps.repl"
+check "repl under --max-memory 64M: the failing line" 1 "$plant" repl --max-memory 64M "$tmp/grow.plant" <"$tmp/steps.repl"
+contains "repl under 64M names the knob" "$tmp/stderr" "the derivation needs more memory than --max-memory 64 MB allows"
+contains "repl under 64M stays at the step before" "$tmp/stdout" "modules, "
 check "bad --max-memory is a usage error" 64 "$plant" derive --max-memory 12X "$tmp/tiny.plant"
 contains "bad --max-memory" "$tmp/stderr" "--max-memory expects a size such as 512M or 4G, found '12X'"
 check "check takes --max-memory" 0 "$plant" check --max-memory 64M "$tmp/tiny.plant"
