@@ -8,6 +8,7 @@
 
 #include "plant/environment_phase.hpp"
 #include "plant/export.hpp"
+#include "plant/memory_budget.hpp"
 
 #include <fmt/format.h>
 
@@ -228,6 +229,8 @@ int run_batch(BatchJob& job) {
     const int jobs =
         static_cast<int>(std::clamp<std::uint64_t>(job.batch.jobs > 0 ? std::uint64_t(job.batch.jobs) : cores,
                                                    1, std::max<std::uint64_t>(plan.shard_size(), 1)));
+    // --max-memory is each variant's budget (docs/batch.md): the process's is that times the jobs
+    memory::set_limit(memory::limit() * static_cast<std::uint64_t>(jobs));
     Programs programs(job, 4 * static_cast<std::size_t>(jobs));
     // the grammar with the first variant's values, before any work: its errors stop the batch
     if (auto first = programs.get(0); !first->program) {

@@ -31,7 +31,6 @@ struct RunCmd {
     int sides = 8;
     bool no_obstacles = false;
     std::string size = "800x800";
-    std::string max_memory;
     bool no_gpu_instancing = false, flatten = false;
     std::optional<std::string> camera, look_at; // as given, even empty
     std::string view = "auto";
@@ -112,9 +111,9 @@ int read_output_options(RunCmd& c, OutputOptions& oo) {
         }
     }
     std::uint64_t max_memory = 0;
-    if (!c.max_memory.empty() && (max_memory = parse_memory(c.max_memory)) == 0) {
+    if (!c.g.max_memory.empty() && (max_memory = parse_memory(c.g.max_memory)) == 0) {
         std::cerr << fmt::format("plant: --max-memory expects a size such as 512M or 4G, found '{}'\n",
-                                 escape_controls(c.max_memory));
+                                 escape_controls(c.g.max_memory));
         return kUsage;
     }
     std::optional<glm::dvec3> camera, look_at;
@@ -170,6 +169,7 @@ int run_main(RunCmd& c) {
     // check the outputs before doing any work
     OutputOptions oo;
     if (int code = read_output_options(c, oo); code != kOk) return code;
+    if (!set_memory_budget(c.g.max_memory)) return kUsage;
     if (c.batch.jobs > 0 && !c.batch.any()) {
         std::cerr << "plant: --jobs runs several variants at once: give --seeds or --grid too\n";
         return kUsage;
@@ -275,11 +275,6 @@ void setup_run(CLI::App& app, int& exit_code) {
                     "PNG: the narrowest branch drawn, in pixels (default 1; 0 lets thin tubes vanish)")
         ->check(CLI::Range(0.0, 100.0))
         ->type_name("PX");
-    cmd->add_option("--max-memory", c->max_memory,
-                    "Memory the run may take, as 512M or 4G: the derivation's string may take half of it, "
-                    "and a run whose meshing and export would need more stops before meshing "
-                    "(default: 8G for the string, half the physical memory for meshing)")
-        ->type_name("SIZE");
     cmd->add_option("--max-triangles", c->max_triangles,
                     "Stop before meshing when the mesh is estimated to have more triangles than this "
                     "(default 20 million, about 3 GB while meshing and a 600 MB .glb)")

@@ -30,6 +30,7 @@ struct ViewModel::Built {
     // An edit at the grammar's last step derives one step more so that it shows: the -n that
     // did, none when the grammar's own length was enough.
     std::optional<int> extended;
+    ViewControls controls; // the page's controls it was made with (its "Save as -D" line)
 };
 
 } // namespace plant::cli

@@ -107,8 +107,10 @@ std::uint64_t ViewModel::rebuild() {
     std::lock_guard build(build_mutex_);
     GrammarOptions g = options_;
     std::set<int> edit_steps; // an edit runs before the step after its own
+    ViewControls controls;
     {
         std::lock_guard lock(mutex_);
+        controls = controls_;
         for (const auto& [name, value] : controls_.params)
             g.defines.push_back(name + "=" + number_text(value));
         if (controls_.seed) g.seed = controls_.seed;
@@ -118,6 +120,7 @@ std::uint64_t ViewModel::rebuild() {
     g.color = false;
     const auto t0 = std::chrono::steady_clock::now();
     auto b = std::make_unique<Built>();
+    b->controls = std::move(controls);
     b->sources = std::make_unique<SourceManager>();
     std::string messages;
     int exit_code = kOk;
@@ -207,12 +210,15 @@ std::string ViewModel::state_json() const {
         j["edit_methods"] = view_edit_methods(*good_->program);
         j["derive_ms"] = derive_ms_;
     }
-    // the command line that grows what is shown
+    // the command line that grows what is shown: the controls of the plant shown, never values
+    // whose derivation failed (a param outside its range); a -D the controls override is left out
+    const ViewControls& shown = good_ ? good_->controls : controls_;
     std::string cmd = "plant run " + options_.file;
-    for (const auto& d : options_.defines) cmd += " -D " + d;
-    for (const auto& [name, value] : controls_.params) cmd += " -D " + name + "=" + number_text(value);
-    if (controls_.seed)
-        cmd += fmt::format(" --seed {}", *controls_.seed);
+    for (const auto& d : options_.defines)
+        if (!shown.params.count(d.substr(0, d.find('=')))) cmd += " -D " + d;
+    for (const auto& [name, value] : shown.params) cmd += " -D " + name + "=" + number_text(value);
+    if (shown.seed)
+        cmd += fmt::format(" --seed {}", *shown.seed);
     else if (options_.seed)
         cmd += fmt::format(" --seed {}", *options_.seed);
     if (good_ && good_->extended)

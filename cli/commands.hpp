@@ -34,6 +34,7 @@ struct GrammarOptions {
     int threads = 0; // 0: one per core
     std::size_t max_modules = 50'000'000;
     std::uint64_t max_steps = kDefaultMaxSteps; // instructions one evaluation may run
+    std::string max_memory;                     // --max-memory SIZE as given; empty: default_max_memory()
     bool color = false;
     // --edits FILE: the decomposition graph's edits (docs/language.md, decomposition graphs);
     // empty: the grammar's `edits "file";`, if any.
@@ -48,6 +49,13 @@ struct GrammarOptions {
 std::uint64_t parse_count(const std::string& option, const std::string& text, std::uint64_t lowest);
 
 void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation);
+
+// --max-memory SIZE, on every command that compiles a grammar: the memory budget
+// (plant/memory_budget.hpp).
+void add_max_memory(CLI::App& cmd, std::string& size);
+// Sets the process's memory budget from --max-memory (default_max_memory() when not given).
+// False, having said why on standard error, when SIZE is not a size (a usage error).
+bool set_memory_budget(const std::string& size);
 
 // --allow-read DIR (repeatable), on every command that compiles a grammar.
 void add_allow_read(CLI::App& cmd, std::vector<std::string>& dirs);

@@ -1,6 +1,8 @@
 #include "commands.hpp"
+#include "outputs.hpp"
 
 #include "plant/environments.hpp"
+#include "plant/memory_budget.hpp"
 
 #include <fmt/format.h>
 
@@ -48,7 +50,39 @@ void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation) {
                        "instructions, the functions it calls included (default {})",
                        kDefaultMaxSteps))
         ->type_name("N");
+    add_max_memory(cmd, o.max_memory);
+    // the same param set twice on one command line is a usage error, not "the last one wins"
+    cmd.parse_complete_callback([&o] {
+        for (std::size_t k = 0; k < o.defines.size(); ++k)
+            for (std::size_t j = 0; j < k; ++j) {
+                const std::string name = o.defines[k].substr(0, o.defines[k].find('='));
+                if (!name.empty() && o.defines[j].substr(0, o.defines[j].find('=')) == name)
+                    throw CLI::ValidationError(fmt::format(
+                        "-D sets {} twice, to '{}' and to '{}': keep one of them", escape_controls(name),
+                        escape_controls(o.defines[j]), escape_controls(o.defines[k])));
+            }
+    });
     o.color = isatty(2) != 0 && std::getenv("NO_COLOR") == nullptr;
+}
+
+void add_max_memory(CLI::App& cmd, std::string& size) {
+    cmd.add_option("--max-memory", size,
+                   "Memory the command may take, as 512M or 4G (default: half the physical memory): "
+                   "the derivation's strings and tables, the skeleton, the mesh, the physics and the "
+                   "export buffers are charged against it before they are allocated, and a stage that "
+                   "would pass it stops with an error (exit 70)")
+        ->type_name("SIZE");
+}
+
+bool set_memory_budget(const std::string& size) {
+    std::uint64_t bytes = default_max_memory();
+    if (!size.empty() && (bytes = parse_memory(size)) == 0) {
+        std::cerr << fmt::format("plant: --max-memory expects a size such as 512M or 4G, found '{}'\n",
+                                 escape_controls(size));
+        return false;
+    }
+    memory::set_limit(bytes);
+    return true;
 }
 
 void add_allow_read(CLI::App& cmd, std::vector<std::string>& dirs) {
@@ -107,7 +141,15 @@ std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& so
     if (!o.appended.empty()) text += "\n" + o.appended;
     Diagnostics diags;
     std::uint32_t id = sources.add(o.file, std::move(text));
-    auto program = compile_source(sources, id, co, diags);
+    std::unique_ptr<Program> program;
+    try {
+        program = compile_source(sources, id, co, diags);
+    } catch (const RuntimeError& e) { // an environment made while compiling is past --max-memory
+        out += render_all(diags, sources, o.color);
+        out += render(Diagnostic{Severity::Error, e.span, e.message, {}}, sources, o.color);
+        exit_code = kRuntime;
+        return nullptr;
+    }
     out += render_all(diags, sources, o.color);
     if (diags.error_count() > diags.all().size())
         out += fmt::format("plant: {} more errors not shown\n", diags.error_count() - diags.all().size());
@@ -152,6 +194,10 @@ DeriveOptions derive_options(const GrammarOptions& o) {
         o.threads > 0 ? o.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     d.max_modules = o.max_modules;
     d.max_steps = o.max_steps;
+    // the strings' estimate (rewrite/engine.cpp) takes half of --max-memory: a step holds the
+    // string it reads and the one it writes
+    if (const std::uint64_t budget = o.max_memory.empty() ? 0 : parse_memory(o.max_memory))
+        d.max_bytes = std::min<std::uint64_t>(d.max_bytes, budget / 2);
     return d;
 }
 

@@ -45,6 +45,9 @@ int main(int argc, char** argv) {
         std::cerr << "plant: " << plant::escape_controls(e.what(), true) << "\n"
                   << "Run 'plant " << (which.empty() ? "" : which + " ") << "--help' for usage.\n";
         return kUsage;
+    } catch (const plant::RuntimeError& e) { // one no command caught (a memory budget refused)
+        std::cerr << "plant: error: " << plant::escape_controls(e.message, true) << "\n";
+        return kRuntime;
     } catch (const std::bad_alloc&) {
         std::cerr << "plant: out of memory (lower --max-modules or the derivation length)\n";
         return kRuntime;

@@ -6,6 +6,7 @@
 
 #include "plant/export.hpp"
 #include "plant/export_text.hpp"
+#include "plant/memory_budget.hpp"
 #include "plant/mesh.hpp"
 
 #include <fmt/format.h>
@@ -216,21 +217,42 @@ std::uint64_t parse_memory(const std::string& text) {
 
 // Before meshing: every skeleton point becomes a ring of sides + 1 vertices (position, normal,
 // texture coordinate: 32 bytes) and 2 * sides triangles (12 bytes each); the scene, its export
-// copy and the exporter's own buffers hold it about three times over. Stops with a Memory error
-// naming --max-memory when that passes the budget.
-static void check_mesh_memory(const Skeleton& skeleton, const OutputOptions& options) {
+// copy and the exporter's own buffers hold it about three times over. The scene's two copies are
+// charged against --max-memory for as long as the scene lives (`scene_memory`), the third by each
+// file as it is written (the bytes returned). Stops with a Memory error naming --max-memory when
+// the budget does not have room for all three beside what the run holds already.
+static double reserve_mesh_memory(const Skeleton& skeleton, const OutputOptions& options,
+                                  memory::Reservation& scene_memory) {
     std::uint64_t points = 0;
     for (const auto& a : skeleton.axes) points += a.points.size();
     const std::uint64_t sides = static_cast<std::uint64_t>(std::max(options.sides, 3));
-    const double bytes = 3.0 * double(points) * double((sides + 1) * 32 + 2 * sides * 12) +
-                         256.0 * double(skeleton.organs.size());
-    const std::uint64_t budget = options.max_memory ? options.max_memory : default_max_memory();
-    if (bytes > double(budget))
+    const double copy =
+        double(points) * double((sides + 1) * 32 + 2 * sides * 12) + 256.0 * double(skeleton.organs.size());
+    const double budget = double(memory::limit()      ? memory::limit()
+                                 : options.max_memory ? options.max_memory
+                                                      : default_max_memory());
+    const double held = memory::limit() ? double(memory::charged()) : 0.0;
+    if (3 * copy > budget - held)
         throw RuntimeError(RuntimeErrorKind::Memory, Span{},
                            fmt::format("meshing would take about {:.1f} GB ({} skeleton points, {} sides a "
-                                       "ring) but --max-memory allows {:.1f} GB: lower --sides or the "
-                                       "derivation length, or raise --max-memory",
-                                       bytes / 1e9, points, sides, double(budget) / 1e9));
+                                       "ring) but --max-memory allows {:.1f} GB, {:.1f} GB of it held by "
+                                       "the string and skeleton: lower --sides or the derivation length, "
+                                       "or raise --max-memory",
+                                       3 * copy / 1e9, points, sides, budget / 1e9, held / 1e9));
+    scene_memory.resize(static_cast<std::size_t>(2 * copy));
+    return copy;
+}
+
+// What writing one file may hold in memory besides the scene: a third copy of the mesh for
+// formats made from it; the text for the others, from what plant run wrote for a 1-million-point
+// skeleton (.skel.json about 410 bytes a point, SVG about 180, rounded up for the text growing),
+// and for the string about 4 bytes a module and 24 a parameter.
+static std::size_t writing_bytes(const OutputFormat& f, const Derivation& d, double mesh_copy,
+                                 std::uint64_t skeleton_points) {
+    if (f.needs == OutputNeeds::Scene) return static_cast<std::size_t>(mesh_copy);
+    if (f.needs == OutputNeeds::Skeleton)
+        return static_cast<std::size_t>(skeleton_points * (f.bytes == skeleton_json_bytes ? 480 : 224));
+    return d.string().size() * 4 + d.string().params.size() * 24;
 }
 
 // Before meshing: the triangles the tubes will have (2 * sides per segment, a fifth more for the
@@ -264,7 +286,7 @@ static void check_triangles(const Skeleton& skeleton, const OutputOptions& optio
 // million vertices): OBJ and PLY peaked at 250 bytes a vertex, the --flatten GLB at 180; the
 // figures below leave room for the text buffer doubling as it grows (up to three times the file
 // while it is copied). Each drawn placement is one more transform in the flattened scene. Only for
-// scenes with placed instances: a plain scene's cost is what check_mesh_memory counted.
+// scenes with placed instances: a plain scene's cost is what reserve_mesh_memory counted.
 static void check_drawn_out_memory(const Scene& scene, const std::vector<std::string>& paths,
                                    const std::vector<const OutputFormat*>& formats,
                                    const OutputOptions& options) {
@@ -345,10 +367,13 @@ OutputSummary write_outputs(const Program& program, const Derivation& d,
         need_skeleton = need_skeleton || f->needs != OutputNeeds::String;
         need_scene = need_scene || f->needs == OutputNeeds::Scene;
     }
+    memory::Reservation scene_memory; // declared before the scene: released after it is freed
+    double mesh_copy = 0;
     Skeleton skeleton;
     Scene scene;
     if (need_skeleton && options.progress) options.progress("interpreting the string");
     if (need_skeleton) {
+        memory::Stage stage("interpreting the string");
         // without interpretation rules the turtle reads the string itself, not a copy of it
         if (program.interpret.empty())
             skeleton = build_skeleton(program, d.string(), turtle_options(d));
@@ -359,7 +384,8 @@ OutputSummary write_outputs(const Program& program, const Derivation& d,
     if (need_skeleton && !need_scene && program.instances)
         for (const auto& p : paths) need_scene = need_scene || format_of(p)->bytes == skeleton_json_bytes;
     if (need_scene) {
-        check_mesh_memory(skeleton, options);
+        memory::Stage stage("meshing");
+        mesh_copy = reserve_mesh_memory(skeleton, options, scene_memory);
         check_triangles(skeleton, options);
         MeshOptions mo;
         mo.sides = options.sides;
@@ -370,6 +396,7 @@ OutputSummary write_outputs(const Program& program, const Derivation& d,
         scene = build_scene(program, skeleton, mo);
         if (options.obstacles) add_environments(d.run_state(), scene);
         check_drawn_out_memory(scene, paths, formats, options);
+        memory::check_resident();
     }
     // All or nothing across the run: every file is written under a temporary name beside its
     // target, and only when all are written are they renamed (PendingFiles removes them on an
@@ -384,14 +411,19 @@ OutputSummary write_outputs(const Program& program, const Derivation& d,
         }
     PendingFiles pending(targets);
     const OutputSources from{program, d, skeleton, scene, options};
+    std::uint64_t skeleton_points = 0;
+    for (const auto& a : skeleton.axes) skeleton_points += a.points.size();
     for (std::size_t k = 0; k < formats.size(); ++k) {
         if (options.progress)
             options.progress(
                 fmt::format("writing {} ({} of {})", escape_controls(paths[k]), k + 1, formats.size()));
+        memory::Stage stage(fmt::format("writing '{}'", escape_controls(paths[k])));
+        memory::Reservation buffer(writing_bytes(*formats[k], d, mesh_copy, skeleton_points));
         if (const auto stream = formats[k]->stream)
             pending.write_with(k, [&](const ByteSink& sink) { stream(from, paths[k], sink); });
         else
             pending.write(k, formats[k]->bytes(from, paths[k]));
+        memory::check_resident();
     }
     for (std::size_t j = 0; j < sidecar_of.size(); ++j)
         pending.write(paths.size() + j, formats[sidecar_of[j]]->sidecar_bytes(from, paths[sidecar_of[j]]));

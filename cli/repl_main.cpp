@@ -179,6 +179,7 @@ void setup_repl(CLI::App& app, int& exit_code) {
     auto file = std::make_shared<std::string>();
     auto max_steps = std::make_shared<std::uint64_t>(kDefaultMaxSteps);
     auto max_modules = std::make_shared<std::size_t>(0);
+    auto max_memory = std::make_shared<std::string>();
     CLI::App* cmd =
         app.add_subcommand("repl", "An interactive session: step a derivation, inspect the string, change "
                                    "rules and params, look at the plant");
@@ -196,9 +197,14 @@ void setup_repl(CLI::App& app, int& exit_code) {
                     "Stop a step with an error when the string grows past this many modules (the session "
                     "stays at the step before)")
         ->check(CLI::PositiveNumber);
+    add_max_memory(*cmd, *max_memory);
     cmd->footer("Reads commands from standard input without a prompt when it is not a terminal:\n"
                 "  plant repl grammar.plant < script");
-    cmd->callback([file, allow, max_steps, max_modules, &exit_code] {
+    cmd->callback([file, allow, max_steps, max_modules, max_memory, &exit_code] {
+        if (!set_memory_budget(*max_memory)) {
+            exit_code = kUsage;
+            return;
+        }
         exit_code =
             repl_main(*file, isatty(2) != 0 && !std::getenv("NO_COLOR"), *allow, *max_steps, *max_modules);
     });

@@ -266,6 +266,9 @@ void Compiler::compile_environment(const ast::ShapeDecl& s) {
     } catch (const InputError& e) { // a file it reads (a mesh) is unreadable or malformed
         diags_->input_error(s.kind_span, e.message);
         return;
+    } catch (RuntimeError& e) { // its particles do not fit in --max-memory: a runtime error still
+        if (!e.span.valid()) e.span = s.kind_span;
+        throw;
     }
     if (!env) {
         diags_->error(s.kind_span,

@@ -4,6 +4,7 @@
 // rewrite/engine.cpp), then hooks again.
 #include "plant/derive.hpp"
 #include "plant/environment.hpp"
+#include "plant/memory_budget.hpp"
 
 #include "plant/streams.hpp"
 #include "plant/vm.hpp"
@@ -28,6 +29,10 @@ bool observes_identities(const Program& p) {
         if (reads_queries(p, g)) return true;
     return false;
 }
+
+// What a step's tables take a module, besides the strings: 4 bytes of bracket table, 2 of the
+// symbol kernel's keys, 2 to spare for the workers' match tables.
+constexpr std::size_t kTableBytesPerModule = 8;
 
 double now_ms() {
     using namespace std::chrono;
@@ -193,6 +198,10 @@ bool Derivation::step() {
     ModuleString next(std::move(engine_->spare));
     ++step_;
     try {
+        // the tables the engine keeps beside the strings for a step (the bracket table, the symbol
+        // kernel's keys, the workers' match tables), charged against --max-memory before the
+        // rewrite (the strings charge for themselves, see big_allocator.hpp)
+        memory::Reservation tables(current_.size() * kTableBytesPerModule);
         engine_->rewrite(*this, current_, next, plan, stream::step(step_), step_);
         commit_graph();
         current_.swap(next);
@@ -203,6 +212,7 @@ bool Derivation::step() {
         engine_->decompose(*this, current_, step_);
         commit_graph();
         Engine::apply_cut(prog_, current_);
+        memory::check_resident(); // the backstop, for what no charge saw
     } catch (RuntimeError& e) {
         e.at_step(step_);
         throw;

@@ -191,7 +191,9 @@ struct assign_stmt : seq<name, assign_op, must<expr>, must<semi>> {};
 struct if_stmt;
 struct else_part : if_must<kw_else, sor<if_stmt, block>> {};
 struct if_stmt : if_must<kw_if, expr, block, opt<else_part>> {};
-struct range_dots : pad<string<'.', '.'>> {};
+// "0...2" would read as 0 .. .2 (a number may start with '.'): a third dot is an error
+struct no_third_dot : not_at<one<'.'>> {};
+struct range_dots : pad<seq<string<'.', '.'>, must<no_third_dot>>> {};
 struct for_stmt : if_must<kw_for, name, kw_in, expr, range_dots, expr, block> {};
 struct produce_stmt : if_must<kw_produce, successor, semi> {};
 struct nproduce_stmt : if_must<kw_nproduce, successor, semi> {};

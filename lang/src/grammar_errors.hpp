@@ -44,6 +44,8 @@ PLANT_ERR(statement, "expected a statement");
 PLANT_ERR(if_stmt, "expected 'if' or '{' after 'else'");
 PLANT_ERR(kw_in, "expected 'in' after the loop variable");
 PLANT_ERR(range_dots, "expected '..' between the bounds of the range");
+// habits::hint adds what "0...2" would read as
+PLANT_ERR(no_third_dot, "expected the range's end after '..'");
 PLANT_ERR(module_decl, "expected a module name");
 PLANT_ERR(param_decl, "expected a parameter name");
 PLANT_ERR(param_list, "expected '(' and the parameter list");

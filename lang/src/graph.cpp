@@ -68,13 +68,23 @@ double NodeValue::at(double t) const {
 DecompositionGraph::DecompositionGraph(const GraphDecl& decl, std::shared_ptr<const GraphEdits> edits,
                                        std::size_t max_bytes)
     : decl_(&decl), edits_(std::move(edits)), max_bytes_(max_bytes) {
+    // the shares by level, in file order within a level: a node finds its level's by binary search
+    if (edits_)
+        for (std::size_t k = 0; k < edits_->edits.size(); ++k)
+            if (edits_->edits[k].share) shares_.push_back(static_cast<int>(k));
+    std::stable_sort(shares_.begin(), shares_.end(), [&](int a, int b) {
+        return edits_->edits[static_cast<std::size_t>(a)].level <
+               edits_->edits[static_cast<std::size_t>(b)].level;
+    });
     add_node(kRoot, -1, 0, 0);
-    resolve();
+    resolve(0);
 }
 
 DecompositionGraph::DecompositionGraph(const DecompositionGraph& other)
     : decl_(other.decl_), edits_(other.edits_), nodes_(other.nodes_), by_handle_(other.by_handle_),
-      values_(other.values_), matches_(other.matches_), max_bytes_(other.max_bytes_) {
+      values_(other.values_), matches_(other.matches_), shares_(other.shares_),
+      level_first_(other.level_first_), comparisons_(other.comparisons_), resolved_(other.resolved_),
+      max_bytes_(other.max_bytes_) {
     std::lock_guard lock(*other.pending_mutex_);
     pending_ = other.pending_;
 }
@@ -147,6 +157,7 @@ void DecompositionGraph::add_node(std::uint64_t handle, int parent, double posit
                         excerpt(path(parent), 80))};
     const int k = static_cast<int>(nodes_.size());
     by_handle_[handle] = k;
+    if (static_cast<std::size_t>(n.depth) == level_first_.size()) level_first_.push_back(k);
     nodes_.push_back(std::move(n));
     // (commit sorts each parent's children once, after adding a pass's nodes)
     if (parent >= 0) nodes_[static_cast<std::size_t>(parent)].children.push_back(k);
@@ -160,6 +171,7 @@ void DecompositionGraph::commit() {
         fresh.assign(pending_.begin(), pending_.end());
         pending_.clear();
     }
+    const std::size_t before = nodes_.size();
     if (nodes_.size() + fresh.size() > kMaxNodes)
         throw RuntimeError{RuntimeErrorKind::General, Span{},
                            fmt::format("the decomposition graph would have more than {} nodes", kMaxNodes)};
@@ -241,99 +253,22 @@ void DecompositionGraph::commit() {
     std::sort(touched.begin(), touched.end());
     touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
     for (int t : touched) {
-        auto& siblings = nodes_[static_cast<std::size_t>(t)].children;
-        std::sort(siblings.begin(), siblings.end(), [&](int a, int b) {
+        GraphNode& parent = nodes_[static_cast<std::size_t>(t)];
+        std::sort(parent.children.begin(), parent.children.end(), [&](int a, int b) {
             const GraphNode &x = nodes_[static_cast<std::size_t>(a)],
                             &y = nodes_[static_cast<std::size_t>(b)];
             return x.position != y.position ? x.position < y.position : x.index < y.index;
         });
+        parent.by_index = parent.children;
+        std::stable_sort(parent.by_index.begin(), parent.by_index.end(), [&](int a, int b) {
+            return nodes_[static_cast<std::size_t>(a)].index < nodes_[static_cast<std::size_t>(b)].index;
+        });
     }
-    resolve();
+    resolve(before);
 }
 
-std::string DecompositionGraph::path(int node, bool with_ranges) const {
-    if (node <= 0) return "/";
-    std::vector<int> chain;
-    for (int k = node; k > 0; k = nodes_[static_cast<std::size_t>(k)].parent) chain.push_back(k);
-    std::string out;
-    for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
-        const GraphNode& n = nodes_[static_cast<std::size_t>(*it)];
-        out += "/" + format_double(n.position);
-        if (n.index != 0) out += fmt::format("#{}", n.index);
-        if (!with_ranges) continue;
-        // halfway to the neighbouring siblings of the same index; 0 or 1 at an end
-        double lo = 0, hi = 1;
-        for (int s : nodes_[static_cast<std::size_t>(n.parent)].children) {
-            const GraphNode& o = nodes_[static_cast<std::size_t>(s)];
-            if (o.index != n.index || s == *it) continue;
-            if (o.position < n.position) lo = std::max(lo, (o.position + n.position) / 2);
-            if (o.position > n.position) hi = std::min(hi, (o.position + n.position) / 2);
-        }
-        // to 9 decimals (0.3, not 0.30000000000000004), but never narrower than the range by more
-        // than rounding noise: the written range must still hold the node's own position
-        auto outward = [](double x, bool up) {
-            const double r = std::round(x * 1e9) / 1e9;
-            if (up ? r < x - 1e-12 : r > x + 1e-12)
-                return (up ? std::ceil(x * 1e9) : std::floor(x * 1e9)) / 1e9;
-            return r;
-        };
-        out += "[" + format_double(outward(lo, false)) + ".." + format_double(outward(hi, true)) + "]";
-    }
-    return out;
-}
-
-// The node an edit's path names now: each component picks, among the children of the same index,
-// the one at its exact position or (range matching) the one in its range nearest its centre.
-int DecompositionGraph::match(const GraphEdit& e) const {
-    int cur = 0;
-    for (const EditStep& step : e.path) {
-        int best = -1;
-        double best_d = 0;
-        const bool ranged = step.ranged && decl_->match == GraphMatch::Range;
-        for (int c : nodes_[static_cast<std::size_t>(cur)].children) {
-            const GraphNode& n = nodes_[static_cast<std::size_t>(c)];
-            if (n.index != step.index) continue;
-            if (!ranged) {
-                if (std::fabs(n.position - step.position) <= kSamePosition) {
-                    best = c;
-                    break;
-                }
-                continue;
-            }
-            if (n.position < step.lo - kSamePosition || n.position > step.hi + kSamePosition) continue;
-            const double d = std::fabs(n.position - (step.lo + step.hi) / 2);
-            if (best < 0 || d < best_d - kSamePosition) { // ties: the lower position (children are sorted)
-                best = c;
-                best_d = d;
-            }
-        }
-        if (best < 0) return -1;
-        cur = best;
-    }
-    return cur;
-}
-
-bool DecompositionGraph::orphaned(std::size_t k) const {
-    if (!edits_ || k >= edits_->edits.size() || matches_[k] >= 0) return false;
-    const GraphEdit& e = edits_->edits[k];
-    if (e.share) return false;
-    GraphEdit prefix = e;
-    for (std::size_t n = 0; n < e.path.size(); ++n) {
-        prefix.path.assign(e.path.begin(), e.path.begin() + static_cast<std::ptrdiff_t>(n));
-        const int at = match(prefix);
-        prefix.path.push_back(e.path[n]);
-        if (at >= 0 && match(prefix) < 0) {
-            for (int c : nodes_[static_cast<std::size_t>(at)].children)
-                if (nodes_[static_cast<std::size_t>(c)].index == e.path[n].index) return true;
-            return false;
-        }
-    }
-    return false;
-}
-
-namespace {
 // A node's own setting of one parameter, before inheritance.
-struct Local {
+struct DecompositionGraph::Local {
     ValueStatus status = ValueStatus::Inherited;
     bool is_private = false;
     double number = 0;
@@ -342,7 +277,8 @@ struct Local {
     int edit = -1;
 };
 
-void apply(Local& l, const GraphEdit& e, int k) {
+namespace {
+void apply(DecompositionGraph::Local& l, const GraphEdit& e, int k) {
     switch (e.op) {
     case EditOp::Set:
         l.status = e.share ? ValueStatus::Shared : ValueStatus::Explicit;
@@ -370,100 +306,142 @@ void apply(Local& l, const GraphEdit& e, int k) {
 }
 } // namespace
 
-void DecompositionGraph::resolve() {
-    const std::size_t P = decl_->params.size(), N = nodes_.size();
-    std::vector<Local> local(N * P);
-    for (std::size_t p = 0; p < P; ++p) {
-        local[p].status = ValueStatus::Explicit;
-        local[p].number = decl_->params[p].number;
-        local[p].curve = decl_->params[p].curve.get();
-        local[p].silhouette = decl_->params[p].silhouette;
-    }
+// A commit resolves only what it can change: the new nodes, and the nodes whose edits now match
+// differently (a new sibling can take a range's edit), each with its subtree, since a value
+// depends only on the node's own edits and its ancestors' values. The other nodes keep theirs.
+void DecompositionGraph::resolve(std::size_t before) {
+    const std::size_t N = nodes_.size(), P = decl_->params.size();
     const std::size_t E = edits_ ? edits_->edits.size() : 0;
-    matches_.assign(E, -1);
-    // shares first, then the node edits (which override a share on their node), each in file order
-    for (int pass = 0; pass < 2; ++pass) {
-        for (std::size_t k = 0; k < E; ++k) {
-            const GraphEdit& e = edits_->edits[k];
-            if (e.share != (pass == 0)) continue;
-            const auto p = static_cast<std::size_t>(e.param);
-            if (e.share) {
-                for (std::size_t n = 0; n < N; ++n) {
-                    if (nodes_[n].depth != e.level) continue;
-                    if (matches_[k] < 0) matches_[k] = static_cast<int>(n);
-                    apply(local[n * P + p], e, static_cast<int>(k));
-                }
-                continue;
-            }
-            const int m = match(e);
-            matches_[k] = m;
-            if (m >= 0) apply(local[static_cast<std::size_t>(m) * P + p], e, static_cast<int>(k));
+    before = std::min(before, N);
+    std::vector<char> dirty(N, 0);
+    std::fill(dirty.begin() + static_cast<std::ptrdiff_t>(before), dirty.end(), 1);
+    std::vector<int> matches(E, -1);
+    std::vector<std::pair<int, int>> by_node; // (node, node edit), file order within a node
+    for (std::size_t k = 0; k < E; ++k) {
+        const GraphEdit& e = edits_->edits[k];
+        if (e.share) { // its level's first node (the share applies to the whole level)
+            const auto level = static_cast<std::size_t>(e.level);
+            matches[k] = level < level_first_.size() ? level_first_[level] : -1;
+            continue;
         }
+        const int m = match(e), was = k < matches_.size() ? matches_[k] : -1;
+        matches[k] = m;
+        if (m != was) {
+            if (was >= 0) dirty[static_cast<std::size_t>(was)] = 1;
+            if (m >= 0) dirty[static_cast<std::size_t>(m)] = 1;
+        }
+        if (m >= 0) by_node.emplace_back(m, static_cast<int>(k));
     }
-    // parents come before their children in nodes_, so one pass resolves everything; a node whose
-    // silhouettes and parent's placements are as at the last commit keeps its placements
-    std::vector<NodeValue> previous(N * P);
-    previous.swap(values_);
-    const std::size_t before = std::min(previous.size() / std::max<std::size_t>(P, 1), N);
-    std::vector<char> same(N, 0);
-    std::vector<int> source(N * P); // the node whose value this node's children inherit
+    matches_ = std::move(matches);
+    std::stable_sort(by_node.begin(), by_node.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    // parents come before their children in nodes_: one pass marks the subtrees and resolves them
+    for (std::size_t n = 1; n < before; ++n)
+        if (dirty[static_cast<std::size_t>(nodes_[n].parent)]) dirty[n] = 1;
+    values_.resize(N * P);
+    std::vector<char> moved(N, 0); // placements computed anew in this call
+    std::vector<NodeValue> previous;
+    std::vector<Local> local;
     for (std::size_t n = 0; n < N; ++n) {
-        const int parent = nodes_[n].parent;
+        if (!dirty[n]) continue;
+        previous.clear();
+        if (n < before)
+            previous.assign(values_.begin() + static_cast<std::ptrdiff_t>(n * P),
+                            values_.begin() + static_cast<std::ptrdiff_t>((n + 1) * P));
+        resolve_node(n, by_node, local);
+        place(n, previous, moved);
+    }
+}
+
+int DecompositionGraph::source(int node, std::size_t p) const {
+    const std::size_t P = decl_->params.size();
+    while (values_[static_cast<std::size_t>(node) * P + p].is_private) // (never the root's)
+        node = nodes_[static_cast<std::size_t>(node)].parent;
+    return node;
+}
+
+// Node n's values from its own edits (the shares of its level, then its node edits, each in file
+// order) and the values it inherits (sections 2.1 and 2.2).
+void DecompositionGraph::resolve_node(std::size_t n, const std::vector<std::pair<int, int>>& by_node,
+                                      std::vector<Local>& local) {
+    const std::size_t P = decl_->params.size();
+    const GraphNode& node = nodes_[n];
+    local.assign(P, Local{});
+    if (n == 0) // the root: the graph block's values, explicit
         for (std::size_t p = 0; p < P; ++p) {
-            const Local& l = local[n * P + p];
-            NodeValue& v = values_[n * P + p];
-            v.status = l.status;
-            v.is_private = n > 0 && l.is_private; // the root's are always public
-            v.edit = l.edit;
-            source[n * P + p] =
-                v.is_private ? source[static_cast<std::size_t>(parent) * P + p] : static_cast<int>(n);
-            const bool own = l.status == ValueStatus::Explicit || l.status == ValueStatus::Shared;
-            if (own || parent < 0) {
-                v.from = static_cast<int>(n);
-                v.number = l.number;
-                if (l.curve) v.curve = {CurveTerm{EditOp::Set, l.curve}};
-                v.silhouette = l.silhouette;
-                continue;
-            }
-            const int from = source[static_cast<std::size_t>(parent) * P + p];
-            const NodeValue& inherited = values_[static_cast<std::size_t>(from) * P + p];
-            // where the value was last set: past ancestors that inherited it themselves
-            v.from = inherited.status == ValueStatus::Inherited ? inherited.from : from;
-            v.number = inherited.number;
-            v.curve = inherited.curve;
-            v.silhouette = inherited.silhouette; // (a silhouette is never relative)
-            if (l.status == ValueStatus::Offset) {
-                v.number += l.number;
-                if (l.curve) v.curve.push_back({EditOp::Offset, l.curve});
-            } else if (l.status == ValueStatus::Fraction) {
-                v.number *= l.number;
-                if (l.curve) v.curve.push_back({EditOp::Fraction, l.curve});
-            }
-            if (!std::isfinite(v.number)) // e.g. `length *= 1e200` on a node that inherits another
-                throw RuntimeError{
-                    RuntimeErrorKind::Arithmetic,
-                    l.edit >= 0 ? edits_->edits[static_cast<std::size_t>(l.edit)].span : Span{},
-                    fmt::format("'{}' at {} is not a finite number ({}) after this edit",
-                                decl_->params[p].name, path(static_cast<int>(n)), format_double(v.number))};
+            local[p].status = ValueStatus::Explicit;
+            local[p].number = decl_->params[p].number;
+            local[p].curve = decl_->params[p].curve.get();
+            local[p].silhouette = decl_->params[p].silhouette;
         }
-        place(n, previous, before, same);
+    auto level = [&](int k) { return edits_->edits[static_cast<std::size_t>(k)].level; };
+    auto share = std::lower_bound(shares_.begin(), shares_.end(), node.depth,
+                                  [&](int k, int depth) { return level(k) < depth; });
+    for (; share != shares_.end() && level(*share) == node.depth; ++share) {
+        const GraphEdit& e = edits_->edits[static_cast<std::size_t>(*share)];
+        apply(local[static_cast<std::size_t>(e.param)], e, *share);
+    }
+    auto edit = std::lower_bound(by_node.begin(), by_node.end(), static_cast<int>(n),
+                                 [](const auto& a, int m) { return a.first < m; });
+    for (; edit != by_node.end() && edit->first == static_cast<int>(n); ++edit) {
+        const GraphEdit& e = edits_->edits[static_cast<std::size_t>(edit->second)];
+        apply(local[static_cast<std::size_t>(e.param)], e, edit->second);
+    }
+    resolved_ += P;
+    const int parent = node.parent;
+    for (std::size_t p = 0; p < P; ++p) {
+        const Local& l = local[p];
+        NodeValue v;
+        v.status = l.status;
+        v.is_private = n > 0 && l.is_private; // the root's are always public
+        v.edit = l.edit;
+        const bool own = l.status == ValueStatus::Explicit || l.status == ValueStatus::Shared;
+        if (own || parent < 0) {
+            v.from = static_cast<int>(n);
+            v.number = l.number;
+            if (l.curve) v.curve = {CurveTerm{EditOp::Set, l.curve}};
+            v.silhouette = l.silhouette;
+            values_[n * P + p] = std::move(v);
+            continue;
+        }
+        const int from = source(parent, p);
+        const NodeValue& inherited = values_[static_cast<std::size_t>(from) * P + p];
+        // where the value was last set: past ancestors that inherited it themselves
+        v.from = inherited.status == ValueStatus::Inherited ? inherited.from : from;
+        v.number = inherited.number;
+        v.curve = inherited.curve;
+        v.silhouette = inherited.silhouette; // (a silhouette is never relative)
+        if (l.status == ValueStatus::Offset) {
+            v.number += l.number;
+            if (l.curve) v.curve.push_back({EditOp::Offset, l.curve});
+        } else if (l.status == ValueStatus::Fraction) {
+            v.number *= l.number;
+            if (l.curve) v.curve.push_back({EditOp::Fraction, l.curve});
+        }
+        if (!std::isfinite(v.number)) // e.g. `length *= 1e200` on a node that inherits another
+            throw RuntimeError{RuntimeErrorKind::Arithmetic,
+                               l.edit >= 0 ? edits_->edits[static_cast<std::size_t>(l.edit)].span : Span{},
+                               fmt::format("'{}' at {} is not a finite number ({}) after this edit",
+                                           decl_->params[p].name, path(static_cast<int>(n)),
+                                           format_double(v.number))};
+        values_[n * P + p] = std::move(v);
     }
 }
 
 // Places node n's silhouettes (Boudon et al. 2003, section 3, Fig. 8): the root's are in world
 // coordinates; a node made by child(n, pos, index, base, dir) has B at base, BT along dir and T on
 // its parent's envelope of the same parameter; any other node keeps its parent's placement.
-void DecompositionGraph::place(std::size_t n, const std::vector<NodeValue>& previous, std::size_t before,
-                               std::vector<char>& same) {
+void DecompositionGraph::place(std::size_t n, const std::vector<NodeValue>& previous,
+                               std::vector<char>& moved) {
     const std::size_t P = decl_->params.size();
     const GraphNode& node = nodes_[n];
     // unchanged since the last commit: the same silhouettes here and an unchanged parent
-    bool keep = n < before && (node.parent < 0 || same[static_cast<std::size_t>(node.parent)]);
+    bool keep = !previous.empty() && (node.parent < 0 || !moved[static_cast<std::size_t>(node.parent)]);
     for (std::size_t p = 0; p < P && keep; ++p)
-        keep = previous[n * P + p].silhouette == values_[n * P + p].silhouette;
-    same[n] = keep;
+        keep = previous[p].silhouette == values_[n * P + p].silhouette;
+    moved[n] = !keep;
     if (keep) {
-        for (std::size_t p = 0; p < P; ++p) values_[n * P + p].placement = previous[n * P + p].placement;
+        for (std::size_t p = 0; p < P; ++p) values_[n * P + p].placement = previous[p].placement;
         return;
     }
     for (std::size_t p = 0; p < P; ++p) {

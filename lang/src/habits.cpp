@@ -65,6 +65,8 @@ std::string hint(const std::string& text, std::size_t byte, const std::string& m
     if ((c == '{' || c == '.') && message.find("after production") != std::string::npos)
         return "; cpfg's { . } polygons are written surface leaf = polygon(...); and drawn with ~leaf (a "
                "production has either '-> successor;' or a '{ }' body, not both)";
+    if (c == '.' && message.find("range's end after '..'") != std::string::npos)
+        return "; `0...2` would read as `0 .. .2`: write `0 .. 2` or `0 .. .2`";
     if (c == ',' && message.find("after production") != std::string::npos)
         return "; L-Py's ',' (previous colour) is written ;(c) here, with the colour index";
     return {};

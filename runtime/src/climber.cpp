@@ -187,7 +187,20 @@ void Climber::segment(const BoundSegment& s) {
     pending_.push_back(s);
 }
 
+std::size_t Climber::air_particles(const physics::FluidSettings& fluid) {
+    const glm::dvec3 cells =
+        glm::max(glm::floor((fluid.domain_hi - fluid.domain_lo) / fluid.spacing + 1e-9), glm::dvec3(1.0));
+    return static_cast<std::size_t>(std::min(cells.x * cells.y * cells.z, 1e12));
+}
+
+void Climber::charge_particles(std::size_t air) {
+    memory::Stage stage("physics");
+    // a new segment may bring a fixed root with it
+    memory_.resize((world_.size() + 2 * pending_.size()) * kBytesPerParticle + air * kBytesPerAirParticle);
+}
+
 void Climber::advance(std::set<ModuleId>& left) {
+    charge_particles(fluid_.size());
     // particles whose modules the grammar removed go too
     for (auto it = particle_of_.begin(); it != particle_of_.end();) {
         if (seen_.count(it->first)) {
@@ -398,6 +411,34 @@ struct ClimberArgs {
 
 // The largest adaption_range and mesh_cell (docs/language.md, "Limits").
 constexpr double kMaxMeshReach = 1000;
+// Emitters and attractors (docs/language.md, "Limits"): every air particle is driven by every
+// emitter each air step, and every growing tip looks at every attractor, so their counts size
+// the work; a radius sizes how many particles one reaches, a velocity how fast the air moves.
+constexpr std::size_t kMaxEmitters = 64, kMaxAttractors = 100000;
+constexpr double kMaxEmitterRadius = 1000, kMaxEmitterSpeed = 1e6, kMaxAttractorRadius = 1000;
+
+// The bound on one argument, checked as it is read: a message naming it and the bound, or "".
+std::string bounded(const std::string& key, double x, const glm::dvec3& v, std::size_t emitters,
+                    std::size_t attractors) {
+    if ((key == "adaption_range" || key == "mesh_cell") && x > kMaxMeshReach)
+        return fmt::format("climber: '{}' must be at most {}, found {}", key, kMaxMeshReach, x);
+    if (key == "emitter_radius" && x > kMaxEmitterRadius)
+        return fmt::format("climber: 'emitter_radius' must be at most {}, found {}", kMaxEmitterRadius, x);
+    if (key == "attractor_radius" && x > kMaxAttractorRadius)
+        return fmt::format("climber: 'attractor_radius' must be at most {}, found {}", kMaxAttractorRadius,
+                           x);
+    // the length scaled by the largest component, so that 1e300 does not square to infinity
+    const double big = std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+    const double speed = big > 0 ? big * glm::length(v / big) : 0.0;
+    if (key == "emitter_velocity" && speed > kMaxEmitterSpeed)
+        return fmt::format("climber: 'emitter_velocity' must be at most {:g} m/s long, found {:g}",
+                           kMaxEmitterSpeed, speed);
+    if (key == "emitter" && emitters >= kMaxEmitters)
+        return fmt::format("climber: at most {} 'emitter' arguments", kMaxEmitters);
+    if (key == "attractor" && attractors >= kMaxAttractors)
+        return fmt::format("climber: at most {} 'attractor' arguments", kMaxAttractors);
+    return "";
+}
 
 bool ClimberArgs::read(const EnvArg& a, std::string& error) {
     // besides the obstacle shapes (ObstacleArgs) and meshes
@@ -435,11 +476,9 @@ bool ClimberArgs::read(const EnvArg& a, std::string& error) {
         error = fmt::format("climber: '{}' must be finite", a.key);
         return false;
     }
-    // the distance grid of a mesh spans the mesh grown by 4 mesh_cell + adaption_range
-    if ((a.key == "adaption_range" || a.key == "mesh_cell") && x > kMaxMeshReach) {
-        error = fmt::format("climber: '{}' must be at most {}, found {}", a.key, kMaxMeshReach, x);
-        return false;
-    }
+    // the numbers that size work or memory have bounds (the distance grid of a mesh spans the
+    // mesh grown by 4 mesh_cell + adaption_range)
+    if (error = bounded(a.key, x, v, emit_at.size(), attract.size()); !error.empty()) return false;
     if (a.key == "substeps")
         c.substeps = static_cast<int>(std::clamp(x, 0.0, 1000.0));
     else if (a.key == "iterations")

@@ -1,6 +1,7 @@
 #include "plant/skeleton.hpp"
 
 #include "plant/derive.hpp"
+#include "plant/memory_budget.hpp"
 
 #include <algorithm>
 #include <new>
@@ -8,7 +9,10 @@
 namespace plant {
 
 PointArena::~PointArena() {
-    for (const Block& b : blocks_) big_pages::unmap(b.at, b.bytes);
+    for (const Block& b : blocks_) {
+        big_pages::unmap(b.at, b.bytes);
+        memory::release(b.bytes);
+    }
 }
 
 void* PointArena::allocate(std::size_t bytes) {
@@ -19,8 +23,12 @@ void* PointArena::allocate(std::size_t bytes) {
         std::size_t size = blocks_.empty() ? first_ : 0;
         for (const Block& b : blocks_) size += b.bytes;
         size = big_pages::rounded(std::max({size, bytes, big_pages::kHuge}));
+        memory::charge(size); // the skeleton's points, against --max-memory
         void* p = big_pages::map(size);
-        if (!p) throw std::bad_alloc();
+        if (!p) {
+            memory::release(size);
+            throw std::bad_alloc();
+        }
         blocks_.push_back(Block{static_cast<char*>(p), size});
         next_ = static_cast<char*>(p);
         end_ = next_ + size;

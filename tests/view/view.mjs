@@ -36,16 +36,17 @@ function startView(file, extra = []) {
 }
 
 // A raw request (no path normalisation, any Host header).
-function request(url, requestPath, headers = {}) {
+function request(url, requestPath, headers = {}, body = undefined) { // a POST when given a body
   const u = new URL(url);
   return new Promise((resolve, reject) => {
-    const req = http.request({ host: u.hostname, port: u.port, path: requestPath, headers }, (res) => {
+    const method = body === undefined ? 'GET' : 'POST';
+    const req = http.request({ host: u.hostname, port: u.port, path: requestPath, headers, method }, (res) => {
       const chunks = [];
       res.on('data', (c) => chunks.push(c));
       res.on('end', () => resolve({ status: res.statusCode, body: Buffer.concat(chunks) }));
     });
     req.on('error', reject);
-    req.end();
+    req.end(body);
   });
 }
 
@@ -175,6 +176,17 @@ async function roseChecks(browser) {
   check(afterParam !== m0, 'changing a param derives again', `${m0} -> ${afterParam} modules`);
   const line = await page.evaluate(() => { document.getElementById('save-d').click(); return document.getElementById('command-line').textContent; });
   check(line.includes('-D N_S=2'), '"Save as -D" shows the command line', line);
+  // a value out of the param's range (1 .. 12) derives to an error, and never reaches "Save as -D"
+  // (sent from here, not the page, so that the page's own controls stay as they were)
+  const port = new URL(url).port;
+  const post = (params) => request(url, '/api/controls', { Host: `127.0.0.1:${port}`, 'Content-Type': 'application/json' },
+    JSON.stringify({ params }));
+  const sent = (await post({ N_S: 99 })).status;
+  await waitFor(page, () => document.getElementById('error').textContent.includes('range'), undefined);
+  const line2 = await page.evaluate(() => { document.getElementById('save-d').click(); return document.getElementById('command-line').textContent; });
+  check(sent === 200 && !line2.includes('N_S=99') && line2.includes('-D N_S=2'), 'a value out of its range is left out of "Save as -D"', `${sent}: ${line2}`);
+  await post({ N_S: 2 });
+  await waitFor(page, () => !document.getElementById('error').textContent, undefined);
 
   // the step slider shows step k
   const k = 3;

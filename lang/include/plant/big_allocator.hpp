@@ -7,7 +7,12 @@
 // - zeroing: the kernel clears every page it hands out, and a growing derivation frees a string
 //   every step. Freed blocks are kept (see big_pages) and their pages moved into the next blocks,
 //   so a page is cleared once per run, not once per step.
+//
+// Every block is charged against the memory budget (memory_budget.hpp) before it is taken, and
+// given back when it is freed.
 #pragma once
+
+#include "plant/memory_budget.hpp"
 
 #include <cstddef>
 #include <cstdint>
@@ -39,14 +44,26 @@ template <typename T> struct BigAllocator {
     BigAllocator() noexcept = default;
     template <typename U> BigAllocator(const BigAllocator<U>&) noexcept {}
 
-    T* allocate(std::size_t n) {
+    // The bytes a block of n takes, as charged.
+    static std::size_t charged_bytes(std::size_t n) {
         const std::size_t bytes = n * sizeof(T);
+        return bytes >= kMapped ? big_pages::rounded(bytes) : bytes;
+    }
+
+    T* allocate(std::size_t n) {
+        if (n > std::size_t(-1) / sizeof(T) / 2) throw std::bad_alloc();
+        const std::size_t bytes = n * sizeof(T);
+        memory::charge(charged_bytes(n));
         void* p =
             bytes >= kMapped ? big_pages::map(big_pages::rounded(bytes)) : std::malloc(bytes ? bytes : 1);
-        if (!p) throw std::bad_alloc();
+        if (!p) {
+            memory::release(charged_bytes(n));
+            throw std::bad_alloc();
+        }
         return static_cast<T*>(p);
     }
     void deallocate(T* p, std::size_t n) noexcept {
+        memory::release(charged_bytes(n));
         if (n * sizeof(T) >= kMapped)
             big_pages::unmap(p, big_pages::rounded(n * sizeof(T)));
         else

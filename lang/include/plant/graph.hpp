@@ -109,6 +109,9 @@ struct GraphNode {
     int index = 0;
     int depth = 0;
     std::vector<int> children; // by position, then index
+    // the same children by index, then position: edit matching finds a component's sibling by
+    // binary search here (DecompositionGraph::match), not by scanning every child
+    std::vector<int> by_index;
     // child(n, pos, index, base, dir): where the branch starts and which way it points, for the
     // placement of the node's silhouettes (Fig. 8); the call's span for errors
     bool placed = false;
@@ -187,9 +190,11 @@ class DecompositionGraph {
     bool full() const;
     std::size_t max_bytes() const { return max_bytes_; }
     // Commits the nodes recorded since the last commit (sorted by path, so the result does not
-    // depend on the threads), then matches the edits, resolves every value and places every
-    // silhouette. Throws RuntimeError (kind General) on a hash collision, too many nodes or a
-    // silhouette that cannot be placed (at the child() call that made the node).
+    // depend on the threads), then matches the edits again and resolves and places the values of
+    // the new nodes and of the nodes an edit now matches differently, with their subtrees (the
+    // other nodes' values cannot have changed). Throws RuntimeError (kind General) on a hash
+    // collision, too many nodes or a silhouette that cannot be placed (at the child() call that
+    // made the node).
     void commit();
 
     std::size_t size() const { return nodes_.size(); }
@@ -205,10 +210,18 @@ class DecompositionGraph {
     const GraphEdits* edits() const { return edits_.get(); }
     // Per edit: the node it applies to (a share: its level's first node), -1 when dormant.
     const std::vector<int>& matches() const { return matches_; }
+    // Siblings compared while matching edit paths since the graph was made (for tests: matching
+    // is a binary search per path component, not a scan of the siblings).
+    std::size_t match_comparisons() const { return comparisons_; }
+    // Node values computed since the graph was made: a commit resolves its new nodes and the
+    // subtrees of nodes whose edits changed, not the whole graph (for tests).
+    std::size_t resolved_values() const { return resolved_; }
     // Whether dormant edit k lost its node: the path stops at a node whose axis has branches of
     // the component's index, none at the position (not an axis that has not grown yet). The
     // REPL drops such edits under single-position matching (the paper's Fig. 10 c).
     bool orphaned(std::size_t k) const;
+
+    struct Local; // a node's own setting of one parameter, before inheritance (graph.cpp)
 
   private:
     struct Pending {
@@ -219,9 +232,19 @@ class DecompositionGraph {
         NodePlace place;
     };
     int match(const GraphEdit& e) const;
-    void resolve();
-    void place(std::size_t node, const std::vector<NodeValue>& previous, std::size_t before,
-               std::vector<char>& same);
+    // The child of `parent` with branch `index` that an edit component names (docs/language.md,
+    // range matching), -1 when none.
+    int match_step(int parent, const EditStep& step) const;
+    // Matches the edits again, then resolves the nodes from `before` on and every node whose
+    // edits changed, with their subtrees (nodes before `before` were resolved by an earlier call).
+    void resolve(std::size_t before);
+    // Node n's values from its own edits (`by_node`: the node edits by node; `local`: scratch).
+    void resolve_node(std::size_t n, const std::vector<std::pair<int, int>>& by_node,
+                      std::vector<Local>& local);
+    // The node whose value of parameter p the children of `node` inherit: the nearest of node
+    // and its ancestors where p is public.
+    int source(int node, std::size_t p) const;
+    void place(std::size_t node, const std::vector<NodeValue>& previous, std::vector<char>& moved);
     void add_node(std::uint64_t handle, int parent, double position, int index);
 
     const GraphDecl* decl_;
@@ -230,6 +253,10 @@ class DecompositionGraph {
     std::unordered_map<std::uint64_t, int> by_handle_;
     std::vector<NodeValue> values_; // nodes x params
     std::vector<int> matches_;
+    std::vector<int> shares_;      // the share edits, in file order
+    std::vector<int> level_first_; // per depth, the first node made at it
+    mutable std::size_t comparisons_ = 0;
+    std::size_t resolved_ = 0;
     bool too_many(std::size_t nodes) const; // (with pending_mutex_ held)
     std::size_t max_bytes_ = std::size_t{4} << 30;
     mutable std::unique_ptr<std::mutex> pending_mutex_ = std::make_unique<std::mutex>();

@@ -31,6 +31,7 @@
 #pragma once
 
 #include "plant/environment.hpp"
+#include "plant/memory_budget.hpp"
 #include "plant/physics/fluid.hpp"
 #include "plant/physics/light.hpp"
 #include "plant/physics/world.hpp"
@@ -97,6 +98,7 @@ class Climber : public Environment {
     void fill_air() {
         attractors_ = config_.attractors;
         if (config_.air) {
+            charge_particles(air_particles(config_.fluid));
             fluid_ = physics::Fluid(config_.fluid);
             fluid_.fill(config_.fluid.domain_lo, config_.fluid.domain_hi);
         }
@@ -126,6 +128,11 @@ class Climber : public Environment {
     const physics::World& world() const { return world_; }
     physics::Handle particle(ModuleId id) const;
 
+    // What a particle costs in memory, for the budget: the world's arrays and step buffers hold
+    // about 800 bytes a segment particle, the SPH air's (neighbour lists included) about 350 an
+    // air particle; both rounded up.
+    static constexpr std::size_t kBytesPerParticle = 1024, kBytesPerAirParticle = 512;
+
   private:
     double occlusion(const glm::dvec3& p) const;
     // The obstacle nearest to p if one is nearer than `within`, and its distance.
@@ -153,6 +160,10 @@ class Climber : public Environment {
     glm::dvec3 wind_{0.0};
     bool wind_changed_ = false;
     physics::LightGrid light_; // the particles, for occlusion
+    // The particles' arrays (world and air) as charged against --max-memory, ahead of growing them.
+    memory::Reservation memory_;
+    void charge_particles(std::size_t air);
+    static std::size_t air_particles(const physics::FluidSettings& fluid);
 };
 
 // Makes a climber from `env name = climber(key: value, ...)`; null and a message on bad input.

@@ -6,7 +6,10 @@
 
 #include <catch2/catch.hpp>
 
+#include <fmt/format.h>
+
 #include <cmath>
+#include <initializer_list>
 
 namespace plant {
 
@@ -439,6 +442,101 @@ rules { A(n, p) -> B(child(n, p)); }
         CHECK(lo <= r.g().node(k).position);
         CHECK(r.g().node(k).position <= hi);
     }
+}
+
+} // namespace plant
+
+namespace plant {
+
+namespace {
+// Laterals of the root at the given positions, made in one step.
+std::string laterals(std::initializer_list<double> positions) {
+    std::string axiom;
+    for (double p : positions) axiom += fmt::format(" L(root(), {})", p);
+    return "graph { bend = linear(0, 0); }\nmodule L(n: node, p), Lat(n: node);\nderive 1;\naxiom:" + axiom +
+           ";\nrules { L(n, p) -> Lat(child(n, p)); }\n";
+}
+} // namespace
+
+TEST_CASE("graph: range matching keeps an edit on its branch while that branch is still there") {
+    const std::string edit = "/0.25[0..0.375] bend = linear(0, 0.4, 0.8)\n";
+    // the range's centre (0.1875) is nearer 0.15, but the edited branch at 0.25 is still there
+    Run a = derive(laterals({0.15, 0.25}), edit);
+    CHECK(a.value("/0.25", "bend").at(1) == Approx(0.8));
+    CHECK(a.value("/0.15", "bend").at(1) == 0);
+    // gone: the branch in the range nearest the recorded position (0.35, not 0.1 by the centre)
+    Run b = derive(laterals({0.1, 0.35}), edit);
+    CHECK(b.value("/0.35", "bend").at(1) == Approx(0.8));
+    CHECK(b.value("/0.1", "bend").at(1) == 0);
+    // equally near: the lower
+    Run c = derive(laterals({0.2, 0.3}), edit);
+    CHECK(c.value("/0.2", "bend").at(1) == Approx(0.8));
+    CHECK(c.value("/0.3", "bend").at(1) == 0);
+    // out of the range: dormant
+    Run d = derive(laterals({0.4, 0.6}), edit);
+    CHECK(d.g().matches()[0] == -1);
+}
+
+TEST_CASE("graph: matching many edits to many siblings is a binary search per path component") {
+    // 5000 laterals at k / 8192 (exact in binary), one edit each with its range: 5000 x 5000
+    // sibling comparisons if each component scanned the siblings, about 5000 x 13 by bisection
+    constexpr int kCount = 5000;
+    const std::string grammar = R"(
+graph { length = 0; }
+module Axis(n: node), Lat(n: node);
+derive 2;
+axiom: Axis(root());
+rules { Axis(n) { for k in 1..5001 { nproduce [ Lat(child(n, k / 8192)) ]; } } }
+)";
+    std::string edits;
+    for (int k = 1; k <= kCount; ++k)
+        edits += fmt::format("/{:.14f}[{:.14f}..{:.14f}] length = {}\n", k / 8192.0, (k - 0.5) / 8192.0,
+                             (k + 0.5) / 8192.0, k);
+    Run r = derive(grammar, edits);
+    REQUIRE(r.g().size() == kCount + 1);
+    int wrong = 0;
+    for (int k = 1; k <= kCount; ++k) {
+        const int m = r.g().matches()[static_cast<std::size_t>(k - 1)];
+        if (m < 0 || r.g().node(m).position != k / 8192.0 || r.g().value(m, 0).number != k) ++wrong;
+    }
+    CHECK(wrong == 0);
+    CHECK(r.g().match_comparisons() < std::size_t{kCount} * 20);
+    // and the ranges `plant graph` and :edit write, from each node's neighbours
+    CHECK(r.g().path(r.g().matches()[0], true) == "/0.0001220703125[0..0.000183106]");
+    CHECK(r.g().path(r.g().matches()[2499], true) == "/0.30517578125[0.305114746..0.305236817]");
+    CHECK(r.g().path(r.g().matches()[4999], true) == "/0.6103515625[0.610290527..1]");
+}
+
+TEST_CASE("graph: a commit resolves its new nodes and the subtrees of the nodes whose edits moved") {
+    // three levels of three (kTree): 1 + 3 + 9 + 27 nodes made over three commits, two
+    // parameters; each commit resolves only its new nodes, so 40 x 2 values in all
+    Run tree = derive(kTree, "/0.5 length = 4\n");
+    CHECK(tree.g().resolved_values() == 40 * 2);
+    CHECK(tree.number("/0.5/0.25/0.75") == 4);
+    // an edit that moves: /0.4 (with its child /0.4/0.5) holds it until /0.3, nearer its recorded
+    // position 0.25, appears at the third step; then /0.4's subtree inherits again
+    const std::string moving = R"(
+graph { length = 10; }
+module A(n: node), B(n: node, k), C(n: node, k);
+axiom: A(root());
+rules {
+  A(n) -> [ B(child(n, 0.4), 0) ] C(n, 0);
+  B(n, k) : k < 1 -> B(child(n, 0.5), k + 1);
+  C(n, k) : k < 1 -> C(n, k + 1);
+  C(n, k) : k >= 1 -> [ B(child(n, 0.3), 1) ];
+}
+)";
+    const std::string edit = "/0.25[0..0.5] length = 3\n";
+    Run two = derive("derive 2;\n" + moving, edit);
+    CHECK(two.number("/0.4") == 3);
+    CHECK(two.number("/0.4/0.5") == 3);
+    Run three = derive("derive 3;\n" + moving, edit);
+    CHECK(three.number("/0.3") == 3);
+    CHECK(three.number("/0.4") == 10);
+    CHECK(three.number("/0.4/0.5") == 10);
+    CHECK(three.value("/0.4/0.5", "length").from == 0);
+    // the root, /0.4, /0.4/0.5, then /0.3 new and /0.4 with its child again: 6 node resolutions
+    CHECK(three.g().resolved_values() == 6);
 }
 
 } // namespace plant

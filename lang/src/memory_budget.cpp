@@ -1,0 +1,96 @@
+// The memory budget (memory_budget.hpp).
+#include "plant/memory_budget.hpp"
+
+#include "plant/diagnostics.hpp"
+
+#include <fmt/format.h>
+
+#include <atomic>
+#include <cstdio>
+#include <mutex>
+#include <unistd.h>
+#include <utility>
+
+namespace plant::memory {
+
+namespace {
+
+std::atomic<std::uint64_t> g_limit{0};
+std::atomic<std::uint64_t> g_charged{0};
+std::mutex g_stage_mutex;
+std::string g_stage = "the derivation";
+
+std::string megabytes(double bytes) {
+    return fmt::format("{:.0f} MB", bytes / double(1 << 20));
+}
+
+[[noreturn]] void refuse(const std::string& detail) {
+    throw RuntimeError(
+        RuntimeErrorKind::Memory, Span{},
+        fmt::format("{} needs more memory than --max-memory {} allows ({}): raise --max-memory", stage(),
+                    megabytes(double(limit())), detail));
+}
+
+} // namespace
+
+void set_limit(std::uint64_t bytes) noexcept {
+    g_limit.store(bytes, std::memory_order_relaxed);
+}
+
+std::uint64_t limit() noexcept {
+    return g_limit.load(std::memory_order_relaxed);
+}
+
+std::uint64_t charged() noexcept {
+    return g_charged.load(std::memory_order_relaxed);
+}
+
+void charge(std::size_t bytes) {
+    const std::uint64_t before = g_charged.fetch_add(bytes, std::memory_order_relaxed);
+    const std::uint64_t cap = limit();
+    if (cap == 0 || before + bytes <= cap) return;
+    g_charged.fetch_sub(bytes, std::memory_order_relaxed);
+    refuse(fmt::format("{} held, {} more asked for", megabytes(double(before)), megabytes(double(bytes))));
+}
+
+void release(std::size_t bytes) noexcept {
+    g_charged.fetch_sub(bytes, std::memory_order_relaxed);
+}
+
+Stage::Stage(std::string what) {
+    std::lock_guard lock(g_stage_mutex);
+    previous_ = std::exchange(g_stage, std::move(what));
+}
+
+Stage::~Stage() {
+    std::lock_guard lock(g_stage_mutex);
+    g_stage = std::move(previous_);
+}
+
+std::string stage() {
+    std::lock_guard lock(g_stage_mutex);
+    return g_stage;
+}
+
+void Reservation::resize(std::size_t bytes) {
+    if (bytes > bytes_)
+        charge(bytes - bytes_);
+    else
+        release(bytes_ - bytes);
+    bytes_ = bytes;
+}
+
+void check_resident() {
+    const std::uint64_t cap = limit();
+    if (cap == 0) return;
+    std::FILE* f = std::fopen("/proc/self/statm", "r");
+    if (!f) return;
+    unsigned long long size = 0, resident = 0;
+    const bool read = std::fscanf(f, "%llu %llu", &size, &resident) == 2;
+    std::fclose(f);
+    if (!read) return;
+    const double bytes = double(resident) * double(::sysconf(_SC_PAGESIZE));
+    if (bytes > double(cap + kResidentSlack)) refuse(fmt::format("the process holds {}", megabytes(bytes)));
+}
+
+} // namespace plant::memory

@@ -1,0 +1,75 @@
+#!/usr/bin/env bash
+# The memory budget (docs/language.md, "Limits"): --max-memory bounds the memory a command really
+# takes, measured as the peak resident size of the child process (getrusage(RUSAGE_CHILDREN),
+# through python3).
+set -u
+plant=$(realpath "${1:?usage: memory.sh PLANT}")
+. "$(dirname "$0")/checks.sh"
+# peak KB prints the child's peak resident size in KB; its exit code is the child's
+peak() {
+  python3 -c '
+import resource, subprocess, sys
+rc = subprocess.call(sys.argv[2:], stdout=open(sys.argv[1] + ".out", "w"), stderr=open(sys.argv[1] + ".err", "w"))
+print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)
+sys.exit(rc)' "$@"
+}
+
+# a string that doubles every step, with a parameter a module: 2^30 modules would take 16 GB
+cat >"$tmp/grow.plant" <<'G'
+axiom: A(1);
+derive 30;
+rules { A(x) -> A(x + 1) A(x * 2); }
+G
+cat >"$tmp/tiny.plant" <<'G'
+axiom: A(1);
+derive 2;
+rules { A(x) -> A(x + 1); }
+G
+# the baseline: what plant takes deriving almost nothing (program, libraries, thread stacks)
+base_kb=$(cd "$tmp" && peak "$tmp/p" "$plant" derive --threads 2 "$tmp/tiny.plant")
+[ -n "$base_kb" ] && ok || bad "baseline: no peak measured"
+for threads in 1 2; do
+  kb=$(cd "$tmp" && peak "$tmp/p" "$plant" derive --threads $threads --max-memory 256M "$tmp/grow.plant")
+  rc=$?
+  [ $rc -eq 70 ] && ok || bad "--max-memory 256M, $threads threads: exit $rc, expected 70"
+  contains "--max-memory 256M names the knob" "$tmp/p.err" "raise --max-memory"
+  # 256 MB and the baseline, and 16 MB for the pages a freed string keeps (big_pages)
+  limit_kb=$((256 * 1024 + base_kb + 16 * 1024))
+  if [ "${kb:-999999999}" -le $limit_kb ]; then ok; else
+    bad "--max-memory 256M, $threads threads: peak resident ${kb} KB, more than 256 MB + baseline $base_kb KB + 16 MB"
+  fi
+  echo "memory: $threads threads peaked at $((kb / 1024)) MB under --max-memory 256M (baseline $((base_kb / 1024)) MB)"
+done
+# run: the skeleton and each file's text are charged too (before the budget, a .skel.json of this
+# tree peaked at 600 MB and an SVG at 320 MB under --max-memory 256M, as only the string was counted)
+cat >"$tmp/tree.plant" <<'G'
+axiom: A;
+derive 19;
+rules { A -> F[+A][-A]; }
+G
+for out in t.svg t.skel.json t.obj; do
+  kb=$(cd "$tmp" && peak "$tmp/p" "$plant" run --max-memory 256M "$tmp/tree.plant" -o "$tmp/$out")
+  rc=$?
+  if [ $rc -eq 70 ]; then
+    contains "run -o $out under 256M names the knob" "$tmp/p.err" "raise --max-memory"
+    [ ! -e "$tmp/$out" ] && ok || bad "run -o $out: exit 70 but $out was written"
+  else
+    [ $rc -eq 0 ] && ok || bad "run -o $out under 256M: exit $rc, expected 0 or 70"
+  fi
+  limit_kb=$((256 * 1024 + base_kb + 16 * 1024))
+  if [ "${kb:-999999999}" -le $limit_kb ]; then ok; else
+    bad "run -o $out under --max-memory 256M: peak resident ${kb} KB, more than 256 MB + baseline $base_kb KB + 16 MB"
+  fi
+  echo "memory: run -o $out peaked at $((kb / 1024)) MB under --max-memory 256M (exit $rc)"
+done
+# repl: a step past the budget fails, and the session stays at the step before it
+printf ':s 30\n:stats\n' >"$tmp/steps.repl"
+check "repl under --max-memory 64M: the failing line" 1 "$plant" repl --max-memory 64M "$tmp/grow.plant" <"$tmp/steps.repl"
+contains "repl under 64M names the knob" "$tmp/stderr" "the derivation needs more memory than --max-memory 64 MB allows"
+contains "repl under 64M stays at the step before" "$tmp/stdout" "modules, "
+check "bad --max-memory is a usage error" 64 "$plant" derive --max-memory 12X "$tmp/tiny.plant"
+contains "bad --max-memory" "$tmp/stderr" "--max-memory expects a size such as 512M or 4G, found '12X'"
+check "check takes --max-memory" 0 "$plant" check --max-memory 64M "$tmp/tiny.plant"
+
+echo "memory: $pass passed, $fail failed"
+[ $fail -eq 0 ]
