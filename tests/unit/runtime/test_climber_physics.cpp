@@ -112,13 +112,17 @@ struct Run {
     double height = 0, drawn = 0;
     std::size_t segments = 0;
     Crossings drawn_crossings, world_crossings; // of the skeleton drawn, and of the world's links
+    bool each_step = false;                     // whether to measure the world's links every step:
+    Crossings step_crossings;                   // summed over the steps
     std::unique_ptr<Derivation> d;
 };
 
 // derives `text` (or, when `text` is empty, the grammar file `path`, so that it finds the files
 // it loads beside it) step by step, checking the links after each step, then measures the skeleton
-std::unique_ptr<Run> derive(const std::string& text, const std::filesystem::path& path = {}) {
+std::unique_ptr<Run> derive(const std::string& text, const std::filesystem::path& path = {},
+                            bool each_step = false) {
     auto r = std::make_unique<Run>();
+    r->each_step = each_step;
     CompileOptions opts;
     opts.environments = runtime_environments();
     if (text.empty()) {
@@ -139,6 +143,12 @@ std::unique_ptr<Run> derive(const std::string& text, const std::filesystem::path
         if (l.rest > 0) CHECK(std::fabs(l.length / l.rest - 1) < 0.1);
         // a link can end off its length only where obstacles pinch it (docs/physics.md)
         CHECK(l.off * 100 <= l.count);
+        if (r->each_step) {
+            const Crossings c = crossings(climber_in(d).world());
+            r->step_crossings.crossing += c.crossing;
+            r->step_crossings.segments += c.segments;
+            r->step_crossings.deepest = std::max(r->step_crossings.deepest, c.deepest);
+        }
     }
     Skeleton s = build_skeleton(*r->compiled->program, d.interpreted(d.string()), turtle_options(d));
     r->drawn_crossings = crossings(s, climber_in(d).world().obstacles());
@@ -212,16 +222,19 @@ TEST_CASE("climber: no segment of any climber grammar crosses an obstacle, as a 
     std::size_t grammars = 0;
     for (const auto& entry : std::filesystem::directory_iterator(dir)) {
         if (entry.path().extension() != ".plant") continue;
-        auto r = derive("", entry.path());
+        auto r = derive("", entry.path(), true);
         const Crossings& c = r->drawn_crossings;
         const Crossings& w = r->world_crossings;
+        const Crossings& e = r->step_crossings;
         INFO(entry.path().filename().string()
              << ": " << c.crossing << " of " << c.segments
              << " drawn segments cross an obstacle, the deepest by " << c.deepest * 1000 << " mm; links "
-             << w.crossing << " of " << w.segments << ", " << w.deepest * 1000 << " mm");
+             << w.crossing << " of " << w.segments << ", " << w.deepest * 1000 << " mm; over the steps "
+             << e.crossing << " of " << e.segments << ", " << e.deepest * 1000 << " mm");
         CHECK(c.segments > 0);
         CHECK(c.crossing == 0);
         CHECK(w.crossing == 0);
+        CHECK(e.crossing == 0);
         ++grammars;
     }
     CHECK(grammars >= 9);
