@@ -420,3 +420,32 @@ TEST_CASE("physics: a stick of long links falls onto two thin rails and rests on
         CHECK(lowest > 0.39); // it rests on the rails instead of falling past them
     }
 }
+
+TEST_CASE("physics: new growth aimed into a support turns along it, as a clear capsule of its length",
+          "[physics]") {
+    using namespace plant::physics;
+    World w{Settings{}};
+    w.add_obstacle({Obstacle::Plane, {0, 0, 0}, {0, 1, 0}});       // the ground
+    w.add_obstacle({Obstacle::Box, {-1, 0, 0.2}, {1, 2, 0.3}});    // a wall on it
+    w.add_obstacle({Obstacle::Sphere, {0, 1, -0.5}, {0.2, 0, 0}}); // a ball
+    const double r = 0.006, len = 0.05;
+    struct Case {
+        glm::dvec3 from, dir;
+    };
+    // straight at the wall, slanting into it, down into the ground beside the wall (the seam),
+    // and up into the ball from below
+    for (const Case& c :
+         {Case{{0, 1, 0.2 - r}, {0, 0, 1}}, Case{{0, 1, 0.2 - r}, glm::normalize(glm::dvec3(0, 1, 1))},
+          Case{{0.3, r, 0.2 - r}, glm::normalize(glm::dvec3(0.2, -1, 0.3))},
+          Case{{0, 1 - 0.2 - r, -0.5}, {0, 1, 0}}}) {
+        const glm::dvec3 end = w.clear_segment_end(c.from, c.from + c.dir * len, r);
+        INFO("from " << c.from.x << " " << c.from.y << " " << c.from.z << " to " << end.x << " " << end.y
+                     << " " << end.z);
+        CHECK(glm::distance(end, c.from) == Approx(len));
+        for (int k = 0; k <= 50; ++k)
+            for (const auto& o : w.obstacles())
+                CHECK(o.distance(c.from + (end - c.from) * (k / 50.0)) > r - 1e-4);
+        // turned as little as it takes: along the surface, not back the way it came
+        CHECK(glm::dot(glm::normalize(end - c.from), c.dir) > -0.05);
+    }
+}
