@@ -14,6 +14,7 @@
 // A file without such comments is a golden test: its derived string is compared with the
 // sidecar NAME.txt beside it, which `--bless` rewrites. docs/testing.md describes them all.
 #include "commands.hpp"
+#include "test_confine.hpp"
 #include "test_matching.hpp"
 
 #include "plant/export.hpp"
@@ -94,15 +95,11 @@ Outcome run_self(const std::vector<std::string>& args, const fs::path& dir) {
     return o;
 }
 
-struct Expectations {
+struct Expectations : TestCommandLine {
     bool script = false;
-    std::string command = "derive";
-    std::vector<std::string> args, out;
+    std::vector<std::string> out;
     std::vector<ExpectedDiagnostic> errors, warnings;
     std::optional<int> exit_code;
-    int command_line = 0, command_col = 0; // where `# command:` names the command
-    int args_line = 0;                     // the line of `# args:`, and where each word begins
-    std::vector<int> arg_cols;
 };
 
 // The words of `rest` with the 1-based column each begins at, `rest` starting at column `col`.
@@ -243,57 +240,6 @@ struct OutputFolder {
     OutputFolder& operator=(const OutputFolder&) = delete;
 };
 
-// What a test may ask for in its comments: `plant derive`, `check` or `run`, never `test` or
-// `repl` (a test that runs tests spawns processes without end), and outputs only as plain file
-// names, which land in `outdir` (a test file from a stranger must not overwrite the user's files).
-// Rewrites the outputs into `outdir`; a `run` without outputs gets the default pair there.
-// Returns an error placed on the comment, or an empty string.
-std::string confine(const fs::path& file, Expectations& e, const fs::path& outdir) {
-    auto at = [&](int line, int col, const std::string& msg) {
-        return fmt::format("  {}:{}:{}: error: {}\n", escape_controls(file.string()), line, col,
-                           escape_controls(msg));
-    };
-    static const std::string kAllowed[] = {"derive", "check", "run"};
-    if (std::find(std::begin(kAllowed), std::end(kAllowed), e.command) == std::end(kAllowed))
-        return at(e.command_line, e.command_col,
-                  fmt::format("plant test runs only 'derive', 'check' and 'run' from a test's comments, "
-                              "not '{}'",
-                              e.command));
-    bool outputs = false;
-    for (std::size_t k = 0; k < e.args.size(); ++k) {
-        const std::string a = e.args[k];
-        std::string prefix, value;
-        std::size_t at_k = k;
-        if (a == "-o" || a == "--output") {
-            if (k + 1 >= e.args.size()) break; // plant itself reports the missing value
-            at_k = ++k;
-            value = e.args[at_k];
-        } else if (a.rfind("--output=", 0) == 0) {
-            prefix = "--output=";
-        } else if (a.rfind("-o", 0) == 0) {
-            prefix = "-o";
-        } else {
-            continue;
-        }
-        if (!prefix.empty()) value = a.substr(prefix.size());
-        outputs = true;
-        if (outdir.empty())
-            return at(e.args_line, e.arg_cols[at_k], "cannot create a folder for the outputs");
-        if (value.empty() || value.find('/') != std::string::npos || value == "." || value == "..")
-            return at(e.args_line, e.arg_cols[at_k],
-                      fmt::format("an output of a test must be a plain file name (no folder, no '..'), "
-                                  "found '{}': plant test writes outputs into a folder of its own",
-                                  value));
-        e.args[at_k] = prefix + (outdir / value).string();
-    }
-    if (e.command == "run" && !outputs) {
-        const std::string stem = file.stem().string();
-        for (const char* ext : {".glb", ".png"})
-            e.args.insert(e.args.end(), {"-o", (outdir / (stem + ext)).string()});
-    }
-    return {};
-}
-
 // Returns an empty string when the test passed, else what went wrong.
 std::string run_one(const fs::path& file, bool bless, std::string& blessed,
                     const std::vector<std::string>& allow_read) {
@@ -301,7 +247,7 @@ std::string run_one(const fs::path& file, bool bless, std::string& blessed,
     if (!read_file(file.string(), text)) return "  cannot read the file\n";
     Expectations e = read_expectations(text);
     OutputFolder outdir;
-    if (std::string refused = confine(file, e, outdir.path); !refused.empty()) return refused;
+    if (std::string refused = confine_test_command(file, e, outdir.path); !refused.empty()) return refused;
     std::vector<std::string> args{e.command, file.filename().string()};
     args.insert(args.end(), e.args.begin(), e.args.end());
     for (const auto& d : allow_read) args.insert(args.end(), {"--allow-read", fs::absolute(d).string()});

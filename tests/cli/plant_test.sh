@@ -9,16 +9,16 @@ src=$(cd "$(dirname "$0")/../.." && pwd)
 
 cp -r "$src/examples/testing" "$tmp/project"
 cd "$tmp/project" || exit 1
-"$plant" test . -v >"$tmp/out" 2>&1
+"$plant" test --allow-read lib . -v >"$tmp/out" 2>&1
 if [ $? -eq 0 ]; then ok; else bad "the example project fails"; cat "$tmp/out"; fi
 contains "the library is named as one" "$tmp/out" "library ./lib/branching.plant (imported, not a test)"
 contains "all pass" "$tmp/out" "8 passed, 0 failed"
 
 # --bless: each file written, with a short diff; the library gets no sidecar
 sed -i 's/^param spread = 25;/param spread = 30;/' lib/branching.plant
-"$plant" test . >"$tmp/out" 2>&1
+"$plant" test --allow-read lib . >"$tmp/out" 2>&1
 if [ $? -eq 1 ]; then ok; else bad "a changed string passes"; fi
-"$plant" test --bless . >"$tmp/out" 2>&1
+"$plant" test --allow-read lib --bless . >"$tmp/out" 2>&1
 contains "bless names the file" "$tmp/out" "wrote ./bush.txt"
 contains "the old line" "$tmp/out" "    1 - F[+(25)F[+(25)"
 contains "the new line" "$tmp/out" "    1 + F[+(30)F[+(30)"
@@ -28,10 +28,10 @@ lacks "its unchanged lines left out" "$tmp/out" "+ vertices"
 contains "bless counts files" "$tmp/out" "2 files written"
 lacks "no sidecars" "$tmp/out" "sidecar"
 if [ ! -e lib/branching.txt ]; then ok; else bad "--bless wrote a golden file for the library"; fi
-"$plant" test . >"$tmp/out" 2>&1
+"$plant" test --allow-read lib . >"$tmp/out" 2>&1
 if [ $? -eq 0 ]; then ok; else bad "after --bless the project fails"; cat "$tmp/out"; fi
 # named on the command line, a library is run (and fails: it has no axiom)
-"$plant" test lib/branching.plant >"$tmp/out" 2>&1
+"$plant" test --allow-read lib lib/branching.plant >"$tmp/out" 2>&1
 if [ $? -eq 1 ]; then ok; else bad "a library named on the command line is not run"; fi
 
 # matching: a wrong message still fails, with or without the position
@@ -47,7 +47,7 @@ t ": unknown name 'spread'" wrong_name
 t ": 5:11: unknown name 'sprad'" wrong_column
 t ": unknown name" cut_mid_message
 t " contains: 'sprod'" wrong_contains
-"$plant" test . -v >"$tmp/out" 2>&1
+"$plant" test --allow-read lib . -v >"$tmp/out" 2>&1
 for f in no_position no_suggestion no_suggestion_placed contains; do contains "$f matches" "$tmp/out" "ok ./$f.plant"; done
 for f in wrong_name wrong_column cut_mid_message wrong_contains; do contains "$f fails" "$tmp/out" "FAIL ./$f.plant"; done
 contains "a contains expectation is shown as one" "$tmp/out" "expected: containing: 'sprod'"
