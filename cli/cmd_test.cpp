@@ -14,6 +14,7 @@
 // A file without such comments is a golden test: its derived string is compared with the
 // sidecar NAME.txt beside it, which `--bless` rewrites. docs/testing.md describes them all.
 #include "commands.hpp"
+#include "test_child.hpp"
 #include "test_confine.hpp"
 #include "test_matching.hpp"
 
@@ -22,17 +23,12 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <fcntl.h>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <regex>
-#include <spawn.h>
 #include <sstream>
-#include <sys/wait.h>
 #include <unistd.h>
-
-extern char** environ;
 
 namespace plant::cli {
 
@@ -40,60 +36,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Outcome {
-    int exit_code = -1;
-    std::string out, err;
-};
-
-std::string slurp(const std::string& path) {
-    std::string s;
-    read_file(path, s);
-    return s;
-}
-
-// Runs this program with `args` in directory `dir`, capturing standard output and error through
-// temporary files. Running in the grammar's own directory keeps the paths in messages the same
-// wherever the tests are run from.
-Outcome run_self(const std::vector<std::string>& args, const fs::path& dir) {
-    Outcome o;
-    char out_name[] = "/tmp/plant-test-out-XXXXXX";
-    char err_name[] = "/tmp/plant-test-err-XXXXXX";
-    int out_fd = mkstemp(out_name);
-    int err_fd = mkstemp(err_name);
-    if (out_fd < 0 || err_fd < 0) {
-        o.err = "cannot create temporary files";
-        return o;
-    }
-    posix_spawn_file_actions_t fa;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_adddup2(&fa, out_fd, 1);
-    posix_spawn_file_actions_adddup2(&fa, err_fd, 2);
-    posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
-    if (!dir.empty()) posix_spawn_file_actions_addchdir_np(&fa, dir.c_str());
-    std::vector<char*> argv;
-    static const std::string self = fs::read_symlink("/proc/self/exe").string();
-    std::string argv0 = self;
-    argv.push_back(argv0.data());
-    std::vector<std::string> copy = args;
-    for (auto& a : copy) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    // children print without colour and see the same environment
-    setenv("NO_COLOR", "1", 1);
-    pid_t pid = 0;
-    if (posix_spawn(&pid, self.c_str(), &fa, nullptr, argv.data(), environ) == 0) {
-        int status = 0;
-        waitpid(pid, &status, 0);
-        o.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    }
-    posix_spawn_file_actions_destroy(&fa);
-    close(out_fd);
-    close(err_fd);
-    o.out = slurp(out_name);
-    o.err = slurp(err_name);
-    unlink(out_name);
-    unlink(err_name);
-    return o;
-}
+constexpr double kDefaultTestTimeout = 300;
 
 struct Expectations : TestCommandLine {
     bool script = false;
@@ -241,8 +184,14 @@ struct OutputFolder {
 };
 
 // Returns an empty string when the test passed, else what went wrong.
+std::string timed_out(double seconds) {
+    return fmt::format("  did not end within {} s: stopped (plant test --timeout SECONDS gives each "
+                       "test more)\n",
+                       seconds);
+}
+
 std::string run_one(const fs::path& file, bool bless, std::string& blessed,
-                    const std::vector<std::string>& allow_read) {
+                    const std::vector<std::string>& allow_read, double timeout) {
     std::string text;
     if (!read_file(file.string(), text)) return "  cannot read the file\n";
     Expectations e = read_expectations(text);
@@ -251,7 +200,8 @@ std::string run_one(const fs::path& file, bool bless, std::string& blessed,
     std::vector<std::string> args{e.command, file.filename().string()};
     args.insert(args.end(), e.args.begin(), e.args.end());
     for (const auto& d : allow_read) args.insert(args.end(), {"--allow-read", fs::absolute(d).string()});
-    Outcome o = run_self(args, file.parent_path());
+    ChildOutcome o = run_child(args, file.parent_path(), timeout);
+    if (o.timed_out) return timed_out(timeout);
     if (e.script) {
         std::vector<std::string> errors, warnings;
         parse_diagnostics(o.err, errors, warnings);
@@ -287,7 +237,11 @@ std::string run_one(const fs::path& file, bool bless, std::string& blessed,
         run_args.insert(run_args.end(), {"-o", tmp_name});
         for (const auto& d : allow_read)
             run_args.insert(run_args.end(), {"--allow-read", fs::absolute(d).string()});
-        Outcome m = run_self(run_args, file.parent_path());
+        ChildOutcome m = run_child(run_args, file.parent_path(), timeout);
+        if (m.timed_out) {
+            unlink(tmp_name);
+            return timed_out(timeout);
+        }
         read_file(tmp_name, mesh);
         unlink(tmp_name);
         if (m.exit_code != 0) return fmt::format("  plant run: exit code {}\n{}", m.exit_code, m.err);
@@ -324,9 +278,11 @@ struct TestCmd {
     std::vector<std::string> allow_read; // passed on to each grammar's command
     bool bless = false;
     bool verbose = false;
+    double timeout = kDefaultTestTimeout; // seconds each child process may take
 };
 
 int test_main(const TestCmd& c) {
+    ChildSignalGuard guard;              // a signal stops the running child too, and then plant test
     std::vector<fs::path> files, walked; // walked: found in a folder, not named
     std::vector<std::string> paths = c.paths.empty() ? std::vector<std::string>{"grammars"} : c.paths;
     for (const auto& p : paths) {
@@ -358,7 +314,8 @@ int test_main(const TestCmd& c) {
             continue;
         }
         std::string blessed;
-        std::string msg = run_one(f, c.bless, blessed, c.allow_read);
+        std::string msg = run_one(f, c.bless, blessed, c.allow_read, c.timeout);
+        if (ChildSignalGuard::pending()) break;
         if (msg.empty()) {
             ++passed;
             if (!blessed.empty()) {
@@ -387,6 +344,12 @@ void setup_test(CLI::App& app, int& exit_code) {
                   "Rewrite the golden files (NAME.txt, NAME.mesh.txt) from the current output; lists each "
                   "file written with a short diff (review it!)");
     cmd->add_flag("-v,--verbose", c->verbose, "List passing tests too");
+    cmd->add_option("--timeout", c->timeout,
+                    fmt::format("Seconds each process a test starts may run before it is stopped and "
+                                "the test fails (default {})",
+                                kDefaultTestTimeout))
+        ->check(CLI::Range(0.1, 86400.0))
+        ->type_name("SECONDS");
     add_allow_read(*cmd, c->allow_read);
     cmd->callback([c, &exit_code] { exit_code = test_main(*c); });
 }
