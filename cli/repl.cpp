@@ -184,16 +184,18 @@ bool Session::need_derivation() {
 bool Session::step(int n) {
     if (!need_derivation()) return true;
     for (int k = 0; k < n; ++k) {
-        auto next = std::make_unique<Derivation>(current());
-        int before = next->steps_done();
+        std::unique_ptr<Derivation> next;
+        int before = current().steps_done();
         auto t0 = std::chrono::steady_clock::now();
         try {
+            // the copy charges the memory budget too: past it, the session stays at this step
+            next = std::make_unique<Derivation>(current());
             next->step();
         } catch (const RuntimeError& e) {
             error() << render(Diagnostic{Severity::Error, e.span, e.message, {}}, *sources_, color_);
             if (e.kind == RuntimeErrorKind::Interrupted)
                 error() << fmt::format("interrupted; still at step {}\n", current().steps_done());
-            else if (e.kind == RuntimeErrorKind::ModuleLimit)
+            else if (e.kind == RuntimeErrorKind::ModuleLimit || e.kind == RuntimeErrorKind::Memory)
                 error() << fmt::format("still at step {}: {}\n", current().steps_done(),
                                        modules(current().string().size()));
             return false;

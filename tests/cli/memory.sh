@@ -67,6 +67,13 @@ printf ':s 30\n:stats\n' >"$tmp/steps.repl"
 check "repl under --max-memory 64M: the failing line" 1 "$plant" repl --max-memory 64M "$tmp/grow.plant" <"$tmp/steps.repl"
 contains "repl under 64M names the knob" "$tmp/stderr" "the derivation needs more memory than --max-memory 64 MB allows"
 contains "repl under 64M stays at the step before" "$tmp/stdout" "modules, "
+# under a budget so small that copying the current step fails, the session survives too
+for m in 8 16; do
+  check "repl under --max-memory ${m}M: the failing line" 1 "$plant" repl --max-memory ${m}M "$tmp/grow.plant" <"$tmp/steps.repl"
+  contains "repl under ${m}M names the knob" "$tmp/stderr" "needs more memory than --max-memory $m MB allows"
+  contains "repl under ${m}M says where it stays" "$tmp/stderr" "still at step "
+  contains "repl under ${m}M goes on to :stats" "$tmp/stdout" "modules, "
+done
 check "bad --max-memory is a usage error" 64 "$plant" derive --max-memory 12X "$tmp/tiny.plant"
 contains "bad --max-memory" "$tmp/stderr" "--max-memory expects a size such as 512M or 4G, found '12X'"
 check "check takes --max-memory" 0 "$plant" check --max-memory 64M "$tmp/tiny.plant"
