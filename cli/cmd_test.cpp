@@ -140,7 +140,8 @@ std::string compare_lists(const char* what, const std::vector<std::string>& want
     for (std::size_t i = 0; i < std::max(want.size(), got.size()); ++i) {
         if (i < want.size() && i < got.size() && want[i] == got[i]) continue;
         msg += fmt::format("  {} {}:\n    expected: {}\n    got:      {}\n", what, i + 1,
-                           i < want.size() ? want[i] : "(nothing)", i < got.size() ? got[i] : "(nothing)");
+                           i < want.size() ? escape_controls(want[i]) : "(nothing)",
+                           i < got.size() ? escape_controls(got[i]) : "(nothing)");
     }
     return msg;
 }
@@ -152,7 +153,7 @@ std::string first_difference(const std::string& want, const std::string& got) {
         std::size_t b = i > 30 ? i - 30 : 0;
         std::string e = s.substr(b, 70);
         std::replace(e.begin(), e.end(), '\n', ' ');
-        return e;
+        return escape_controls(e);
     };
     return fmt::format(
         "  differs at byte {} (expected {} bytes, got {})\n    expected: ...{}\n    got:      ...{}\n", i,
@@ -216,7 +217,7 @@ std::string run_one(const fs::path& file, bool bless, std::string& blessed,
                 msg += compare_lists("output line", e.out, lines_of(o.out));
         }
         if (!msg.empty() && !o.err.empty() && errors.empty() && warnings.empty())
-            msg += "  stderr:\n" + o.err;
+            msg += "  stderr:\n" + escape_controls(o.err, true);
         return msg;
     }
     fs::path sidecar = file;
@@ -224,7 +225,8 @@ std::string run_one(const fs::path& file, bool bless, std::string& blessed,
     fs::path mesh_sidecar = file;
     mesh_sidecar.replace_extension(".mesh.txt");
     if (o.exit_code != 0)
-        return fmt::format("  exit code {} (a golden grammar must derive cleanly)\n{}", o.exit_code, o.err);
+        return fmt::format("  exit code {} (a golden grammar must derive cleanly)\n{}", o.exit_code,
+                           escape_controls(o.err, true));
     // the mesh summary: counts and bounds of `plant run`'s scene
     std::string mesh;
     if (bless || fs::exists(mesh_sidecar)) {
@@ -244,14 +246,16 @@ std::string run_one(const fs::path& file, bool bless, std::string& blessed,
         }
         read_file(tmp_name, mesh);
         unlink(tmp_name);
-        if (m.exit_code != 0) return fmt::format("  plant run: exit code {}\n{}", m.exit_code, m.err);
+        if (m.exit_code != 0)
+            return fmt::format("  plant run: exit code {}\n{}", m.exit_code, escape_controls(m.err, true));
     }
     if (bless) {
         for (const auto& [path, content] : {std::pair{sidecar, o.out}, std::pair{mesh_sidecar, mesh}}) {
             std::string old;
             const bool existed = read_file(path.string(), old);
             if (!existed || old != content) {
-                if (!write_atomically(path, content)) return "  cannot write " + path.string() + "\n";
+                if (!write_atomically(path, content))
+                    return "  cannot write " + escape_controls(path.string()) + "\n";
                 blessed += fmt::format("wrote {}{}\n{}", escape_controls(path.string()),
                                        existed ? "" : " (new)", short_diff(old, content));
             }
@@ -261,13 +265,13 @@ std::string run_one(const fs::path& file, bool bless, std::string& blessed,
     std::string want;
     if (!read_file(sidecar.string(), want))
         return fmt::format("  no expectations: add '# expect' comments or create {} with --bless\n",
-                           sidecar.string());
+                           escape_controls(sidecar.string()));
     if (want != o.out) return first_difference(want, o.out);
     if (fs::exists(mesh_sidecar)) {
         std::string want_mesh;
         read_file(mesh_sidecar.string(), want_mesh);
         if (want_mesh != mesh)
-            return "  mesh summary (" + mesh_sidecar.filename().string() + ") differs\n" +
+            return "  mesh summary (" + escape_controls(mesh_sidecar.filename().string()) + ") differs\n" +
                    first_difference(want_mesh, mesh);
     }
     return {};
@@ -310,7 +314,8 @@ int test_main(const TestCmd& c) {
     int passed = 0, failed = 0, written = 0;
     for (const auto& f : files) {
         if (std::find(libraries.begin(), libraries.end(), f) != libraries.end()) {
-            if (c.verbose) std::cout << "library " << f.string() << " (imported, not a test)\n";
+            if (c.verbose)
+                std::cout << "library " << escape_controls(f.string()) << " (imported, not a test)\n";
             continue;
         }
         std::string blessed;
@@ -322,11 +327,11 @@ int test_main(const TestCmd& c) {
                 for (const std::string& line : lines_of(blessed)) written += line.rfind("wrote ", 0) == 0;
                 std::cout << blessed;
             } else if (c.verbose) {
-                std::cout << "ok " << f.string() << "\n";
+                std::cout << "ok " << escape_controls(f.string()) << "\n";
             }
         } else {
             ++failed;
-            std::cout << "FAIL " << f.string() << "\n" << msg;
+            std::cout << "FAIL " << escape_controls(f.string()) << "\n" << msg;
         }
     }
     if (c.bless) std::cout << fmt::format("{} file{} written\n", written, written == 1 ? "" : "s");

@@ -60,8 +60,8 @@ std::string compare_diagnostics(const char* what, const std::vector<ExpectedDiag
         if (i < want.size() && i < got.size() && diagnostic_matches(want[i], got[i])) continue;
         std::string expected = "(nothing)";
         if (i < want.size()) expected = (want[i].contains ? "containing: " : "") + want[i].text;
-        msg += fmt::format("  {} {}:\n    expected: {}\n    got:      {}\n", what, i + 1, expected,
-                           i < got.size() ? got[i] : "(nothing)");
+        msg += fmt::format("  {} {}:\n    expected: {}\n    got:      {}\n", what, i + 1,
+                           escape_controls(expected), i < got.size() ? escape_controls(got[i]) : "(nothing)");
     }
     return msg;
 }
