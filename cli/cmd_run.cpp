@@ -112,8 +112,7 @@ int read_output_options(RunCmd& c, OutputOptions& oo) {
     }
     std::uint64_t max_memory = 0;
     if (!c.g.max_memory.empty() && (max_memory = parse_memory(c.g.max_memory)) == 0) {
-        std::cerr << fmt::format("plant: --max-memory expects a size such as 512M or 4G, found '{}'\n",
-                                 escape_controls(c.g.max_memory));
+        std::cerr << "plant: " << memory_usage_error(c.g.max_memory) << "\n";
         return kUsage;
     }
     std::optional<glm::dvec3> camera, look_at;

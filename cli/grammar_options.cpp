@@ -66,19 +66,24 @@ void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation) {
 }
 
 void add_max_memory(CLI::App& cmd, std::string& size) {
-    cmd.add_option("--max-memory", size,
-                   "Memory the command may take, as 512M or 4G (default: half the physical memory): "
-                   "the derivation's strings and tables, the skeleton, the mesh, the physics and the "
-                   "export buffers are charged against it before they are allocated, and a stage that "
-                   "would pass it stops with an error (exit 70)")
+    cmd.add_option_function<std::string>(
+           "--max-memory",
+           [&size](const std::string& v) {
+               // checked here, so that an empty value is an error too, not the default
+               if (parse_memory(v) == 0) throw CLI::ValidationError(memory_usage_error(v));
+               size = v;
+           },
+           "Memory the command may take, as 512M or 4G (default: half the physical memory): "
+           "the derivation's strings and tables, the skeleton, the mesh, the physics and the "
+           "export buffers are charged against it before they are allocated, and a stage that "
+           "would pass it stops with an error (exit 70)")
         ->type_name("SIZE");
 }
 
 bool set_memory_budget(const std::string& size) {
     std::uint64_t bytes = default_max_memory();
     if (!size.empty() && (bytes = parse_memory(size)) == 0) {
-        std::cerr << fmt::format("plant: --max-memory expects a size such as 512M or 4G, found '{}'\n",
-                                 escape_controls(size));
+        std::cerr << "plant: " << memory_usage_error(size) << "\n";
         return false;
     }
     memory::set_limit(bytes);

@@ -2,6 +2,7 @@
 #include "pending_files.hpp"
 #include "run_progress.hpp"
 
+#include "plant/diagnostics.hpp"
 #include "plant/environment.hpp"
 
 #include "plant/export.hpp"
@@ -13,6 +14,7 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -198,10 +200,18 @@ std::optional<glm::dvec3> parse_point(const std::string& text) {
 }
 
 std::uint64_t parse_memory(const std::string& text) {
-    char* end = nullptr;
-    const double v = std::strtod(text.c_str(), &end);
-    if (end == text.c_str() || !(v > 0)) return 0;
-    const std::string unit(end);
+    // digits, an optional fraction and an optional unit: no sign, exponent, hexadecimal, "inf"
+    std::size_t k = 0;
+    while (k < text.size() && std::isdigit(static_cast<unsigned char>(text[k]))) ++k;
+    if (k == 0) return 0;
+    if (k < text.size() && text[k] == '.') {
+        const std::size_t f = ++k;
+        while (k < text.size() && std::isdigit(static_cast<unsigned char>(text[k]))) ++k;
+        if (k == f) return 0;
+    }
+    if (k > 30) return 0;
+    const double v = std::strtod(text.substr(0, k).c_str(), nullptr);
+    const std::string unit = text.substr(k);
     double scale = 1;
     if (unit == "K" || unit == "k")
         scale = 1024.0;
@@ -212,7 +222,13 @@ std::uint64_t parse_memory(const std::string& text) {
     else if (!unit.empty())
         return 0;
     const double bytes = v * scale;
-    return bytes >= 1 && bytes < 1.8e19 ? static_cast<std::uint64_t>(bytes) : 0;
+    return bytes >= double(kMinMaxMemory) && bytes < 1.8e19 ? static_cast<std::uint64_t>(bytes) : 0;
+}
+
+std::string memory_usage_error(const std::string& text) {
+    return fmt::format("--max-memory expects a size such as 512M or 4G, found '{}': digits and the unit "
+                       "K, M or G, at least 1M",
+                       escape_controls(text));
 }
 
 // Before meshing: every skeleton point becomes a ring of sides + 1 vertices (position, normal,

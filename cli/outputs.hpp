@@ -50,8 +50,14 @@ std::optional<glm::dvec3> parse_point(const std::string& text);
 
 // Half the machine's physical memory: the default of --max-memory.
 std::uint64_t default_max_memory();
-// "512M", "4G", "1.5G" or a number of bytes; 0 when it cannot be read.
+// The smallest --max-memory: 1 MB (below it no command can do anything, and "--max-memory 1" is
+// more likely a forgotten unit than a budget of one byte).
+constexpr std::uint64_t kMinMaxMemory = std::uint64_t(1) << 20;
+// "512M", "4G", "1.5G" or a number of bytes, at least kMinMaxMemory; 0 when it cannot be read
+// (empty, a sign, an exponent, hexadecimal, an unknown unit) or is smaller.
 std::uint64_t parse_memory(const std::string& text);
+// The usage error for a --max-memory that parse_memory refuses.
+std::string memory_usage_error(const std::string& text);
 
 // What a format is made from; each stage needs the ones before it.
 enum class OutputNeeds {

@@ -85,8 +85,8 @@ std::string make_child(const DecompositionGraph& g, const double* a, bool with_i
     if (records && !g.record(h, parent, pos, index, place))
         return g.full()
                    ? fmt::format("the decomposition graph would have more than {} nodes, {} values (nodes "
-                                 "times parameters) or {} MB of memory (a quarter of plant run's "
-                                 "--max-memory, at most 1024 MB)",
+                                 "times parameters) or {} MB of memory (a quarter of the "
+                                 "command's --max-memory, at most 1024 MB)",
                                  DecompositionGraph::kMaxNodes, DecompositionGraph::kMaxValues,
                                  g.max_bytes() >> 20)
                    : "two paths of the decomposition graph made in this pass have the same handle";

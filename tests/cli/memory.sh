@@ -77,6 +77,14 @@ done
 check "bad --max-memory is a usage error" 64 "$plant" derive --max-memory 12X "$tmp/tiny.plant"
 contains "bad --max-memory" "$tmp/stderr" "--max-memory expects a size such as 512M or 4G, found '12X'"
 check "check takes --max-memory" 0 "$plant" check --max-memory 64M "$tmp/tiny.plant"
+# a size is digits and a unit, at least 1M: no empty value, no hexadecimal, exponent or sign
+for bad in 1 1023K '' 0x10M 1e3M -1G 0.5M inf 12MB; do
+  check "--max-memory '$bad' is a usage error" 64 "$plant" derive --max-memory "$bad" "$tmp/tiny.plant"
+  contains "--max-memory '$bad' says what to write" "$tmp/stderr" "found '$bad': digits and the unit K, M or G, at least 1M"
+done
+for good in 1M 1024K 1.5G 2g 1048576; do
+  check "--max-memory $good is a size" 0 "$plant" check --max-memory "$good" "$tmp/tiny.plant"
+done
 
 echo "memory: $pass passed, $fail failed"
 [ $fail -eq 0 ]
