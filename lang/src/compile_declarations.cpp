@@ -290,7 +290,7 @@ void Compiler::compile_settings(const ast::File& f) {
                               fmt::format("the number of steps must be a whole number from 0 to "
                                           "1000000, found {}",
                                           *v));
-            if (s.key == Key::Seed && (!whole || *v < 0 || *v >= 9.0e18)) // the range start() accepts
+            if (s.key == Key::Seed && (!whole || *v < 0 || *v > 9.0e18)) // the range start() accepts
                 diags_->error(s.value->span,
                               fmt::format("the seed must be a whole number from 0 to 9e18, found {}", *v));
             if (s.key == Key::WidthScale && !(*v > 0 && *v <= 1e6))

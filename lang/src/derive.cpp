@@ -128,7 +128,7 @@ void Derivation::start() {
             fmt::format("the number of steps must be a whole number from 0 to 1000000, found {}", steps)};
     target_ = static_cast<int>(steps);
     double seed = setting(Key::Seed, 0);
-    if (!(seed >= 0 && seed < 9.0e18) || seed != std::floor(seed))
+    if (!(seed >= 0 && seed <= 9.0e18) || seed != std::floor(seed))
         throw RuntimeError{RuntimeErrorKind::Setting, where(Key::Seed),
                            fmt::format("the seed must be a whole number from 0 to 9e18, found {}", seed)};
     seed_ = opt_.seed ? *opt_.seed : static_cast<std::uint64_t>(seed);
