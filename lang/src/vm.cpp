@@ -545,7 +545,12 @@ RunStatus execute(const Code& code, double* frame, EvalEnv& env, double* result)
             if (method.access == EnvAccess::Edit) {
                 // the compiler allows edits in hooks only, and only hooks run with hook_run set
                 if (!env.hook_run) fail(code, pc, "an environment can be changed only in hooks");
-                env.hook_run->environment(e)->edit(m, st + sp);
+                try {
+                    env.hook_run->environment(e)->edit(m, st + sp);
+                } catch (RuntimeError& refused) { // an edit's argument out of bounds: at the call
+                    if (!refused.span.valid() && pc < code.spans.size()) refused.span = code.spans[pc];
+                    throw;
+                }
             } else {
                 const Environment* object = env.run ? env.run->environment(e) : decl.initial.get();
                 object->query(m, st + sp, r);

@@ -113,6 +113,16 @@ void Climber::query(std::size_t method, const double* a, double* r) const {
     }
 }
 
+namespace {
+
+// The length of `v`, scaled by its largest component so that 1e300 does not square to infinity.
+double emit_speed(const glm::dvec3& v) {
+    const double big = std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+    return big > 0 ? big * glm::length(v / big) : 0.0;
+}
+
+} // namespace
+
 void Climber::edit(std::size_t method, const double* a) {
     const auto m = static_cast<M>(method);
     // edits with a non-finite vector are ignored: they would poison the world
@@ -137,6 +147,13 @@ void Climber::edit(std::size_t method, const double* a) {
         seed_requests_.push_back(id_of(a[0]));
         return;
     case M::Emit:
+        // the bound of `emitter_velocity` (docs/language.md "Limits") holds for emit too; the VM
+        // places the error on the call
+        if (const double speed = emit_speed(vec(a + 1)); speed > 1e6)
+            throw RuntimeError(RuntimeErrorKind::General, Span{},
+                               fmt::format("emit: the velocity must be at most 1e6 m/s long, as an "
+                                           "emitter_velocity, found {:g}",
+                                           speed));
         if (std::isfinite(a[0]) && a[0] >= 0 && a[0] < 1e9)
             emits_.emplace_back(static_cast<std::size_t>(a[0]), vec(a + 1));
         return;
