@@ -34,17 +34,17 @@ void on_stop(int sig) {
     g_stop.store(true);
 }
 
-// SIGINT and SIGTERM only set g_stop while a batch runs: the workers stop at their next look,
-// abandon the variants under way (PendingFiles removes their files) and the batch ends by the
-// signal after writing the manifest of the variants done. A signal ignored when plant started
-// (a background job of a script: nohup, `&`) stays ignored.
+// SIGINT, SIGTERM and SIGHUP (as SIGTERM) only set g_stop while a batch runs: the workers stop at their next
+// look, abandon the variants under way (PendingFiles removes their files) and the batch ends by the signal
+// after writing the manifest of the variants done. A signal ignored when plant started (a background job of a
+// script: nohup, `&`) stays ignored.
 class StopOnSignal {
   public:
     StopOnSignal() {
         struct sigaction sa {};
         sa.sa_handler = on_stop;
         sigemptyset(&sa.sa_mask);
-        for (auto [sig, old] : {std::pair{SIGINT, &old_int_}, {SIGTERM, &old_term_}}) {
+        for (auto [sig, old] : {std::pair{SIGINT, &old_int_}, {SIGTERM, &old_term_}, {SIGHUP, &old_hup_}}) {
             sigaction(sig, nullptr, old);
             if ((old->sa_flags & SA_SIGINFO) || old->sa_handler != SIG_IGN) sigaction(sig, &sa, nullptr);
         }
@@ -54,13 +54,14 @@ class StopOnSignal {
         PendingFiles::share_signals(nullptr);
         sigaction(SIGINT, &old_int_, nullptr);
         sigaction(SIGTERM, &old_term_, nullptr);
+        sigaction(SIGHUP, &old_hup_, nullptr);
     }
     StopOnSignal(const StopOnSignal&) = delete;
     StopOnSignal& operator=(const StopOnSignal&) = delete;
 
   private:
     struct sigaction old_int_ {
-    }, old_term_{};
+    }, old_term_{}, old_hup_{};
 };
 
 struct Compiled {

@@ -26,7 +26,7 @@ struct Registry {
     const std::atomic<bool>* live = nullptr;
     std::size_t count = 0;
     struct sigaction old_int {
-    }, old_term{};
+    }, old_term{}, old_hup{}; // SIGHUP (the terminal closed) is handled as SIGTERM
 };
 std::atomic<Registry*> g_registry{nullptr};
 std::atomic<const std::atomic<bool>*> g_shared_stop{nullptr}; // share_signals()
@@ -34,7 +34,7 @@ std::atomic<const std::atomic<bool>*> g_shared_stop{nullptr}; // share_signals()
 void on_signal(int sig, siginfo_t* info, void* context) {
     Registry* r = g_registry.load();
     if (!r) return;
-    const struct sigaction& old = sig == SIGINT ? r->old_int : r->old_term;
+    const struct sigaction& old = sig == SIGINT ? r->old_int : sig == SIGHUP ? r->old_hup : r->old_term;
     if (!(old.sa_flags & SA_SIGINFO) && old.sa_handler == SIG_IGN) return;
     if ((old.sa_flags & SA_SIGINFO) && old.sa_sigaction) {
         old.sa_sigaction(sig, info, context);
@@ -72,19 +72,22 @@ PendingFiles::PendingFiles(const std::vector<std::string>& targets)
     }
     if (g_shared_stop.load()) return; // a batch: its own handlers stop it
     owns_signals_ = true;
-    auto* r = new Registry{temps_.data(), live_.get(), temps_.size(), {}, {}};
+    auto* r = new Registry{temps_.data(), live_.get(), temps_.size(), {}, {}, {}};
     struct sigaction sa {};
     sa.sa_sigaction = on_signal;
     sa.sa_flags = SA_SIGINFO;
     sigemptyset(&sa.sa_mask);
     sigaddset(&sa.sa_mask, SIGINT);
     sigaddset(&sa.sa_mask, SIGTERM);
+    sigaddset(&sa.sa_mask, SIGHUP);
     // the old actions are read before the registry is published, so the handler always has them
     sigaction(SIGINT, nullptr, &r->old_int);
     sigaction(SIGTERM, nullptr, &r->old_term);
+    sigaction(SIGHUP, nullptr, &r->old_hup);
     g_registry.store(r);
     sigaction(SIGINT, &sa, nullptr);
     sigaction(SIGTERM, &sa, nullptr);
+    sigaction(SIGHUP, &sa, nullptr);
 }
 
 PendingFiles::~PendingFiles() {
@@ -92,6 +95,7 @@ PendingFiles::~PendingFiles() {
     if (r) {
         sigaction(SIGINT, &r->old_int, nullptr);
         sigaction(SIGTERM, &r->old_term, nullptr);
+        sigaction(SIGHUP, &r->old_hup, nullptr);
         g_registry.store(nullptr);
         delete r;
     }

@@ -194,25 +194,30 @@ check "second output is a folder" 73 "$plant" run "$tmp/plant.plant" -o "$tmp/ke
 contains "the target is named" "$tmp/stderr" "cannot write '$tmp/keep/b.skel.json'"
 contains "the first output keeps its old contents" "$tmp/keep/a.txt" "old"
 # SIGINT while a slow output is being made removes the temporary files already written and ends
-# the process by the signal (job control, so the background run does not ignore SIGINT)
+# the process by the signal (job control, so the background run does not ignore SIGINT); SIGHUP
+# (the terminal closed) the same
 printf 'axiom: A;\nderive 15;\nrules { A -> F[+A][-A]; }\n' >"$tmp/slow.plant"
-mkdir -p "$tmp/sig"
-set -m
-"$plant" run "$tmp/slow.plant" -o "$tmp/sig/s.txt" -o "$tmp/sig/s.png" -o "$tmp/sig/s.obj" --sides 64 --size 12000x5000 \
-  >/dev/null 2>&1 &
-slow=$!
-set +m
-for _ in $(seq 200); do
-  ls -a "$tmp/sig" | grep -q plant-tmp && break
-  sleep 0.05
+for sig in INT HUP; do
+  rm -rf "$tmp/sig"
+  mkdir -p "$tmp/sig"
+  set -m
+  "$plant" run "$tmp/slow.plant" -o "$tmp/sig/s.txt" -o "$tmp/sig/s.png" -o "$tmp/sig/s.obj" --sides 64 --size 12000x5000 \
+    >/dev/null 2>&1 &
+  slow=$!
+  set +m
+  for _ in $(seq 200); do
+    ls -a "$tmp/sig" | grep -q plant-tmp && break
+    sleep 0.05
+  done
+  kill -s $sig "$slow" 2>/dev/null
+  wait "$slow"
+  got=$?
+  want=$((128 + $(kill -l $sig)))
+  if [ "$got" -eq $want ]; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL SIG$sig during run: exit $got, expected $want"; fi
+  if ls -a "$tmp/sig" | grep -qv '^\.\.\?$'; then
+    fail=$((fail + 1)); echo "FAIL SIG$sig during run left files:"; ls -a "$tmp/sig"
+  else pass=$((pass + 1)); fi
 done
-kill -INT "$slow" 2>/dev/null
-wait "$slow"
-got=$?
-if [ "$got" -eq 130 ]; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL SIGINT during run: exit $got, expected 130"; fi
-if ls -a "$tmp/sig" | grep -qv '^\.\.\?$'; then
-  fail=$((fail + 1)); echo "FAIL SIGINT during run left files:"; ls -a "$tmp/sig"
-else pass=$((pass + 1)); fi
 check "upper-case extension" 0 "$plant" run "$tmp/plant.plant" -o "$tmp/UP.GLB"
 printf 'axiom: F @R(1e308, 1e308, 0) F;\n' >"$tmp/huge.plant"
 check "huge heading" 0 "$plant" run "$tmp/huge.plant" -o "$tmp/huge.skel.json"
