@@ -104,6 +104,23 @@ void setup_derive(CLI::App& app, int& exit_code) {
         [c, &exit_code] { exit_code = set_memory_budget(c->g.max_memory) ? derive_main(*c) : kUsage; });
 }
 
+namespace {
+
+// The settings evaluated as `derive` evaluates them (`seed 1/0;`, `derive d;` with a param out of
+// range): an error for check, not only for derive and run. Whether they passed.
+bool check_settings(const GrammarOptions& o, const Program& program, const SourceManager& sources) {
+    try {
+        Derivation d(program, derive_options(o));
+        d.evaluate_settings();
+        return true;
+    } catch (const RuntimeError& e) {
+        std::cerr << render(Diagnostic{Severity::Error, e.span, e.message, {}}, sources, o.color);
+        return false;
+    }
+}
+
+} // namespace
+
 void setup_check(CLI::App& app, int& exit_code) {
     auto c = std::make_shared<GrammarOptions>();
     CLI::App* cmd = app.add_subcommand(
@@ -117,6 +134,10 @@ void setup_check(CLI::App& app, int& exit_code) {
         SourceManager sources;
         int code = kOk;
         auto program = load_program(*c, sources, code);
+        if (program && !check_settings(*c, *program, sources)) {
+            exit_code = kGrammar;
+            return;
+        }
         exit_code = program ? report_dormant_edits(*c, *program, sources) : code;
     });
 }

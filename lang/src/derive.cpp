@@ -101,17 +101,28 @@ void Derivation::run_hook(HookKind kind) {
     if (effects.stop) stopped_ = true;
 }
 
-void Derivation::start() {
+namespace {
+
+// What a setting, and the axiom after them, are evaluated with: the program, the run's state and
+// globals, and the VM's budget.
+EvalEnv settings_env(Derivation& d, const Program& prog) {
+    EvalEnv env;
+    env.prog = &prog;
+    env.run = &d.run_state();
+    env.globals = d.globals().data();
+    env.max_steps = d.options().max_steps;
+    env.interrupt = d.options().interrupt;
+    return env;
+}
+
+} // namespace
+
+void Derivation::evaluate_settings() {
     // the environments as declared (a second start begins afresh); the graph gets half the
     // string's budget, at most 1 GiB (a bonsai's graph holds hundreds of nodes, not millions)
     run_ = RunState(prog_, opt_.edits ? opt_.edits : prog_.graph.edits,
                     std::min(opt_.max_bytes / 2, std::size_t{1} << 30));
-    EvalEnv env;
-    env.prog = &prog_;
-    env.run = &run_;
-    env.globals = globals_.data();
-    env.max_steps = opt_.max_steps;
-    env.interrupt = opt_.interrupt;
+    EvalEnv env = settings_env(*this, prog_);
     using Key = ast::SettingKey;
     auto setting = [&](Key key, double fallback) {
         const Code& c = prog_.setting(key);
@@ -140,6 +151,11 @@ void Derivation::start() {
         throw RuntimeError{
             RuntimeErrorKind::Setting, where(Key::WidthScale),
             fmt::format("width_scale must be a number above 0 and at most 1000000, found {}", width_scale_)};
+}
+
+void Derivation::start() {
+    evaluate_settings();
+    EvalEnv env = settings_env(*this, prog_);
     step_ = 0;
     stopped_ = false;
     group_ = -1;

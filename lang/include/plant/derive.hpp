@@ -93,6 +93,10 @@ class Derivation {
 
     // Evaluates settings, builds the axiom (with decomposition) and runs `on start`.
     void start();
+    // The first part of start(): evaluates the settings (derive, seed, angle, step, width,
+    // width_scale) and checks their ranges, throwing a RuntimeError at the setting otherwise.
+    // `plant check` calls it alone, so that it refuses what `derive` would.
+    void evaluate_settings();
     // Runs one step with its hooks. Returns false when the derivation is over (the target step
     // count was reached or a hook said `stop;`).
     bool step();
