@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 
+#include <unistd.h>
+
 #include <filesystem>
 
 namespace plant {
@@ -127,7 +129,20 @@ void Compiler::compile_surface(const ast::ShapeDecl& s) {
         fs::path p(s.args[0]->text);
         if (p.is_relative()) p = fs::path(sm_.file(s.span.file).name()).parent_path() / p;
         def.path = p.lexically_normal().string();
-        if (readable(s.args[0]->text, def.path, s.args[0]->span).empty()) return;
+        const std::string id = readable(s.args[0]->text, def.path, s.args[0]->span);
+        if (id.empty()) return;
+        // a missing or unreadable file is an input error now, for check as for run (exit 66)
+        std::error_code ec;
+        const auto status = fs::status(id, ec);
+        const char* why = !fs::exists(status)               ? "no such file"
+                          : !fs::is_regular_file(status)    ? "not a regular file"
+                          : ::access(id.c_str(), R_OK) != 0 ? "permission denied"
+                                                            : nullptr;
+        if (why) {
+            diags_->input_error(s.args[0]->span,
+                                fmt::format("cannot read surface file '{}': {}", s.args[0]->text, why));
+            return;
+        }
     } else {
         diags_->error(
             s.kind_span,
