@@ -63,6 +63,22 @@ glm::vec3 unit_normal(glm::vec3 n) {
     return n;
 }
 
+// Whether unit_normal leaves each of the `n` vec3 floats at `bytes` as it is: a squared length
+// within [(1 - 1e-5)^2, (1 + 1e-5)^2], narrowed by 1e-6 each side for the rounding of the squared
+// length against glm::length's (a normal near the edge takes the exact path). NaN fails.
+bool all_unit(const unsigned char* bytes, std::size_t n) {
+    constexpr float kLow = (1.0f - 1e-5f) * (1.0f - 1e-5f) + 1e-6f,
+                    kHigh = (1.0f + 1e-5f) * (1.0f + 1e-5f) - 1e-6f;
+    bool ok = true;
+    for (std::size_t k = 0; k < n; ++k) {
+        float v[3];
+        std::memcpy(v, bytes + k * sizeof v, sizeof v);
+        const float s = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        ok &= (s >= kLow) & (s <= kHigh);
+    }
+    return ok;
+}
+
 // A run of the buffer's bytes: borrowed from the scene (or from GltfBuilder::owned), or normals
 // (vec3 floats) to renormalize on the way out.
 struct Piece {
@@ -118,7 +134,9 @@ struct GltfBuilder {
         return static_cast<int>(model.bufferViews.size() - 1);
     }
 
-    // Hands the buffer's bytes to `sink`, normals renormalized a block at a time.
+    // Hands the buffer's bytes to `sink`, normals renormalized a block at a time. The mesher's
+    // normals are unit already: a block that unit_normal would leave as it is goes out from the
+    // scene's own array, only the others through a copy.
     void write_buffer(const ByteSink& sink) const {
         std::vector<glm::vec3> block;
         for (const Piece& piece : pieces) {
@@ -127,11 +145,16 @@ struct GltfBuilder {
                 continue;
             }
             constexpr std::size_t kBlock = 1 << 15; // 384 kB a write
-            block.resize(kBlock);
             const std::size_t count = piece.size / sizeof(glm::vec3);
             for (std::size_t at = 0; at < count; at += kBlock) {
                 const std::size_t n = std::min(kBlock, count - at);
-                std::memcpy(block.data(), piece.bytes + at * sizeof(glm::vec3), n * sizeof(glm::vec3));
+                const unsigned char* from = piece.bytes + at * sizeof(glm::vec3);
+                if (all_unit(from, n)) {
+                    sink(from, n * sizeof(glm::vec3));
+                    continue;
+                }
+                block.resize(kBlock);
+                std::memcpy(block.data(), from, n * sizeof(glm::vec3));
                 for (std::size_t k = 0; k < n; ++k) block[k] = unit_normal(block[k]);
                 sink(block.data(), n * sizeof(glm::vec3));
             }
@@ -219,13 +242,19 @@ struct GltfBuilder {
         mesh.name = name;
 
         // POSITION, with the min and max the specification requires.
-        glm::vec3 lo(std::numeric_limits<float>::max()), hi(std::numeric_limits<float>::lowest());
+        // One pass the compiler vectorizes: a coordinate is finite when its magnitude is at most
+        // the largest float (false for infinities and NaN); min and max compare as glm's do.
+        constexpr float kLargest = std::numeric_limits<float>::max();
+        float lx = kLargest, ly = kLargest, lz = kLargest, hx = -kLargest, hy = -kLargest, hz = -kLargest;
+        bool finite = true;
         for (const glm::vec3& p : part.positions) {
-            if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-                throw ExportError("glTF export: " + name + " has a position that is not finite");
-            lo = glm::min(lo, p);
-            hi = glm::max(hi, p);
+            finite &=
+                (std::fabs(p.x) <= kLargest) & (std::fabs(p.y) <= kLargest) & (std::fabs(p.z) <= kLargest);
+            lx = p.x < lx ? p.x : lx, ly = p.y < ly ? p.y : ly, lz = p.z < lz ? p.z : lz;
+            hx = hx < p.x ? p.x : hx, hy = hy < p.y ? p.y : hy, hz = hz < p.z ? p.z : hz;
         }
+        if (!finite) throw ExportError("glTF export: " + name + " has a position that is not finite");
+        const glm::vec3 lo(lx, ly, lz), hi(hx, hy, hz);
         const int pos_view = add_view(part.positions.data(), nv * sizeof(glm::vec3), array_buffer);
         const int pos = add_accessor(pos_view, 0, nv, TINYGLTF_TYPE_VEC3, TINYGLTF_COMPONENT_TYPE_FLOAT);
         model.accessors[std::size_t(pos)].minValues = {lo.x, lo.y, lo.z};
