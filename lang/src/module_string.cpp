@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cstring>
 #include <unordered_set>
@@ -11,26 +12,50 @@ namespace plant {
 
 void ModuleString::append_range(const ModuleString& o, std::size_t b, std::size_t e) {
     if (b >= e) return;
+    const std::size_t m0 = sym.size(), p0 = params.size();
     if (e - b == 1) { // the common case in context-sensitive grammars: one module between rewrites
+        if ((m0 & (kBlock - 1)) == 0) block_at.push_back(static_cast<std::uint32_t>(p0));
         sym.push_back(o.sym[b]);
+        nargs.push_back(o.nargs[b]);
         if (keep_ids) ids.push_back(o.ids[b]);
-        for (std::uint32_t k = o.poff[b]; k < o.poff[e]; ++k) params.push_back(o.params[k]);
-        poff.push_back(static_cast<std::uint32_t>(params.size()));
+        const double* a = o.args(b);
+        for (std::uint32_t k = 0; k < o.nargs[b]; ++k) params.push_back(a[k]);
         return;
     }
-    const std::size_t n = e - b, m0 = sym.size(), p0 = params.size();
-    const std::uint32_t pb = o.poff[b], pe = o.poff[e];
+    const std::size_t n = e - b, pb = o.offset(b), pe = o.offset(e);
     sym.resize(m0 + n);
+    nargs.resize(m0 + n);
     if (keep_ids) ids.resize(m0 + n);
-    poff.resize(m0 + n + 1);
     params.resize(p0 + (pe - pb));
     std::memcpy(sym.data() + m0, o.sym.data() + b, n * sizeof(SymbolId));
+    std::memcpy(nargs.data() + m0, o.nargs.data() + b, n);
     if (keep_ids) std::memcpy(ids.data() + m0, o.ids.data() + b, n * sizeof(ModuleId));
     if (pe > pb) std::memcpy(params.data() + p0, o.params.data() + pb, (pe - pb) * sizeof(double));
-    const auto shift = static_cast<std::uint32_t>(p0 - pb); // unsigned wrap-around is intended
-    std::uint32_t* dst = poff.data() + m0 + 1;
-    const std::uint32_t* src = o.poff.data() + b + 1;
-    for (std::size_t i = 0; i < n; ++i) dst[i] = src[i] + shift;
+    index_from(m0, p0);
+}
+
+void ModuleString::truncate(std::size_t m) {
+    if (m >= size()) return;
+    params.resize(offset(m));
+    sym.resize(m);
+    nargs.resize(m);
+    if (keep_ids) ids.resize(m);
+    block_at.resize((m + kBlock - 1) >> kBlockShift);
+}
+
+void ModuleString::index_range(std::size_t b, std::size_t e, std::size_t p) {
+    const std::uint8_t* a = nargs.data();
+    std::size_t i = b;
+    // up to the first block start at or after b
+    for (; i < e && (i & (kBlock - 1)) != 0; ++i) p += a[i];
+    // whole blocks: one entry, then a sum of kBlock bytes (which the compiler vectorises)
+    for (; i < e; i += kBlock) {
+        block_at[i >> kBlockShift] = static_cast<std::uint32_t>(p);
+        const std::size_t end = std::min(e, i + kBlock);
+        std::uint32_t sum = 0;
+        for (std::size_t j = i; j < end; ++j) sum += a[j];
+        p += sum;
+    }
 }
 
 void bracket_table(const ModuleString& s, SymbolId open, SymbolId close, std::vector<std::uint32_t>& match) {

@@ -160,21 +160,21 @@ void TurtleEnvironmentPhase::run(const Derivation& d, RunState& state, ModuleStr
     }
     // ?E(env, slots...): the named environment answers at the module's position (docs/language.md,
     // environment objects: open L-systems' communication modules)
-    for (std::size_t i = 0; !sink.positions.empty() && i < string.size(); ++i) {
+    double* a = string.params.data(); // module i's parameters: the string is read in order
+    for (std::size_t i = 0; !sink.positions.empty() && i < string.size(); a += string.arity(i), ++i) {
         if (p.symbols[string.sym[i]].turtle_op != TurtleOp::Communicate || string.arity(i) < 2) continue;
         auto it = sink.positions.find(string.id(i));
-        double* a = string.params.data() + string.poff[i];
         const auto env = static_cast<std::size_t>(a[0]);
         if (it == sink.positions.end() || a[0] < 0 || env >= state.size() || !state.environment(env))
             continue;
         state.environment(env)->communicate(it->second.position, string.id(i), it->second.axis, a + 1,
                                             string.arity(i) - 1);
     }
-    for (std::size_t i = 0; i < string.size(); ++i) {
+    a = string.params.data();
+    for (std::size_t i = 0; i < string.size(); a += string.arity(i), ++i) {
         if (!p.symbols[string.sym[i]].query || string.arity(i) != 3) continue;
         auto it = sink.found.find(string.id(i));
         if (it == sink.found.end()) continue;
-        double* a = string.params.data() + string.poff[i];
         a[0] = it->second.x;
         a[1] = it->second.y;
         a[2] = it->second.z;

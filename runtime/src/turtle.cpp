@@ -145,7 +145,8 @@ class Turtle {
     }
 
     void run() {
-        for (std::size_t i = 0; i < s_.size(); ++i) {
+        at_ = s_.params.data();
+        for (std::size_t i = 0; i < s_.size(); at_ += s_.arity(i), ++i) {
             const SymbolId sym = s_.sym[i];
             if (sym >= ops_.size()) continue;
             if (bound_[sym])
@@ -158,10 +159,12 @@ class Turtle {
     }
 
   private:
+    const double* at_ = nullptr; // the parameters of the module run() is at (the string is read in order)
+
     double arg(std::size_t i, std::uint32_t k, double fallback) const {
-        return s_.arity(i) > k ? s_.args(i)[k] : fallback;
+        return s_.arity(i) > k ? at_[k] : fallback;
     }
-    glm::dvec3 vec_arg(std::size_t i, std::uint32_t k) const { return vec(s_.args(i) + k); }
+    glm::dvec3 vec_arg(std::size_t /*i*/, std::uint32_t k) const { return vec(at_ + k); }
 
     void check(std::size_t i) const {
         auto finite = [](const glm::dvec3& v) {
@@ -194,7 +197,7 @@ class Turtle {
     // its position and the turtle takes its frame
     void bound_segment(std::size_t i) {
         double len = arg(i, 0, t_.step);
-        if (s_.arity(i) > 1) t_.width = 2 * s_.args(i)[1];
+        if (s_.arity(i) > 1) t_.width = 2 * at_[1];
         start_axis();
         glm::dvec3 from = t_.position;
         glm::dvec3 p;
@@ -220,7 +223,7 @@ class Turtle {
 
     void forward(std::size_t i) {
         double len = arg(i, 0, t_.step);
-        if (s_.arity(i) > 1) t_.width = s_.args(i)[1];
+        if (s_.arity(i) > 1) t_.width = at_[1];
         start_axis();
         glm::dvec3 from = t_.position;
         t_.position += t_.heading * len;
@@ -285,7 +288,7 @@ class Turtle {
     void place_instance(std::size_t i, int index) {
         const std::size_t width = program_.instances ? instance_arg_width((*program_.instances)[index]) : 0;
         const std::uint32_t n = s_.arity(i);
-        const double* a = s_.args(i);
+        const double* a = at_;
         std::vector<double> args(a, a + std::min<std::size_t>(n, width));
         args.resize(width, 0.0);
         const double scale = n > width ? a[width] : 1.0;

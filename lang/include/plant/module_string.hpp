@@ -1,5 +1,5 @@
 // The module string: flat arrays, no per-module heap objects (docs/design.md, the module
-// string). Module i has symbol sym[i], parameters params[poff[i] .. poff[i+1]) and
+// string). Module i has symbol sym[i], nargs[i] parameters from params[offset(i)] and
 // the identity ids[i] (docs/language.md, module identity). Vec3 parameters occupy three consecutive doubles.
 //
 // A string may go without identities (keep_ids false, ids empty): a derivation whose identities
@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <functional>
 #include <span>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
@@ -25,44 +26,93 @@ using SymbolId = std::uint16_t;
 constexpr SymbolId kNoSymbol = 0xFFFF;
 using ModuleId = std::uint64_t;
 
+// Module i's parameters start at the sum of the arities before it. No per-module offset is
+// stored (it was 4 of the 12.2 bytes a module cost on the parametric tree, issue 22): `nargs`
+// holds each arity in a byte (the compiler allows at most 255 numbers a module), and `block_at`
+// the offset of every kBlock-th module, so that a random access adds at most kBlock - 1 bytes.
+// Sequential readers keep a running offset instead (`offset` once, then `+= arity(i)`).
 struct ModuleString {
+    static constexpr std::size_t kBlockShift = 6;
+    static constexpr std::size_t kBlock = std::size_t{1} << kBlockShift;
+    static constexpr std::uint32_t kMaxArity = 255;
+
     BigVector<SymbolId> sym;
-    BigVector<std::uint32_t> poff{0}; // size() + 1 entries
+    BigVector<std::uint8_t> nargs; // arity of each module
     BigVector<double> params;
-    BigVector<ModuleId> ids; // empty when !keep_ids
+    BigVector<std::uint32_t> block_at; // block_at[j]: where module j * kBlock's parameters start
+    BigVector<ModuleId> ids;           // empty when !keep_ids
     bool keep_ids = true;
 
     std::size_t size() const { return sym.size(); }
     ModuleId id(std::size_t i) const { return keep_ids ? ids[i] : 0; }
     bool empty() const { return sym.empty(); }
-    std::uint32_t arity(std::size_t i) const { return poff[i + 1] - poff[i]; }
-    const double* args(std::size_t i) const { return params.data() + poff[i]; }
-    std::span<const double> arg_span(std::size_t i) const { return {params.data() + poff[i], arity(i)}; }
+    std::uint32_t arity(std::size_t i) const { return nargs[i]; }
+    // Where module i's parameters start (i == size(): the end of the parameters).
+    std::size_t offset(std::size_t i) const {
+        if (i >= size()) return params.size();
+        std::size_t at = block_at[i >> kBlockShift];
+        for (std::size_t j = i & ~(kBlock - 1); j < i; ++j) at += nargs[j];
+        return at;
+    }
+    const double* args(std::size_t i) const { return params.data() + offset(i); }
+    double* args(std::size_t i) { return params.data() + offset(i); }
+    std::span<const double> arg_span(std::size_t i) const { return {args(i), arity(i)}; }
 
     void clear() {
         sym.clear();
-        poff.assign(1, 0);
+        nargs.clear();
         params.clear();
+        block_at.clear();
         ids.clear();
     }
     void push(SymbolId s, const double* p, std::uint32_t k, ModuleId id) {
+        if (k > kMaxArity) throw std::length_error("a module can carry at most 255 numbers");
+        if ((sym.size() & (kBlock - 1)) == 0) block_at.push_back(static_cast<std::uint32_t>(params.size()));
         sym.push_back(s);
+        nargs.push_back(static_cast<std::uint8_t>(k));
         for (std::uint32_t i = 0; i < k; ++i) params.push_back(p[i]);
-        poff.push_back(static_cast<std::uint32_t>(params.size()));
         if (keep_ids) ids.push_back(id);
     }
     // Appends modules [b, e) of another string (which keeps identities if this one does).
     void append_range(const ModuleString& o, std::size_t b, std::size_t e);
     void append(const ModuleString& o) { append_range(o, 0, o.size()); }
+    // Cuts the string to its first m modules.
+    void truncate(std::size_t m);
+    // The number of parameters modules [b, e) carry.
+    std::size_t params_of(std::size_t b, std::size_t e) const {
+        std::size_t sum = 0;
+        for (std::size_t j = b; j < e; ++j) sum += nargs[j];
+        return sum;
+    }
+    // Sizes the arrays for m modules and p parameters without indexing them (for writers that
+    // fill them directly, then call index_from or index_range).
+    void resize_arrays(std::size_t m, std::size_t p) {
+        sym.resize(m);
+        nargs.resize(m);
+        if (keep_ids) ids.resize(m);
+        params.resize(p);
+    }
+    // After sym, nargs and params were written directly: sizes block_at for size() modules and
+    // fills its entries for modules from b on, module b's parameters starting at p. index_range
+    // fills those of modules [b, e) only, block_at being sized already (a thread's stretch).
+    // index_upto sizes block_at for e modules and fills those of [b, e) (a writer whose arrays
+    // are open past e).
+    void index_from(std::size_t b, std::size_t p) { index_upto(b, size(), p); }
+    void index_upto(std::size_t b, std::size_t e, std::size_t p) {
+        block_at.resize((e + kBlock - 1) >> kBlockShift);
+        index_range(b, e, p);
+    }
+    void index_range(std::size_t b, std::size_t e, std::size_t p);
     // Bytes held by the arrays (capacity, not size: what the process really pays).
     std::size_t bytes() const {
-        return sym.capacity() * sizeof(SymbolId) + poff.capacity() * sizeof(std::uint32_t) +
-               params.capacity() * sizeof(double) + ids.capacity() * sizeof(ModuleId);
+        return sym.capacity() * sizeof(SymbolId) + nargs.capacity() + params.capacity() * sizeof(double) +
+               block_at.capacity() * sizeof(std::uint32_t) + ids.capacity() * sizeof(ModuleId);
     }
     void swap(ModuleString& o) noexcept {
         sym.swap(o.sym);
-        poff.swap(o.poff);
+        nargs.swap(o.nargs);
         params.swap(o.params);
+        block_at.swap(o.block_at);
         ids.swap(o.ids);
         std::swap(keep_ids, o.keep_ids);
     }

@@ -33,9 +33,9 @@ bool holds(Op op, double x, double y) {
 // The first production whose condition holds applies; when it is weighted, every weighted
 // production from it on whose condition holds is a candidate and one is drawn by weight, with
 // the same arithmetic as Rewriter::choose (general.cpp), so that both routes draw alike.
-const RulePlan::Guard* Rewriter::pick_guarded(std::size_t i, const RulePlan::Guarded& g) const {
+const RulePlan::Guard* Rewriter::pick_guarded(std::size_t i, const double* a,
+                                              const RulePlan::Guarded& g) const {
     if (in.arity(i) != g.width) return nullptr; // no pattern matches
-    const double* a = in.args(i);
     const RulePlan::Guard* gs = plan.guards.data() + g.first;
     auto ok = [&](const RulePlan::Guard& q) {
         if (q.op == Op::Halt) return true;
@@ -77,7 +77,8 @@ const RulePlan::Guard* Rewriter::pick_guarded(std::size_t i, const RulePlan::Gua
 
 Rewriter::Counts Rewriter::count_direct(std::size_t b, std::size_t e) const {
     Counts c;
-    for (std::size_t i = b; i < e; ++i) {
+    const double* a = in.params.data() + in.offset(b); // module i's parameters
+    for (std::size_t i = b; i < e; a += in.arity(i), ++i) {
         const SymbolId s = in.sym[i];
         if (!plan.has_prod[s]) {
             ++c.modules;
@@ -88,7 +89,7 @@ Rewriter::Counts Rewriter::count_direct(std::size_t b, std::size_t e) const {
         if (!pr) {
             const RulePlan::Guarded& g = plan.guarded[static_cast<std::size_t>(plan.guarded_at[s])];
             if (!g.uniform)
-                if (const RulePlan::Guard* q = pick_guarded(i, g)) pr = q->pr;
+                if (const RulePlan::Guard* q = pick_guarded(i, a, g)) pr = q->pr;
             if (!pr) { // copied, or as large as a copy
                 ++c.modules;
                 c.params += in.arity(i);
@@ -122,8 +123,9 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
     w.frame.assign(plan.frame_size, 0.0);
     SymbolId* S = out.sym.data() + m_at;
     ModuleId* ID = Ids ? out.ids.data() + m_at : nullptr;
-    std::uint32_t* PO = out.poff.data() + m_at + 1; // poff[m_at] is the previous stretch's end
+    std::uint8_t* NA = out.nargs.data() + m_at;
     double* PA = out.params.data() + p_at;
+    std::size_t q = in.offset(b); // where module i's parameters start
     const std::uint32_t* at = plan.outcome_at.data();
     const ModuleId id0 = id_at;
     std::size_t p = p_at;
@@ -141,38 +143,41 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
         std::uint32_t outcome = at[s] + 1;
         if (!prp && plan.has_prod[s]) {
             const RulePlan::Guarded& g = plan.guarded[static_cast<std::size_t>(plan.guarded_at[s])];
-            if (const RulePlan::Guard* q = pick_guarded(i, g)) {
-                prp = q->pr;
-                outcome += static_cast<std::uint32_t>(q - (plan.guards.data() + g.first));
+            if (const RulePlan::Guard* gd = pick_guarded(i, in.params.data() + q, g)) {
+                prp = gd->pr;
+                outcome += static_cast<std::uint32_t>(gd - (plan.guards.data() + g.first));
             }
         }
         if (!prp) { // a run of modules without productions (or none that applies): copy it
             std::size_t j = i + 1;
             while (j < e && !plan.has_prod[in.sym[j]]) ++j;
             const std::size_t n = j - i;
-            for (std::size_t k = i; k < j; ++k) ++tally[at[in.sym[k]]];
-            const std::uint32_t pb = in.poff[i], pe = in.poff[j];
-            const auto shift = static_cast<std::uint32_t>(p - pb); // wraps around on purpose
-            if (n <= 8 && pe - pb <= 8) {
+            std::uint32_t np = 0;
+            for (std::size_t k = i; k < j; ++k) {
+                ++tally[at[in.sym[k]]];
+                np += in.nargs[k];
+            }
+            if (n <= 8 && np <= 8) {
                 // the usual run between two rewritten modules is a few turtle symbols: plain
                 // loops beat three library calls
                 for (std::size_t k = 0; k < n; ++k) {
                     S[k] = in.sym[i + k];
                     if constexpr (Ids) ID[k] = in.ids[i + k];
-                    PO[k] = in.poff[i + 1 + k] + shift;
+                    NA[k] = in.nargs[i + k];
                 }
-                for (std::uint32_t k = 0; k < pe - pb; ++k) PA[k] = in.params[pb + k];
+                for (std::uint32_t k = 0; k < np; ++k) PA[k] = in.params[q + k];
             } else {
                 std::memcpy(S, in.sym.data() + i, n * sizeof(SymbolId));
                 if constexpr (Ids) std::memcpy(ID, in.ids.data() + i, n * sizeof(ModuleId));
-                if (pe > pb) std::memcpy(PA, in.params.data() + pb, (pe - pb) * sizeof(double));
-                for (std::size_t k = 0; k < n; ++k) PO[k] = in.poff[i + 1 + k] + shift;
+                std::memcpy(NA, in.nargs.data() + i, n);
+                if (np) std::memcpy(PA, in.params.data() + q, np * sizeof(double));
             }
             S += n;
             if constexpr (Ids) ID += n;
-            PO += n;
-            PA += pe - pb;
-            p += pe - pb;
+            NA += n;
+            PA += np;
+            p += np;
+            q += np;
             i = j;
             continue;
         }
@@ -180,7 +185,7 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
         const Production& pr = *prp;
         const SuccessorTemplate& t = pr.tmpl;
         if (!t.holes.empty()) {
-            const double* a = in.args(i);
+            const double* a = in.params.data() + q;
             for (const auto& pa : pr.strict[0].args) {
                 for (int k = 0; k < pa.width; ++k) w.frame[pa.slot + k] = a[k];
                 a += pa.width;
@@ -193,18 +198,21 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
             check_holes(t, values);
         }
         const std::size_t m = t.syms.size();
-        put_template<Ids>(t, values, p, Ids ? in.ids[i] : 0, id_at, S, PO, PA, ID);
+        put_template<Ids>(t, plan.outcome_nargs.data() + plan.outcome_nargs_at[outcome], values,
+                          Ids ? in.ids[i] : 0, id_at, S, NA, PA, ID);
         if constexpr (Ids) ID += m;
         S += m;
-        PO += m;
+        NA += m;
         PA += t.params.size();
         p += t.params.size();
+        q += in.nargs[i];
         ++i;
     }
     Counts c;
     c.modules = static_cast<std::size_t>(S - (out.sym.data() + m_at));
     c.params = p - p_at;
     c.new_ids = id_at - id0;
+    out.index_range(m_at, m_at + c.modules, p_at); // block_at is sized by the caller
     return c;
 }
 

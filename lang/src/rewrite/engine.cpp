@@ -140,7 +140,7 @@ void Engine::rewrite_one_thread(const Derivation& d, Rewriter& rw, const ModuleS
     auto room = [](std::size_t want) { return want < 65536 ? 2 * want : want; };
     w.out.sym.reserve(room(static_cast<std::size_t>(n * growth * 1.02) + 16));
     if (w.out.keep_ids) w.out.ids.reserve(w.out.sym.capacity());
-    w.out.poff.reserve(w.out.sym.capacity() + 1);
+    w.out.nargs.reserve(w.out.sym.capacity());
     w.out.params.reserve(room(static_cast<std::size_t>(in.params.size() * param_growth * 1.02) + 16));
     try {
         if (plan.right_new) {
@@ -185,7 +185,7 @@ void Engine::rewrite_parallel(const Derivation& d, Rewriter& rw, const ModuleStr
                 }
                 w.out.sym.reserve(static_cast<std::size_t>(modules * growth * 1.02) + 16);
                 if (w.out.keep_ids) w.out.ids.reserve(w.out.sym.capacity());
-                w.out.poff.reserve(w.out.sym.capacity() + 1);
+                w.out.nargs.reserve(w.out.sym.capacity());
                 w.out.params.reserve(static_cast<std::size_t>(params * param_growth * 1.02) + 16);
                 try {
                     rw.run_range(w, b, e);
@@ -220,9 +220,10 @@ void Engine::rewrite_parallel(const Derivation& d, Rewriter& rw, const ModuleStr
         ids += workers[t].env.new_count;
     }
     out.swap(workers[0].out);
+    const std::size_t m0 = out.size(), p0 = out.params.size(); // worker 0's part
     out.sym.resize(total);
+    out.nargs.resize(total);
     if (out.keep_ids) out.ids.resize(total);
-    out.poff.resize(total + 1);
     out.params.resize(total_params);
     {
         std::vector<std::jthread> pool;
@@ -231,11 +232,11 @@ void Engine::rewrite_parallel(const Derivation& d, Rewriter& rw, const ModuleStr
                 ModuleString& src = workers[t].out;
                 std::copy(src.sym.begin(), src.sym.end(),
                           out.sym.begin() + static_cast<std::ptrdiff_t>(mod_at[t]));
+                std::copy(src.nargs.begin(), src.nargs.end(),
+                          out.nargs.begin() + static_cast<std::ptrdiff_t>(mod_at[t]));
                 std::copy(src.params.begin(), src.params.end(),
                           out.params.begin() + static_cast<std::ptrdiff_t>(par_at[t]));
-                for (std::size_t i = 0; i < src.size(); ++i) {
-                    out.poff[mod_at[t] + i] = static_cast<std::uint32_t>(par_at[t] + src.poff[i]);
-                    if (!out.keep_ids) continue;
+                for (std::size_t i = 0; out.keep_ids && i < src.size(); ++i) {
                     ModuleId id = src.ids[i];
                     out.ids[mod_at[t] + i] = (id & kNewIdBit) ? id_at[t] + (id & ~kNewIdBit) : id;
                 }
@@ -243,7 +244,7 @@ void Engine::rewrite_parallel(const Derivation& d, Rewriter& rw, const ModuleStr
             });
         }
     }
-    out.poff[total] = static_cast<std::uint32_t>(total_params);
+    out.index_from(m0, p0);
     next_id = ids;
 }
 
@@ -284,10 +285,10 @@ bool Engine::rewrite_direct(const Derivation& d, Rewriter& rw, const ModuleStrin
         check_limits(d, modules, params); // before allocating anything
     }
     out.sym.resize(modules);
+    out.nargs.resize(modules);
     if (out.keep_ids) out.ids.resize(modules);
-    out.poff.resize(modules + 1);
     out.params.resize(params);
-    out.poff[0] = 0;
+    out.block_at.resize((modules + ModuleString::kBlock - 1) >> ModuleString::kBlockShift);
     std::vector<Worker> workers(T);
     std::vector<std::size_t> m_at(T), p_at(T);
     std::vector<ModuleId> id_at(T);
@@ -316,9 +317,10 @@ bool Engine::rewrite_direct(const Derivation& d, Rewriter& rw, const ModuleStrin
     if (sized) { // the counts were exact or a bound: cut to what was written
         const Rewriter::Counts& c = counts_at[0];
         out.sym.resize(c.modules);
+        out.nargs.resize(c.modules);
         if (out.keep_ids) out.ids.resize(c.modules);
-        out.poff.resize(c.modules + 1);
         out.params.resize(c.params);
+        out.block_at.resize((c.modules + ModuleString::kBlock - 1) >> ModuleString::kBlockShift);
         ids = next_id + c.new_ids;
     }
     next_id = ids;

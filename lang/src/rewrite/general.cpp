@@ -135,12 +135,9 @@ std::size_t Rewriter::apply_template(Worker& w, std::size_t i, const Production&
     const std::size_t m = t.syms.size();
     if (m <= 4 && t.holes.empty()) { // short constant successors: plain appends
         for (std::size_t j = 0; j < m; ++j) {
-            out.sym.push_back(t.syms[j]);
-            for (std::uint32_t k = j ? t.param_end[j - 1] : 0; k < t.param_end[j]; ++k)
-                out.params.push_back(t.params[k]);
-            out.poff.push_back(static_cast<std::uint32_t>(out.params.size()));
+            const std::uint32_t from = j ? t.param_end[j - 1] : 0;
             const ModuleId id = static_cast<int>(j) == t.keep ? in.id(i) : env.id_base + env.new_count++;
-            if (out.keep_ids) out.ids.push_back(id);
+            out.push(t.syms[j], t.params.data() + from, t.param_end[j] - from, id);
         }
         if (out.size() > env.max_output) limit_error();
         return 1;
@@ -148,16 +145,19 @@ std::size_t Rewriter::apply_template(Worker& w, std::size_t i, const Production&
     const std::size_t m0 = out.sym.size();
     const std::size_t p0 = out.params.size();
     out.sym.resize(m0 + m);
+    out.nargs.resize(m0 + m);
     if (out.keep_ids) out.ids.resize(m0 + m);
-    out.poff.resize(m0 + m + 1);
     out.params.resize(p0 + t.params.size());
     std::copy(t.syms.begin(), t.syms.end(), out.sym.begin() + static_cast<std::ptrdiff_t>(m0));
     double* pp = out.params.data() + p0;
     std::copy(t.params.begin(), t.params.end(), pp);
     for (std::size_t h = 0; h < t.holes.size(); ++h) pp[t.holes[h]] = values[h];
-    std::uint32_t* po = out.poff.data() + m0 + 1;
-    const auto base = static_cast<std::uint32_t>(p0);
-    for (std::size_t j = 0; j < m; ++j) po[j] = base + t.param_end[j];
+    std::uint32_t from = 0;
+    for (std::size_t j = 0; j < m; ++j) {
+        out.nargs[m0 + j] = static_cast<std::uint8_t>(t.param_end[j] - from);
+        from = t.param_end[j];
+    }
+    out.index_from(m0, p0);
     if (out.keep_ids) {
         ModuleId* ids = out.ids.data() + m0;
         for (std::size_t j = 0; j < m; ++j)
@@ -190,10 +190,7 @@ std::size_t Rewriter::run_body(Worker& w, std::size_t i, const Production& pr) {
     env.keep_count = 0;
     if (st == RunStatus::Produced || env.produced) return pr.strict.size();
     // not applied: drop anything a partial body emitted
-    w.out.sym.resize(mark);
-    if (w.out.keep_ids) w.out.ids.resize(mark);
-    w.out.params.resize(w.out.poff[mark]);
-    w.out.poff.resize(mark + 1);
+    w.out.truncate(mark);
     return 0;
 }
 

@@ -179,6 +179,15 @@ void RulePlan::build_outcomes() {
             outcome_sym.push_back(s);
         }
     }
+    for (const SuccessorTemplate* t : outcome_tmpl) {
+        outcome_nargs_at.push_back(static_cast<std::uint32_t>(outcome_nargs.size()));
+        if (!t) continue;
+        std::uint32_t from = 0;
+        for (std::uint32_t end : t->param_end) {
+            outcome_nargs.push_back(static_cast<std::uint8_t>(end - from));
+            from = end;
+        }
+    }
 }
 
 // The symbol kernel's tables. It needs every rewritten symbol to be parameterless: a direct

@@ -94,7 +94,8 @@ class Rewriter {
 
     // The production a guarded symbol's module i gets (see RulePlan::Guarded), decided as
     // apply() and choose() would decide it; nullptr: none applies, the module is copied.
-    const RulePlan::Guard* pick_guarded(std::size_t i, const RulePlan::Guarded& g) const;
+    // a: module i's parameters
+    const RulePlan::Guard* pick_guarded(std::size_t i, const double* a, const RulePlan::Guarded& g) const;
     // The seed and phase of the step's random draws (weighted choice on the direct path).
     std::uint64_t seed = 0, phase = 0;
 
@@ -117,21 +118,53 @@ class Rewriter {
     [[noreturn]] void limit_error() const;
     [[noreturn]] void hole_error(const SuccessorTemplate& t, std::size_t h, double value) const;
 
-    // Writes successor template t, its computed numbers in `values`, at S, PO, PA and ID, its
-    // parameters starting at parameter p of the output. Module t.keep gets the identity `kept`
-    // (the predecessor's), the others new ones counted on from `next_new`. Identities are
-    // written only when Ids.
+    // Copies n bytes without a library call for the short runs templates have (their arities):
+    // two overlapping fixed-size copies cover 4 to 16 bytes.
+    static void copy_bytes(std::uint8_t* d, const std::uint8_t* s, std::size_t n) {
+        if (n > 16) {
+            std::memcpy(d, s, n);
+        } else if (n >= 8) {
+            std::uint64_t a, b;
+            std::memcpy(&a, s, 8);
+            std::memcpy(&b, s + n - 8, 8);
+            std::memcpy(d, &a, 8);
+            std::memcpy(d + n - 8, &b, 8);
+        } else if (n >= 4) {
+            std::uint32_t a, b;
+            std::memcpy(&a, s, 4);
+            std::memcpy(&b, s + n - 4, 4);
+            std::memcpy(d, &a, 4);
+            std::memcpy(d + n - 4, &b, 4);
+        } else {
+            for (std::size_t j = 0; j < n; ++j) d[j] = s[j];
+        }
+    }
+
+    // Writes successor template t, its computed numbers in `values`, at S, NA (arities), PA and
+    // ID. Module t.keep gets the identity `kept` (the predecessor's), the others new ones counted
+    // on from `next_new`. Identities are written only when Ids. `arities`: the template's
+    // arities ready to copy (RulePlan::outcome_nargs), or nullptr to work them out from
+    // t.param_end. The caller indexes the parameters (ModuleString::index_range) once the
+    // stretch is written.
     template <bool Ids>
-    static void put_template(const SuccessorTemplate& t, const double* values, std::size_t p, ModuleId kept,
-                             ModuleId& next_new, SymbolId* S, std::uint32_t* PO, double* PA, ModuleId* ID) {
+    static void put_template(const SuccessorTemplate& t, const std::uint8_t* arities, const double* values,
+                             ModuleId kept, ModuleId& next_new, SymbolId* S, std::uint8_t* NA, double* PA,
+                             ModuleId* ID) {
         const std::size_t m = t.syms.size();
         if (m != 0) std::memcpy(S, t.syms.data(), m * sizeof(SymbolId));
         // An erasing or parameterless successor has no parameter storage;
         // memcpy with a null source is undefined even for zero bytes.
         if (!t.params.empty()) std::memcpy(PA, t.params.data(), t.params.size() * sizeof(double));
         for (std::size_t h = 0; h < t.holes.size(); ++h) PA[t.holes[h]] = values[h];
-        const auto p32 = static_cast<std::uint32_t>(p);
-        for (std::size_t j = 0; j < m; ++j) PO[j] = p32 + t.param_end[j];
+        if (arities) {
+            copy_bytes(NA, arities, m);
+        } else {
+            std::uint32_t from = 0;
+            for (std::size_t j = 0; j < m; ++j) {
+                NA[j] = static_cast<std::uint8_t>(t.param_end[j] - from);
+                from = t.param_end[j];
+            }
+        }
         if constexpr (Ids) {
             for (std::size_t j = 0; j < m; ++j) ID[j] = static_cast<int>(j) == t.keep ? kept : next_new++;
         } else {

@@ -121,15 +121,15 @@ template <bool Whole> void Rewriter::run_symbols(Worker& w, std::size_t b, std::
             }
         }
     }
-    if (m > env.max_output) {
-        resize(out.sym, m);
-        limit_error();
-    }
     resize(out.sym, m);
-    const std::size_t m0 = out.poff.size();
-    resize(out.poff, m + 1);
-    std::fill(out.poff.begin() + static_cast<std::ptrdiff_t>(m0), out.poff.end(),
+    const std::size_t m0 = out.nargs.size();
+    resize(out.nargs, m);
+    std::fill(out.nargs.begin() + static_cast<std::ptrdiff_t>(m0), out.nargs.end(), std::uint8_t{0});
+    const std::size_t b0 = out.block_at.size();
+    resize(out.block_at, (m + ModuleString::kBlock - 1) >> ModuleString::kBlockShift);
+    std::fill(out.block_at.begin() + static_cast<std::ptrdiff_t>(b0), out.block_at.end(),
               static_cast<std::uint32_t>(p_end));
+    if (m > env.max_output) limit_error();
     env.new_count += static_cast<ModuleId>(fresh);
 }
 

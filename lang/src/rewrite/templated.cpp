@@ -26,34 +26,35 @@ template <bool Ids> void Rewriter::run_templates(Worker& w, std::size_t b, std::
     double values[256];
     std::size_t m = out.size(), p = out.params.size();
     std::size_t mcap = 0, pcap = 0;
+    std::size_t m_open = m, p_open = p; // the string is indexed (block_at) up to module m_open
     SymbolId* S = nullptr;
-    std::uint32_t* PO = nullptr; // PO[m]: where module m's parameters end
+    std::uint8_t* NA = nullptr;
     double* PA = nullptr;
     ModuleId* ID = nullptr;
     auto open = [&](std::size_t need_m, std::size_t need_p) {
         mcap = std::max({out.sym.capacity(), need_m, 2 * m});
         pcap = std::max({out.params.capacity(), need_p, 2 * p});
-        out.sym.resize(mcap);
-        if constexpr (Ids) out.ids.resize(mcap);
-        out.poff.resize(mcap + 1);
-        out.params.resize(pcap);
+        if (S) out.index_upto(m_open, m, p_open); // open already: index what was written
+        m_open = m;
+        p_open = p;
+        out.resize_arrays(mcap, pcap);
         S = out.sym.data();
-        PO = out.poff.data() + 1;
+        NA = out.nargs.data();
         PA = out.params.data();
         if constexpr (Ids) ID = out.ids.data();
     };
     auto close = [&] {
-        out.sym.resize(m);
-        if constexpr (Ids) out.ids.resize(m);
-        out.poff.resize(m + 1);
-        out.params.resize(p);
+        out.resize_arrays(m, p);
+        out.index_from(m_open, p_open);
+        S = nullptr;
     };
+    std::size_t q = in.offset(b); // where input module i's parameters start
     const std::size_t per_module = std::max<std::size_t>(Mmax, 1);
     std::size_t next_limits = b + 65536, next_check = b;
     std::size_t i = b;
     auto run_length = [&] {
         std::size_t k = std::min({e - i, next_limits - i, std::size_t{4096}, (mcap - m) / per_module});
-        while (k > 0 && p + (in.poff[i + k] - in.poff[i]) + Pmax * k > pcap) k /= 2;
+        while (k > 0 && p + in.params_of(i, i + k) + Pmax * k > pcap) k /= 2;
         return k;
     };
     open(m + per_module, p + Pmax);
@@ -70,19 +71,19 @@ template <bool Ids> void Rewriter::run_templates(Worker& w, std::size_t b, std::
             }
             std::size_t k = run_length();
             if (k == 0) {
-                open(m + per_module, p + (in.poff[i + 1] - in.poff[i]) + Pmax);
+                open(m + per_module, p + in.nargs[i] + Pmax);
                 k = run_length(); // at least 1 now
             }
             next_check = i + k;
         }
         const SymbolId sym = in.sym[i];
-        const std::uint32_t arity = in.poff[i + 1] - in.poff[i];
+        const std::uint32_t arity = in.nargs[i];
         const Production* pr = nullptr;
         if (plan.has_prod[sym]) {
             pr = plan.direct[sym];
             if (pr && arity == pr->strict[0].width) {
                 if (!pr->tmpl.holes.empty()) {
-                    const double* a = in.params.data() + in.poff[i];
+                    const double* a = in.params.data() + q;
                     for (const auto& pa : pr->strict[0].args) {
                         for (int k = 0; k < pa.width; ++k) w.frame[pa.slot + k] = a[k];
                         a += pa.width;
@@ -97,6 +98,7 @@ template <bool Ids> void Rewriter::run_templates(Worker& w, std::size_t b, std::
                     out.append_range(in, i, i + 1);
                     used = 1;
                 }
+                q += in.params_of(i, i + used);
                 i += used;
                 m = out.size();
                 p = out.params.size();
@@ -108,8 +110,9 @@ template <bool Ids> void Rewriter::run_templates(Worker& w, std::size_t b, std::
         if (!pr) { // copied as it is
             S[m] = sym;
             if constexpr (Ids) ID[m] = in.ids[i];
-            for (std::uint32_t k = in.poff[i]; k < in.poff[i + 1]; ++k) PA[p++] = in.params[k];
-            PO[m] = static_cast<std::uint32_t>(p);
+            NA[m] = static_cast<std::uint8_t>(arity);
+            for (std::uint32_t k = 0; k < arity; ++k) PA[p++] = in.params[q + k];
+            q += arity;
             ++m;
             ++i;
             continue;
@@ -124,11 +127,12 @@ template <bool Ids> void Rewriter::run_templates(Worker& w, std::size_t b, std::
             check_holes(t, values);
         }
         ModuleId next_new = env.id_base + env.new_count;
-        put_template<Ids>(t, values, p, Ids ? in.ids[i] : 0, next_new, S + m, PO + m, PA + p,
+        put_template<Ids>(t, nullptr, values, Ids ? in.ids[i] : 0, next_new, S + m, NA + m, PA + p,
                           Ids ? ID + m : nullptr);
         env.new_count = next_new - env.id_base;
         m += t.syms.size();
         p += t.params.size();
+        q += arity;
         ++i;
     }
     close();
