@@ -15,6 +15,7 @@
 // the JSON; normals are renormalized as they are written, a block at a time.
 #include "plant/export.hpp"
 
+#include "bounds.hpp"
 #include "export_placement.hpp"
 
 #include <tiny_gltf.h>
@@ -242,19 +243,9 @@ struct GltfBuilder {
         mesh.name = name;
 
         // POSITION, with the min and max the specification requires.
-        // One pass the compiler vectorizes: a coordinate is finite when its magnitude is at most
-        // the largest float (false for infinities and NaN); min and max compare as glm's do.
-        constexpr float kLargest = std::numeric_limits<float>::max();
-        float lx = kLargest, ly = kLargest, lz = kLargest, hx = -kLargest, hy = -kLargest, hz = -kLargest;
-        bool finite = true;
-        for (const glm::vec3& p : part.positions) {
-            finite &=
-                (std::fabs(p.x) <= kLargest) & (std::fabs(p.y) <= kLargest) & (std::fabs(p.z) <= kLargest);
-            lx = p.x < lx ? p.x : lx, ly = p.y < ly ? p.y : ly, lz = p.z < lz ? p.z : lz;
-            hx = hx < p.x ? p.x : hx, hy = hy < p.y ? p.y : hy, hz = hz < p.z ? p.z : hz;
-        }
-        if (!finite) throw ExportError("glTF export: " + name + " has a position that is not finite");
-        const glm::vec3 lo(lx, ly, lz), hi(hx, hy, hz);
+        glm::vec3 lo(std::numeric_limits<float>::max()), hi(std::numeric_limits<float>::lowest());
+        if (!grow_point_bounds(part.positions.data(), nv, lo, hi))
+            throw ExportError("glTF export: " + name + " has a position that is not finite");
         const int pos_view = add_view(part.positions.data(), nv * sizeof(glm::vec3), array_buffer);
         const int pos = add_accessor(pos_view, 0, nv, TINYGLTF_TYPE_VEC3, TINYGLTF_COMPONENT_TYPE_FLOAT);
         model.accessors[std::size_t(pos)].minValues = {lo.x, lo.y, lo.z};

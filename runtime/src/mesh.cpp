@@ -193,11 +193,19 @@ std::vector<TubePath> tube_paths(const Skeleton& skeleton, const MeshOptions& o)
             next[pa] = static_cast<int>(c);
         }
     }
+    std::size_t starts = n;
     for (std::size_t a = 0; a < n; ++a)
-        if (next[a] >= 0) continued[static_cast<std::size_t>(next[a])] = 1;
+        if (next[a] >= 0) continued[static_cast<std::size_t>(next[a])] = 1, --starts;
+    tubes.reserve(starts);
     for (std::size_t a = 0; a < n; ++a) {
         if (continued[a]) continue; // meshed as part of its parent's tube
         TubePath& t = tubes.emplace_back();
+        std::size_t length = 0; // the points of the chain, each joint counted once
+        for (std::size_t k = a;; k = static_cast<std::size_t>(next[k])) {
+            length += skeleton.axes[k].points.size() - (length > 0 ? 1 : 0);
+            if (next[k] < 0) break;
+        }
+        t.reserve(length);
         for (std::size_t k = a;;) {
             const auto& pts = skeleton.axes[k].points;
             // the joint point is the child's first one: its radius and colour start the child's part
