@@ -51,8 +51,11 @@ constexpr EnvMethod kClimberMethods[] = {
                "seed a new branch at module id: ivy.seeded(id) holds in the next step"),
     env_method(M::Emit, "emit", {N, V}, N, Edit, false,
                "set emitter k's air velocity (in the order declared; vec3(0, 0, 0): off)"),
+    env_method(M::ClearDir, "clear_dir", {V, V, N}, V, Pure, false,
+               "unit heading of v, turned as little as keeps the segment p to p + v (radius r) out of "
+               "every obstacle"),
 };
-static_assert(method_table(kClimberMethods, M::Emit));
+static_assert(method_table(kClimberMethods, M::ClearDir));
 
 } // namespace
 
@@ -89,6 +92,11 @@ void Climber::query(std::size_t method, const double* a, double* r) const {
     case M::Occlusion:
         r[0] = occlusion(vec(a));
         return;
+    case M::ClearDir: {
+        glm::dvec3 g = clear_dir(vec(a), vec(a + 3), a[6]);
+        r[0] = g.x, r[1] = g.y, r[2] = g.z;
+        return;
+    }
     case M::Anchored: {
         physics::Handle h = particle(id_of(a[0]));
         r[0] = h.valid() && world_.alive(h) && world_.anchored(h) ? 1 : 0;
@@ -367,6 +375,18 @@ glm::dvec3 Climber::grow_dir(const glm::dvec3& p, const glm::dvec3& h) const {
         f = g;
     }
     return f;
+}
+
+glm::dvec3 Climber::clear_dir(const glm::dvec3& p, const glm::dvec3& v, double r) const {
+    // the new segment resolved against the obstacles before it is drawn (docs/physics.md,
+    // "Obstacles"): the turtle draws it from p along the heading returned, as long as v
+    const double len = finite(v) ? glm::length(v) : 0;
+    const glm::dvec3 f = len > 1e-12 && len < 1e6 ? v / len : glm::dvec3(0, 1, 0);
+    if (!finite(p) || !(len > 1e-12 && len < 1e6) || !std::isfinite(r) || r <= 0) return f;
+    const glm::dvec3 end = world_.clear_segment_end(p, p + v, std::min(r, 1e6));
+    const glm::dvec3 d = end - p;
+    const double l = glm::length(d);
+    return finite(d) && l > 1e-12 ? d / l : f;
 }
 
 namespace {

@@ -17,7 +17,9 @@
 //
 // Methods (ClimberMethod and its table in climber.cpp): grow_dir(p, h) (h turned by surface
 // adaption, Eq. 6, by painted attractors and by phototropism weighted by occlusion, Eq. 7),
-// occlusion(p), anchored(id), particles(), seeded(id); edits, in hooks only: pull(id, target),
+// occlusion(p), anchored(id), particles(), seeded(id), clear_dir(p, v, r) (v's direction turned
+// as little as keeps the segment from p to p + v, a capsule of radius r, out of every obstacle);
+// edits, in hooks only: pull(id, target),
 // cut(id), wind(a), move(k, delta), seed(id), emit(k, velocity).
 //
 // With air_min and air_max the climber also runs SPH air in that box (section 5.3): each 25 ms
@@ -61,6 +63,8 @@ enum class ClimberMethod : std::uint8_t {
     Move,
     Seed,
     Emit,
+    // a query, after the edits so that their numbers stay
+    ClearDir,
 };
 
 const EnvironmentKind& climber_kind();
@@ -134,6 +138,7 @@ class Climber : public Environment {
     // The obstacle nearest to p if one is nearer than `within`, and its distance.
     const physics::Obstacle* nearest_obstacle(const glm::dvec3& p, double within, double& distance) const;
     glm::dvec3 grow_dir(const glm::dvec3& p, const glm::dvec3& h) const;
+    glm::dvec3 clear_dir(const glm::dvec3& p, const glm::dvec3& v, double r) const;
     void rebuild_occupancy();
 
     std::vector<Attractor> attractors_; // the painted samples not yet reached

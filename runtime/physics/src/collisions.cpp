@@ -40,8 +40,8 @@ glm::dvec3 Obstacle::normal(const glm::dvec3& p) const {
 
 void World::integrate() {
     // Eq. 17-18, with damping; then obstacles: a particle inside one is put back on its surface
-    // (its radius off it), its velocity losing the normal part (or bouncing by the elasticity)
-    // and some of the tangential part (friction)
+    // (its radius off it, never into another obstacle), its velocity losing the normal part (or
+    // bouncing by the elasticity) and some of the tangential part (friction)
     const double dt = settings_.dt;
     const std::size_t n = x_.size();
     const std::vector<glm::dvec3>& old = scratch_.old;
@@ -52,11 +52,12 @@ void World::integrate() {
             age_[i] += dt;
             if (fixed_[i]) continue;
             const double r = std::min({radii_[i].x, radii_[i].y, radii_[i].z});
-            for (const auto& o : obstacles_) {
-                double d = signed_distance(o, x_[i]) - r;
-                if (d >= 0) continue;
-                glm::dvec3 nrm = surface_normal(o, x_[i]);
-                x_[i] -= nrm * d;
+            for (std::size_t k = 0; k < obstacles_.size(); ++k) {
+                const Obstacle& o = obstacles_[k];
+                if (signed_distance(o, x_[i]) - r >= 0) continue;
+                // out by the shortest way that does not end in another obstacle (exit_point)
+                glm::dvec3 nrm;
+                x_[i] = exit_point(x_[i], r, k, &nrm);
                 double vn = glm::dot(v_[i], nrm);
                 glm::dvec3 tangential = v_[i] - nrm * vn;
                 v_[i] = tangential * (1 - o.friction) + (vn < 0 ? -vn * o.elasticity : vn) * nrm;

@@ -103,9 +103,8 @@ void World::grow() {
         if (g.phototropism > 0) {
             f = phototropism(f, g.to_light, occlusion(x_[i]), g.phototropism, settings_.dt * 40);
         }
-        glm::dvec3 pos = x_[i] + f * g.segment_length;
-        for (const auto& o : obstacles_) // never grow into an obstacle
-            if (o.distance(pos) < radii_[i].x) pos -= o.normal(pos) * (o.distance(pos) - radii_[i].x);
+        // never grow into an obstacle: the new segment, as a capsule, clear of all of them
+        const glm::dvec3 pos = clear_segment_end(x_[i], x_[i] + f * g.segment_length, radii_[i].x);
         Handle parent{i, generation_[i]};
         add_grown(parent, pos, heading_to(f), radii_[i]);
         // lateral branching with probability BP, at most B buds per particle
@@ -119,7 +118,9 @@ void World::grow() {
                 glm::cross(f, std::fabs(f.y) < 0.9 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0)));
             glm::dvec3 axis = glm::angleAxis(around, f) * side;
             glm::dvec3 lf = glm::angleAxis(angle, axis) * f;
-            add_grown(parent, x_[i] + lf * g.segment_length, heading_to(lf), radii_[i] * g.falloff);
+            const glm::dvec3 at =
+                clear_segment_end(x_[i], x_[i] + lf * g.segment_length, radii_[i].x * g.falloff);
+            add_grown(parent, at, heading_to(lf), radii_[i] * g.falloff);
             ++laterals_[i];
         }
     }

@@ -76,19 +76,21 @@ bool World::outside_obstacles(glm::dvec3& x, double r, const glm::dvec3* parent)
     // along the normal at the parent: a link whose parent is on one face of a thin rail stays on
     // that face instead of being pushed over the rail's edge onto the next face, a stretch away.
     bool moved = false;
-    for (const auto& o : obstacles_) {
+    for (std::size_t k = 0; k < obstacles_.size(); ++k) {
+        const Obstacle& o = obstacles_[k];
         double d = signed_distance(o, x) - r;
         if (d >= 0) continue;
         moved = true;
         if (parent && signed_distance(o, *parent) < 2 * r) {
             const glm::dvec3 n = surface_normal(o, *parent);
-            for (int k = 0; k < 8 && d < 0; ++k) { // inside a box the distance is to the nearest face
+            // inside a box the distance is to the nearest face
+            for (int round = 0; round < 8 && d < 0; ++round) {
                 x -= n * d;
                 d = signed_distance(o, x) - r;
             }
             if (d >= 0) continue;
         }
-        x -= surface_normal(o, x) * d;
+        x = exit_point(x, r, k); // not into another obstacle where two meet
     }
     return moved;
 }

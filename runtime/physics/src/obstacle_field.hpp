@@ -42,4 +42,10 @@ inline glm::dvec3 surface_normal(const Obstacle& o, const glm::dvec3& p) {
     return l > 0 ? g / l : glm::dvec3(0, 1, 0);
 }
 
+// The least signed distance of obstacle o along the segment from a to b, and where (t in [0, 1]
+// from a): exact for planes and spheres, a golden-section search for boxes (convex along a line;
+// none when both ends are beyond one face by r or more, which returns r), samples half a cell
+// apart refined by a search for a sampled grid (segment_contacts.cpp).
+double deepest_on_segment(const Obstacle& o, const glm::dvec3& a, const glm::dvec3& b, double r, double& t);
+
 } // namespace plant::physics

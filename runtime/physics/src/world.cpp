@@ -131,6 +131,8 @@ void World::step() {
     if (settings_.collisions) separate_particles();
     // contacts and obstacles push particles: the links get their lengths back (length.cpp)
     keep_shape(false, false);
+    // and the links between particles, as capsules, out of the obstacles (segment_contacts.cpp)
+    resolve_segments();
     double collision_ms = ms(clock::now() - t0).count();
     t0 = clock::now();
     integrate();

@@ -165,6 +165,10 @@ class World {
     // Whether h is anchored to obstacle k.
     bool anchored_to(Handle h, std::size_t k) const;
     void add_obstacle(const Obstacle& o) { obstacles_.push_back(o); }
+    // `to` moved as little as it takes for the segment from `from`, a capsule of radius r, to lie
+    // outside every obstacle, at the segment's length from `from` (a new segment's end, before it
+    // is drawn: segment_contacts.cpp). Where `from` itself is too near an obstacle, as far as it can.
+    glm::dvec3 clear_segment_end(const glm::dvec3& from, const glm::dvec3& to, double r) const;
     // Removes obstacle k (later ones move down one); its anchors let go, so what it held falls.
     void remove_obstacle(std::size_t k);
     // Moves obstacle k by `delta` (section 5.2: the user moves objects and the plants adapt).
@@ -300,6 +304,15 @@ class World {
     // turn of the segment from p's parent to p, or by p's own rotation when p has no parent;
     // with `back`, the other way (a current offset to p's rest frame)
     glm::dvec3 carried(std::uint32_t p, const glm::dvec3& v, bool back = false) const;
+    // segment_contacts.cpp: x pushed out of obstacle k, r off its surface, by the shortest way that
+    // does not end inside another obstacle (a box's nearest clear face) when there is one; with
+    // `normal`, the direction it went
+    glm::dvec3 exit_point(const glm::dvec3& x, double r, std::size_t k, glm::dvec3* normal = nullptr) const;
+    // every link (particle and parent) as a capsule of the particle's thinnest radius out of the
+    // obstacles, both ends moved by their barycentric weights and inverse masses
+    void resolve_segments();
+    // the contacts of the link into i with the obstacles, ends weighted wp and wi; whether any
+    bool link_contacts(std::uint32_t i, double wp, double wi);
     void separate_particles();  // contacts between particles (section 5.2)
     void integrate();           // Eq. 17-18 with damping, and contacts with obstacles
     void break_overstretched(); // connections stretched past the break threshold let go
@@ -349,7 +362,9 @@ class World {
         std::vector<double> thin;                    // each particle's thinnest radius
         std::vector<glm::dmat3> rest_moment;         // 0.2 m D R̄ᵀ, while the groups are current
         std::vector<glm::dvec3> push;
-        std::vector<double> stiffness; // each particle's s, during a step
+        std::vector<std::uint8_t> near;           // links near an obstacle (resolve_segments)
+        std::vector<std::uint32_t> contact_links; // the same, as a list in index order
+        std::vector<double> stiffness;            // each particle's s, during a step
         Groups groups;
         // the length and bending sweep (length.cpp): each link's rest offset from the parent,
         // its rest length and unit direction (kept with the groups), and its direction now

@@ -1,0 +1,306 @@
+// Segments against obstacles (docs/physics.md, "Obstacles"): the link between a particle and its
+// parent is a capsule of the particle's thinnest radius, and no capsule may cross an obstacle.
+// Resolving particle centres alone let a link pass through a post thinner than the link is long
+// (issue 18: 175 of 1,223 links of Fig. 11 crossed a post or a rail, up to 11.6 mm deep).
+//
+// Hädrich et al. 2017 (section 5.2) keep particles out of obstacles' signed distance fields; for
+// the links between them we do what position-based dynamics does for an edge against a surface
+// (Müller et al. 2007, section 3.5's "collision constraints", applied at the closest point of an
+// edge as in edge-edge contacts): find the point of the segment deepest in the obstacle, and move
+// both end particles by their barycentric weights and inverse masses so that point comes out.
+//
+// All obstacles are resolved together: a point pushed out of one obstacle into another (a post
+// standing on the ground, pushed out through its bottom face into the ground plane) leaves the
+// first obstacle through the nearest face that is clear of every other one instead, so a seam
+// between two supports does not leak.
+#include "plant/physics/world.hpp"
+
+#include "obstacle_field.hpp"
+#include "parallel.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace plant::physics {
+
+namespace {
+
+// a box's capsule test that needs no search: both ends beyond the same face by r or more
+bool beyond_one_face(const Obstacle& o, const glm::dvec3& a, const glm::dvec3& b, double r) {
+    const glm::dvec3 c = (o.a + o.b) * 0.5, h = (o.b - o.a) * 0.5;
+    const glm::dvec3 qa = a - c, qb = b - c;
+    for (int j = 0; j < 3; ++j)
+        if ((qa[j] - h[j] >= r && qb[j] - h[j] >= r) || (-qa[j] - h[j] >= r && -qb[j] - h[j] >= r))
+            return true;
+    return false;
+}
+
+// the least of f over [lo, hi] for f convex there: golden-section search
+template <class F> double golden_min(F&& f, double lo, double hi, double& at) {
+    constexpr double g = 0.6180339887498949;
+    double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
+    double f1 = f(x1), f2 = f(x2);
+    for (int k = 0; k < 24; ++k) { // 0.618^24: within 1e-5 of the segment's length
+        if (f1 <= f2) {
+            hi = x2, x2 = x1, f2 = f1;
+            x1 = hi - g * (hi - lo), f1 = f(x1);
+        } else {
+            lo = x1, x1 = x2, f1 = f2;
+            x2 = lo + g * (hi - lo), f2 = f(x2);
+        }
+    }
+    at = f1 <= f2 ? x1 : x2;
+    return std::min(f1, f2);
+}
+
+} // namespace
+
+double deepest_on_segment(const Obstacle& o, const glm::dvec3& a, const glm::dvec3& b, double r, double& t) {
+    const glm::dvec3 d = b - a;
+    const double len2 = glm::dot(d, d);
+    auto at = [&](double s) { return signed_distance(o, a + d * s); };
+    switch (o.kind) {
+    case Obstacle::Plane: { // linear along the segment: an end is deepest
+        const double da = at(0), db = at(1);
+        t = da <= db ? 0 : 1;
+        return std::min(da, db);
+    }
+    case Obstacle::Sphere:
+        t = len2 > 0 ? std::clamp(glm::dot(o.a - a, d) / len2, 0.0, 1.0) : 0.0;
+        return at(t);
+    case Obstacle::Box: { // convex along the segment
+        if (beyond_one_face(o, a, b, r)) {
+            t = 0;
+            return r;
+        }
+        const double da = at(0), db = at(1);
+        // convex: when the distance grows from an end into the segment, that end is its least
+        // (a link lying along a face, the common case, needs no search)
+        constexpr double h = 1e-6;
+        const bool rises_a = at(h) >= da, rises_b = at(1 - h) >= db;
+        if (rises_a || rises_b) {
+            const bool from_a = rises_a && (da <= db || !rises_b);
+            t = from_a ? 0 : 1;
+            return from_a ? da : db;
+        }
+        double s = 0;
+        const double inner = golden_min(at, 0.0, 1.0, s);
+        if (inner < std::min(da, db)) {
+            t = s;
+            return inner;
+        }
+        t = da <= db ? 0 : 1;
+        return std::min(da, db);
+    }
+    case Obstacle::Grid: { // not convex: samples half a cell apart, then the best one's neighbourhood
+        const double cell = o.grid ? o.grid->cell : 1;
+        const int n = std::clamp(static_cast<int>(std::ceil(std::sqrt(len2) / (cell / 2))), 1, 64);
+        int best = 0;
+        double low = at(0);
+        for (int k = 1; k <= n; ++k) {
+            const double v = at(static_cast<double>(k) / n);
+            if (v < low) low = v, best = k;
+        }
+        double s = 0;
+        const double lo = std::max(0, best - 1) / static_cast<double>(n);
+        const double hi = std::min(n, best + 1) / static_cast<double>(n);
+        const double refined = golden_min(at, lo, hi, s);
+        t = refined < low ? s : static_cast<double>(best) / n;
+        return std::min(refined, low);
+    }
+    }
+    t = 0;
+    return 1e300;
+}
+
+glm::dvec3 World::exit_point(const glm::dvec3& x, double r, std::size_t k, glm::dvec3* normal) const {
+    // out of obstacle k along its normal, r off its surface: the shortest way out
+    const Obstacle& o = obstacles_[k];
+    const double d = signed_distance(o, x) - r;
+    const glm::dvec3 nrm = surface_normal(o, x);
+    glm::dvec3 out = x - nrm * d;
+    // a sampled grid's distance is not exact (in a concave corner it grows more slowly than the
+    // distance moved along its normal): a few more steps along the normal there
+    for (int more = 0; o.kind == Obstacle::Grid && more < 4; ++more) {
+        const double left = signed_distance(o, out) - r;
+        if (left >= -1e-5) break;
+        out -= surface_normal(o, out) * left;
+    }
+    if (normal) *normal = nrm;
+    auto clear = [&](const glm::dvec3& p) {
+        for (std::size_t j = 0; j < obstacles_.size(); ++j)
+            if (signed_distance(obstacles_[j], p) < r - 1e-9) return false;
+        return true;
+    };
+    if (o.kind != Obstacle::Box || obstacles_.size() < 2 || clear(out)) return out;
+    // that way leads into another obstacle (a post's bottom face into the ground): out through
+    // the box's face, and then out of the other obstacles along their normals, that moves x the
+    // least and ends clear of every obstacle; when none does, the shortest way
+    const glm::dvec3 c = (o.a + o.b) * 0.5, h = (o.b - o.a) * 0.5;
+    glm::dvec3 best = out;
+    // a face farther than 5 cm beyond the shortest way (the top of a tall post for a point at its
+    // foot) is no way out for a particle a step moved
+    double best_move = glm::length(out - x) + 0.05;
+    bool found = false;
+    for (int j = 0; j < 3; ++j)
+        for (const double side : {-1.0, 1.0}) {
+            glm::dvec3 p = x;
+            p[j] = c[j] + side * (h[j] + r);
+            for (std::size_t m = 0; m < obstacles_.size(); ++m) {
+                if (m == k) continue;
+                const double dm = signed_distance(obstacles_[m], p) - r;
+                if (dm < 0) p -= surface_normal(obstacles_[m], p) * dm;
+            }
+            const double move = glm::length(p - x);
+            if (move < best_move && clear(p)) best = p, best_move = move, found = true;
+        }
+    if (normal && found && best_move > 0) *normal = (best - x) / best_move;
+    return best;
+}
+
+glm::dvec3 World::clear_segment_end(const glm::dvec3& from, const glm::dvec3& to, double r) const {
+    // `from` stays and the segment keeps its length: its direction turns, as little as it takes,
+    // until the capsule is clear. Against the obstacle it is deepest in, first the part of the
+    // direction into the surface (at the deepest point) goes, so a shoot aimed straight at a wall
+    // runs along it instead of turning back; then, where the surface curves toward the segment,
+    // the deepest point is lifted out along the normal, the direction turned by that much.
+    const double length = glm::length(to - from);
+    if (!(length > 1e-12)) return to;
+    glm::dvec3 dir = (to - from) / length;
+    for (int round = 0; round < 8; ++round) {
+        double worst = r - 1e-9, at = 0;
+        std::size_t hit = obstacles_.size();
+        for (std::size_t k = 0; k < obstacles_.size(); ++k) {
+            double t = 0;
+            const double d = deepest_on_segment(obstacles_[k], from, from + dir * length, r, t);
+            if (d < worst) worst = d, at = t, hit = k;
+        }
+        if (hit == obstacles_.size()) break;
+        const glm::dvec3 c = from + dir * (length * at);
+        glm::dvec3 n;
+        const glm::dvec3 out = exit_point(c, r, hit, &n);
+        const double into = glm::dot(dir, n);
+        if (into < 0) dir -= n * into; // along the surface
+        if (glm::length(dir) < 1e-6) { // straight at it: any way along it
+            dir = glm::cross(n, std::fabs(n.y) < 0.9 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0));
+        }
+        dir = glm::normalize(dir);
+        // the rest of the way out, at the deepest point, bounded where that point is near `from`
+        const double lift = glm::length(out - c);
+        if (into >= 0 || round > 0) dir = glm::normalize(dir + n * (lift / (length * std::max(at, 0.25))));
+    }
+    return from + dir * length;
+}
+
+void World::resolve_segments() {
+    const std::size_t n = x_.size();
+    if (obstacles_.empty() || n < 2) return;
+    auto& sc = scratch_;
+    // broad phase: a link whose midpoint is farther than half its length and its radius (and a
+    // margin of 2 mm for this pass's pushes) from an obstacle cannot reach it (a signed distance
+    // changes no faster than the distance)
+    auto& near = sc.near;
+    near.assign(n, 0);
+    parallel_ranges(n, settings_.threads, 2048, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) {
+            const std::uint32_t p = parent_[i];
+            if (!alive_[i] || p == kNone) continue;
+            const glm::dvec3 mid = (x_[i] + x_[p]) * 0.5;
+            const double reach = 0.5 * glm::length(x_[i] - x_[p]) + sc.thin_of(i, radii_) + 0.002;
+            for (const auto& o : obstacles_)
+                if (signed_distance(o, mid) < reach) {
+                    near[i] = 1;
+                    break;
+                }
+        }
+    });
+    // the links that share a particle with a near link (the link into its parent, its siblings
+    // and the links out of its particle) are checked too, as a push can bring them in; and the
+    // links sharing a particle with those get their lengths back where the pushes moved them
+    auto ring = [&](std::uint8_t from, std::uint8_t to) {
+        auto mark = [&](std::uint32_t j) {
+            if (!near[j]) near[j] = to;
+        };
+        for (std::uint32_t i = 0; i < n; ++i) {
+            if (near[i] != from) continue;
+            const std::uint32_t p = parent_[i];
+            if (parent_[p] != kNone) mark(p);
+            for (const std::uint32_t c : children_[p]) mark(c);
+            for (const std::uint32_t c : children_[i]) mark(c);
+        }
+    };
+    ring(1, 2);
+    ring(2, 3);
+    auto& links = sc.contact_links;
+    links.clear();
+    for (std::uint32_t i = 0; i < n; ++i)
+        if (near[i]) links.push_back(i);
+    if (links.empty()) return;
+    auto weight = [&](std::uint32_t j) {
+        if (fixed_[j]) return 0.0;
+        for (const auto& pull : pulls_)
+            if (pull.first == j) return 0.0; // a dragged particle stays where it is dragged
+        return 1.0 / std::max(m_[j], 1e-12);
+    };
+    // Gauss-Seidel over those links, in index order (one thread: the same result on any thread
+    // count). A first sweep of contacts alone: when no capsule is in an obstacle, nothing more.
+    // Else sweeps of each link's rest length (a distance constraint, both ends by inverse mass)
+    // and then its contacts, until no capsule is in any obstacle or after four, and up to three
+    // last sweeps of contacts alone, so the obstacles have the last word.
+    for (int sweep = 0; sweep < 8; ++sweep) {
+        const bool lengths = sweep > 0 && sweep < 5;
+        bool any = false;
+        for (const std::uint32_t i : links) {
+            const std::uint32_t p = parent_[i];
+            const double wp = weight(p), wi = weight(i);
+            if (wp + wi <= 0) continue;
+            const glm::dvec3 d = x_[i] - x_[p];
+            const double len = glm::length(d), want = sc.rest_length[i];
+            if (lengths && len > 1e-12 && want > 1e-12) {
+                const glm::dvec3 fix = d * ((len - want) / (len * (wp + wi)));
+                x_[p] += fix * wp;
+                x_[i] -= fix * wi;
+            }
+            if (near[i] < 3) any = link_contacts(i, wp, wi) || any;
+        }
+        if (!any) break;
+    }
+}
+
+bool World::link_contacts(std::uint32_t i, double wp, double wi) {
+    // the link from i's parent to i against each obstacle: the point deepest in it comes out
+    // (exit_point), the two ends moved by their barycentric weights a = 1 - t, b = t and inverse
+    // masses (friction stays with the particles' own contacts, integrate())
+    const std::uint32_t p = parent_[i];
+    const double r = scratch_.thin_of(i, radii_);
+    bool any = false;
+    for (std::size_t k = 0; k < obstacles_.size(); ++k) {
+        double t = 0;
+        if (deepest_on_segment(obstacles_[k], x_[p], x_[i], r, t) >= r - 1e-9) continue;
+        const double a = 1 - t, b = t, sum = a * a * wp + b * b * wi;
+        if (sum < 1e-12 * (wp + wi)) continue; // only a fixed end is inside
+        const glm::dvec3 c = x_[p] * a + x_[i] * b;
+        const glm::dvec3 dc = exit_point(c, r, k) - c;
+        glm::dvec3 move_p = dc * (a * wp / sum), move_i = dc * (b * wi / sum);
+        // a point near an end that cannot move would swing the other end far: at most twice the
+        // push a sweep; the next sweeps or steps finish it
+        const double most = std::max(glm::length(move_p), glm::length(move_i)), bound = 2 * glm::length(dc);
+        if (most > bound) move_p *= bound / most, move_i *= bound / most;
+        x_[p] += move_p;
+        x_[i] += move_i;
+        any = true;
+        // a link pinched across an obstacle (its ends on two sides of a rail thicker than it is
+        // long) cannot come out by its contact alone: it stretches at most 20 % here, and the
+        // length constraint pulls it back over the following steps
+        const glm::dvec3 e = x_[i] - x_[p];
+        const double len = glm::length(e), most_len = 1.2 * scratch_.rest_length[i];
+        if (most_len > 0 && len > most_len) {
+            const glm::dvec3 fix = e * ((len - most_len) / (len * (wp + wi)));
+            x_[p] += fix * wp;
+            x_[i] -= fix * wi;
+        }
+    }
+    return any;
+}
+
+} // namespace plant::physics

@@ -1,0 +1,282 @@
+// The climber figure grammars (grammars/climbers/) against their captions in Hädrich et al. 2017,
+// "Interactive Modeling and Authoring of Climbing Plants" (issue 18, item 5). Each test measures the
+// effect its figure shows with a tolerance, not exact numbers, so that the physics may change under
+// it; docs/physics.md lists what each checks.
+#include "helpers.hpp"
+#include "plant/climber.hpp"
+#include "plant/environment_phase.hpp"
+#include "plant/environments.hpp"
+#include "plant/skeleton.hpp"
+#include "plant/turtle.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+using namespace plant;
+
+namespace {
+
+const std::filesystem::path kFigures = std::filesystem::path(PLANT_SOURCE_DIR) / "grammars" / "climbers";
+
+using Defines = std::vector<std::pair<std::string, std::string>>;
+
+// A figure grammar derived step by step, with the deepest any particle's centre went into an
+// obstacle over every step.
+struct Figure {
+    SourceManager sources;
+    Diagnostics diags;
+    std::unique_ptr<Program> program;
+    TurtleEnvironmentPhase phase;
+    DeriveOptions options;
+    std::unique_ptr<Derivation> d;
+    double deepest = 0;     // metres inside an obstacle, the worst particle centre of any step
+    std::string deepest_at; // which step and obstacle
+
+    const physics::World& world() const {
+        REQUIRE(d->run_state().size() > 0);
+        const Environment* env = d->run_state().environment(0);
+        REQUIRE(env);
+        REQUIRE(&env->kind() == &climber_kind());
+        return static_cast<const Climber&>(*env).world();
+    }
+    Skeleton skeleton() const {
+        return build_skeleton(*program, d->interpreted(d->string()), turtle_options(*d));
+    }
+    std::size_t count(const std::string& module) const {
+        const std::string s = format_string(*program, d->string(), false);
+        std::size_t n = 0;
+        for (std::size_t at = s.find(module + "("); at != std::string::npos;
+             at = s.find(module + "(", at + 1))
+            ++n;
+        return n;
+    }
+    std::size_t alive() const {
+        const physics::World& w = world();
+        std::size_t n = 0;
+        for (std::uint32_t i = 0; i < w.size(); ++i) n += w.alive(w.handle(i)) ? 1 : 0;
+        return n;
+    }
+    void measure_depth() {
+        const physics::World& w = world();
+        for (std::uint32_t i = 0; i < w.size(); ++i) {
+            const physics::Handle h = w.handle(i);
+            if (!w.alive(h)) continue;
+            for (std::size_t k = 0; k < w.obstacles().size(); ++k) {
+                const double depth = -w.obstacles()[k].distance(w.position(h));
+                if (depth > deepest) {
+                    deepest = depth;
+                    deepest_at =
+                        "step " + std::to_string(d->steps_done()) + ", obstacle " + std::to_string(k);
+                }
+            }
+        }
+    }
+};
+
+// Compiles grammars/climbers/`name` with `defines` and derives it `steps` steps (all: -1).
+std::unique_ptr<Figure> grow(const std::string& name, const Defines& defines = {}, int steps = -1) {
+    auto f = std::make_unique<Figure>();
+    CompileOptions opts;
+    opts.environments = runtime_environments();
+    opts.defines = defines;
+    f->program = compile_file(f->sources, (kFigures / name).string(), opts, f->diags);
+    INFO(render_all(f->diags, f->sources));
+    REQUIRE(f->program);
+    f->options.environment_phase = &f->phase;
+    f->d = std::make_unique<Derivation>(*f->program, f->options);
+    f->d->start();
+    while ((steps < 0 || f->d->steps_done() < steps) && f->d->step()) f->measure_depth();
+    return f;
+}
+
+struct Segment {
+    glm::dvec3 a, b;
+    double length() const { return glm::distance(a, b); }
+    glm::dvec3 mid() const { return 0.5 * (a + b); }
+};
+
+std::vector<Segment> segments(const Skeleton& s) {
+    std::vector<Segment> out;
+    for (const auto& axis : s.axes)
+        for (std::size_t k = 1; k < axis.points.size(); ++k)
+            out.push_back({axis.points[k - 1].position, axis.points[k].position});
+    return out;
+}
+
+double distance_to(const glm::dvec3& p, const Segment& s) {
+    const glm::dvec3 ab = s.b - s.a;
+    const double l2 = glm::dot(ab, ab);
+    const double t = l2 > 0 ? std::clamp(glm::dot(p - s.a, ab) / l2, 0.0, 1.0) : 0.0;
+    return glm::distance(p, s.a + t * ab);
+}
+
+// The largest distance a particle moved between two runs of one grammar (particles by index).
+double largest_move(const physics::World& a, const physics::World& b) {
+    double most = 0;
+    for (std::uint32_t i = 0; i < std::min(a.size(), b.size()); ++i) {
+        const physics::Handle ha = a.handle(i), hb = b.handle(i);
+        if (a.alive(ha) && b.alive(hb)) most = std::max(most, glm::distance(a.position(ha), b.position(hb)));
+    }
+    return most;
+}
+
+} // namespace
+
+TEST_CASE("climber figures: no particle of any figure grammar ends a step inside an obstacle", "[climber]") {
+    // A particle is put back one radius (6 mm for a main stem) outside; a centre inside a surface
+    // means the stem went through it. Before segments were collided as capsules (issue 18 item 2)
+    // the worst was 12.5 mm (fig01_car.plant, in the car mesh at step 35) and this
+    // allowed 5 mm; now no centre of any figure grammar is inside an obstacle at any step
+    // (measured: 0 mm in each), so it allows 1 mm, the capsule check's tolerance.
+    std::size_t grammars = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(kFigures)) {
+        if (entry.path().extension() != ".plant") continue;
+        auto f = grow(entry.path().filename().string());
+        INFO(entry.path().filename().string() << ": deepest " << f->deepest << " m at " << f->deepest_at);
+        CHECK(f->deepest < 0.001);
+        ++grammars;
+    }
+    CHECK(grammars >= 12);
+}
+
+TEST_CASE("climber figures: Fig. 7's gust of wind moves the plant more than 5 cm", "[climber]") {
+    // fig07_editing.plant blows from step 26 to 33; the same plant without the gust, at step 33
+    auto calm = grow("fig07_editing.plant", {{"gust", "0"}}, 33);
+    auto blown = grow("fig07_editing.plant", {}, 33);
+    const double moved = largest_move(calm->world(), blown->world());
+    INFO("the gust moved a particle " << moved << " m");
+    CHECK(moved > 0.05);
+    // and the cut at step 42 took the seeded branch away
+    auto before_cut = grow("fig07_editing.plant", {}, 41);
+    auto after_cut = grow("fig07_editing.plant", {}, 43);
+    CHECK(after_cut->count("Seg") + 10 < before_cut->count("Seg"));
+}
+
+TEST_CASE("climber figures: Fig. 14 right's plants favour the building's lit side", "[climber]") {
+    auto stem_length = [](const Figure& f, double side) {
+        double l = 0;
+        for (const Segment& s : segments(f.skeleton()))
+            if (s.mid().x * side > 0) l += s.length();
+        return l;
+    };
+    auto lit = grow("fig14_right.plant");
+    const double right = stem_length(*lit, 1), left = stem_length(*lit, -1);
+    auto above = grow("fig14_right.plant", {{"light_x", "0"}});
+    const double even_right = stem_length(*above, 1), even_left = stem_length(*above, -1);
+    INFO("lit from the right: " << right << " m right, " << left << " m left; from above: " << even_right
+                                << " m, " << even_left << " m");
+    CHECK(right > 1.5 * left);
+    CHECK(even_right < 1.3 * even_left); // the light does it, not the seeding
+}
+
+TEST_CASE("climber figures: Fig. 14 left's shoots past the water tank bend down under gravity", "[climber]") {
+    // stems pointing more than 30 degrees below horizontal, over 4 cm from every obstacle
+    auto hanging = [](const Figure& f) {
+        const physics::World& w = f.world();
+        double l = 0;
+        for (const Segment& s : segments(f.skeleton())) {
+            if (s.b.y - s.a.y > -0.5 * s.length()) continue;
+            bool free = true;
+            for (const auto& o : w.obstacles()) free = free && o.distance(s.b) > 0.04;
+            if (free) l += s.length();
+        }
+        return l;
+    };
+    auto heavy = grow("fig14_left.plant");
+    auto weightless = grow("fig14_left.plant", {{"gravity_y", "0"}});
+    const double down = hanging(*heavy), floating = hanging(*weightless);
+    INFO("hanging stem: " << down << " m under gravity, " << floating << " m weightless");
+    CHECK(down > 0.5);
+    CHECK(floating < 0.25 * down);
+}
+
+TEST_CASE("climber figures: Fig. 10's stems cover the dome's upper half", "[climber]") {
+    auto f = grow("fig10_dome.plant");
+    const std::vector<Segment> segs = segments(f->skeleton());
+    // a Fibonacci lattice of 600 points on the dome (radius 0.8 about the origin), those at
+    // y >= 0.4 kept: the upper half of the 0.8 m it stands above the ground
+    const double golden = 3.14159265358979 * (3 - std::sqrt(5.0));
+    std::size_t points = 0, covered = 0;
+    for (int i = 0; i < 600; ++i) {
+        const double y = 1 - (i + 0.5) / 600.0;
+        const double r = std::sqrt(1 - y * y);
+        const glm::dvec3 p = 0.8 * glm::dvec3(r * std::cos(golden * i), y, r * std::sin(golden * i));
+        if (p.y < 0.4) continue;
+        ++points;
+        for (const Segment& s : segs)
+            if (distance_to(p, s) < 0.05) {
+                ++covered;
+                break;
+            }
+    }
+    INFO(covered << " of " << points << " points of the upper half within 5 cm of a stem");
+    REQUIRE(points > 100);
+    CHECK(covered > 0.7 * points);
+}
+
+TEST_CASE("climber figures: Fig. 5's branching probability and variance show", "[climber]") {
+    struct Shoots {
+        std::size_t count = 0;
+        double lean = 0; // mean angle of the laterals from the vertical, degrees
+    };
+    auto shoots = [](const std::string& variant) {
+        auto f = grow("fig05_branching.plant", {{"variant", variant}});
+        Shoots s;
+        std::size_t laterals = 0;
+        for (const auto& axis : f->skeleton().axes) {
+            ++s.count;
+            if (axis.parent < 0 || axis.points.size() < 3) continue;
+            const glm::dvec3 d = axis.points.back().position - axis.points.front().position;
+            if (glm::length(d) <= 0) continue;
+            s.lean += std::acos(std::clamp(d.y / glm::length(d), -1.0, 1.0)) * 180 / 3.14159265358979;
+            ++laterals;
+        }
+        if (laterals > 0) s.lean /= static_cast<double>(laterals);
+        return s;
+    };
+    const Shoots a = shoots("1"), b = shoots("2"), c = shoots("3");
+    INFO("(a) " << a.count << " shoots; (b) " << b.count << " shoots leaning " << b.lean << " deg; (c) "
+                << c.count << " leaning " << c.lean << " deg");
+    CHECK(b.count > 2.5 * static_cast<double>(a.count)); // branching probability
+    CHECK(b.lean > c.lean + 10);                         // branching variance
+}
+
+TEST_CASE("climber figures: Fig. 6's dragged branch breaks off and leaves the plant", "[climber]") {
+    // fig06_break.plant drags segment #306 from step 28 on
+    auto before = grow("fig06_break.plant", {}, 28);
+    auto broken = grow("fig06_break.plant", {}, 31);
+    auto undisturbed = grow("fig06_break.plant", {{"drag", "0"}}, 31);
+    INFO("segments: " << before->count("Seg") << " before the drag, " << broken->count("Seg") << " after, "
+                      << undisturbed->count("Seg") << " undisturbed");
+    CHECK(broken->count("Seg") + 5 < before->count("Seg")); // the part above the break is gone
+    CHECK(broken->alive() + 5 < undisturbed->alive());      // and its particles
+    CHECK(undisturbed->count("Seg") > before->count("Seg"));
+}
+
+TEST_CASE("climber figures: Fig. 1's plants are cut away from the car's windows and lights", "[climber]") {
+    // the boxes of fig01_car.plant's over_glass()
+    const std::vector<std::pair<glm::dvec3, glm::dvec3>> glass = {
+        {{-0.5, 0.76, 0.43}, {0.4, 1.1, 0.6}},    {{-0.5, 0.76, -0.6}, {0.4, 1.1, -0.43}},
+        {{0.43, 0.76, -0.38}, {0.6, 1.1, 0.38}},  {{-0.7, 0.76, -0.38}, {-0.53, 1.1, 0.38}},
+        {{0.98, 0.4, 0.18}, {1.15, 0.62, 0.4}},   {{0.98, 0.4, -0.4}, {1.15, 0.62, -0.18}},
+        {{-1.15, 0.4, 0.18}, {-0.98, 0.62, 0.4}}, {{-1.15, 0.4, -0.4}, {-0.98, 0.62, -0.18}}};
+    auto over_glass = [&](const Figure& f) {
+        std::size_t n = 0;
+        for (const Segment& s : segments(f.skeleton()))
+            for (const auto& [lo, hi] : glass)
+                if (glm::all(glm::greaterThanEqual(s.b, lo)) && glm::all(glm::lessThanEqual(s.b, hi))) ++n;
+        return n;
+    };
+    auto pruned = grow("fig01_car.plant");
+    auto wild = grow("fig01_car.plant", {{"prune_from", "1000"}});
+    INFO(over_glass(*pruned) << " stem points over glass pruned, " << over_glass(*wild) << " unpruned");
+    CHECK(over_glass(*wild) > 20); // the plants do grow over the glass
+    CHECK(over_glass(*pruned) == 0);
+    CHECK(pruned->count("Seg") > 300); // and cover the rest of the car
+}
