@@ -59,6 +59,10 @@ void check_mesh_part(const MeshPart& part, const std::string& what) {
     if (part.indices.size() % 3 != 0)
         throw ExportError(what + " has an index count (" + std::to_string(part.indices.size()) +
                           ") that is not a multiple of 3");
+    // the largest index first (a loop the compiler vectorizes), the offending one only past it
+    std::uint32_t top = 0;
+    for (std::uint32_t i : part.indices) top = i > top ? i : top;
+    if (part.indices.empty() || top < nv) return;
     for (std::uint32_t i : part.indices)
         if (i >= nv)
             throw ExportError(what + " has index " + std::to_string(i) + " but only " + std::to_string(nv) +

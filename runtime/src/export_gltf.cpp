@@ -15,6 +15,7 @@
 // the JSON; normals are renormalized as they are written, a block at a time.
 #include "plant/export.hpp"
 
+#include "bounds.hpp"
 #include "export_placement.hpp"
 
 #include <tiny_gltf.h>
@@ -61,6 +62,22 @@ glm::vec3 unit_normal(glm::vec3 n) {
     if (!(len > 1e-20f) || !std::isfinite(len)) return glm::vec3(0.0f, 1.0f, 0.0f);
     if (std::abs(len - 1.0f) > 1e-5f) n /= len;
     return n;
+}
+
+// Whether unit_normal leaves each of the `n` vec3 floats at `bytes` as it is: a squared length
+// within [(1 - 1e-5)^2, (1 + 1e-5)^2], narrowed by 1e-6 each side for the rounding of the squared
+// length against glm::length's (a normal near the edge takes the exact path). NaN fails.
+bool all_unit(const unsigned char* bytes, std::size_t n) {
+    constexpr float kLow = (1.0f - 1e-5f) * (1.0f - 1e-5f) + 1e-6f,
+                    kHigh = (1.0f + 1e-5f) * (1.0f + 1e-5f) - 1e-6f;
+    bool ok = true;
+    for (std::size_t k = 0; k < n; ++k) {
+        float v[3];
+        std::memcpy(v, bytes + k * sizeof v, sizeof v);
+        const float s = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        ok &= (s >= kLow) & (s <= kHigh);
+    }
+    return ok;
 }
 
 // A run of the buffer's bytes: borrowed from the scene (or from GltfBuilder::owned), or normals
@@ -118,7 +135,9 @@ struct GltfBuilder {
         return static_cast<int>(model.bufferViews.size() - 1);
     }
 
-    // Hands the buffer's bytes to `sink`, normals renormalized a block at a time.
+    // Hands the buffer's bytes to `sink`, normals renormalized a block at a time. The mesher's
+    // normals are unit already: a block that unit_normal would leave as it is goes out from the
+    // scene's own array, only the others through a copy.
     void write_buffer(const ByteSink& sink) const {
         std::vector<glm::vec3> block;
         for (const Piece& piece : pieces) {
@@ -127,11 +146,16 @@ struct GltfBuilder {
                 continue;
             }
             constexpr std::size_t kBlock = 1 << 15; // 384 kB a write
-            block.resize(kBlock);
             const std::size_t count = piece.size / sizeof(glm::vec3);
             for (std::size_t at = 0; at < count; at += kBlock) {
                 const std::size_t n = std::min(kBlock, count - at);
-                std::memcpy(block.data(), piece.bytes + at * sizeof(glm::vec3), n * sizeof(glm::vec3));
+                const unsigned char* from = piece.bytes + at * sizeof(glm::vec3);
+                if (all_unit(from, n)) {
+                    sink(from, n * sizeof(glm::vec3));
+                    continue;
+                }
+                block.resize(kBlock);
+                std::memcpy(block.data(), from, n * sizeof(glm::vec3));
                 for (std::size_t k = 0; k < n; ++k) block[k] = unit_normal(block[k]);
                 sink(block.data(), n * sizeof(glm::vec3));
             }
@@ -220,12 +244,8 @@ struct GltfBuilder {
 
         // POSITION, with the min and max the specification requires.
         glm::vec3 lo(std::numeric_limits<float>::max()), hi(std::numeric_limits<float>::lowest());
-        for (const glm::vec3& p : part.positions) {
-            if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-                throw ExportError("glTF export: " + name + " has a position that is not finite");
-            lo = glm::min(lo, p);
-            hi = glm::max(hi, p);
-        }
+        if (!grow_point_bounds(part.positions.data(), nv, lo, hi))
+            throw ExportError("glTF export: " + name + " has a position that is not finite");
         const int pos_view = add_view(part.positions.data(), nv * sizeof(glm::vec3), array_buffer);
         const int pos = add_accessor(pos_view, 0, nv, TINYGLTF_TYPE_VEC3, TINYGLTF_COMPONENT_TYPE_FLOAT);
         model.accessors[std::size_t(pos)].minValues = {lo.x, lo.y, lo.z};

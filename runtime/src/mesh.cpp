@@ -193,11 +193,19 @@ std::vector<TubePath> tube_paths(const Skeleton& skeleton, const MeshOptions& o)
             next[pa] = static_cast<int>(c);
         }
     }
+    std::size_t starts = n;
     for (std::size_t a = 0; a < n; ++a)
-        if (next[a] >= 0) continued[static_cast<std::size_t>(next[a])] = 1;
+        if (next[a] >= 0) continued[static_cast<std::size_t>(next[a])] = 1, --starts;
+    tubes.reserve(starts);
     for (std::size_t a = 0; a < n; ++a) {
         if (continued[a]) continue; // meshed as part of its parent's tube
         TubePath& t = tubes.emplace_back();
+        std::size_t length = 0; // the points of the chain, each joint counted once
+        for (std::size_t k = a;; k = static_cast<std::size_t>(next[k])) {
+            length += skeleton.axes[k].points.size() - (length > 0 ? 1 : 0);
+            if (next[k] < 0) break;
+        }
+        t.reserve(length);
         for (std::size_t k = a;;) {
             const auto& pts = skeleton.axes[k].points;
             // the joint point is the child's first one: its radius and colour start the child's part
@@ -244,12 +252,16 @@ void mesh_tube(const TubePath& path, const MeshOptions& o, MeshPart& part,
     const auto stride = static_cast<std::uint32_t>(sides + 1);
     const auto base = static_cast<std::uint32_t>(part.positions.size());
     const std::size_t count = rings.size() * stride;
-    part.positions.resize(base + count);
-    part.normals.resize(base + count);
-    part.uvs.resize(base + count);
-    glm::vec3* pos = part.positions.data() + base;
-    glm::vec3* nrm = part.normals.data() + base;
-    glm::vec2* uv = part.uvs.data() + base;
+    // appended one by one into room made first: resize would write every vertex twice (zeros,
+    // then the vertex); the caller sized the arrays for the whole skeleton, and when they are
+    // short the room doubles, as it would with resize
+    const std::size_t room = std::max<std::size_t>(base + count, 2 * std::size_t{base});
+    if (part.positions.capacity() < base + count) part.positions.reserve(room);
+    if (part.normals.capacity() < base + count) part.normals.reserve(room);
+    if (part.uvs.capacity() < base + count) part.uvs.reserve(room);
+    auto& pos = part.positions;
+    auto& nrm = part.normals;
+    auto& uv = part.uvs;
     double arc = 0;
     for (std::size_t k = 0; k < rings.size(); ++k) {
         const Ring& R = rings[k];
@@ -268,9 +280,9 @@ void mesh_tube(const TubePath& path, const MeshOptions& o, MeshPart& part,
             const glm::dvec3 radial = s.cosines[j] * normal + s.sines[j] * binormal;
             glm::dvec3 offset = radial * R.radius;
             if (mitered) offset += R.bend * (glm::dot(offset, R.bend) * (R.miter - 1.0));
-            *pos++ = glm::vec3(R.center + offset);
-            *nrm++ = glm::vec3((radial + along) * tilt);
-            *uv++ = glm::vec2(s.us[j], static_cast<float>(arc));
+            pos.emplace_back(R.center + offset);
+            nrm.emplace_back((radial + along) * tilt);
+            uv.emplace_back(s.us[j], static_cast<float>(arc));
         }
     }
     // triangles, grouped by material (looked up only when the colour or texture changes along the

@@ -4,6 +4,7 @@
 
 #include "plant/export.hpp"
 
+#include "bounds.hpp"
 #include "mesh_file.hpp"
 #include "openmesh.hpp"
 #include "scene_build.hpp"
@@ -32,14 +33,8 @@ void grow_bounds(const Scene& scene, const glm::mat4* placed, glm::vec3& lo, glm
         for (const auto& p : scene.tubes.positions) add(glm::vec3(*placed * glm::vec4(p, 1.0f)));
     } else {
         // the tubes of a whole tree: the same comparisons as glm::min and glm::max (a NaN
-        // coordinate leaves the bound as it was), one coordinate at a time
-        float lx = lo.x, ly = lo.y, lz = lo.z, hx = hi.x, hy = hi.y, hz = hi.z;
-        for (const auto& p : scene.tubes.positions) {
-            lx = p.x < lx ? p.x : lx, ly = p.y < ly ? p.y : ly, lz = p.z < lz ? p.z : lz;
-            hx = hx < p.x ? p.x : hx, hy = hy < p.y ? p.y : hy, hz = hz < p.z ? p.z : hz;
-        }
-        lo = glm::vec3(lx, ly, lz);
-        hi = glm::vec3(hx, hy, hz);
+        // coordinate leaves the bound as it was), many points at a time
+        grow_point_bounds(scene.tubes.positions.data(), scene.tubes.positions.size(), lo, hi);
     }
     for (const auto& inst : scene.instances) {
         const MeshPart& proto = scene.prototypes[inst.prototype];

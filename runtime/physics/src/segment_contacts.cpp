@@ -25,6 +25,10 @@ namespace plant::physics {
 
 namespace {
 
+// how far a link pinched across an obstacle may stretch (or squash) in the contact pass: its ends
+// on two sides of a rail thicker than it is long cannot both be clear at its rest length
+constexpr double kPinched = 1.2;
+
 // a box's capsule test that needs no search: both ends beyond the same face by r or more
 bool beyond_one_face(const Obstacle& o, const glm::dvec3& a, const glm::dvec3& b, double r) {
     const glm::dvec3 c = (o.a + o.b) * 0.5, h = (o.b - o.a) * 0.5;
@@ -256,10 +260,17 @@ void World::resolve_segments() {
             if (wp + wi <= 0) continue;
             const glm::dvec3 d = x_[i] - x_[p];
             const double len = glm::length(d), want = sc.rest_length[i];
-            if (lengths && len > 1e-12 && want > 1e-12) {
-                const glm::dvec3 fix = d * ((len - want) / (len * (wp + wi)));
-                x_[p] += fix * wp;
-                x_[i] -= fix * wi;
+            if (len > 1e-12 && want > 1e-12) {
+                // the length sweeps put the link back to its rest length; the last sweeps, of
+                // contacts, keep it within kPinched of it: a contact on a neighbouring link (its
+                // parent's or a child's) moves one of its ends and can stretch it further than a
+                // contact on the link itself does (link_contacts bounds that one)
+                const double to = lengths ? want : std::clamp(len, want / kPinched, want * kPinched);
+                if (to != len) {
+                    const glm::dvec3 fix = d * ((len - to) / (len * (wp + wi)));
+                    x_[p] += fix * wp;
+                    x_[i] -= fix * wi;
+                }
             }
             if (near[i] < 3) any = link_contacts(i, wp, wi) || any;
         }
@@ -293,7 +304,7 @@ bool World::link_contacts(std::uint32_t i, double wp, double wi) {
         // long) cannot come out by its contact alone: it stretches at most 20 % here, and the
         // length constraint pulls it back over the following steps
         const glm::dvec3 e = x_[i] - x_[p];
-        const double len = glm::length(e), most_len = 1.2 * scratch_.rest_length[i];
+        const double len = glm::length(e), most_len = kPinched * scratch_.rest_length[i];
         if (most_len > 0 && len > most_len) {
             const glm::dvec3 fix = e * ((len - most_len) / (len * (wp + wi)));
             x_[p] += fix * wp;

@@ -91,7 +91,11 @@ std::unique_ptr<Figure> grow(const std::string& name, const Defines& defines = {
     f->options.environment_phase = &f->phase;
     f->d = std::make_unique<Derivation>(*f->program, f->options);
     f->d->start();
-    while ((steps < 0 || f->d->steps_done() < steps) && f->d->step()) f->measure_depth();
+    // step() returns false for the last step it has just run: that state is measured too
+    for (bool more = true; more && (steps < 0 || f->d->steps_done() < steps);) {
+        more = f->d->step();
+        f->measure_depth();
+    }
     return f;
 }
 

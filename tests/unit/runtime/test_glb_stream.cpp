@@ -83,3 +83,31 @@ TEST_CASE("a .gltf holds the same buffer as the .glb", "[export][gltf]") {
     REQUIRE(json.buffers.size() == 1);
     CHECK(json.buffers[0].data == binary.buffers[0].data);
 }
+
+TEST_CASE("unit normals go out from the scene's array, a block with one that is not through a copy",
+          "[export][gltf]") {
+    Scene s = strip(70'001);
+    for (glm::vec3& n : s.tubes.normals) n = glm::vec3(0.0f, 0.0f, 1.0f);
+    s.tubes.normals[2 * 32768 + 5] = glm::vec3(0.0f, 0.0f, 1.00003f);  // past unit_normal's 1e-5
+    s.tubes.normals[2 * 32768 + 6] = glm::vec3(0.0f, 0.0f, 1.000004f); // within it: kept as it is
+    const auto* first = static_cast<const void*>(s.tubes.normals.data());
+    const auto* third = static_cast<const void*>(s.tubes.normals.data() + 2 * 32768);
+    bool first_borrowed = false, third_borrowed = false;
+    std::string file;
+    gltf_to(s, GltfContainer::Binary, "x.glb", GltfLayout::GpuInstancing,
+            [&](const void* data, std::size_t size) {
+                first_borrowed = first_borrowed || data == first;
+                third_borrowed = third_borrowed || data == third;
+                file.append(static_cast<const char*>(data), size);
+            });
+    CHECK(first_borrowed);
+    CHECK_FALSE(third_borrowed);
+    const tinygltf::Model m = test::parse_glb(file);
+    const tinygltf::Accessor& a = m.accessors[std::size_t(m.meshes[0].primitives[0].attributes.at("NORMAL"))];
+    const tinygltf::BufferView& v = m.bufferViews[std::size_t(a.bufferView)];
+    std::vector<glm::vec3> normals(a.count);
+    std::memcpy(normals.data(), m.buffers[0].data.data() + v.byteOffset, a.count * sizeof(glm::vec3));
+    CHECK(normals[2 * 32768 + 5] == glm::vec3(0.0f, 0.0f, 1.0f));
+    CHECK(normals[2 * 32768 + 6] == glm::vec3(0.0f, 0.0f, 1.000004f));
+    CHECK(normals[2 * 32768 + 7] == glm::vec3(0.0f, 0.0f, 1.0f));
+}
