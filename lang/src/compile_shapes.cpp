@@ -131,10 +131,14 @@ void Compiler::compile_surface(const ast::ShapeDecl& s) {
         def.path = p.lexically_normal().string();
         const std::string id = readable(s.args[0]->text, def.path, s.args[0]->span);
         if (id.empty()) return;
-        // a missing or unreadable file is an input error now, for check as for run (exit 66)
+        // a missing or unreadable file is an input error now, for check as for run (exit 66);
+        // with reads confined (the plant command, the Python module) the compiler is the one
+        // place that vets the files a grammar reads, so it looks here; a program embedding the
+        // compiler without confinement finds out when the scene is built
         std::error_code ec;
         const auto status = fs::status(id, ec);
-        const char* why = !fs::exists(status)               ? "no such file"
+        const char* why = !opts_.confine_reads              ? nullptr
+                          : !fs::exists(status)             ? "no such file"
                           : !fs::is_regular_file(status)    ? "not a regular file"
                           : ::access(id.c_str(), R_OK) != 0 ? "permission denied"
                                                             : nullptr;
