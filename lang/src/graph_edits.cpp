@@ -108,8 +108,8 @@ struct PathReader {
 class LineReader {
   public:
     LineReader(const Program& prog, const SourceManager& sm, std::uint32_t file, std::uint32_t b,
-               std::uint32_t e, Diagnostics& diags)
-        : prog_(prog), sm_(sm), file_(file), text_(sm.file(file).text()), pos_(b), end_(e), diags_(diags) {}
+               std::uint32_t e)
+        : prog_(prog), sm_(sm), file_(file), text_(sm.file(file).text()), pos_(b), end_(e) {}
 
     GraphEdit read() {
         GraphEdit edit;
@@ -388,7 +388,6 @@ class LineReader {
     std::uint32_t file_;
     const std::string& text_;
     std::uint32_t pos_, end_;
-    Diagnostics& diags_;
 };
 
 // Where a comment starts on the line [b, e): a '#' first on the line or after a blank (a '#'
@@ -425,7 +424,7 @@ std::shared_ptr<const GraphEdits> parse_edits(const Program& program, const Sour
                 break;
             }
             try {
-                out->edits.push_back(LineReader(program, sources, file_id, b, e, diags).read());
+                out->edits.push_back(LineReader(program, sources, file_id, b, e).read());
             } catch (const Failure& f) {
                 diags.error(f.span, f.message);
                 if (diags.error_count() - errors >= 20) break;

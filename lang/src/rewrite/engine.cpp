@@ -49,14 +49,14 @@ void Engine::check_limits(const Derivation& d, std::size_t modules, std::size_t 
     if (modules > d.opt_.max_modules)
         throw limit(fmt::format("the string grew past the limit of {} modules (raise it with --max-modules)",
                                 d.opt_.max_modules));
-    std::size_t estimate =
-        modules * (sizeof(SymbolId) + sizeof(std::uint32_t) + (d.current_.keep_ids ? sizeof(ModuleId) : 0)) +
-        params * sizeof(double);
+    // a module holds its symbol and a byte of arity (the block offsets add 4 bytes per 64
+    // modules, docs/architecture.md), its identity when kept, and its parameters
+    std::size_t estimate = modules * (sizeof(SymbolId) + 1 + (d.current_.keep_ids ? sizeof(ModuleId) : 0)) +
+                           modules / 16 + params * sizeof(double);
     if (estimate > d.opt_.max_bytes)
-        throw limit(
-            fmt::format("the string needs about {:.1f} GiB, more than the limit of {:.1f} GiB (plant run: "
-                        "raise --max-memory, which gives the string half of it)",
-                        estimate / double(1 << 30), d.opt_.max_bytes / double(1 << 30)));
+        throw limit(fmt::format("the string needs about {} MB, more than the {} MB it may take (half of "
+                                "--max-memory): raise --max-memory",
+                                (estimate + (1 << 20) - 1) >> 20, d.opt_.max_bytes >> 20));
 }
 
 const RulePlan& Engine::plan_for(const Program& prog, const std::vector<const RuleSet*>& sets) {
