@@ -4,7 +4,10 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <numbers>
 
@@ -102,7 +105,60 @@ glm::dvec3 Envelope::control_point(int k) const {
     }
 }
 
+namespace {
+
+// The last reaches computed on this thread, keyed on every bit of the envelope and the ray.
+// reach() is a pure function costing about 170 evaluations of level(); a REPL or `plant view`
+// edit derives the whole plant again, and every silhouette the edit does not touch asks the same
+// questions as before (docs/bonsai.md, "Time"). A hit returns the very double computed before.
+class ReachMemo {
+  public:
+    static constexpr std::size_t kSlots = 1024; // direct-mapped: about 200 KB a thread
+    using Key = std::array<std::uint64_t, 22>;
+    // a field added to Envelope must be added to the key
+    static_assert(sizeof(Envelope) == 16 * sizeof(double));
+
+    static Key key(const Envelope& e, const glm::dvec3& p, const glm::dvec3& d) {
+        const double v[22] = {e.top.x,     e.top.y,     e.top.z,     e.bottom.x,  e.bottom.y,  e.bottom.z,
+                              e.radius[0], e.radius[1], e.radius[2], e.radius[3], e.height[0], e.height[1],
+                              e.height[2], e.height[3], e.c_top,     e.c_bottom,  p.x,         p.y,
+                              p.z,         d.x,         d.y,         d.z};
+        Key k;
+        std::memcpy(k.data(), v, sizeof v);
+        return k;
+    }
+    const double* find(const Key& k) const {
+        const Slot& s = slots_[slot_of(k)];
+        return s.used && s.key == k ? &s.value : nullptr;
+    }
+    void put(const Key& k, double value) { slots_[slot_of(k)] = Slot{true, k, value}; }
+
+  private:
+    struct Slot {
+        bool used = false;
+        Key key{};
+        double value = 0;
+    };
+    static std::size_t slot_of(const Key& k) {
+        std::uint64_t h = 1469598103934665603ull; // FNV-1a over the words
+        for (std::uint64_t w : k) h = (h ^ w) * 1099511628211ull;
+        return static_cast<std::size_t>(h ^ (h >> 29)) % kSlots;
+    }
+    std::vector<Slot> slots_ = std::vector<Slot>(kSlots);
+};
+
+} // namespace
+
 double Envelope::reach(const glm::dvec3& p, const glm::dvec3& d) const {
+    thread_local ReachMemo memo;
+    const ReachMemo::Key k = ReachMemo::key(*this, p, d);
+    if (const double* hit = memo.find(k)) return *hit;
+    const double r = reach_uncached(p, d);
+    memo.put(k, r);
+    return r;
+}
+
+double Envelope::reach_uncached(const glm::dvec3& p, const glm::dvec3& d) const {
     const double len = glm::length(d);
     if (!all_finite(p) || !all_finite(d) || !(len > 0) || !std::isfinite(len) || level(p) > 1.0) return 0;
     const glm::dvec3 u = d / len;

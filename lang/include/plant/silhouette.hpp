@@ -39,7 +39,10 @@ struct Envelope {
     // The distance from p along the direction d (any length but zero) to where the ray first
     // leaves the envelope; 0 when p is outside or d is zero or not finite. Samples the ray every
     // 1/128 of its chord through the envelope's box, then bisects the first step that leaves.
+    // Remembers its last answers (per thread, keyed on every bit of the envelope and the ray),
+    // so asking again costs a lookup; reach_uncached always computes.
     double reach(const glm::dvec3& p, const glm::dvec3& d) const;
+    double reach_uncached(const glm::dvec3& p, const glm::dvec3& d) const;
     // The box holding the envelope.
     glm::dvec3 lo() const;
     glm::dvec3 hi() const;
@@ -96,7 +99,10 @@ struct PlacedSilhouette {
 
     double level(const glm::dvec3& p) const { return silhouette->envelope.level(placement.to_local(p)); }
     bool contains(const glm::dvec3& p) const { return level(p) <= 1.0; }
+    // Remembers its last answers (per thread, keyed on every bit of the envelope and the ray),
+    // so asking again costs a lookup; reach_uncached always computes.
     double reach(const glm::dvec3& p, const glm::dvec3& d) const;
+    double reach_uncached(const glm::dvec3& p, const glm::dvec3& d) const;
     glm::dvec3 axis(double t) const { return placement.to_world(silhouette->axis.point(t)); }
     glm::dvec3 heading(double t) const { return placement.direction_to_world(silhouette->axis.heading(t)); }
     glm::dvec3 base() const { return placement.to_world(silhouette->base()); }

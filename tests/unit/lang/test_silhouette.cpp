@@ -10,6 +10,7 @@
 #include <numbers>
 #include <random>
 #include <string>
+#include <vector>
 
 using namespace plant;
 
@@ -113,6 +114,49 @@ TEST_CASE("silhouette envelope: reach lands on the envelope", "[silhouette]") {
     CHECK(e.reach({0, 6, 0}, {0, 0, 0}) == 0);
     CHECK(e.reach({0, 6, 0}, {NAN, 0, 0}) == 0);
     CHECK(e.reach({0, 6, 0}, {INFINITY, 0, 0}) == 0);
+}
+
+TEST_CASE("silhouette envelope: reach remembers its answers only for the same envelope and ray",
+          "[silhouette]") {
+    // For each field of the envelope that shapes it (the top's x and z do not: only its height
+    // counts), a ray whose answer the field changes: the base envelope answers first, so a memo
+    // that left the field out of its key would hand that answer to the changed envelope.
+    const Envelope base = crown();
+    std::vector<std::pair<glm::dvec3, glm::dvec3>> rays;
+    const glm::dvec3 dirs[] = {{1, 0, 0},  {-1, 0, 0}, {0, 0, 1},   {0, 0, -1},  {0, 1, 0},
+                               {0, -1, 0}, {1, 1, 1},  {-1, -1, 1}, {1, -1, -1}, {-1, 0.5, -1}};
+    for (const glm::dvec3& at : {glm::dvec3{0, 6, 0}, glm::dvec3{0.3, 5.5, -0.2}, glm::dvec3{0, 3, 0}})
+        for (const glm::dvec3& d : dirs) rays.emplace_back(at, d);
+    for (int field = 0; field < 16; ++field) {
+        if (field == 0 || field == 2) continue;
+        Envelope e = base;
+        double* v[16] = {&e.top.x,     &e.top.y,     &e.top.z,     &e.bottom.x,  &e.bottom.y,  &e.bottom.z,
+                         &e.radius[0], &e.radius[1], &e.radius[2], &e.radius[3], &e.height[0], &e.height[1],
+                         &e.height[2], &e.height[3], &e.c_top,     &e.c_bottom};
+        *v[field] += field < 6 ? 0.05 : (field < 14 ? 0.1 : 0.3);
+        INFO("field " << field);
+        bool shaped = false;
+        for (const auto& [p, d] : rays) {
+            const double before = base.reach(p, d), after = e.reach_uncached(p, d);
+            if (before == after) continue;
+            shaped = true;
+            CHECK(e.reach(p, d) == after);
+            CHECK(base.reach(p, d) == before);
+        }
+        CHECK(shaped);
+    }
+    // the ray's every component
+    const glm::dvec3 p{0.3, 5.5, -0.2}, d{0.4, 0.7, 0.2};
+    const double first = base.reach(p, d);
+    CHECK(first == base.reach_uncached(p, d));
+    for (int c = 0; c < 6; ++c) {
+        glm::dvec3 q = p, u = d;
+        (c < 3 ? q[c] : u[c - 3]) += 0.05;
+        INFO("component " << c);
+        CHECK(base.reach_uncached(q, u) != first);
+        CHECK(base.reach(q, u) == base.reach_uncached(q, u));
+    }
+    CHECK(base.reach(p, d) == first);
 }
 
 TEST_CASE("silhouette axis: polyline by arc length, Bezier by de Casteljau", "[silhouette]") {
