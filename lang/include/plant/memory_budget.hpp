@@ -62,8 +62,8 @@ class Reservation {
 
 // The backstop for what no charge sees (small allocations, libraries' own): throws like
 // charge() when the process's resident memory (/proc/self/statm) is past the budget plus
-// kResidentSlack, the program's own baseline. Reads one small file: call it between stages and
-// between derivation steps, not in loops.
+// kResidentSlack, the program's own baseline. Reads one small file, at most once every 2 ms (a
+// call sooner returns at once): call it between stages and between derivation steps.
 constexpr std::uint64_t kResidentSlack = std::uint64_t{96} << 20;
 void check_resident();
 
