@@ -118,8 +118,6 @@ DeriveOptions variant_options(const BatchJob& job, std::uint64_t n, Progress& pr
     DeriveOptions opt = derive_options(job.grammar);
     if (auto seed = job.plan.seed_of(n)) opt.seed = seed;
     opt.threads = job.grammar.threads > 0 ? job.grammar.threads : 1; // the variants fill the cores
-    if (job.output.max_memory)
-        opt.max_bytes = std::min<std::uint64_t>(opt.max_bytes, job.output.max_memory / 2);
     opt.interrupt = &g_stop;
     opt.on_print = [&progress, n](const std::string& text) {
         progress.print(fmt::format("variant {}: {}", n, escape_controls(text, true)));

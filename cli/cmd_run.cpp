@@ -174,16 +174,13 @@ int run_main(RunCmd& c) {
         return kUsage;
     }
     if (c.batch.any()) return run_many(c, oo);
-    const std::uint64_t max_memory = oo.max_memory;
     int exit_code = kOk;
     SourceManager sources;
     auto program = load_program(c.g, sources, exit_code);
     if (!program) return exit_code;
     RunProgress progress(isatty(2) != 0);
     auto t0 = std::chrono::steady_clock::now();
-    DeriveOptions opt = derive_options(c.g);
-    // the string's share of --max-memory: a step holds the string it reads and the one it writes
-    if (max_memory) opt.max_bytes = std::min<std::uint64_t>(opt.max_bytes, max_memory / 2);
+    DeriveOptions opt = derive_options(c.g); // (it gives the strings their share of --max-memory)
     TurtleEnvironmentPhase phase;
     opt.environment_phase = &phase;
     opt.on_print = [](const std::string& text) { std::cerr << escape_controls(text, true); };

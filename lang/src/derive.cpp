@@ -228,7 +228,7 @@ bool Derivation::step() {
         engine_->decompose(*this, current_, step_);
         commit_graph();
         Engine::apply_cut(prog_, current_);
-        memory::check_resident(); // the backstop, for what no charge saw
+        memory::check_resident_between_steps(); // the backstop, for what no charge saw
     } catch (RuntimeError& e) {
         e.at_step(step_);
         throw;

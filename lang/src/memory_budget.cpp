@@ -85,16 +85,6 @@ void Reservation::resize(std::size_t bytes) {
 void check_resident() {
     const std::uint64_t cap = limit();
     if (cap == 0) return;
-    // Reading the file costs three system calls (about 15 us): a derivation of many short steps
-    // (ABOP 1.31a, 30 steps in 0.2 ms) would spend most of its time here. Between two reads less
-    // than 2 ms apart the process cannot have grown past kResidentSlack unseen by the charges.
-    static std::atomic<std::int64_t> last_ns{std::numeric_limits<std::int64_t>::min()};
-    const std::int64_t now = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                 std::chrono::steady_clock::now().time_since_epoch())
-                                 .count();
-    std::int64_t last = last_ns.load(std::memory_order_relaxed);
-    if (last != std::numeric_limits<std::int64_t>::min() && now - last < 2'000'000) return;
-    last_ns.store(now, std::memory_order_relaxed);
     std::FILE* f = std::fopen("/proc/self/statm", "r");
     if (!f) return;
     unsigned long long size = 0, resident = 0;
@@ -103,6 +93,20 @@ void check_resident() {
     if (!read) return;
     const double bytes = double(resident) * double(::sysconf(_SC_PAGESIZE));
     if (bytes > double(cap + kResidentSlack)) refuse(fmt::format("the process holds {}", megabytes(bytes)));
+}
+
+void check_resident_between_steps() {
+    // Reading the file costs three system calls (about 15 us): a derivation of many short steps
+    // (ABOP 1.31a, 30 steps in 0.2 ms) would spend most of its time here. Between two reads less
+    // than 2 ms apart the process cannot have grown past kResidentSlack unseen by the charges.
+    static std::atomic<std::int64_t> last_ns{std::numeric_limits<std::int64_t>::min()};
+    const std::int64_t now = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                 std::chrono::steady_clock::now().time_since_epoch())
+                                 .count();
+    const std::int64_t last = last_ns.load(std::memory_order_relaxed);
+    if (last != std::numeric_limits<std::int64_t>::min() && now - last < 2'000'000) return;
+    last_ns.store(now, std::memory_order_relaxed);
+    check_resident();
 }
 
 } // namespace plant::memory

@@ -62,9 +62,11 @@ class Reservation {
 
 // The backstop for what no charge sees (small allocations, libraries' own): throws like
 // charge() when the process's resident memory (/proc/self/statm) is past the budget plus
-// kResidentSlack, the program's own baseline. Reads one small file, at most once every 2 ms (a
-// call sooner returns at once): call it between stages and between derivation steps.
+// kResidentSlack, the program's own baseline. Reads one small file: call it between stages, not
+// in loops. Between derivation steps, check_resident_between_steps reads it at most every 2 ms
+// (a call sooner returns at once), so that many short steps do not pay for it.
 constexpr std::uint64_t kResidentSlack = std::uint64_t{96} << 20;
 void check_resident();
+void check_resident_between_steps();
 
 } // namespace plant::memory
