@@ -97,9 +97,9 @@ std::size_t find_id(const ModuleString& s, ModuleId id) {
 // Module i of `s`: its name, parameters (named when declared) and any graph node they name.
 void describe(const Program& program, const Derivation& d, const ModuleString& s, std::size_t i,
               nlohmann::json& j) {
-    const SymbolInfo& info = program.symbols[s.sym[i]];
+    const SymbolInfo& info = program.symbols[s.symbol(i)];
     j["module"] = info.name;
-    const std::span<const double> args = s.arg_span(i);
+    const ModuleArgs args = s.args(i);
     nlohmann::json params = nlohmann::json::array();
     const DecompositionGraph* graph = d.run_state().graph();
     std::size_t at = 0;

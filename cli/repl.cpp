@@ -275,7 +275,7 @@ void Session::find(const std::string& pattern) {
         std::vector<std::size_t> found;
         if (auto sym = program_->symbols.find(pattern))
             for (std::size_t i = 0; i < s.size(); ++i)
-                if (s.sym[i] == *sym) found.push_back(i);
+                if (s.symbol(i) == *sym) found.push_back(i);
         list(found, "match");
         return;
     }
@@ -314,7 +314,8 @@ void Session::stats() {
     const ModuleString& s = current().string();
     std::map<SymbolId, std::size_t> counts;
     int depth = 0, max_depth = 0;
-    for (SymbolId x : s.sym) {
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        const SymbolId x = s.symbol(i);
         ++counts[x];
         if (x == program_->symbols.open_bracket) max_depth = std::max(max_depth, ++depth);
         if (x == program_->symbols.close_bracket) --depth;

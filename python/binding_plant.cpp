@@ -97,9 +97,9 @@ py::list PyPlant::modules() {
     py::list out(s.size());
     for (std::size_t i = 0; i < s.size(); ++i) {
         py::tuple params(s.arity(i));
-        const double* a = s.args(i);
+        const ModuleArgs a = s.args(i);
         for (std::uint32_t k = 0; k < s.arity(i); ++k) params[k] = py::float_(a[k]);
-        out[i] = module_class(names.at(s.sym[i]), params);
+        out[i] = module_class(names.at(s.symbol(i)), params);
     }
     return out;
 }

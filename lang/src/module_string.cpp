@@ -12,22 +12,22 @@ namespace plant {
 
 void ModuleString::append_range(const ModuleString& o, std::size_t b, std::size_t e) {
     if (b >= e) return;
-    const std::size_t m0 = sym.size(), p0 = params.size();
+    const std::size_t m0 = kinds.size(), p0 = params.size();
     if (e - b == 1) { // the common case in context-sensitive grammars: one module between rewrites
         if ((m0 & (kBlock - 1)) == 0) block_at.push_back(static_cast<std::uint32_t>(p0));
-        sym.push_back(o.sym[b]);
+        kinds.push_back(o.kinds[b]);
         nargs.push_back(o.nargs[b]);
         if (keep_ids) ids.push_back(o.ids[b]);
-        const double* a = o.args(b);
-        for (std::uint32_t k = 0; k < o.nargs[b]; ++k) params.push_back(a[k]);
+        const double* a = o.params.data() + o.offset(b);
+        for (std::uint32_t k = 0; k < o.stored(b); ++k) params.push_back(a[k]);
         return;
     }
     const std::size_t n = e - b, pb = o.offset(b), pe = o.offset(e);
-    sym.resize(m0 + n);
+    kinds.resize(m0 + n);
     nargs.resize(m0 + n);
     if (keep_ids) ids.resize(m0 + n);
     params.resize(p0 + (pe - pb));
-    std::memcpy(sym.data() + m0, o.sym.data() + b, n * sizeof(SymbolId));
+    std::memcpy(kinds.data() + m0, o.kinds.data() + b, n * sizeof(KindId));
     std::memcpy(nargs.data() + m0, o.nargs.data() + b, n);
     if (keep_ids) std::memcpy(ids.data() + m0, o.ids.data() + b, n * sizeof(ModuleId));
     if (pe > pb) std::memcpy(params.data() + p0, o.params.data() + pb, (pe - pb) * sizeof(double));
@@ -37,7 +37,7 @@ void ModuleString::append_range(const ModuleString& o, std::size_t b, std::size_
 void ModuleString::truncate(std::size_t m) {
     if (m >= size()) return;
     params.resize(offset(m));
-    sym.resize(m);
+    kinds.resize(m);
     nargs.resize(m);
     if (keep_ids) ids.resize(m);
     block_at.resize((m + kBlock - 1) >> kBlockShift);
@@ -65,7 +65,7 @@ void bracket_table(const ModuleString& s, SymbolId open, SymbolId close, std::ve
     // '[' below it until its ']' is found. No allocation besides the table.
     std::uint32_t top = n;
     for (std::uint32_t i = 0; i < n; ++i) {
-        const SymbolId x = s.sym[i];
+        const SymbolId x = s.symbol(i);
         if (x == open) {
             match[i] = top;
             top = i;
@@ -116,7 +116,7 @@ std::string format_string(const Program& program, const ModuleString& s, bool wi
             for (std::size_t l = 2; l <= info.name.size(); ++l) prefixes.insert(info.name.substr(0, l));
     const std::string* prev = nullptr; // name of the previous module when it ends in a letter run
     for (std::size_t i = 0; i < s.size() && out.size() <= max_chars; ++i) {
-        const std::string& name = program.symbols[s.sym[i]].name;
+        const std::string& name = program.symbols[s.symbol(i)].name;
         bool letter_start =
             !name.empty() && (std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_');
         // a space only where reading back would merge two names
@@ -127,7 +127,7 @@ std::string format_string(const Program& program, const ModuleString& s, bool wi
         std::uint32_t k = s.arity(i);
         if (k > 0 || name == ";") { // a bare ';' would end the statement when read back
             out += '(';
-            const double* a = s.args(i);
+            const ModuleArgs a = s.args(i);
             for (std::uint32_t j = 0; j < k; ++j) {
                 if (j) out += ',';
                 out += format_double(a[j]);
@@ -159,9 +159,9 @@ void cut_branches(ModuleString& s, SymbolId open, SymbolId close,
         int depth = 0;
         ++i;
         while (i < n) {
-            if (s.sym[i] == open)
+            if (s.symbol(i) == open)
                 ++depth;
-            else if (s.sym[i] == close) {
+            else if (s.symbol(i) == close) {
                 if (depth == 0) break;
                 --depth;
             }

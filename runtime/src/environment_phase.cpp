@@ -24,7 +24,7 @@ class QuerySink : public TurtleSink {
   public:
     QuerySink(const Program& p, const ModuleString& s) : program_(p), string_(s) {}
     void query(std::size_t module, const TurtleState& t) override {
-        const TurtleOp op = program_.symbols[string_.sym[module]].turtle_op;
+        const TurtleOp op = program_.symbols[string_.symbol(module)].turtle_op;
         if (op == TurtleOp::Communicate) { // answered after the environments see the plant
             positions[string_.id(module)] = Place{t.position, t.axis};
             return;
@@ -55,7 +55,7 @@ class BoundSink : public TurtleSink {
               const std::unordered_set<ModuleId>& own)
         : string_(s), by_symbol_(by_symbol), own_(own) {}
     void segment(const TurtleSegment& seg) override {
-        const SymbolId sym = string_.sym[seg.module];
+        const SymbolId sym = string_.symbol(seg.module);
         Environment* holder = sym < by_symbol_.size() ? by_symbol_[sym] : nullptr;
         if (!holder || !own_.count(seg.id)) return;
         const TurtleState& t = *seg.state;
@@ -95,7 +95,7 @@ void advance_bound(const Derivation& d, RunState& state, ModuleString& string) {
     // identity that the next step may give to another module
     std::unordered_set<ModuleId> own;
     for (std::size_t i = 0; i < string.size(); ++i)
-        if (string.sym[i] < by_symbol.size() && by_symbol[string.sym[i]]) own.insert(string.id(i));
+        if (string.symbol(i) < by_symbol.size() && by_symbol[string.symbol(i)]) own.insert(string.id(i));
     BoundSink sink(interpreted, by_symbol, own);
     interpret(p, interpreted, turtle_options(d), sink);
     std::set<ModuleId> gone;
@@ -160,9 +160,11 @@ void TurtleEnvironmentPhase::run(const Derivation& d, RunState& state, ModuleStr
     }
     // ?E(env, slots...): the named environment answers at the module's position (docs/language.md,
     // environment objects: open L-systems' communication modules)
-    double* a = string.params.data(); // module i's parameters: the string is read in order
-    for (std::size_t i = 0; !sink.positions.empty() && i < string.size(); a += string.arity(i), ++i) {
-        if (p.symbols[string.sym[i]].turtle_op != TurtleOp::Communicate || string.arity(i) < 2) continue;
+    // module i's parameters (the string is read in order); query and communication modules are
+    // always of plain kinds, every number stored, so `a` may be written
+    double* a = string.params.data();
+    for (std::size_t i = 0; !sink.positions.empty() && i < string.size(); a += string.stored(i), ++i) {
+        if (p.symbols[string.symbol(i)].turtle_op != TurtleOp::Communicate || string.arity(i) < 2) continue;
         auto it = sink.positions.find(string.id(i));
         const auto env = static_cast<std::size_t>(a[0]);
         if (it == sink.positions.end() || a[0] < 0 || env >= state.size() || !state.environment(env))
@@ -171,8 +173,8 @@ void TurtleEnvironmentPhase::run(const Derivation& d, RunState& state, ModuleStr
                                             string.arity(i) - 1);
     }
     a = string.params.data();
-    for (std::size_t i = 0; i < string.size(); a += string.arity(i), ++i) {
-        if (!p.symbols[string.sym[i]].query || string.arity(i) != 3) continue;
+    for (std::size_t i = 0; i < string.size(); a += string.stored(i), ++i) {
+        if (!p.symbols[string.symbol(i)].query || string.arity(i) != 3) continue;
         auto it = sink.found.find(string.id(i));
         if (it == sink.found.end()) continue;
         a[0] = it->second.x;

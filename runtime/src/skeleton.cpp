@@ -49,7 +49,7 @@ std::size_t segments_in(const Program& program, const ModuleString& s) {
         draws[k] = info.turtle_op == TurtleOp::Forward || !info.bound_to.empty();
     }
     std::size_t n = 0;
-    for (const SymbolId sym : s.sym) n += sym < draws.size() && draws[sym];
+    for (std::size_t i = 0; i < s.size(); ++i) n += s.symbol(i) < draws.size() && draws[s.symbol(i)];
     return n;
 }
 
@@ -86,7 +86,7 @@ void SkeletonBuilder::segment(const TurtleSegment& s) {
     const TurtleState& t = *s.state;
     SkeletonAxis& a = skeleton_.axes[static_cast<std::size_t>(t.axis)];
     a.points.push_back(SkeletonPoint{t.position, t.heading, t.left, t.up, t.width / 2, s.id, t.color,
-                                     t.texture, string_.sym[s.module]});
+                                     t.texture, string_.symbol(s.module)});
 }
 
 void SkeletonBuilder::organ(const TurtleOrgan& o) {

@@ -146,8 +146,8 @@ class Turtle {
 
     void run() {
         at_ = s_.params.data();
-        for (std::size_t i = 0; i < s_.size(); at_ += s_.arity(i), ++i) {
-            const SymbolId sym = s_.sym[i];
+        for (std::size_t i = 0; i < s_.size(); at_ += s_.stored(i), ++i) {
+            const SymbolId sym = s_.symbol(i);
             if (sym >= ops_.size()) continue;
             if (bound_[sym])
                 bound_segment(i);
@@ -161,10 +161,14 @@ class Turtle {
   private:
     const double* at_ = nullptr; // the parameters of the module run() is at (the string is read in order)
 
+    ModuleArgs args(std::size_t i) const { return s_.args_at(i, at_); }
     double arg(std::size_t i, std::uint32_t k, double fallback) const {
-        return s_.arity(i) > k ? at_[k] : fallback;
+        return s_.arity(i) > k ? args(i)[k] : fallback;
     }
-    glm::dvec3 vec_arg(std::size_t /*i*/, std::uint32_t k) const { return vec(at_ + k); }
+    glm::dvec3 vec_arg(std::size_t i, std::uint32_t k) const {
+        const ModuleArgs a = args(i);
+        return {a[k], a[k + 1], a[k + 2]};
+    }
 
     void check(std::size_t i) const {
         auto finite = [](const glm::dvec3& v) {
@@ -173,7 +177,7 @@ class Turtle {
         if (!finite(t_.position) || !finite(t_.heading) || !finite(t_.left) || !finite(t_.up))
             throw RuntimeError(RuntimeErrorKind::Turtle, Span{},
                                fmt::format("the turtle left finite space at module {} ('{}') of the string",
-                                           i + 1, program_.symbols[s_.sym[i]].name));
+                                           i + 1, program_.symbols[s_.symbol(i)].name));
     }
 
     void tropism() {
@@ -197,7 +201,7 @@ class Turtle {
     // its position and the turtle takes its frame
     void bound_segment(std::size_t i) {
         double len = arg(i, 0, t_.step);
-        if (s_.arity(i) > 1) t_.width = 2 * at_[1];
+        if (s_.arity(i) > 1) t_.width = 2 * args(i)[1];
         start_axis();
         glm::dvec3 from = t_.position;
         glm::dvec3 p;
@@ -223,7 +227,7 @@ class Turtle {
 
     void forward(std::size_t i) {
         double len = arg(i, 0, t_.step);
-        if (s_.arity(i) > 1) t_.width = at_[1];
+        if (s_.arity(i) > 1) t_.width = args(i)[1];
         start_axis();
         glm::dvec3 from = t_.position;
         t_.position += t_.heading * len;
@@ -276,7 +280,7 @@ class Turtle {
                 fmt::format("module {} ('{}') of the string sets texture {}, but the grammar declares {}: "
                             "declare one with 'texture bark = image(\"bark.png\");' and write "
                             "SetTexture(bark), or SetTexture(-1) for none",
-                            i + 1, program_.symbols[s_.sym[i]].name, format_double(t),
+                            i + 1, program_.symbols[s_.symbol(i)].name, format_double(t),
                             n == 0   ? std::string("no textures")
                             : n == 1 ? std::string("only texture 0")
                                      : fmt::format("textures 0 to {}", n - 1)));
@@ -288,18 +292,18 @@ class Turtle {
     void place_instance(std::size_t i, int index) {
         const std::size_t width = program_.instances ? instance_arg_width((*program_.instances)[index]) : 0;
         const std::uint32_t n = s_.arity(i);
-        const double* a = at_;
-        std::vector<double> args(a, a + std::min<std::size_t>(n, width));
-        args.resize(width, 0.0);
+        const ModuleArgs a = this->args(i);
+        std::vector<double> args(width, 0.0);
+        for (std::size_t k = 0; k < std::min<std::size_t>(n, width); ++k) args[k] = a[k];
         const double scale = n > width ? a[width] : 1.0;
         if (!std::isfinite(scale) || scale <= 0)
             throw RuntimeError(
                 RuntimeErrorKind::Turtle, Span{},
                 fmt::format("module {} ('{}') of the string places an instance at scale {}: the "
                             "scale must be a positive number",
-                            i + 1, program_.symbols[s_.sym[i]].name, scale));
+                            i + 1, program_.symbols[s_.symbol(i)].name, scale));
         sink_.organ(
-            TurtleOrgan{{OrganKind::Instance, program_.symbols[s_.sym[i]].name, index, std::move(args)},
+            TurtleOrgan{{OrganKind::Instance, program_.symbols[s_.symbol(i)].name, index, std::move(args)},
                         frame_matrix(t_, scale),
                         t_.color,
                         i,
@@ -390,7 +394,7 @@ void Turtle::apply(TurtleOp op, std::size_t i) {
         // "~name": the surface's name follows the prefix row's name
         sink_.organ(TurtleOrgan{
             {OrganKind::Surface,
-             program_.symbols[s_.sym[i]].name.substr(turtle_symbol(TurtleOp::Surface)->name.size()),
+             program_.symbols[s_.symbol(i)].name.substr(turtle_symbol(TurtleOp::Surface)->name.size()),
              -1,
              {}},
             frame_matrix(t_, arg(i, 0, 1.0)),

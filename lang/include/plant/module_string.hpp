@@ -1,6 +1,12 @@
 // The module string: flat arrays, no per-module heap objects (docs/design.md, the module
-// string). Module i has symbol sym[i], nargs[i] parameters from params[offset(i)] and
-// the identity ids[i] (docs/language.md, module identity). Vec3 parameters occupy three consecutive doubles.
+// string). Module i has the kind kinds[i] (today its symbol: symbol(i)), nargs[i] parameters
+// from params[offset(i)] and the identity ids[i] (docs/language.md, module identity). Vec3
+// parameters occupy three consecutive doubles.
+//
+// Readers go through symbol(i) and args(i) (or args_at for one that walks the string in order,
+// keeping its own position in `params`, advanced by stored(i)), never through `kinds` and
+// `params` directly: that leaves room for kinds whose constant numbers are kept in a table
+// rather than in `params` (docs/architecture.md, memory).
 //
 // A string may go without identities (keep_ids false, ids empty): a derivation whose identities
 // nobody can observe (`plant derive` without --ids, a program that never calls id() and has no
@@ -25,6 +31,27 @@ namespace plant {
 using SymbolId = std::uint16_t;
 constexpr SymbolId kNoSymbol = 0xFFFF;
 using ModuleId = std::uint64_t;
+// What the string stores per module in place of its symbol. Every kind is plain today: its id is
+// its symbol's, and all of its numbers are stored.
+using KindId = std::uint16_t;
+
+// A module's numbers, read one at a time (not a pointer: see the note at the top).
+class ModuleArgs {
+  public:
+    ModuleArgs(const double* stored, std::uint32_t n) : p_(stored), n_(n) {}
+    double operator[](std::size_t k) const { return p_[k]; }
+    std::uint32_t size() const { return n_; }
+    bool empty() const { return n_ == 0; }
+    // Copies the numbers to out[0 .. size()).
+    void copy_to(double* out) const {
+        for (std::uint32_t k = 0; k < n_; ++k) out[k] = p_[k];
+    }
+    std::vector<double> vector() const { return {p_, p_ + n_}; }
+
+  private:
+    const double* p_;
+    std::uint32_t n_;
+};
 
 // Module i's parameters start at the sum of the arities before it. No per-module offset is
 // stored (it was 4 of the 12.2 bytes a module cost on the parametric tree, issue 22): `nargs`
@@ -36,17 +63,20 @@ struct ModuleString {
     static constexpr std::size_t kBlock = std::size_t{1} << kBlockShift;
     static constexpr std::uint32_t kMaxArity = 255;
 
-    BigVector<SymbolId> sym;
+    BigVector<KindId> kinds;
     BigVector<std::uint8_t> nargs; // arity of each module
     BigVector<double> params;
     BigVector<std::uint32_t> block_at; // block_at[j]: where module j * kBlock's parameters start
     BigVector<ModuleId> ids;           // empty when !keep_ids
     bool keep_ids = true;
 
-    std::size_t size() const { return sym.size(); }
+    std::size_t size() const { return kinds.size(); }
     ModuleId id(std::size_t i) const { return keep_ids ? ids[i] : 0; }
-    bool empty() const { return sym.empty(); }
+    bool empty() const { return kinds.empty(); }
+    SymbolId symbol(std::size_t i) const { return kinds[i]; }
     std::uint32_t arity(std::size_t i) const { return nargs[i]; }
+    // How many of module i's numbers `params` holds (all of them today).
+    std::uint32_t stored(std::size_t i) const { return nargs[i]; }
     // Where module i's parameters start (i == size(): the end of the parameters).
     std::size_t offset(std::size_t i) const {
         if (i >= size()) return params.size();
@@ -54,12 +84,14 @@ struct ModuleString {
         for (std::size_t j = i & ~(kBlock - 1); j < i; ++j) at += nargs[j];
         return at;
     }
-    const double* args(std::size_t i) const { return params.data() + offset(i); }
-    double* args(std::size_t i) { return params.data() + offset(i); }
-    std::span<const double> arg_span(std::size_t i) const { return {args(i), arity(i)}; }
+    ModuleArgs args(std::size_t i) const { return {params.data() + offset(i), arity(i)}; }
+    // Module i's numbers for a reader whose own position in `params` is `at` (offset(i)).
+    ModuleArgs args_at(std::size_t i, const double* at) const { return {at, arity(i)}; }
+    // Where module i's numbers can be written in place.
+    double* stored_args(std::size_t i) { return params.data() + offset(i); }
 
     void clear() {
-        sym.clear();
+        kinds.clear();
         nargs.clear();
         params.clear();
         block_at.clear();
@@ -67,8 +99,8 @@ struct ModuleString {
     }
     void push(SymbolId s, const double* p, std::uint32_t k, ModuleId id) {
         if (k > kMaxArity) throw std::length_error("a module can carry at most 255 numbers");
-        if ((sym.size() & (kBlock - 1)) == 0) block_at.push_back(static_cast<std::uint32_t>(params.size()));
-        sym.push_back(s);
+        if ((kinds.size() & (kBlock - 1)) == 0) block_at.push_back(static_cast<std::uint32_t>(params.size()));
+        kinds.push_back(s);
         nargs.push_back(static_cast<std::uint8_t>(k));
         for (std::uint32_t i = 0; i < k; ++i) params.push_back(p[i]);
         if (keep_ids) ids.push_back(id);
@@ -87,12 +119,12 @@ struct ModuleString {
     // Sizes the arrays for m modules and p parameters without indexing them (for writers that
     // fill them directly, then call index_from or index_range).
     void resize_arrays(std::size_t m, std::size_t p) {
-        sym.resize(m);
+        kinds.resize(m);
         nargs.resize(m);
         if (keep_ids) ids.resize(m);
         params.resize(p);
     }
-    // After sym, nargs and params were written directly: sizes block_at for size() modules and
+    // After kinds, nargs and params were written directly: sizes block_at for size() modules and
     // fills its entries for modules from b on, module b's parameters starting at p. index_range
     // fills those of modules [b, e) only, block_at being sized already (a thread's stretch).
     // index_upto sizes block_at for e modules and fills those of [b, e) (a writer whose arrays
@@ -105,11 +137,11 @@ struct ModuleString {
     void index_range(std::size_t b, std::size_t e, std::size_t p);
     // Bytes held by the arrays (capacity, not size: what the process really pays).
     std::size_t bytes() const {
-        return sym.capacity() * sizeof(SymbolId) + nargs.capacity() + params.capacity() * sizeof(double) +
+        return kinds.capacity() * sizeof(KindId) + nargs.capacity() + params.capacity() * sizeof(double) +
                block_at.capacity() * sizeof(std::uint32_t) + ids.capacity() * sizeof(ModuleId);
     }
     void swap(ModuleString& o) noexcept {
-        sym.swap(o.sym);
+        kinds.swap(o.kinds);
         nargs.swap(o.nargs);
         params.swap(o.params);
         block_at.swap(o.block_at);

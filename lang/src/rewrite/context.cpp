@@ -44,14 +44,14 @@ bool Rewriter::match_right(std::size_t e, std::span<const PatternModule> pats, d
     const SymbolId open = P.symbols.open_bracket, close = P.symbols.close_bracket;
     for (const auto& p : pats) {
         if (p.sym == open) {
-            while (j < n && P.ignored[in.sym[j]]) ++j;
-            if (j >= n || in.sym[j] != open) return false;
+            while (j < n && P.ignored[in.symbol(j)]) ++j;
+            if (j >= n || in.symbol(j) != open) return false;
             ++j;
             continue;
         }
         if (p.sym == close) { // skip the rest of the current branch
-            while (j < n && in.sym[j] != close) {
-                if (in.sym[j] == open) {
+            while (j < n && in.symbol(j) != close) {
+                if (in.symbol(j) == open) {
                     if (match[j] >= n) return false;
                     j = match[j] + 1;
                 } else {
@@ -77,11 +77,11 @@ bool Rewriter::match_left_new(const ModuleString& out, const std::vector<Pattern
     for (std::size_t k = pats.size(); k-- > 0;) {
         for (;;) {
             if (j < 0) return false;
-            SymbolId s = out.sym[static_cast<std::size_t>(j)];
+            SymbolId s = out.symbol(static_cast<std::size_t>(j));
             if (s == close) { // skip the whole preceding branch
                 int depth = 0;
                 for (; j >= 0; --j) {
-                    SymbolId t = out.sym[static_cast<std::size_t>(j)];
+                    SymbolId t = out.symbol(static_cast<std::size_t>(j));
                     if (t == close)
                         ++depth;
                     else if (t == open && --depth == 0)
@@ -108,11 +108,11 @@ bool Rewriter::match_right_new(const ModuleString& out, const std::vector<Patter
     for (const auto& pat : pats) {
         for (;;) {
             if (!it.valid) return false;
-            SymbolId s = out.sym[it.i];
+            SymbolId s = out.symbol(it.i);
             if (s == open && pat.sym != open) { // skip the lateral branch
                 int depth = 0;
                 for (; it.valid; it.next()) {
-                    SymbolId t = out.sym[it.i];
+                    SymbolId t = out.symbol(it.i);
                     if (t == open)
                         ++depth;
                     else if (t == close && --depth == 0)
@@ -161,7 +161,7 @@ std::vector<std::size_t> find_matches(const Derivation& d, const Program& progra
     w.env.step = d.steps_done();
     const Production& pr = rules.productions[0];
     for (std::size_t i = 0; i < s.size(); ++i)
-        if (s.sym[i] == pr.strict[0].sym && rw.matches_at(w, i, pr)) out.push_back(i);
+        if (s.symbol(i) == pr.strict[0].sym && rw.matches_at(w, i, pr)) out.push_back(i);
     return out;
 }
 

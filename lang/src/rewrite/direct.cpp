@@ -79,7 +79,7 @@ Rewriter::Counts Rewriter::count_direct(std::size_t b, std::size_t e) const {
     Counts c;
     const double* a = in.params.data() + in.offset(b); // module i's parameters
     for (std::size_t i = b; i < e; a += in.arity(i), ++i) {
-        const SymbolId s = in.sym[i];
+        const SymbolId s = in.symbol(i);
         if (!plan.has_prod[s]) {
             ++c.modules;
             c.params += in.arity(i);
@@ -121,7 +121,7 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
                                         std::size_t m_at, std::size_t p_at, ModuleId id_at,
                                         std::uint64_t* tally) {
     w.frame.assign(plan.frame_size, 0.0);
-    SymbolId* S = out.sym.data() + m_at;
+    KindId* S = out.kinds.data() + m_at;
     ModuleId* ID = Ids ? out.ids.data() + m_at : nullptr;
     std::uint8_t* NA = out.nargs.data() + m_at;
     double* PA = out.params.data() + p_at;
@@ -138,7 +138,7 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
             if (w.env.interrupt && w.env.interrupt->load())
                 throw RuntimeError{RuntimeErrorKind::Interrupted, Span{}, "interrupted"};
         }
-        const SymbolId s = in.sym[i];
+        const SymbolId s = in.symbol(i);
         const Production* prp = plan.direct[s];
         std::uint32_t outcome = at[s] + 1;
         if (!prp && plan.has_prod[s]) {
@@ -150,24 +150,24 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
         }
         if (!prp) { // a run of modules without productions (or none that applies): copy it
             std::size_t j = i + 1;
-            while (j < e && !plan.has_prod[in.sym[j]]) ++j;
+            while (j < e && !plan.has_prod[in.symbol(j)]) ++j;
             const std::size_t n = j - i;
             std::uint32_t np = 0;
             for (std::size_t k = i; k < j; ++k) {
-                ++tally[at[in.sym[k]]];
+                ++tally[at[in.symbol(k)]];
                 np += in.nargs[k];
             }
             if (n <= 8 && np <= 8) {
                 // the usual run between two rewritten modules is a few turtle symbols: plain
                 // loops beat three library calls
                 for (std::size_t k = 0; k < n; ++k) {
-                    S[k] = in.sym[i + k];
+                    S[k] = in.symbol(i + k);
                     if constexpr (Ids) ID[k] = in.ids[i + k];
                     NA[k] = in.nargs[i + k];
                 }
                 for (std::uint32_t k = 0; k < np; ++k) PA[k] = in.params[q + k];
             } else {
-                std::memcpy(S, in.sym.data() + i, n * sizeof(SymbolId));
+                std::memcpy(S, in.kinds.data() + i, n * sizeof(KindId));
                 if constexpr (Ids) std::memcpy(ID, in.ids.data() + i, n * sizeof(ModuleId));
                 std::memcpy(NA, in.nargs.data() + i, n);
                 if (np) std::memcpy(PA, in.params.data() + q, np * sizeof(double));
@@ -209,7 +209,7 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
         ++i;
     }
     Counts c;
-    c.modules = static_cast<std::size_t>(S - (out.sym.data() + m_at));
+    c.modules = static_cast<std::size_t>(S - (out.kinds.data() + m_at));
     c.params = p - p_at;
     c.new_ids = id_at - id0;
     out.index_range(m_at, m_at + c.modules, p_at); // block_at is sized by the caller

@@ -29,8 +29,8 @@ namespace {
 // Whether some module of `s` is the first module of a predecessor in `rs`: a pass over the
 // symbols is much cheaper than a rewrite that copies the whole string unchanged.
 bool any_candidate(const ModuleString& s, const RuleSet& rs) {
-    for (SymbolId x : s.sym)
-        if (x < rs.by_symbol.size() && !rs.by_symbol[x].empty()) return true;
+    for (std::size_t i = 0; i < s.size(); ++i)
+        if (const SymbolId x = s.symbol(i); x < rs.by_symbol.size() && !rs.by_symbol[x].empty()) return true;
     return false;
 }
 
@@ -107,7 +107,7 @@ void Engine::rewrite(const Derivation& d, const ModuleString& in, ModuleString& 
     // The direct path needs every module's successor to be a direct template: a plan with
     // symbols rewritten otherwise would find one in nearly every string, after counting up to it.
     // (interpretation rewrites a copy of the string and leaves the counts to the string itself)
-    const bool counted = !interpreting && counts.of == in.sym.data() && counts.size == n && !in.empty();
+    const bool counted = !interpreting && counts.of == in.kinds.data() && counts.size == n && !in.empty();
     if (!interpreting) forget_counts();
     if (!plan.sequential() && plan.all_direct &&
         rewrite_direct(d, rw, in, out, plan, threads, counted, setup)) {
@@ -138,9 +138,9 @@ void Engine::rewrite_one_thread(const Derivation& d, Rewriter& rw, const ModuleS
     // A small string reserves twice what it expects: its arrays come back as the spare two
     // steps on (see Derivation::step), and then still fit, instead of being reallocated.
     auto room = [](std::size_t want) { return want < 65536 ? 2 * want : want; };
-    w.out.sym.reserve(room(static_cast<std::size_t>(n * growth * 1.02) + 16));
-    if (w.out.keep_ids) w.out.ids.reserve(w.out.sym.capacity());
-    w.out.nargs.reserve(w.out.sym.capacity());
+    w.out.kinds.reserve(room(static_cast<std::size_t>(n * growth * 1.02) + 16));
+    if (w.out.keep_ids) w.out.ids.reserve(w.out.kinds.capacity());
+    w.out.nargs.reserve(w.out.kinds.capacity());
     w.out.params.reserve(room(static_cast<std::size_t>(in.params.size() * param_growth * 1.02) + 16));
     try {
         if (plan.right_new) {
@@ -183,9 +183,9 @@ void Engine::rewrite_parallel(const Derivation& d, Rewriter& rw, const ModuleStr
                     params = in.params.size();
                     w.env.id_base = next_id;
                 }
-                w.out.sym.reserve(static_cast<std::size_t>(modules * growth * 1.02) + 16);
-                if (w.out.keep_ids) w.out.ids.reserve(w.out.sym.capacity());
-                w.out.nargs.reserve(w.out.sym.capacity());
+                w.out.kinds.reserve(static_cast<std::size_t>(modules * growth * 1.02) + 16);
+                if (w.out.keep_ids) w.out.ids.reserve(w.out.kinds.capacity());
+                w.out.nargs.reserve(w.out.kinds.capacity());
                 w.out.params.reserve(static_cast<std::size_t>(params * param_growth * 1.02) + 16);
                 try {
                     rw.run_range(w, b, e);
@@ -221,7 +221,7 @@ void Engine::rewrite_parallel(const Derivation& d, Rewriter& rw, const ModuleStr
     }
     out.swap(workers[0].out);
     const std::size_t m0 = out.size(), p0 = out.params.size(); // worker 0's part
-    out.sym.resize(total);
+    out.kinds.resize(total);
     out.nargs.resize(total);
     if (out.keep_ids) out.ids.resize(total);
     out.params.resize(total_params);
@@ -230,8 +230,8 @@ void Engine::rewrite_parallel(const Derivation& d, Rewriter& rw, const ModuleStr
         for (std::size_t t = 1; t < workers.size(); ++t) {
             pool.emplace_back([&, t] {
                 ModuleString& src = workers[t].out;
-                std::copy(src.sym.begin(), src.sym.end(),
-                          out.sym.begin() + static_cast<std::ptrdiff_t>(mod_at[t]));
+                std::copy(src.kinds.begin(), src.kinds.end(),
+                          out.kinds.begin() + static_cast<std::ptrdiff_t>(mod_at[t]));
                 std::copy(src.nargs.begin(), src.nargs.end(),
                           out.nargs.begin() + static_cast<std::ptrdiff_t>(mod_at[t]));
                 std::copy(src.params.begin(), src.params.end(),
@@ -284,7 +284,7 @@ bool Engine::rewrite_direct(const Derivation& d, Rewriter& rw, const ModuleStrin
         }
         check_limits(d, modules, params); // before allocating anything
     }
-    out.sym.resize(modules);
+    out.kinds.resize(modules);
     out.nargs.resize(modules);
     if (out.keep_ids) out.ids.resize(modules);
     out.params.resize(params);
@@ -316,7 +316,7 @@ bool Engine::rewrite_direct(const Derivation& d, Rewriter& rw, const ModuleStrin
         if (w.error) throw *w.error;
     if (sized) { // the counts were exact or a bound: cut to what was written
         const Rewriter::Counts& c = counts_at[0];
-        out.sym.resize(c.modules);
+        out.kinds.resize(c.modules);
         out.nargs.resize(c.modules);
         if (out.keep_ids) out.ids.resize(c.modules);
         out.params.resize(c.params);
@@ -392,7 +392,7 @@ void Engine::count_outcomes(const RulePlan& plan, const std::vector<std::vector<
     }
     counts.modules = std::move(modules);
     counts.arity = std::move(arity);
-    counts.of = out.sym.data();
+    counts.of = out.kinds.data();
     counts.size = out.size();
 }
 
@@ -406,7 +406,7 @@ void Engine::decompose(const Derivation& d, ModuleString& s, int step_for_env) {
         ModuleId before = next_id;
         rewrite(d, s, next, plan_for(prog, sets), stream::decompose(step_for_env, pass), step_for_env);
         bool changed =
-            next_id != before || next.size() != s.size() || next.sym != s.sym || next.params != s.params;
+            next_id != before || next.size() != s.size() || next.kinds != s.kinds || next.params != s.params;
         s.swap(next);
         if (!changed) break;
     }
@@ -417,13 +417,13 @@ void Engine::apply_cut(const Program& prog, ModuleString& s) {
     const SymbolId cut = prog.symbols.cut, open = prog.symbols.open_bracket,
                    close = prog.symbols.close_bracket;
     bool any = false;
-    for (SymbolId x : s.sym)
-        if (x == cut) {
+    for (std::size_t i = 0; i < s.size(); ++i)
+        if (s.symbol(i) == cut) {
             any = true;
             break;
         }
     if (!any) return;
-    cut_branches(s, open, close, [&](std::size_t i) { return s.sym[i] == cut; });
+    cut_branches(s, open, close, [&](std::size_t i) { return s.symbol(i) == cut; });
 }
 
 ModuleString Engine::interpreted(const Derivation& d, const ModuleString& s) {
@@ -441,7 +441,7 @@ ModuleString Engine::interpreted(const Derivation& d, const ModuleString& s) {
         if (!any_candidate(cur, prog.interpret)) break;
         ModuleString next;
         rewrite(d, cur, next, plan_for(prog, sets), stream::interpret(d.step_, pass), d.step_);
-        bool changed = next.sym != cur.sym || next.params != cur.params;
+        bool changed = next.kinds != cur.kinds || next.params != cur.params;
         cur.swap(next);
         if (!changed) break;
     }

@@ -57,20 +57,21 @@ void Rewriter::run_range(Worker& w, std::size_t b, std::size_t e) {
     w.frame.assign(plan.frame_size, 0.0);
     std::size_t i = b;
     while (i < e) {
-        if (!plan.has_prod[in.sym[i]]) {
+        if (!plan.has_prod[in.symbol(i)]) {
             std::size_t j = i + 1;
-            while (j < e && !plan.has_prod[in.sym[j]]) ++j;
+            while (j < e && !plan.has_prod[in.symbol(j)]) ++j;
             w.out.append_range(in, i, j);
             i = j;
             if (w.out.size() > w.env.max_output || w.out.params.size() > w.env.max_params) limit_error();
             continue;
         }
-        if (const Production* pr = plan.direct[in.sym[i]]; pr && in.arity(i) == pr->strict[0].width) {
+        if (const Production* pr = plan.direct[in.symbol(i)]; pr && in.arity(i) == pr->strict[0].width) {
             if (!pr->tmpl.holes.empty()) {
-                const double* a = in.args(i);
+                const ModuleArgs a = in.args(i);
+                std::size_t at = 0;
                 for (const auto& pa : pr->strict[0].args) {
-                    for (int k = 0; k < pa.width; ++k) w.frame[pa.slot + k] = a[k];
-                    a += pa.width;
+                    for (int k = 0; k < pa.width; ++k) w.frame[pa.slot + k] = a[at + k];
+                    at += pa.width;
                 }
                 w.env.position = i;
                 w.env.draw = 0;
@@ -80,7 +81,7 @@ void Rewriter::run_range(Worker& w, std::size_t b, std::size_t e) {
             ++i;
             continue;
         }
-        if (!plan.ctx_block.empty() && plan.ctx_block[in.sym[i]] >= 0 && in.arity(i) == 0) {
+        if (!plan.ctx_block.empty() && plan.ctx_block[in.symbol(i)] >= 0 && in.arity(i) == 0) {
             if (const Production* pr = table_lookup(i)) {
                 w.env.position = i;
                 w.env.draw = 0;
@@ -107,7 +108,7 @@ std::size_t Rewriter::apply(Worker& w, std::size_t i) {
     env.position = i;
     env.draw = 0;
     env.id = in.id(i);
-    const SymbolId sym = in.sym[i];
+    const SymbolId sym = in.symbol(i);
     for (std::size_t si = 0; si < plan.sets.size(); ++si) {
         const RuleSet& rs = *plan.sets[si];
         const auto& cands = rs.by_symbol[sym];
@@ -142,13 +143,13 @@ std::size_t Rewriter::apply_template(Worker& w, std::size_t i, const Production&
         if (out.size() > env.max_output) limit_error();
         return 1;
     }
-    const std::size_t m0 = out.sym.size();
+    const std::size_t m0 = out.kinds.size();
     const std::size_t p0 = out.params.size();
-    out.sym.resize(m0 + m);
+    out.kinds.resize(m0 + m);
     out.nargs.resize(m0 + m);
     if (out.keep_ids) out.ids.resize(m0 + m);
     out.params.resize(p0 + t.params.size());
-    std::copy(t.syms.begin(), t.syms.end(), out.sym.begin() + static_cast<std::ptrdiff_t>(m0));
+    std::copy(t.syms.begin(), t.syms.end(), out.kinds.begin() + static_cast<std::ptrdiff_t>(m0));
     double* pp = out.params.data() + p0;
     std::copy(t.params.begin(), t.params.end(), pp);
     for (std::size_t h = 0; h < t.holes.size(); ++h) pp[t.holes[h]] = values[h];
@@ -176,7 +177,7 @@ std::size_t Rewriter::run_body(Worker& w, std::size_t i, const Production& pr) {
     ModuleId keep_ids[32];
     const std::size_t k = std::min<std::size_t>(pr.strict.size(), 32);
     for (std::size_t m = 0; m < k; ++m) {
-        keep_syms[m] = in.sym[i + m];
+        keep_syms[m] = in.symbol(i + m);
         keep_ids[m] = in.id(i + m);
     }
     env.keep_syms = keep_syms;
@@ -204,7 +205,7 @@ std::size_t Rewriter::choose(Worker& w, std::size_t i, std::size_t set0, std::si
     Option options[64];
     std::size_t count = 0;
     double total = 0;
-    const SymbolId sym = in.sym[i];
+    const SymbolId sym = in.symbol(i);
     for (std::size_t si = set0; si < plan.sets.size(); ++si) {
         const auto& cands = plan.sets[si]->by_symbol[sym];
         for (std::size_t ci = si == set0 ? cand0 : 0; ci < cands.size(); ++ci) {

@@ -20,7 +20,7 @@ void Rewriter::run_backward(Worker& w) {
     while (k-- > 0) {
         piece_starts.push_back(w.out.size());
         std::size_t used = 0;
-        for (const auto& [si, pi] : by_last[in.sym[k]]) {
+        for (const auto& [si, pi] : by_last[in.symbol(k)]) {
             const Production& pr = plan.sets[si]->productions[pi];
             const std::size_t len = pr.strict.size();
             if (len > k + 1) continue;

@@ -52,16 +52,16 @@ class Rewriter {
     // The production the context table gives for module i, which has a table and no parameters.
     // nullptr: none applies.
     const Production* table_lookup(std::size_t i) const {
-        const SymbolId sym = in.sym[i];
+        const SymbolId sym = in.symbol(i);
         std::size_t lk = 0, rk = 0;
         if (plan.ctx_sides[sym] & 1) {
             const std::int64_t j = left_step(static_cast<std::int64_t>(i) - 1);
             if (j >= 0 && in.arity(static_cast<std::size_t>(j)) == 0)
-                lk = plan.ctx_key[in.sym[static_cast<std::size_t>(j)]];
+                lk = plan.ctx_key[in.symbol(static_cast<std::size_t>(j))];
         }
         if (plan.ctx_sides[sym] & 2) {
             const std::size_t j = right_step(i + 1);
-            if (j < n && in.arity(j) == 0) rk = plan.ctx_key[in.sym[j]];
+            if (j < n && in.arity(j) == 0) rk = plan.ctx_key[in.symbol(j)];
         }
         return plan.ctx_entries[static_cast<std::size_t>(plan.ctx_block[sym]) + lk * plan.ctx_keys + rk];
     }
@@ -148,7 +148,7 @@ class Rewriter {
     // stretch is written.
     template <bool Ids>
     static void put_template(const SuccessorTemplate& t, const std::uint8_t* arities, const double* values,
-                             ModuleId kept, ModuleId& next_new, SymbolId* S, std::uint8_t* NA, double* PA,
+                             ModuleId kept, ModuleId& next_new, KindId* S, std::uint8_t* NA, double* PA,
                              ModuleId* ID) {
         const std::size_t m = t.syms.size();
         if (m != 0) std::memcpy(S, t.syms.data(), m * sizeof(SymbolId));
@@ -202,15 +202,16 @@ class Rewriter {
     // several context modules and for the new string, are in context.cpp)
 
     bool match_in(const ModuleString& s, std::size_t j, const PatternModule& pm, double* frame) const {
-        if (s.sym[j] != pm.sym || s.arity(j) != pm.width) return false;
-        const double* a = s.args(j);
+        if (s.symbol(j) != pm.sym || s.arity(j) != pm.width) return false;
+        const ModuleArgs a = s.args(j);
+        std::size_t at = 0;
         for (const auto& pa : pm.args) {
             if (pa.bind) {
-                for (int k = 0; k < pa.width; ++k) frame[pa.slot + k] = a[k];
-            } else if (!std::isnan(pa.value) && a[0] != pa.value) {
+                for (int k = 0; k < pa.width; ++k) frame[pa.slot + k] = a[at + k];
+            } else if (!std::isnan(pa.value) && a[at] != pa.value) {
                 return false;
             }
-            a += pa.width;
+            at += pa.width;
         }
         return true;
     }
@@ -223,7 +224,7 @@ class Rewriter {
     // is stepped over to the parent, ignored modules are stepped over. -1 when there is none.
     std::int64_t left_step(std::int64_t j) const {
         while (j >= 0) {
-            SymbolId s = in.sym[static_cast<std::size_t>(j)];
+            SymbolId s = in.symbol(static_cast<std::size_t>(j));
             if (s == P.symbols.close_bracket) {
                 std::uint32_t m = match[static_cast<std::size_t>(j)];
                 if (m >= n) return -1;
@@ -251,7 +252,7 @@ class Rewriter {
     std::size_t right_step(std::size_t j) const {
         const SymbolId open = P.symbols.open_bracket, close = P.symbols.close_bracket;
         while (j < n) {
-            SymbolId s = in.sym[j];
+            SymbolId s = in.symbol(j);
             if (s == open) {
                 if (match[j] >= n) return n;
                 j = match[j] + 1;

@@ -31,7 +31,7 @@ template <bool Whole> void Rewriter::run_symbols(Worker& w, std::size_t b, std::
     using Plan = RulePlan;
     ModuleString& out = w.out;
     EvalEnv& env = w.env;
-    const SymbolId* in_sym = in.sym.data();
+    const SymbolId* in_sym = in.kinds.data();
     const Plan::SymbolRow* rows = plan.sym_rows.data();
     const std::uint32_t* succ_at = plan.succ_at.data();
     const Plan::SymbolSucc* succs = plan.succs.data();
@@ -77,12 +77,12 @@ template <bool Whole> void Rewriter::run_symbols(Worker& w, std::size_t b, std::
     std::size_t depth = 0; // the left keys at the open '['s are on the stack
     std::uint64_t fresh = 0;
     std::size_t i = b, next_check = b + 65536;
-    resize(out.sym, std::max(out.sym.capacity(), m)); // the room reserved is written in place
+    resize(out.kinds, std::max(out.kinds.capacity(), m)); // the room reserved is written in place
     while (i < e) {
         // the modules that fit: each writes at most Mmax, and a copy writes kPad
-        std::size_t room = out.sym.size() >= m + kPad ? (out.sym.size() - m - kPad) / Mmax : 0;
+        std::size_t room = out.kinds.size() >= m + kPad ? (out.kinds.size() - m - kPad) / Mmax : 0;
         if (room == 0) {
-            resize(out.sym, std::max(m + Mmax + kPad, 2 * out.sym.size()));
+            resize(out.kinds, std::max(m + Mmax + kPad, 2 * out.kinds.size()));
             continue;
         }
         if (i >= next_check) {
@@ -90,12 +90,12 @@ template <bool Whole> void Rewriter::run_symbols(Worker& w, std::size_t b, std::
             if (env.interrupt && env.interrupt->load())
                 throw RuntimeError{RuntimeErrorKind::Interrupted, Span{}, "interrupted"};
             if (m > env.max_output) {
-                resize(out.sym, m);
+                resize(out.kinds, m);
                 limit_error();
             }
         }
         const std::size_t stop = std::min({e, i + room, next_check});
-        SymbolId* S = out.sym.data();
+        KindId* S = out.kinds.data();
         for (; i < stop; ++i) {
             const Plan::SymbolRow row = rows[in_sym[i]];
             std::size_t at = row.block;
@@ -121,7 +121,7 @@ template <bool Whole> void Rewriter::run_symbols(Worker& w, std::size_t b, std::
             }
         }
     }
-    resize(out.sym, m);
+    resize(out.kinds, m);
     const std::size_t m0 = out.nargs.size();
     resize(out.nargs, m);
     std::fill(out.nargs.begin() + static_cast<std::ptrdiff_t>(m0), out.nargs.end(), std::uint8_t{0});

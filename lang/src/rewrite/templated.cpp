@@ -27,18 +27,18 @@ template <bool Ids> void Rewriter::run_templates(Worker& w, std::size_t b, std::
     std::size_t m = out.size(), p = out.params.size();
     std::size_t mcap = 0, pcap = 0;
     std::size_t m_open = m, p_open = p; // the string is indexed (block_at) up to module m_open
-    SymbolId* S = nullptr;
+    KindId* S = nullptr;
     std::uint8_t* NA = nullptr;
     double* PA = nullptr;
     ModuleId* ID = nullptr;
     auto open = [&](std::size_t need_m, std::size_t need_p) {
-        mcap = std::max({out.sym.capacity(), need_m, 2 * m});
+        mcap = std::max({out.kinds.capacity(), need_m, 2 * m});
         pcap = std::max({out.params.capacity(), need_p, 2 * p});
         if (S) out.index_upto(m_open, m, p_open); // open already: index what was written
         m_open = m;
         p_open = p;
         out.resize_arrays(mcap, pcap);
-        S = out.sym.data();
+        S = out.kinds.data();
         NA = out.nargs.data();
         PA = out.params.data();
         if constexpr (Ids) ID = out.ids.data();
@@ -76,7 +76,7 @@ template <bool Ids> void Rewriter::run_templates(Worker& w, std::size_t b, std::
             }
             next_check = i + k;
         }
-        const SymbolId sym = in.sym[i];
+        const SymbolId sym = in.symbol(i);
         const std::uint32_t arity = in.nargs[i];
         const Production* pr = nullptr;
         if (plan.has_prod[sym]) {

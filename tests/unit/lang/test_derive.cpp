@@ -259,7 +259,7 @@ void same_without_identities(const Program& program, DeriveOptions o) {
     without.run();
     const ModuleString &a = with.string(), &b = without.string();
     REQUIRE(a.size() == b.size());
-    CHECK(std::equal(a.sym.begin(), a.sym.end(), b.sym.begin()));
+    CHECK(std::equal(a.kinds.begin(), a.kinds.end(), b.kinds.begin()));
     CHECK(std::equal(a.nargs.begin(), a.nargs.end(), b.nargs.begin()));
     CHECK(std::equal(a.block_at.begin(), a.block_at.end(), b.block_at.begin()));
     CHECK(std::equal(a.params.begin(), a.params.end(), b.params.begin()));
@@ -387,11 +387,11 @@ TEST_CASE("the symbol kernel writes the same for any split of the string", "[der
             w.env.max_params = 1u << 30;
             w.out.keep_ids = false;
             rw.run_range(w, b, e);
-            return std::vector<SymbolId>(w.out.sym.begin(), w.out.sym.end());
+            return std::vector<SymbolId>(w.out.kinds.begin(), w.out.kinds.end());
         };
         const auto whole = run(0, in.size());
         REQUIRE(in.size() >= 10);
-        REQUIRE(whole != std::vector<SymbolId>(in.sym.begin(), in.sym.end())); // the step rewrites
+        REQUIRE(whole != std::vector<SymbolId>(in.kinds.begin(), in.kinds.end())); // the step rewrites
         for (std::size_t k = 1; k < in.size(); ++k) {
             auto split = run(0, k);
             const auto rest = run(k, in.size());

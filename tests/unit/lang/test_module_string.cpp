@@ -99,7 +99,7 @@ TEST_CASE("module string: parameters found from arities and block offsets", "[mo
     SECTION("written directly, then indexed in stretches") {
         ModuleString t;
         t.keep_ids = false;
-        t.sym = s.sym;
+        t.kinds = s.kinds;
         t.nargs = s.nargs;
         t.params = s.params;
         t.block_at.assign((t.size() + ModuleString::kBlock - 1) / ModuleString::kBlock, 0xdead);
@@ -145,7 +145,7 @@ TEST_CASE("module string: indexing stretches, arity 0 and not at block starts", 
         ModuleString t;
         t.keep_ids = false;
         t.resize_arrays(s.size(), s.params.size());
-        std::copy(s.sym.begin(), s.sym.end(), t.sym.begin());
+        std::copy(s.kinds.begin(), s.kinds.end(), t.kinds.begin());
         std::copy(s.nargs.begin(), s.nargs.end(), t.nargs.begin());
         std::copy(s.params.begin(), s.params.end(), t.params.begin());
         t.block_at.assign((t.size() + ModuleString::kBlock - 1) / ModuleString::kBlock, 0xdead);

@@ -89,7 +89,7 @@ class Walker {
 
     void run() {
         for (std::size_t i = 0; i < s_.size(); ++i) {
-            const std::string& n = program_.symbols[s_.sym[i]].name;
+            const std::string& n = program_.symbols[s_.symbol(i)].name;
             ++r_.counts[n];
             step(n, s_.args(i));
         }
@@ -101,7 +101,7 @@ class Walker {
     }
     RoseStem& stem() { return r_.stems[static_cast<std::size_t>(f_.stem)]; }
 
-    void step(const std::string& n, const double* a) {
+    void step(const std::string& n, const ModuleArgs& a) {
         if (n == "[") {
             stack_.push_back(f_);
             f_.holds = Holds::Nothing;
@@ -191,7 +191,7 @@ RoseModel grow_rose_model(const std::string& path, std::uint64_t seed, const Ros
         rose.trunk_candidates = 0;
         const ModuleString& s = d.string();
         for (std::size_t i = 0; i < s.size(); ++i)
-            if (program->symbols[s.sym[i]].name == "Stem" && static_cast<int>(s.args(i)[0]) == RoseTrunk)
+            if (program->symbols[s.symbol(i)].name == "Stem" && static_cast<int>(s.args(i)[0]) == RoseTrunk)
                 ++rose.trunk_candidates;
     }
     d.finish();

@@ -74,7 +74,7 @@ Rose grow(const std::string& path, std::uint64_t seed,
             axis_of_first[rose.skeleton.axes[a].points[1].id] = static_cast<int>(a);
 
     const ModuleString& s = d.string();
-    auto name = [&](std::size_t i) -> const std::string& { return program->symbols[s.sym[i]].name; };
+    auto name = [&](std::size_t i) -> const std::string& { return program->symbols[s.symbol(i)].name; };
     for (std::size_t i = 0; i < s.size(); ++i) {
         ++rose.counts[name(i)];
         if (name(i) != "Stem") continue;

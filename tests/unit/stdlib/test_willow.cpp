@@ -124,7 +124,7 @@ class Walker {
 
     void count_shoots(const Program& p, const ModuleString& s) {
         for (std::size_t i = 0; i < s.size(); ++i) {
-            if (p.symbols[s.sym[i]].name != "Shoot") continue;
+            if (p.symbols[s.symbol(i)].name != "Shoot") continue;
             // Shoot(g, n, len, w, d, s)
             const int gen = static_cast<int>(s.args(i)[0]);
             ++g_.shoots_by_generation[gen];
