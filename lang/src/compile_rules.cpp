@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 namespace plant {
@@ -107,6 +108,78 @@ void Compiler::compile_production(const ast::Production& p, RuleSet& set) {
 
 void Compiler::finish_rule_set(RuleSet& set) {
     set.index(P_.symbols.size());
+}
+
+// The kinds of the successor templates' modules (docs/architecture.md, memory): a module with
+// constant numbers gets a kind of its own, shared by every module with the same symbol, the
+// same constants and its holes in the same places, and the string stores only its holes. Plain
+// (every number stored, the kind's id the symbol's): a module without constants, and every
+// query or communication module, whose numbers the environment phase writes in place.
+void Compiler::assign_kinds() {
+    P_.kinds = KindTable{};
+    P_.kinds.plain = static_cast<std::uint32_t>(P_.symbols.size());
+    std::map<std::vector<std::uint64_t>, KindId> known;
+    auto each = [&](RuleSet& rs) {
+        for (Production& pr : rs.productions)
+            if (pr.tmpl.valid) assign_kinds(pr.tmpl, known);
+    };
+    each(P_.rules);
+    for (RuleSet& g : P_.groups) each(g);
+    each(P_.decompose);
+    each(P_.interpret);
+}
+
+void Compiler::assign_kinds(SuccessorTemplate& t, std::map<std::vector<std::uint64_t>, KindId>& known) {
+    KindTable& T = P_.kinds;
+    std::vector<std::uint8_t> hole(t.params.size(), 0);
+    for (std::uint32_t h : t.holes) hole[h] = 1;
+    std::vector<std::uint32_t> where(t.params.size(), 0);
+    t.kinds.clear();
+    t.stored.clear();
+    t.stored_nargs.clear();
+    std::uint32_t from = 0;
+    for (std::size_t j = 0; j < t.syms.size(); from = t.param_end[j], ++j) {
+        const SymbolId s = t.syms[j];
+        const std::uint32_t end = t.param_end[j], n = end - from;
+        const SymbolInfo& info = P_.symbols[s];
+        bool constants = false;
+        for (std::uint32_t k = from; k < end; ++k) constants |= hole[k] == 0;
+        const std::size_t first = t.stored.size();
+        if (!constants || info.query || info.turtle_op == TurtleOp::Communicate ||
+            T.plain + T.size() >= kNoSymbol) { // plain
+            for (std::uint32_t k = from; k < end; ++k) {
+                where[k] = static_cast<std::uint32_t>(t.stored.size());
+                t.stored.push_back(t.params[k]);
+            }
+            t.kinds.push_back(s);
+            t.stored_nargs.push_back(static_cast<std::uint8_t>(n));
+            continue;
+        }
+        std::vector<std::uint64_t> key{s, n};
+        for (std::uint32_t k = from; k < end; ++k) {
+            key.push_back(hole[k]);
+            key.push_back(hole[k] ? 0 : std::bit_cast<std::uint64_t>(t.params[k]));
+            if (hole[k]) {
+                where[k] = static_cast<std::uint32_t>(t.stored.size());
+                t.stored.push_back(0.0);
+            }
+        }
+        auto [it, fresh] = known.try_emplace(std::move(key), static_cast<KindId>(T.plain + T.size()));
+        if (fresh) {
+            T.symbol.push_back(s);
+            T.arity.push_back(static_cast<std::uint8_t>(n));
+            T.layout_at.push_back(static_cast<std::uint32_t>(T.slot.size()));
+            std::int16_t at = 0;
+            for (std::uint32_t k = from; k < end; ++k) {
+                T.slot.push_back(hole[k] ? at++ : std::int16_t{-1});
+                T.value.push_back(hole[k] ? 0.0 : t.params[k]);
+            }
+        }
+        t.kinds.push_back(it->second);
+        t.stored_nargs.push_back(static_cast<std::uint8_t>(t.stored.size() - first));
+    }
+    t.stored_holes.clear();
+    for (std::uint32_t h : t.holes) t.stored_holes.push_back(where[h]);
 }
 
 // Splits a letter run by longest match over declared module names, else one letter a module.

@@ -185,6 +185,7 @@ void Compiler::finish() {
     for (auto& g : P_.groups) finish_rule_set(g);
     finish_rule_set(P_.decompose);
     finish_rule_set(P_.interpret);
+    assign_kinds();
 }
 
 std::unique_ptr<Program> compile_source(SourceManager& sources, std::uint32_t file_id,

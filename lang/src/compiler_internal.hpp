@@ -141,6 +141,8 @@ class Compiler {
     void compile_settings(const ast::File& f);
     void finish();
     void finish_rule_set(RuleSet& set);
+    void assign_kinds();
+    void assign_kinds(SuccessorTemplate& t, std::map<std::vector<std::uint64_t>, KindId>& known);
 
     // whole-program checks (check.cpp)
     void check_defines_used();

@@ -166,6 +166,7 @@ void Derivation::start() {
     env.phase = stream::kAxiom;
     ModuleString axiom;
     axiom.keep_ids = opt_.identities || observes_identities(prog_);
+    axiom.use_kinds(&prog_.kinds);
     env.out = &axiom;
     env.max_output = opt_.max_modules;
     env.id_base = engine_->next_id;

@@ -10,8 +10,29 @@
 
 namespace plant {
 
+bool ModuleString::has_table_kinds() const {
+    if (!kind_table || kind_table->size() == 0) return false;
+    const KindId* k = kinds.data();
+    std::uint32_t any = 0;
+    for (std::size_t i = 0, n = size(); i < n; ++i) any |= k[i] >= plain_below;
+    return any != 0;
+}
+
+bool ModuleString::same_modules(const ModuleString& o) const {
+    if (size() != o.size()) return false;
+    if (kinds == o.kinds && kind_table == o.kind_table) return params == o.params;
+    for (std::size_t i = 0, at = 0, o_at = 0; i < size(); at += stored(i), o_at += o.stored(i), ++i) {
+        if (symbol(i) != o.symbol(i) || arity(i) != o.arity(i)) return false;
+        const ModuleArgs a = args_at(i, params.data() + at), b = o.args_at(i, o.params.data() + o_at);
+        for (std::uint32_t k = 0; k < a.size(); ++k)
+            if (a[k] != b[k]) return false;
+    }
+    return true;
+}
+
 void ModuleString::append_range(const ModuleString& o, std::size_t b, std::size_t e) {
     if (b >= e) return;
+    if (!kind_table && o.kind_table) use_kinds(o.kind_table);
     const std::size_t m0 = kinds.size(), p0 = params.size();
     if (e - b == 1) { // the common case in context-sensitive grammars: one module between rewrites
         if ((m0 & (kBlock - 1)) == 0) block_at.push_back(static_cast<std::uint32_t>(p0));
@@ -147,6 +168,7 @@ void cut_branches(ModuleString& s, SymbolId open, SymbolId close,
                   const std::function<bool(std::size_t)>& cuts) {
     ModuleString out;
     out.keep_ids = s.keep_ids;
+    out.use_kinds(s.kind_table);
     const std::size_t n = s.size();
     std::size_t i = 0;
     while (i < n) {

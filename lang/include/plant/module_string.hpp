@@ -31,26 +31,50 @@ namespace plant {
 using SymbolId = std::uint16_t;
 constexpr SymbolId kNoSymbol = 0xFFFF;
 using ModuleId = std::uint64_t;
-// What the string stores per module in place of its symbol. Every kind is plain today: its id is
-// its symbol's, and all of its numbers are stored.
+// What the string stores per module in place of its symbol. A *plain* kind's id is its symbol's
+// and the string stores all of its numbers. The compiler adds a kind for each module of a
+// successor template that has constant numbers (`&(30)`, `A(1, w)`): the string stores only
+// its computed numbers, the table the rest (docs/architecture.md, memory).
 using KindId = std::uint16_t;
+
+struct KindTable {
+    // Kinds below `plain` are plain; kind k >= plain is entry k - plain of the arrays below.
+    std::uint32_t plain = 0x10000;
+    std::vector<SymbolId> symbol;
+    std::vector<std::uint8_t> arity;
+    std::vector<std::uint32_t> layout_at; // its numbers' entries in `slot` and `value`
+    std::vector<std::int16_t> slot;       // per number: its place among the stored ones, or -1
+    std::vector<double> value;            // per number: the constant (when slot is -1)
+    std::size_t size() const { return symbol.size(); }
+};
 
 // A module's numbers, read one at a time (not a pointer: see the note at the top).
 class ModuleArgs {
   public:
-    ModuleArgs(const double* stored, std::uint32_t n) : p_(stored), n_(n) {}
-    double operator[](std::size_t k) const { return p_[k]; }
+    ModuleArgs(const double* stored, std::uint32_t n, const std::int16_t* slot = nullptr,
+               const double* value = nullptr)
+        : p_(stored), n_(n), slot_(slot), value_(value) {}
+    double operator[](std::size_t k) const {
+        if (!slot_) return p_[k];
+        return slot_[k] >= 0 ? p_[slot_[k]] : value_[k];
+    }
     std::uint32_t size() const { return n_; }
     bool empty() const { return n_ == 0; }
     // Copies the numbers to out[0 .. size()).
     void copy_to(double* out) const {
-        for (std::uint32_t k = 0; k < n_; ++k) out[k] = p_[k];
+        for (std::uint32_t k = 0; k < n_; ++k) out[k] = (*this)[k];
     }
-    std::vector<double> vector() const { return {p_, p_ + n_}; }
+    std::vector<double> vector() const {
+        std::vector<double> v(n_);
+        copy_to(v.data());
+        return v;
+    }
 
   private:
     const double* p_;
     std::uint32_t n_;
+    const std::int16_t* slot_;
+    const double* value_;
 };
 
 // Module i's parameters start at the sum of the arities before it. No per-module offset is
@@ -64,18 +88,33 @@ struct ModuleString {
     static constexpr std::uint32_t kMaxArity = 255;
 
     BigVector<KindId> kinds;
-    BigVector<std::uint8_t> nargs; // arity of each module
+    BigVector<std::uint8_t> nargs; // numbers stored for each module (its arity, for a plain kind)
     BigVector<double> params;
     BigVector<std::uint32_t> block_at; // block_at[j]: where module j * kBlock's parameters start
     BigVector<ModuleId> ids;           // empty when !keep_ids
     bool keep_ids = true;
+    const KindTable* kind_table = nullptr; // none: every kind is plain
+    std::uint32_t plain_below = 0x10000;   // kinds below are plain (kind_table->plain)
+
+    void use_kinds(const KindTable* t) {
+        kind_table = t;
+        plain_below = t ? t->plain : 0x10000;
+    }
+    // Whether some module has a kind that is not plain.
+    bool has_table_kinds() const;
 
     std::size_t size() const { return kinds.size(); }
     ModuleId id(std::size_t i) const { return keep_ids ? ids[i] : 0; }
     bool empty() const { return kinds.empty(); }
-    SymbolId symbol(std::size_t i) const { return kinds[i]; }
-    std::uint32_t arity(std::size_t i) const { return nargs[i]; }
-    // How many of module i's numbers `params` holds (all of them today).
+    SymbolId symbol(std::size_t i) const {
+        const KindId k = kinds[i];
+        return k < plain_below ? k : kind_table->symbol[k - plain_below];
+    }
+    std::uint32_t arity(std::size_t i) const {
+        const KindId k = kinds[i];
+        return k < plain_below ? nargs[i] : kind_table->arity[k - plain_below];
+    }
+    // How many of module i's numbers `params` holds.
     std::uint32_t stored(std::size_t i) const { return nargs[i]; }
     // Where module i's parameters start (i == size(): the end of the parameters).
     std::size_t offset(std::size_t i) const {
@@ -84,11 +123,19 @@ struct ModuleString {
         for (std::size_t j = i & ~(kBlock - 1); j < i; ++j) at += nargs[j];
         return at;
     }
-    ModuleArgs args(std::size_t i) const { return {params.data() + offset(i), arity(i)}; }
+    ModuleArgs args(std::size_t i) const { return args_at(i, params.data() + offset(i)); }
     // Module i's numbers for a reader whose own position in `params` is `at` (offset(i)).
-    ModuleArgs args_at(std::size_t i, const double* at) const { return {at, arity(i)}; }
-    // Where module i's numbers can be written in place.
+    ModuleArgs args_at(std::size_t i, const double* at) const {
+        const KindId k = kinds[i];
+        if (k < plain_below) return {at, nargs[i]};
+        const std::size_t e = k - plain_below, l = kind_table->layout_at[e];
+        return {at, kind_table->arity[e], kind_table->slot.data() + l, kind_table->value.data() + l};
+    }
+    // Where module i's stored numbers can be written in place (all its numbers for a plain kind:
+    // query and communication modules always are).
     double* stored_args(std::size_t i) { return params.data() + offset(i); }
+    // Whether both strings hold the same modules, symbol and numbers (their kinds may differ).
+    bool same_modules(const ModuleString& o) const;
 
     void clear() {
         kinds.clear();
@@ -97,15 +144,21 @@ struct ModuleString {
         block_at.clear();
         ids.clear();
     }
+    // Appends a module of symbol s (a plain kind) and its k numbers.
     void push(SymbolId s, const double* p, std::uint32_t k, ModuleId id) {
         if (k > kMaxArity) throw std::length_error("a module can carry at most 255 numbers");
+        push_kind(s, p, k, id);
+    }
+    // Appends a module of kind `kind` whose k stored numbers are p[0 .. k).
+    void push_kind(KindId kind, const double* p, std::uint32_t k, ModuleId id) {
         if ((kinds.size() & (kBlock - 1)) == 0) block_at.push_back(static_cast<std::uint32_t>(params.size()));
-        kinds.push_back(s);
+        kinds.push_back(kind);
         nargs.push_back(static_cast<std::uint8_t>(k));
         for (std::uint32_t i = 0; i < k; ++i) params.push_back(p[i]);
         if (keep_ids) ids.push_back(id);
     }
-    // Appends modules [b, e) of another string (which keeps identities if this one does).
+    // Appends modules [b, e) of another string (which keeps identities if this one does, and
+    // whose kinds this one's table knows: a string without a table takes the other's).
     void append_range(const ModuleString& o, std::size_t b, std::size_t e);
     void append(const ModuleString& o) { append_range(o, 0, o.size()); }
     // Cuts the string to its first m modules.
@@ -147,6 +200,8 @@ struct ModuleString {
         block_at.swap(o.block_at);
         ids.swap(o.ids);
         std::swap(keep_ids, o.keep_ids);
+        std::swap(kind_table, o.kind_table);
+        std::swap(plain_below, o.plain_below);
     }
 };
 

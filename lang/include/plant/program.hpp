@@ -167,6 +167,13 @@ struct SuccessorTemplate {
     std::vector<std::uint32_t> holes;     // parameter index of each computed number
     std::vector<Span> hole_spans;
     int keep = -1; // module that keeps the predecessor's identity
+    // What the string stores of it (see KindTable; Compiler::assign_kinds): each module's kind,
+    // the numbers stored (constants of plain kinds and the holes), where each hole goes among
+    // them, and each module's count of them.
+    std::vector<KindId> kinds;
+    std::vector<double> stored;
+    std::vector<std::uint32_t> stored_holes;
+    std::vector<std::uint8_t> stored_nargs;
     Code values;
     // When every computed number is a bound name, optionally times or plus a constant (the
     // common `A(l * r1, w)`), the numbers are computed without the stack machine.
@@ -333,6 +340,8 @@ struct Program {
     std::vector<std::uint8_t> ignored; // per symbol: skipped when matching context
     bool uses_cut = false;             // some successor or the axiom produces '%'
     bool uses_id = false;              // some code calls id()
+
+    KindTable kinds; // the kinds of the successor templates' modules (see SuccessorTemplate)
 
     RuleSet rules;               // the unnamed, always-active group
     std::vector<RuleSet> groups; // named groups, selected by `use`

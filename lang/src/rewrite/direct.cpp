@@ -33,7 +33,7 @@ bool holds(Op op, double x, double y) {
 // The first production whose condition holds applies; when it is weighted, every weighted
 // production from it on whose condition holds is a candidate and one is drawn by weight, with
 // the same arithmetic as Rewriter::choose (general.cpp), so that both routes draw alike.
-const RulePlan::Guard* Rewriter::pick_guarded(std::size_t i, const double* a,
+const RulePlan::Guard* Rewriter::pick_guarded(std::size_t i, const ModuleArgs& a,
                                               const RulePlan::Guarded& g) const {
     if (in.arity(i) != g.width) return nullptr; // no pattern matches
     const RulePlan::Guard* gs = plan.guards.data() + g.first;
@@ -77,22 +77,22 @@ const RulePlan::Guard* Rewriter::pick_guarded(std::size_t i, const double* a,
 
 Rewriter::Counts Rewriter::count_direct(std::size_t b, std::size_t e) const {
     Counts c;
-    const double* a = in.params.data() + in.offset(b); // module i's parameters
-    for (std::size_t i = b; i < e; a += in.arity(i), ++i) {
+    const double* a = in.params.data() + in.offset(b); // module i's stored parameters
+    for (std::size_t i = b; i < e; a += in.stored(i), ++i) {
         const SymbolId s = in.symbol(i);
         if (!plan.has_prod[s]) {
             ++c.modules;
-            c.params += in.arity(i);
+            c.params += in.stored(i);
             continue;
         }
         const Production* pr = plan.direct[s];
         if (!pr) {
             const RulePlan::Guarded& g = plan.guarded[static_cast<std::size_t>(plan.guarded_at[s])];
             if (!g.uniform)
-                if (const RulePlan::Guard* q = pick_guarded(i, a, g)) pr = q->pr;
+                if (const RulePlan::Guard* q = pick_guarded(i, in.args_at(i, a), g)) pr = q->pr;
             if (!pr) { // copied, or as large as a copy
                 ++c.modules;
-                c.params += in.arity(i);
+                c.params += in.stored(i);
                 continue;
             }
         } else if (in.arity(i) != pr->strict[0].width) {
@@ -100,7 +100,7 @@ Rewriter::Counts Rewriter::count_direct(std::size_t b, std::size_t e) const {
             return c;
         }
         c.modules += pr->tmpl.syms.size();
-        c.params += pr->tmpl.params.size();
+        c.params += pr->tmpl.stored.size();
         c.new_ids += pr->tmpl.syms.size() - (pr->tmpl.keep >= 0 ? 1 : 0);
     }
     return c;
@@ -143,7 +143,7 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
         std::uint32_t outcome = at[s] + 1;
         if (!prp && plan.has_prod[s]) {
             const RulePlan::Guarded& g = plan.guarded[static_cast<std::size_t>(plan.guarded_at[s])];
-            if (const RulePlan::Guard* gd = pick_guarded(i, in.params.data() + q, g)) {
+            if (const RulePlan::Guard* gd = pick_guarded(i, in.args_at(i, in.params.data() + q), g)) {
                 prp = gd->pr;
                 outcome += static_cast<std::uint32_t>(gd - (plan.guards.data() + g.first));
             }
@@ -161,7 +161,7 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
                 // the usual run between two rewritten modules is a few turtle symbols: plain
                 // loops beat three library calls
                 for (std::size_t k = 0; k < n; ++k) {
-                    S[k] = in.symbol(i + k);
+                    S[k] = in.kinds[i + k];
                     if constexpr (Ids) ID[k] = in.ids[i + k];
                     NA[k] = in.nargs[i + k];
                 }
@@ -185,11 +185,7 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
         const Production& pr = *prp;
         const SuccessorTemplate& t = pr.tmpl;
         if (!t.holes.empty()) {
-            const double* a = in.params.data() + q;
-            for (const auto& pa : pr.strict[0].args) {
-                for (int k = 0; k < pa.width; ++k) w.frame[pa.slot + k] = a[k];
-                a += pa.width;
-            }
+            bind_args(w, i, in.params.data() + q, pr.strict[0]);
             w.env.position = i;
             w.env.draw = 0;
             w.env.id = in.id(i);
@@ -203,8 +199,8 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
         if constexpr (Ids) ID += m;
         S += m;
         NA += m;
-        PA += t.params.size();
-        p += t.params.size();
+        PA += t.stored.size();
+        p += t.stored.size();
         q += in.nargs[i];
         ++i;
     }

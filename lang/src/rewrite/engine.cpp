@@ -101,9 +101,11 @@ void Engine::rewrite(const Derivation& d, const ModuleString& in, ModuleString& 
         w.env.max_steps = d.opt_.max_steps;
         w.env.graph_records = !interpreting; // interpretation makes no node that lives on
         w.out.keep_ids = in.keep_ids;
+        w.out.use_kinds(in.kind_table);
     };
     out.clear();
     out.keep_ids = in.keep_ids;
+    out.use_kinds(in.kind_table);
     // The direct path needs every module's successor to be a direct template: a plan with
     // symbols rewritten otherwise would find one in nearly every string, after counting up to it.
     // (interpretation rewrites a copy of the string and leaves the counts to the string itself)
@@ -349,10 +351,11 @@ bool Engine::size_from_counts(const RulePlan& plan, const ModuleString& in, std:
         if (!plan.has_prod[s]) {
             modules += c;
         } else if (const Production* pr = plan.direct[s]) {
-            if (counts.arity[s] != static_cast<std::int32_t>(pr->strict[0].width)) return false;
+            if (counts.arity[s] != static_cast<std::int32_t>(pr->strict[0].width) || counts.stored[s] < 0)
+                return false;
             modules += c * pr->tmpl.syms.size();
-            params += c * pr->tmpl.params.size();
-            params -= c * pr->strict[0].width;
+            params += c * pr->tmpl.stored.size();
+            params -= c * static_cast<std::size_t>(counts.stored[s]);
         } else {
             const RulePlan::Guarded& g = plan.guarded[static_cast<std::size_t>(plan.guarded_at[s])];
             std::size_t most_m = 1, most_p = 0; // the copy keeps its own parameters, already counted
@@ -360,7 +363,7 @@ bool Engine::size_from_counts(const RulePlan& plan, const ModuleString& in, std:
                 for (std::uint32_t k = 0; k < g.count; ++k) {
                     const SuccessorTemplate& t = plan.guards[g.first + k].pr->tmpl;
                     most_m = std::max(most_m, t.syms.size());
-                    most_p = std::max(most_p, t.params.size());
+                    most_p = std::max(most_p, t.stored.size());
                 }
             modules += c * most_m;
             params += c * most_p;
@@ -373,8 +376,11 @@ void Engine::count_outcomes(const RulePlan& plan, const std::vector<std::vector<
                             bool counted, const ModuleString& out) {
     const std::size_t S = plan.has_prod.size();
     std::vector<std::uint64_t> modules(S, 0);
-    std::vector<std::int32_t> arity(S, -2); // -2: no module yet
-    auto merge = [&](std::size_t s, std::int32_t a) { arity[s] = arity[s] == -2 || arity[s] == a ? a : -1; };
+    std::vector<std::int32_t> arity(S, -2), stored(S, -2); // -2: no module yet
+    auto merge = [&](std::size_t s, std::int32_t a, std::int32_t k) {
+        arity[s] = arity[s] == -2 || arity[s] == a ? a : -1;
+        stored[s] = stored[s] == -2 || stored[s] == k ? k : -1;
+    };
     for (std::size_t o = 0; o < plan.outcome_tmpl.size(); ++o) {
         std::uint64_t c = 0;
         for (const auto& t : tallies) c += t[o];
@@ -382,16 +388,19 @@ void Engine::count_outcomes(const RulePlan& plan, const std::vector<std::vector<
         if (const SuccessorTemplate* t = plan.outcome_tmpl[o]) {
             for (std::size_t j = 0; j < t->syms.size(); ++j) {
                 modules[t->syms[j]] += c;
-                merge(t->syms[j], static_cast<std::int32_t>(t->param_end[j] - (j ? t->param_end[j - 1] : 0)));
+                merge(t->syms[j], static_cast<std::int32_t>(t->param_end[j] - (j ? t->param_end[j - 1] : 0)),
+                      t->stored_nargs[j]);
             }
         } else {
             const SymbolId s = plan.outcome_sym[o];
             modules[s] += c;
-            merge(s, counted && counts.arity.size() == S ? counts.arity[s] : -1);
+            const bool known = counted && counts.arity.size() == S;
+            merge(s, known ? counts.arity[s] : -1, known ? counts.stored[s] : -1);
         }
     }
     counts.modules = std::move(modules);
     counts.arity = std::move(arity);
+    counts.stored = std::move(stored);
     counts.of = out.kinds.data();
     counts.size = out.size();
 }
@@ -405,8 +414,7 @@ void Engine::decompose(const Derivation& d, ModuleString& s, int step_for_env) {
         ModuleString next;
         ModuleId before = next_id;
         rewrite(d, s, next, plan_for(prog, sets), stream::decompose(step_for_env, pass), step_for_env);
-        bool changed =
-            next_id != before || next.size() != s.size() || next.kinds != s.kinds || next.params != s.params;
+        bool changed = next_id != before || !next.same_modules(s);
         s.swap(next);
         if (!changed) break;
     }
@@ -441,7 +449,7 @@ ModuleString Engine::interpreted(const Derivation& d, const ModuleString& s) {
         if (!any_candidate(cur, prog.interpret)) break;
         ModuleString next;
         rewrite(d, cur, next, plan_for(prog, sets), stream::interpret(d.step_, pass), d.step_);
-        bool changed = next.kinds != cur.kinds || next.params != cur.params;
+        bool changed = !cur.same_modules(next);
         cur.swap(next);
         if (!changed) break;
     }

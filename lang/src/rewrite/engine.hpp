@@ -67,6 +67,7 @@ struct Engine {
     struct StringCounts {
         std::vector<std::uint64_t> modules; // per symbol
         std::vector<std::int32_t> arity;    // per symbol: what every module has; -1 they differ or unknown
+        std::vector<std::int32_t> stored;   // per symbol: the numbers every module stores; -1 likewise
         const SymbolId* of = nullptr;
         std::size_t size = 0;
     } counts;

@@ -15,6 +15,7 @@ namespace plant {
 Rewriter::Rewriter(const RulePlan& rule_plan, const ModuleString& in, std::vector<std::uint32_t>* brackets,
                    std::vector<std::uint16_t>* scratch, bool whole)
     : plan(rule_plan), P(rule_plan.P), in(in), n(in.size()), kernel_scratch(whole ? scratch : nullptr) {
+    table_kinds = plan.symbol_kernel && in.params.empty() && in.has_table_kinds();
     if (whole && kernel_applies()) return;
     if (plan.brackets) {
         std::vector<std::uint32_t>& table = brackets ? *brackets : own_match;
@@ -135,10 +136,10 @@ std::size_t Rewriter::apply_template(Worker& w, std::size_t i, const Production&
     }
     const std::size_t m = t.syms.size();
     if (m <= 4 && t.holes.empty()) { // short constant successors: plain appends
-        for (std::size_t j = 0; j < m; ++j) {
-            const std::uint32_t from = j ? t.param_end[j - 1] : 0;
+        const double* p = t.stored.data();
+        for (std::size_t j = 0; j < m; p += t.stored_nargs[j], ++j) {
             const ModuleId id = static_cast<int>(j) == t.keep ? in.id(i) : env.id_base + env.new_count++;
-            out.push(t.syms[j], t.params.data() + from, t.param_end[j] - from, id);
+            out.push_kind(t.kinds[j], p, t.stored_nargs[j], id);
         }
         if (out.size() > env.max_output) limit_error();
         return 1;
@@ -148,16 +149,13 @@ std::size_t Rewriter::apply_template(Worker& w, std::size_t i, const Production&
     out.kinds.resize(m0 + m);
     out.nargs.resize(m0 + m);
     if (out.keep_ids) out.ids.resize(m0 + m);
-    out.params.resize(p0 + t.params.size());
-    std::copy(t.syms.begin(), t.syms.end(), out.kinds.begin() + static_cast<std::ptrdiff_t>(m0));
+    out.params.resize(p0 + t.stored.size());
+    std::copy(t.kinds.begin(), t.kinds.end(), out.kinds.begin() + static_cast<std::ptrdiff_t>(m0));
     double* pp = out.params.data() + p0;
-    std::copy(t.params.begin(), t.params.end(), pp);
-    for (std::size_t h = 0; h < t.holes.size(); ++h) pp[t.holes[h]] = values[h];
-    std::uint32_t from = 0;
-    for (std::size_t j = 0; j < m; ++j) {
-        out.nargs[m0 + j] = static_cast<std::uint8_t>(t.param_end[j] - from);
-        from = t.param_end[j];
-    }
+    std::copy(t.stored.begin(), t.stored.end(), pp);
+    for (std::size_t h = 0; h < t.holes.size(); ++h) pp[t.stored_holes[h]] = values[h];
+    std::copy(t.stored_nargs.begin(), t.stored_nargs.end(),
+              out.nargs.begin() + static_cast<std::ptrdiff_t>(m0));
     out.index_from(m0, p0);
     if (out.keep_ids) {
         ModuleId* ids = out.ids.data() + m0;

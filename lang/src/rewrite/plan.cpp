@@ -151,10 +151,11 @@ bool RulePlan::build_guards(SymbolId sym) {
     entry.first = static_cast<std::uint32_t>(guards.size());
     entry.count = static_cast<std::uint32_t>(gs.size());
     entry.width = width;
-    entry.uniform = true;
+    // (a module of sym stores all its numbers unless some template gives it a kind of constants)
+    entry.uniform = std::find(P.kinds.symbol.begin(), P.kinds.symbol.end(), sym) == P.kinds.symbol.end();
     for (const Guard& g : gs) {
         const SuccessorTemplate& t = g.pr->tmpl;
-        entry.uniform = entry.uniform && t.syms.size() == 1 && t.params.size() == width && t.keep == 0;
+        entry.uniform = entry.uniform && t.syms.size() == 1 && t.stored.size() == width && t.keep == 0;
     }
     guarded_at[sym] = static_cast<std::int32_t>(guarded.size());
     guarded.push_back(entry);
@@ -181,12 +182,7 @@ void RulePlan::build_outcomes() {
     }
     for (const SuccessorTemplate* t : outcome_tmpl) {
         outcome_nargs_at.push_back(static_cast<std::uint32_t>(outcome_nargs.size()));
-        if (!t) continue;
-        std::uint32_t from = 0;
-        for (std::uint32_t end : t->param_end) {
-            outcome_nargs.push_back(static_cast<std::uint8_t>(end - from));
-            from = end;
-        }
+        if (t) outcome_nargs.insert(outcome_nargs.end(), t->stored_nargs.begin(), t->stored_nargs.end());
     }
 }
 

@@ -83,7 +83,8 @@ struct RulePlan {
     std::vector<std::uint32_t> outcome_at;
     std::vector<const SuccessorTemplate*> outcome_tmpl; // nullptr: the copy
     std::vector<SymbolId> outcome_sym;
-    // The arities of an outcome's template modules, ready to copy into the string's `nargs`:
+    // How many numbers the string stores for each of an outcome's template modules, ready to
+    // copy into the string's `nargs`:
     // from outcome_nargs_at[o] (one entry per module of outcome_tmpl[o]; none for the copy).
     std::vector<std::uint32_t> outcome_nargs_at;
     std::vector<std::uint8_t> outcome_nargs;

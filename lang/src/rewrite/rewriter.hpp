@@ -67,7 +67,10 @@ class Rewriter {
     }
 
     // Whether run_range rewrites this string with the symbol kernel (run_symbols).
-    bool kernel_applies() const { return plan.symbol_kernel && in.params.empty() && !in.keep_ids; }
+    // (its tables are the symbols': not for a string with kinds of constant numbers)
+    bool kernel_applies() const {
+        return plan.symbol_kernel && in.params.empty() && !in.keep_ids && !table_kinds;
+    }
 
     // Whether production `pr` (pattern, context and condition) matches at module i: the REPL's
     // :find. Binds the worker's frame.
@@ -95,7 +98,7 @@ class Rewriter {
     // The production a guarded symbol's module i gets (see RulePlan::Guarded), decided as
     // apply() and choose() would decide it; nullptr: none applies, the module is copied.
     // a: module i's parameters
-    const RulePlan::Guard* pick_guarded(std::size_t i, const double* a, const RulePlan::Guarded& g) const;
+    const RulePlan::Guard* pick_guarded(std::size_t i, const ModuleArgs& a, const RulePlan::Guarded& g) const;
     // The seed and phase of the step's random draws (weighted choice on the direct path).
     std::uint64_t seed = 0, phase = 0;
 
@@ -140,35 +143,41 @@ class Rewriter {
         }
     }
 
-    // Writes successor template t, its computed numbers in `values`, at S, NA (arities), PA and
-    // ID. Module t.keep gets the identity `kept` (the predecessor's), the others new ones counted
-    // on from `next_new`. Identities are written only when Ids. `arities`: the template's
-    // arities ready to copy (RulePlan::outcome_nargs), or nullptr to work them out from
-    // t.param_end. The caller indexes the parameters (ModuleString::index_range) once the
+    // Writes successor template t, its computed numbers in `values`, at S (kinds), NA (numbers
+    // stored), PA and ID: its kinds and stored numbers (SuccessorTemplate::kinds). Module t.keep
+    // gets the identity `kept` (the predecessor's), the others new ones counted on from
+    // `next_new`. Identities are written only when Ids. `stored`: the template's counts of
+    // stored numbers ready to copy (RulePlan::outcome_nargs), or nullptr to take them from
+    // t.stored_nargs. The caller indexes the parameters (ModuleString::index_range) once the
     // stretch is written.
     template <bool Ids>
-    static void put_template(const SuccessorTemplate& t, const std::uint8_t* arities, const double* values,
+    static void put_template(const SuccessorTemplate& t, const std::uint8_t* stored, const double* values,
                              ModuleId kept, ModuleId& next_new, KindId* S, std::uint8_t* NA, double* PA,
                              ModuleId* ID) {
         const std::size_t m = t.syms.size();
-        if (m != 0) std::memcpy(S, t.syms.data(), m * sizeof(SymbolId));
+        if (m != 0) std::memcpy(S, t.kinds.data(), m * sizeof(KindId));
         // An erasing or parameterless successor has no parameter storage;
         // memcpy with a null source is undefined even for zero bytes.
-        if (!t.params.empty()) std::memcpy(PA, t.params.data(), t.params.size() * sizeof(double));
-        for (std::size_t h = 0; h < t.holes.size(); ++h) PA[t.holes[h]] = values[h];
-        if (arities) {
-            copy_bytes(NA, arities, m);
-        } else {
-            std::uint32_t from = 0;
-            for (std::size_t j = 0; j < m; ++j) {
-                NA[j] = static_cast<std::uint8_t>(t.param_end[j] - from);
-                from = t.param_end[j];
-            }
-        }
+        // (none is when every stored number is computed, the usual case)
+        if (t.stored.size() != t.holes.size())
+            std::memcpy(PA, t.stored.data(), t.stored.size() * sizeof(double));
+        for (std::size_t h = 0; h < t.holes.size(); ++h) PA[t.stored_holes[h]] = values[h];
+        copy_bytes(NA, stored ? stored : t.stored_nargs.data(), m);
         if constexpr (Ids) {
             for (std::size_t j = 0; j < m; ++j) ID[j] = static_cast<int>(j) == t.keep ? kept : next_new++;
         } else {
             next_new += m - (t.keep >= 0 ? 1 : 0);
+        }
+    }
+
+    // Binds the numbers of module i, whose stored ones start at `at`, to the names of pattern
+    // module pm (which binds all of them) in w.frame.
+    void bind_args(Worker& w, std::size_t i, const double* at, const PatternModule& pm) const {
+        const ModuleArgs a = in.args_at(i, at);
+        std::size_t from = 0;
+        for (const auto& pa : pm.args) {
+            for (int k = 0; k < pa.width; ++k) w.frame[pa.slot + static_cast<std::size_t>(k)] = a[from + k];
+            from += static_cast<std::size_t>(pa.width);
         }
     }
 
@@ -315,6 +324,7 @@ class Rewriter {
     const RulePlan& plan;
     const Program& P;
     const ModuleString& in;
+    bool table_kinds = false; // some module of `in` has a kind of constant numbers
     const std::size_t n;
     std::vector<std::uint32_t> own_match;
     std::vector<std::uint16_t>* kernel_scratch = nullptr; // run_symbols's right keys, kept from step to step

@@ -77,18 +77,12 @@ template <bool Ids> void Rewriter::run_templates(Worker& w, std::size_t b, std::
             next_check = i + k;
         }
         const SymbolId sym = in.symbol(i);
-        const std::uint32_t arity = in.nargs[i];
+        const std::uint32_t arity = in.arity(i), stored = in.nargs[i];
         const Production* pr = nullptr;
         if (plan.has_prod[sym]) {
             pr = plan.direct[sym];
             if (pr && arity == pr->strict[0].width) {
-                if (!pr->tmpl.holes.empty()) {
-                    const double* a = in.params.data() + q;
-                    for (const auto& pa : pr->strict[0].args) {
-                        for (int k = 0; k < pa.width; ++k) w.frame[pa.slot + k] = a[k];
-                        a += pa.width;
-                    }
-                }
+                if (!pr->tmpl.holes.empty()) bind_args(w, i, in.params.data() + q, pr->strict[0]);
             } else if (!pr && arity == 0) {
                 pr = table_lookup(i); // nullptr: no production applies, the module is copied
             } else {                  // matching after all, with the arrays at their true size
@@ -108,11 +102,11 @@ template <bool Ids> void Rewriter::run_templates(Worker& w, std::size_t b, std::
             }
         }
         if (!pr) { // copied as it is
-            S[m] = sym;
+            S[m] = in.kinds[i];
             if constexpr (Ids) ID[m] = in.ids[i];
-            NA[m] = static_cast<std::uint8_t>(arity);
-            for (std::uint32_t k = 0; k < arity; ++k) PA[p++] = in.params[q + k];
-            q += arity;
+            NA[m] = static_cast<std::uint8_t>(stored);
+            for (std::uint32_t k = 0; k < stored; ++k) PA[p++] = in.params[q + k];
+            q += stored;
             ++m;
             ++i;
             continue;
@@ -131,8 +125,8 @@ template <bool Ids> void Rewriter::run_templates(Worker& w, std::size_t b, std::
                           Ids ? ID + m : nullptr);
         env.new_count = next_new - env.id_base;
         m += t.syms.size();
-        p += t.params.size();
-        q += arity;
+        p += t.stored.size();
+        q += stored;
         ++i;
     }
     close();
