@@ -85,8 +85,9 @@ void bracket_table(const ModuleString& s, SymbolId open, SymbolId close, std::ve
     // The stack of open brackets is kept in the table itself: an open '[' holds the index of the
     // '[' below it until its ']' is found. No allocation besides the table.
     std::uint32_t top = n;
+    const SymbolReader sym_of = s.symbols();
     for (std::uint32_t i = 0; i < n; ++i) {
-        const SymbolId x = s.symbol(i);
+        const SymbolId x = sym_of(i);
         if (x == open) {
             match[i] = top;
             top = i;
@@ -136,8 +137,11 @@ std::string format_string(const Program& program, const ModuleString& s, bool wi
         if (info.declared && info.name.size() > 1 && std::isalpha(static_cast<unsigned char>(info.name[0])))
             for (std::size_t l = 2; l <= info.name.size(); ++l) prefixes.insert(info.name.substr(0, l));
     const std::string* prev = nullptr; // name of the previous module when it ends in a letter run
-    for (std::size_t i = 0; i < s.size() && out.size() <= max_chars; ++i) {
-        const std::string& name = program.symbols[s.symbol(i)].name;
+    const SymbolReader sym_of = s.symbols();
+    const double* at = s.params.data(); // module i's stored numbers (the string is read in order)
+    const std::uint8_t* stored = s.nargs.data();
+    for (std::size_t i = 0; i < s.size() && out.size() <= max_chars; at += stored[i], ++i) {
+        const std::string& name = program.symbols[sym_of(i)].name;
         bool letter_start =
             !name.empty() && (std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_');
         // a space only where reading back would merge two names
@@ -145,10 +149,11 @@ std::string format_string(const Program& program, const ModuleString& s, bool wi
             if (prev->size() > 1 || *prev == "~" || prefixes.count(*prev + name[0])) out += ' ';
         }
         out += name;
-        std::uint32_t k = s.arity(i);
+        const KindId kind = sym_of.kinds[i];
+        const std::uint32_t k = kind < sym_of.plain ? stored[i] : s.kind_table->arity[kind - sym_of.plain];
         if (k > 0 || name == ";") { // a bare ';' would end the statement when read back
             out += '(';
-            const ModuleArgs a = s.args(i);
+            const ModuleArgs a = s.args_at(i, at);
             for (std::uint32_t j = 0; j < k; ++j) {
                 if (j) out += ',';
                 out += format_double(a[j]);

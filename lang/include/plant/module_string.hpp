@@ -48,6 +48,19 @@ struct KindTable {
     std::size_t size() const { return symbol.size(); }
 };
 
+// Module symbols for a loop over many modules: the string's arrays read through copies the
+// compiler keeps in registers (members read through the string are reloaded after every store
+// through a byte pointer, which may alias them).
+struct SymbolReader {
+    const KindId* kinds;
+    std::uint32_t plain;
+    const SymbolId* table;
+    SymbolId operator()(std::size_t i) const {
+        const KindId k = kinds[i];
+        return k < plain ? k : table[k - plain];
+    }
+};
+
 // A module's numbers, read one at a time (not a pointer: see the note at the top).
 class ModuleArgs {
   public:
@@ -106,6 +119,9 @@ struct ModuleString {
     std::size_t size() const { return kinds.size(); }
     ModuleId id(std::size_t i) const { return keep_ids ? ids[i] : 0; }
     bool empty() const { return kinds.empty(); }
+    SymbolReader symbols() const {
+        return {kinds.data(), plain_below, kind_table ? kind_table->symbol.data() : nullptr};
+    }
     SymbolId symbol(std::size_t i) const {
         const KindId k = kinds[i];
         return k < plain_below ? k : kind_table->symbol[k - plain_below];

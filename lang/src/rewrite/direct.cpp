@@ -77,9 +77,10 @@ const RulePlan::Guard* Rewriter::pick_guarded(std::size_t i, const ModuleArgs& a
 
 Rewriter::Counts Rewriter::count_direct(std::size_t b, std::size_t e) const {
     Counts c;
+    const SymbolReader sym_of = in.symbols();
     const double* a = in.params.data() + in.offset(b); // module i's stored parameters
     for (std::size_t i = b; i < e; a += in.stored(i), ++i) {
-        const SymbolId s = in.symbol(i);
+        const SymbolId s = sym_of(i);
         if (!plan.has_prod[s]) {
             ++c.modules;
             c.params += in.stored(i);
@@ -113,14 +114,27 @@ Rewriter::Counts Rewriter::count_direct(std::size_t b, std::size_t e) const {
 Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out,
                                         std::size_t m_at, std::size_t p_at, ModuleId id_at,
                                         std::uint64_t* tally) {
-    if (out.keep_ids) return write_direct<true>(w, b, e, out, m_at, p_at, id_at, tally);
-    return write_direct<false>(w, b, e, out, m_at, p_at, id_at, tally);
+    // Kinds: whether the program has kinds of constant numbers (otherwise every kind is its
+    // symbol, and the loop does without the test)
+    const bool kinds = in.kind_table && in.kind_table->size() > 0;
+    if (out.keep_ids)
+        return kinds ? write_direct<true, true>(w, b, e, out, m_at, p_at, id_at, tally)
+                     : write_direct<true, false>(w, b, e, out, m_at, p_at, id_at, tally);
+    return kinds ? write_direct<false, true>(w, b, e, out, m_at, p_at, id_at, tally)
+                 : write_direct<false, false>(w, b, e, out, m_at, p_at, id_at, tally);
 }
-template <bool Ids>
+template <bool Ids, bool Kinds>
 Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out,
                                         std::size_t m_at, std::size_t p_at, ModuleId id_at,
                                         std::uint64_t* tally) {
     w.frame.assign(plan.frame_size, 0.0);
+    const SymbolReader reader = in.symbols();
+    auto sym_of = [reader](std::size_t j) -> SymbolId {
+        if constexpr (Kinds)
+            return reader(j);
+        else
+            return reader.kinds[j];
+    };
     KindId* S = out.kinds.data() + m_at;
     ModuleId* ID = Ids ? out.ids.data() + m_at : nullptr;
     std::uint8_t* NA = out.nargs.data() + m_at;
@@ -138,7 +152,7 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
             if (w.env.interrupt && w.env.interrupt->load())
                 throw RuntimeError{RuntimeErrorKind::Interrupted, Span{}, "interrupted"};
         }
-        const SymbolId s = in.symbol(i);
+        const SymbolId s = sym_of(i);
         const Production* prp = plan.direct[s];
         std::uint32_t outcome = at[s] + 1;
         if (!prp && plan.has_prod[s]) {
@@ -150,11 +164,11 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
         }
         if (!prp) { // a run of modules without productions (or none that applies): copy it
             std::size_t j = i + 1;
-            while (j < e && !plan.has_prod[in.symbol(j)]) ++j;
+            while (j < e && !plan.has_prod[sym_of(j)]) ++j;
             const std::size_t n = j - i;
             std::uint32_t np = 0;
             for (std::size_t k = i; k < j; ++k) {
-                ++tally[at[in.symbol(k)]];
+                ++tally[at[sym_of(k)]];
                 np += in.nargs[k];
             }
             if (n <= 8 && np <= 8) {

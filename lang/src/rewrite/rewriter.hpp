@@ -107,7 +107,7 @@ class Rewriter {
     ModuleString assemble_backward(const ModuleString& pieces) const;
 
   private:
-    template <bool Ids>
+    template <bool Ids, bool Kinds>
     Counts write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at,
                         std::size_t p_at, ModuleId id_at, std::uint64_t* tally);
     template <bool Ids> void run_templates(Worker& w, std::size_t b, std::size_t e);

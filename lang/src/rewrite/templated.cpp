@@ -48,6 +48,7 @@ template <bool Ids> void Rewriter::run_templates(Worker& w, std::size_t b, std::
         out.index_from(m_open, p_open);
         S = nullptr;
     };
+    const SymbolReader sym_of = in.symbols();
     std::size_t q = in.offset(b); // where input module i's parameters start
     const std::size_t per_module = std::max<std::size_t>(Mmax, 1);
     std::size_t next_limits = b + 65536, next_check = b;
@@ -76,7 +77,7 @@ template <bool Ids> void Rewriter::run_templates(Worker& w, std::size_t b, std::
             }
             next_check = i + k;
         }
-        const SymbolId sym = in.symbol(i);
+        const SymbolId sym = sym_of(i);
         const std::uint32_t arity = in.arity(i), stored = in.nargs[i];
         const Production* pr = nullptr;
         if (plan.has_prod[sym]) {
