@@ -79,9 +79,9 @@ int derive_main(const DeriveCmd& c) {
             write_stdout(stats_out);
             return kRuntime;
         }
-        stats_out +=
-            fmt::format("total steps={} modules={} bytes={} ms={:.4f} peak_rss_kb={}\n", d.steps_done(),
-                        d.string().size(), d.string().bytes(), total_ms, peak_rss_kb());
+        stats_out += fmt::format("total steps={} modules={} bytes={} ms={:.4f} peak_rss_kb={} work={}\n",
+                                 d.steps_done(), d.string().size(), d.string().bytes(), total_ms,
+                                 peak_rss_kb(), d.work_done());
         return write_stdout(stats_out);
     }
     if (!ok) return kRuntime;

@@ -34,6 +34,7 @@ struct GrammarOptions {
     int threads = 0; // 0: one per core
     std::size_t max_modules = 50'000'000;
     std::uint64_t max_steps = kDefaultMaxSteps; // instructions one evaluation may run
+    std::uint64_t max_work = kDefaultMaxWork;   // work the whole derivation may do (--max-work)
     std::string max_memory;                     // --max-memory SIZE as given; empty: default_max_memory()
     bool color = false;
     // --edits FILE: the decomposition graph's edits (docs/language.md, decomposition graphs);
@@ -49,6 +50,10 @@ struct GrammarOptions {
 std::uint64_t parse_count(const std::string& option, const std::string& text, std::uint64_t lowest);
 
 void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation);
+
+// --max-work N: the whole derivation's work budget (DeriveOptions::max_work); `what` says what
+// one budget covers for this command.
+void add_max_work(CLI::App& cmd, std::uint64_t& max_work, const char* what);
 
 // --max-memory SIZE, on every command that compiles a grammar: the memory budget
 // (plant/memory_budget.hpp).

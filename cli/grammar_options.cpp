@@ -50,6 +50,7 @@ void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation) {
                        "instructions, the functions it calls included (default {})",
                        kDefaultMaxSteps))
         ->type_name("N");
+    add_max_work(cmd, o.max_work, "the derivation");
     add_max_memory(cmd, o.max_memory);
     // the same param set twice on one command line is a usage error, not "the last one wins"
     cmd.parse_complete_callback([&o] {
@@ -63,6 +64,16 @@ void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation) {
             }
     });
     o.color = isatty(2) != 0 && std::getenv("NO_COLOR") == nullptr;
+}
+
+void add_max_work(CLI::App& cmd, std::uint64_t& max_work, const char* what) {
+    cmd.add_option_function<std::string>(
+           "--max-work", [&max_work](const std::string& v) { max_work = parse_count("--max-work", v, 1); },
+           fmt::format("Stop with an error (exit 70) when {} does more than this much work: every VM "
+                       "instruction plus every module its steps write (default {}, minutes of "
+                       "running, not days)",
+                       what, kDefaultMaxWork))
+        ->type_name("N");
 }
 
 void add_max_memory(CLI::App& cmd, std::string& size) {
@@ -199,6 +210,7 @@ DeriveOptions derive_options(const GrammarOptions& o) {
         o.threads > 0 ? o.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     d.max_modules = o.max_modules;
     d.max_steps = o.max_steps;
+    d.max_work = o.max_work;
     // the strings' estimate (rewrite/engine.cpp) takes half of --max-memory: a step holds the
     // string it reads and the one it writes
     if (const std::uint64_t budget = o.max_memory.empty() ? 0 : parse_memory(o.max_memory))

@@ -80,6 +80,7 @@ enum class RuntimeErrorKind {
     ModuleLimit, // the string outgrew --max-modules or --max-bytes
     Interrupted, // the derivation was asked to stop (Ctrl-C in the REPL)
     StepLimit,   // one evaluation ran more instructions than --max-steps allows
+    WorkLimit,   // the whole run did more work than --max-work allows
     Setting,     // a setting (derive, seed) out of its range
     Turtle,      // the turtle cannot interpret the string (unbalanced ']', leaving finite space)
     Geometry,    // the plant cannot be meshed (a surface that cannot be loaded, out-of-range points)

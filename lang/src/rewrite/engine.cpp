@@ -100,6 +100,10 @@ void Engine::rewrite(const Derivation& d, const ModuleString& in, ModuleString& 
         w.env.interrupt = d.opt_.interrupt;
         w.env.max_steps = d.opt_.max_steps;
         w.env.graph_records = !interpreting; // interpretation makes no node that lives on
+        if (!interpreting) {                 // (the turtle's view is not the derivation's work)
+            w.env.max_work = d.opt_.max_work;
+            w.env.work_limit = d.opt_.max_work - std::min(d.opt_.max_work, work);
+        }
         w.out.keep_ids = in.keep_ids;
     };
     out.clear();
@@ -128,6 +132,10 @@ void Engine::rewrite(const Derivation& d, const ModuleString& in, ModuleString& 
                 : std::max(0.5, std::min(16.0, double(out.params.size()) / double(in.params.size())));
     }
     check_limits(d, out);
+    if (!interpreting) { // the workers' instructions were added as they finished; now the modules
+        work += out.size();
+        if (work > d.opt_.max_work) throw_work_limit(d.opt_.max_work);
+    }
 }
 
 // The whole string on one thread, which numbers new modules in string order as it writes them.
@@ -159,6 +167,7 @@ void Engine::rewrite_one_thread(const Derivation& d, Rewriter& rw, const ModuleS
         throw;
     }
     next_id += w.env.new_count;
+    if (!interpreting) work += w.env.work;
 }
 
 // Worker 0 writes into buffers sized for the whole output and numbers its new modules directly;
@@ -203,6 +212,7 @@ void Engine::rewrite_parallel(const Derivation& d, Rewriter& rw, const ModuleStr
         }
         total += w.out.size();
         total_params += w.out.params.size();
+        if (!interpreting) work += w.env.work;
     }
     if (total > d.opt_.max_modules) {
         check_limits(d, total, total_params);
@@ -312,8 +322,10 @@ bool Engine::rewrite_direct(const Derivation& d, Rewriter& rw, const ModuleStrin
             w.error = err;
         }
     });
-    for (auto& w : workers)
+    for (auto& w : workers) {
         if (w.error) throw *w.error;
+        if (!interpreting) work += w.env.work;
+    }
     if (sized) { // the counts were exact or a bound: cut to what was written
         const Rewriter::Counts& c = counts_at[0];
         out.sym.resize(c.modules);
