@@ -181,7 +181,7 @@ void setup_repl(CLI::App& app, int& exit_code) {
     auto max_steps = std::make_shared<std::uint64_t>(kDefaultMaxSteps);
     auto max_modules = std::make_shared<std::size_t>(0);
     auto max_work = std::make_shared<std::uint64_t>(kDefaultMaxWork);
-    auto max_memory = std::make_shared<std::string>();
+    auto max_memory = std::make_shared<std::uint64_t>(0);
     CLI::App* cmd =
         app.add_subcommand("repl", "An interactive session: step a derivation, inspect the string, change "
                                    "rules and params, look at the plant");
@@ -204,10 +204,7 @@ void setup_repl(CLI::App& app, int& exit_code) {
     cmd->footer("Reads commands from standard input without a prompt when it is not a terminal:\n"
                 "  plant repl grammar.plant < script");
     cmd->callback([file, allow, max_steps, max_modules, max_work, max_memory, &exit_code] {
-        if (!set_memory_budget(*max_memory)) {
-            exit_code = kUsage;
-            return;
-        }
+        set_memory_budget(*max_memory);
         exit_code = repl_main(*file, isatty(2) != 0 && !std::getenv("NO_COLOR"), *allow, *max_steps,
                               *max_modules, *max_work);
     });

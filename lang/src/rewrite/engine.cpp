@@ -6,6 +6,7 @@
 // identities are numbered in string order, so the result is the same for any number of threads.
 #include "engine.hpp"
 
+#include "plant/memory_budget.hpp"
 #include "plant/streams.hpp"
 #include "rewriter.hpp"
 
@@ -178,10 +179,12 @@ void Engine::rewrite_parallel(const Derivation& d, Rewriter& rw, const ModuleStr
                               int threads, const Setup& setup) {
     const std::size_t n = in.size();
     std::vector<Worker> workers(static_cast<std::size_t>(threads));
+    const std::string* stage = memory::Stage::current(); // (interpretation's, say, not the derivation's)
     {
         std::vector<std::jthread> pool;
         for (int t = 0; t < threads; ++t) {
             pool.emplace_back([&, t] {
+                memory::InStage named(stage);
                 Worker& w = workers[static_cast<std::size_t>(t)];
                 setup(w);
                 std::size_t b = n * static_cast<std::size_t>(t) / static_cast<std::size_t>(threads);
