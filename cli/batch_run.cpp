@@ -112,7 +112,21 @@ struct Shared {
     Programs& programs;
     ManifestWriter& manifest;
     Progress& progress;
+    int jobs; // variants running at once, each with a 1/jobs share of --max-memory
 };
+
+// What a variant stopped by the memory budget, or by its string's share of it, is told besides:
+// that its share is a part of --max-memory, and how to give it more.
+std::string share_hint(const RuntimeError& e, int jobs) {
+    const bool memory =
+        e.kind == RuntimeErrorKind::Memory ||
+        (e.kind == RuntimeErrorKind::ModuleLimit && e.message.find("--max-memory") != std::string::npos);
+    if (!memory || jobs < 2) return "";
+    return fmt::format(
+        " (with --jobs {0} each variant has a 1/{0} share of --max-memory: lower --jobs or raise "
+        "--max-memory)",
+        jobs);
+}
 
 DeriveOptions variant_options(const BatchJob& job, std::uint64_t n, Progress& progress) {
     DeriveOptions opt = derive_options(job.grammar);
@@ -155,7 +169,8 @@ bool run_variant(Shared& s, std::uint64_t n, ManifestRow& row) {
         if (e.kind == RuntimeErrorKind::Interrupted || g_stop.load()) return false;
         row.status = "runtime_error";
         row.message =
-            first_error(render(Diagnostic{Severity::Error, e.span, e.message, {}}, compiled->sources, false));
+            first_error(render(Diagnostic{Severity::Error, e.span, e.message + share_hint(e, s.jobs), {}},
+                               compiled->sources, false));
     } catch (const ExportError& e) {
         if (g_stop.load()) return false;
         row.status = "output_error";
@@ -228,8 +243,11 @@ int run_batch(BatchJob& job) {
     const int jobs =
         static_cast<int>(std::clamp<std::uint64_t>(job.batch.jobs > 0 ? std::uint64_t(job.batch.jobs) : cores,
                                                    1, std::max<std::uint64_t>(plan.shard_size(), 1)));
-    // --max-memory is each variant's budget (docs/batch.md): the process's is that times the jobs
-    memory::set_limit(memory::limit() * static_cast<std::uint64_t>(jobs));
+    // --max-memory bounds the process (docs/batch.md): each of the variants running at once has a
+    // 1/jobs share, for its string's estimate and its mesh's (the charges add up to the process's)
+    const std::uint64_t share = memory::limit() / static_cast<std::uint64_t>(jobs);
+    job.grammar.max_memory = share;
+    job.output.max_memory = share;
     Programs programs(job, 4 * static_cast<std::size_t>(jobs));
     // the grammar with the first variant's values, before any work: its errors stop the batch
     if (auto first = programs.get(0); !first->program) {
@@ -251,7 +269,7 @@ int run_batch(BatchJob& job) {
         try {
             ManifestWriter manifest(job.batch.manifest, plan);
             Progress progress(plan.shard_size(), isatty(2) != 0);
-            Shared shared{job, programs, manifest, progress};
+            Shared shared{job, programs, manifest, progress, jobs};
             run_pool(shared, jobs);
             progress.finish(g_stop.load());
             manifest.finish();

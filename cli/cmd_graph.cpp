@@ -245,8 +245,10 @@ void setup_graph(CLI::App& app, int& exit_code) {
         "Each parameter shows its value (a curve by its values at t = 0, 0.25, 0.5, 0.75 and 1), its "
         "status (explicit, inherited, relative-offset, relative-fraction, shared), public or private, "
         "and the node the value comes from; then each edit and the node it applies to, or 'dormant'.");
-    cmd->callback(
-        [c, &exit_code] { exit_code = set_memory_budget(c->g.max_memory) ? graph_main(*c) : kUsage; });
+    cmd->callback([c, &exit_code] {
+        set_memory_budget(c->g.max_memory);
+        exit_code = graph_main(*c);
+    });
 }
 
 } // namespace plant::cli

@@ -110,18 +110,13 @@ int read_output_options(RunCmd& c, OutputOptions& oo) {
             return kUsage;
         }
     }
-    std::uint64_t max_memory = 0;
-    if (!c.g.max_memory.empty() && (max_memory = parse_memory(c.g.max_memory)) == 0) {
-        std::cerr << "plant: " << memory_usage_error(c.g.max_memory) << "\n";
-        return kUsage;
-    }
     std::optional<glm::dvec3> camera, look_at;
     if (!read_view(c, camera, look_at)) return kUsage;
     oo.sides = c.sides;
     oo.obstacles = !c.no_obstacles;
     oo.width = width;
     oo.height = height;
-    oo.max_memory = max_memory;
+    oo.max_memory = c.g.max_memory;
     oo.gltf_layout = c.flatten             ? GltfLayout::Baked
                      : c.no_gpu_instancing ? GltfLayout::Nodes
                                            : GltfLayout::GpuInstancing;
@@ -168,7 +163,7 @@ int run_main(RunCmd& c) {
     // check the outputs before doing any work
     OutputOptions oo;
     if (int code = read_output_options(c, oo); code != kOk) return code;
-    if (!set_memory_budget(c.g.max_memory)) return kUsage;
+    set_memory_budget(c.g.max_memory);
     if (c.batch.jobs > 0 && !c.batch.any()) {
         std::cerr << "plant: --jobs runs several variants at once: give --seeds or --grid too\n";
         return kUsage;

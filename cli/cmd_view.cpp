@@ -157,8 +157,10 @@ void setup_view(CLI::App& app, int& exit_code) {
         ->check(CLI::Range(3, 64))
         ->capture_default_str();
     cmd->add_flag("--no-obstacles", c->no_obstacles, "Leave the environments' walls and boxes out");
-    cmd->callback(
-        [c, &exit_code] { exit_code = set_memory_budget(c->g.max_memory) ? view_main(*c) : kUsage; });
+    cmd->callback([c, &exit_code] {
+        set_memory_budget(c->g.max_memory);
+        exit_code = view_main(*c);
+    });
 }
 
 } // namespace plant::cli

@@ -34,7 +34,8 @@ struct GrammarOptions {
     int threads = 0; // 0: one per core
     std::size_t max_modules = 50'000'000;
     std::uint64_t max_steps = kDefaultMaxSteps; // instructions one evaluation may run
-    std::string max_memory;                     // --max-memory SIZE as given; empty: default_max_memory()
+    std::uint64_t max_work = kDefaultMaxWork;   // work the whole derivation may do (--max-work)
+    std::uint64_t max_memory = 0;               // --max-memory in bytes; 0: default_max_memory()
     bool color = false;
     // --edits FILE: the decomposition graph's edits (docs/language.md, decomposition graphs);
     // empty: the grammar's `edits "file";`, if any.
@@ -50,12 +51,16 @@ std::uint64_t parse_count(const std::string& option, const std::string& text, st
 
 void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation);
 
+// --max-work N: the whole derivation's work budget (DeriveOptions::max_work); `what` says what
+// one budget covers for this command.
+void add_max_work(CLI::App& cmd, std::uint64_t& max_work, const char* what);
+
 // --max-memory SIZE, on every command that compiles a grammar: the memory budget
-// (plant/memory_budget.hpp).
-void add_max_memory(CLI::App& cmd, std::string& size);
-// Sets the process's memory budget from --max-memory (default_max_memory() when not given).
-// False, having said why on standard error, when SIZE is not a size (a usage error).
-bool set_memory_budget(const std::string& size);
+// (plant/memory_budget.hpp), read once, here, into `bytes` (a SIZE that does not read is a usage
+// error, exit 64).
+void add_max_memory(CLI::App& cmd, std::uint64_t& bytes);
+// Sets the process's memory budget: `bytes` from --max-memory, 0 for default_max_memory().
+void set_memory_budget(std::uint64_t bytes);
 
 // --allow-read DIR (repeatable), on every command that compiles a grammar.
 void add_allow_read(CLI::App& cmd, std::vector<std::string>& dirs);

@@ -50,6 +50,7 @@ void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation) {
                        "instructions, the functions it calls included (default {})",
                        kDefaultMaxSteps))
         ->type_name("N");
+    add_max_work(cmd, o.max_work, "the derivation");
     add_max_memory(cmd, o.max_memory);
     // the same param set twice on one command line is a usage error, not "the last one wins"
     cmd.parse_complete_callback([&o] {
@@ -65,13 +66,22 @@ void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation) {
     o.color = isatty(2) != 0 && std::getenv("NO_COLOR") == nullptr;
 }
 
-void add_max_memory(CLI::App& cmd, std::string& size) {
+void add_max_work(CLI::App& cmd, std::uint64_t& max_work, const char* what) {
+    cmd.add_option_function<std::string>(
+           "--max-work", [&max_work](const std::string& v) { max_work = parse_count("--max-work", v, 1); },
+           fmt::format("Stop with an error (exit 70) when {} does more than this much work: every VM "
+                       "instruction plus every module its steps write (default {}, minutes of "
+                       "running, not days)",
+                       what, kDefaultMaxWork))
+        ->type_name("N");
+}
+
+void add_max_memory(CLI::App& cmd, std::uint64_t& bytes) {
     cmd.add_option_function<std::string>(
            "--max-memory",
-           [&size](const std::string& v) {
-               // checked here, so that an empty value is an error too, not the default
-               if (parse_memory(v) == 0) throw CLI::ValidationError(memory_usage_error(v));
-               size = v;
+           [&bytes](const std::string& v) {
+               // an empty value is an error too, not the default
+               if ((bytes = parse_memory(v)) == 0) throw CLI::ValidationError(memory_usage_error(v));
            },
            "Memory the command may take, as 512M or 4G (default: half the physical memory): "
            "the derivation's strings and tables, the skeleton, the mesh, the physics and the "
@@ -80,14 +90,8 @@ void add_max_memory(CLI::App& cmd, std::string& size) {
         ->type_name("SIZE");
 }
 
-bool set_memory_budget(const std::string& size) {
-    std::uint64_t bytes = default_max_memory();
-    if (!size.empty() && (bytes = parse_memory(size)) == 0) {
-        std::cerr << "plant: " << memory_usage_error(size) << "\n";
-        return false;
-    }
-    memory::set_limit(bytes);
-    return true;
+void set_memory_budget(std::uint64_t bytes) {
+    memory::set_limit(bytes ? bytes : default_max_memory());
 }
 
 void add_allow_read(CLI::App& cmd, std::vector<std::string>& dirs) {
@@ -199,10 +203,10 @@ DeriveOptions derive_options(const GrammarOptions& o) {
         o.threads > 0 ? o.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     d.max_modules = o.max_modules;
     d.max_steps = o.max_steps;
+    d.max_work = o.max_work;
     // the strings' estimate (rewrite/engine.cpp) takes half of --max-memory: a step holds the
     // string it reads and the one it writes
-    if (const std::uint64_t budget = o.max_memory.empty() ? 0 : parse_memory(o.max_memory))
-        d.max_bytes = std::min<std::uint64_t>(d.max_bytes, budget / 2);
+    if (o.max_memory) d.max_bytes = std::min<std::uint64_t>(d.max_bytes, o.max_memory / 2);
     return d;
 }
 

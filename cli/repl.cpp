@@ -31,6 +31,7 @@ DeriveOptions Session::options() const {
     o.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     o.interrupt = interrupt_;
     o.max_steps = max_steps_;
+    o.max_work = max_work_;
     if (max_modules_ > 0) o.max_modules = max_modules_;
     static TurtleEnvironmentPhase phase;
     o.environment_phase = &phase;
@@ -127,7 +128,8 @@ bool Session::rebuild(int steps, const std::string* extra_fn) {
         }
     } catch (const RuntimeError& e) {
         error() << render(Diagnostic{Severity::Error, e.span, e.message, {}}, *sources, color_);
-        if (e.kind == RuntimeErrorKind::ModuleLimit && !history_.empty() && !extra_fn)
+        if ((e.kind == RuntimeErrorKind::ModuleLimit || e.kind == RuntimeErrorKind::WorkLimit) &&
+            !history_.empty() && !extra_fn)
             error() << fmt::format("not changed; still at step {}: {}\n", current().steps_done(),
                                    modules(current().string().size()));
         last_error_runtime_ = true;
@@ -190,12 +192,14 @@ bool Session::step(int n) {
         try {
             // the copy charges the memory budget too: past it, the session stays at this step
             next = std::make_unique<Derivation>(current());
+            if (k == 0) next->reset_work(); // each command starts a fresh --max-work budget
             next->step();
         } catch (const RuntimeError& e) {
             error() << render(Diagnostic{Severity::Error, e.span, e.message, {}}, *sources_, color_);
             if (e.kind == RuntimeErrorKind::Interrupted)
                 error() << fmt::format("interrupted; still at step {}\n", current().steps_done());
-            else if (e.kind == RuntimeErrorKind::ModuleLimit || e.kind == RuntimeErrorKind::Memory)
+            else if (e.kind == RuntimeErrorKind::ModuleLimit || e.kind == RuntimeErrorKind::Memory ||
+                     e.kind == RuntimeErrorKind::WorkLimit)
                 error() << fmt::format("still at step {}: {}\n", current().steps_done(),
                                        modules(current().string().size()));
             return false;

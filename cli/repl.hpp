@@ -63,6 +63,7 @@ class Session {
     // --allow-read: folders the grammar may read besides its own (file_access.hpp)
     void allow_read(std::vector<std::string> dirs) { allow_read_ = std::move(dirs); }
     void set_max_steps(std::uint64_t n) { max_steps_ = n; }   // --max-steps
+    void set_max_work(std::uint64_t n) { max_work_ = n; }     // --max-work: each command's budget
     void set_max_modules(std::size_t n) { max_modules_ = n; } // --max-modules; 0: the default
     int load(const std::string& path); // :load; 0, or the exit code of the failure (65, 66, 70)
     // Whether some line since the last call reported an error (scripts exit 1 when one did).
@@ -136,6 +137,7 @@ class Session {
     bool color_;
     const std::atomic<bool>* interrupt_ = nullptr;
     std::uint64_t max_steps_ = kDefaultMaxSteps;
+    std::uint64_t max_work_ = kDefaultMaxWork;
     std::size_t max_modules_ = 0;
 
     std::vector<std::string> allow_read_;       // --allow-read
@@ -172,6 +174,7 @@ class Session {
 };
 
 int repl_main(const std::string& file, bool color, const std::vector<std::string>& allow_read = {},
-              std::uint64_t max_steps = kDefaultMaxSteps, std::size_t max_modules = 0);
+              std::uint64_t max_steps = kDefaultMaxSteps, std::size_t max_modules = 0,
+              std::uint64_t max_work = kDefaultMaxWork);
 
 } // namespace plant::cli

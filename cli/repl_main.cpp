@@ -121,11 +121,12 @@ int read_script(Session& session, bool prompt) {
 } // namespace
 
 int repl_main(const std::string& file, bool color, const std::vector<std::string>& allow_read,
-              std::uint64_t max_steps, std::size_t max_modules) {
+              std::uint64_t max_steps, std::size_t max_modules, std::uint64_t max_work) {
     const bool interactive = isatty(0) != 0;
     Session session(std::cout, std::cerr, color && interactive);
     session.allow_read(allow_read);
     session.set_max_steps(max_steps);
+    session.set_max_work(max_work);
     session.set_max_modules(max_modules);
     // (before the grammar is loaded: the derivation made then keeps the flag for its steps)
     if (interactive) session.set_interrupt(&g_interrupt);
@@ -179,7 +180,8 @@ void setup_repl(CLI::App& app, int& exit_code) {
     auto file = std::make_shared<std::string>();
     auto max_steps = std::make_shared<std::uint64_t>(kDefaultMaxSteps);
     auto max_modules = std::make_shared<std::size_t>(0);
-    auto max_memory = std::make_shared<std::string>();
+    auto max_work = std::make_shared<std::uint64_t>(kDefaultMaxWork);
+    auto max_memory = std::make_shared<std::uint64_t>(0);
     CLI::App* cmd =
         app.add_subcommand("repl", "An interactive session: step a derivation, inspect the string, change "
                                    "rules and params, look at the plant");
@@ -197,16 +199,14 @@ void setup_repl(CLI::App& app, int& exit_code) {
                     "Stop a step with an error when the string grows past this many modules (the session "
                     "stays at the step before)")
         ->check(CLI::PositiveNumber);
+    add_max_work(*cmd, *max_work, "one command (a :step, a re-derivation after an edit)");
     add_max_memory(*cmd, *max_memory);
     cmd->footer("Reads commands from standard input without a prompt when it is not a terminal:\n"
                 "  plant repl grammar.plant < script");
-    cmd->callback([file, allow, max_steps, max_modules, max_memory, &exit_code] {
-        if (!set_memory_budget(*max_memory)) {
-            exit_code = kUsage;
-            return;
-        }
-        exit_code =
-            repl_main(*file, isatty(2) != 0 && !std::getenv("NO_COLOR"), *allow, *max_steps, *max_modules);
+    cmd->callback([file, allow, max_steps, max_modules, max_work, max_memory, &exit_code] {
+        set_memory_budget(*max_memory);
+        exit_code = repl_main(*file, isatty(2) != 0 && !std::getenv("NO_COLOR"), *allow, *max_steps,
+                              *max_modules, *max_work);
     });
 }
 

@@ -56,6 +56,24 @@ ModuleId Derivation::next_id() const {
     return engine_->next_id;
 }
 
+std::uint64_t Derivation::work_done() const {
+    return engine_->work;
+}
+
+void Derivation::reset_work() {
+    engine_->work = 0;
+}
+
+void Derivation::limit_work(EvalEnv& env) const {
+    env.max_work = opt_.max_work;
+    env.work_limit = opt_.max_work - std::min(opt_.max_work, engine_->work);
+}
+
+void Derivation::charge_work(const EvalEnv& env) {
+    engine_->work += env.work;
+    if (engine_->work > opt_.max_work) throw_work_limit(opt_.max_work);
+}
+
 ModuleString Derivation::interpreted(const ModuleString& s) const {
     return engine_->interpreted(*this, s);
 }
@@ -82,9 +100,11 @@ void Derivation::run_hook(HookKind kind) {
     env.max_steps = opt_.max_steps;
     env.interrupt = opt_.interrupt;
     if (opt_.on_print) effects.on_print = &opt_.on_print; // each line as it is printed
+    limit_work(env);
     std::vector<double> frame(std::max<std::size_t>(prog_.hook_frame[k], 1));
     try {
         plant::run(prog_.hooks[k], frame.data(), env);
+        charge_work(env);
     } catch (RuntimeError& e) {
         e.step = step_;
         e.message = fmt::format("step {}, on {}: {}", step_, ast::spelling(kind), e.message);
@@ -112,6 +132,8 @@ EvalEnv settings_env(Derivation& d, const Program& prog) {
     env.globals = d.globals().data();
     env.max_steps = d.options().max_steps;
     env.interrupt = d.options().interrupt;
+    env.max_work = d.options().max_work;
+    env.work_limit = d.options().max_work; // (start() counts from zero)
     return env;
 }
 
@@ -151,9 +173,11 @@ void Derivation::evaluate_settings() {
         throw RuntimeError{
             RuntimeErrorKind::Setting, where(Key::WidthScale),
             fmt::format("width_scale must be a number above 0 and at most 1000000, found {}", width_scale_)};
+    engine_->work += env.work; // (each setting is bounded by --max-steps alone)
 }
 
 void Derivation::start() {
+    engine_->work = 0;
     evaluate_settings();
     EvalEnv env = settings_env(*this, prog_);
     step_ = 0;
@@ -174,6 +198,8 @@ void Derivation::start() {
     try {
         plant::run(prog_.axiom, nullptr, env);
         commit_graph();
+        env.work += axiom.size(); // the axiom's modules are written too
+        charge_work(env);
     } catch (const RuntimeError& e) {
         if (e.kind == RuntimeErrorKind::ModuleLimit) engine_->check_limits(*this, axiom);
         throw;

@@ -54,6 +54,25 @@ std::size_t utf8_length(std::string_view s, std::size_t i) {
 
 namespace {
 
+// The code point of the well-formed UTF-8 sequence of `n` bytes at s[i].
+char32_t code_point(std::string_view s, std::size_t i, std::size_t n) {
+    const auto at = [&](std::size_t k) { return static_cast<unsigned char>(s[i + k]); };
+    char32_t cp = n == 2 ? at(0) & 0x1fu : n == 3 ? at(0) & 0x0fu : at(0) & 0x07u;
+    for (std::size_t k = 1; k < n; ++k) cp = (cp << 6) | (at(k) & 0x3fu);
+    return cp;
+}
+
+// Characters that are not shown but change what is: the C1 controls (U+0080 to U+009F, the
+// terminal's 8-bit escapes) and Unicode's format characters that reorder or hide text (zero
+// width spaces and joiners, the marks U+200E and U+200F, the bidirectional embeddings,
+// overrides and isolates U+202A to U+202E and U+2066 to U+2069, the invisible operators
+// U+2060 to U+2064, the byte-order mark U+FEFF): a right-to-left override in a file name
+// would make a message read backwards (the "Trojan Source" attack, Boucher and Anderson 2021).
+bool hidden_format(char32_t c) {
+    return (c >= 0x80 && c <= 0x9f) || (c >= 0x200b && c <= 0x200f) || (c >= 0x202a && c <= 0x202e) ||
+           (c >= 0x2060 && c <= 0x2064) || (c >= 0x2066 && c <= 0x2069) || c == 0xfeff;
+}
+
 // Replaces control bytes and bytes that are not UTF-8 so that binary garbage in a source line
 // cannot mangle the terminal; tabs become a space so the caret lines up. A well-formed UTF-8
 // character (a '→' or 'ω' typed from a book) is kept. `cols` receives, for each byte, the
@@ -66,7 +85,11 @@ std::string printable(std::string_view s, std::vector<std::size_t>& cols) {
     for (std::size_t i = 0; i < s.size();) {
         const auto c = static_cast<unsigned char>(s[i]);
         std::size_t n = c >= 0x80 ? utf8_length(s, i) : 0;
-        if (n > 0) {
+        if (n > 0 && hidden_format(code_point(s, i, n))) { // shown as one '?'
+            out += '?';
+            cols.insert(cols.end(), n, col);
+            i += n;
+        } else if (n > 0) {
             out.append(s.substr(i, n));
             cols.insert(cols.end(), n, col);
             i += n;
@@ -139,9 +162,9 @@ std::string escape_controls(std::string_view text, bool keep_lines) {
         if (n == 0) {
             out += fmt::format("\\x{:02x}", c);
             ++i;
-        } else if (n == 2 && c == 0xc2 && static_cast<unsigned char>(text[i + 1]) < 0xa0) {
-            out += fmt::format("\\u{:04x}", static_cast<unsigned char>(text[i + 1])); // a C1 control
-            i += 2;
+        } else if (const char32_t cp = code_point(text, i, n); hidden_format(cp)) {
+            out += fmt::format("\\u{:04x}", static_cast<std::uint32_t>(cp)); // a C1 control, a bidi override
+            i += n;
         } else {
             out.append(text.substr(i, n));
             i += n;

@@ -9,7 +9,6 @@
 #include <chrono>
 #include <cstdio>
 #include <limits>
-#include <mutex>
 #include <unistd.h>
 #include <utility>
 
@@ -19,8 +18,10 @@ namespace {
 
 std::atomic<std::uint64_t> g_limit{0};
 std::atomic<std::uint64_t> g_charged{0};
-std::mutex g_stage_mutex;
-std::string g_stage = "the derivation";
+// What this thread is doing, owned by the innermost Stage (or InStage) alive on it; null: the
+// derivation. Per thread, so that commands running side by side (the view server's requests,
+// --jobs variants) each name their own stage.
+thread_local const std::string* t_stage = nullptr;
 
 std::string megabytes(double bytes) {
     return fmt::format("{:.0f} MB", bytes / double(1 << 20));
@@ -59,19 +60,28 @@ void release(std::size_t bytes) noexcept {
     g_charged.fetch_sub(bytes, std::memory_order_relaxed);
 }
 
-Stage::Stage(std::string what) {
-    std::lock_guard lock(g_stage_mutex);
-    previous_ = std::exchange(g_stage, std::move(what));
+Stage::Stage(std::string what) : what_(std::move(what)), previous_(t_stage) {
+    t_stage = &what_;
 }
 
 Stage::~Stage() {
-    std::lock_guard lock(g_stage_mutex);
-    g_stage = std::move(previous_);
+    t_stage = previous_;
+}
+
+const std::string* Stage::current() noexcept {
+    return t_stage;
+}
+
+InStage::InStage(const std::string* stage) noexcept : previous_(t_stage) {
+    t_stage = stage;
+}
+
+InStage::~InStage() {
+    t_stage = previous_;
 }
 
 std::string stage() {
-    std::lock_guard lock(g_stage_mutex);
-    return g_stage;
+    return t_stage ? *t_stage : std::string("the derivation");
 }
 
 void Reservation::resize(std::size_t bytes) {

@@ -214,6 +214,8 @@ std::string format_number(double v) {
 [[gnu::noinline]] std::int64_t next_slice(const Code& code, std::size_t pc, EvalEnv& env) {
     if (env.interrupt && env.interrupt->load(std::memory_order_relaxed))
         fail(code, pc, "interrupted", RuntimeErrorKind::Interrupted);
+    // (the slices handed out so far are used up: this evaluation ran max_steps - steps_left)
+    if (env.work + (env.max_steps - env.steps_left) > env.work_limit) throw_work_limit(env.max_work);
     if (env.steps_left == 0) {
         std::string where = env.function >= 0
                                 ? fmt::format(" (in function '{}')", env.prog->functions[env.function].name)
@@ -249,7 +251,18 @@ RunStatus run(const Code& code, double* frame, EvalEnv& env, double* result) {
     env.slice = static_cast<std::int64_t>(std::min<std::uint64_t>(env.max_steps, kStepSlice));
     env.steps_left = env.max_steps - static_cast<std::uint64_t>(env.slice);
     env.function = -1;
-    return execute(code, frame, env, result);
+    RunStatus status = execute(code, frame, env, result);
+    // every instruction took one from the slice or the steps left
+    env.work += env.max_steps - env.steps_left - static_cast<std::uint64_t>(env.slice);
+    if (env.work > env.work_limit) throw_work_limit(env.max_work);
+    return status;
+}
+
+void throw_work_limit(std::uint64_t max_work) {
+    throw RuntimeError{RuntimeErrorKind::WorkLimit, Span{},
+                       fmt::format("the run did more than {} units of work (VM instructions and modules "
+                                   "written, --max-work): raise --max-work",
+                                   max_work)};
 }
 
 namespace {

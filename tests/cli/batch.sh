@@ -7,33 +7,8 @@ plant=$(realpath "${1:?usage: batch.sh PLANT}")
 here=$(cd "$(dirname "$0")" && pwd)
 bush=$here/batch/bush.plant
 unlucky=$here/batch/unlucky.plant
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+. "$here/checks.sh"
 cd "$tmp" || exit 1
-pass=0
-fail=0
-
-ok() { pass=$((pass + 1)); }
-bad() {
-  fail=$((fail + 1))
-  echo "FAIL $*"
-}
-check() { # check NAME EXPECTED_EXIT COMMAND... ; output saved in stdout and stderr
-  local name=$1 want=$2
-  shift 2
-  "$@" >stdout 2>stderr
-  local got=$?
-  if [ "$got" -eq "$want" ]; then ok; else
-    bad "$name: exit $got, expected $want"
-    sed 's/^/  /' stderr | head -5
-  fi
-}
-contains() { # contains NAME FILE TEXT
-  if grep -qF -- "$3" "$2"; then ok; else
-    bad "$1: '$3' not in $2"
-    sed 's/^/  /' "$2" | head -5
-  fi
-}
 same() { # same NAME FILE1 FILE2
   if cmp -s "$2" "$3"; then ok; else
     bad "$1: $2 and $3 differ"

@@ -23,6 +23,11 @@ contains() { # contains NAME FILE TEXT
     sed 's/^/  /' "$2" | head -10
   fi
 }
+holds() { # holds NAME COMMAND... : the command succeeds
+  local name=$1
+  shift
+  if "$@"; then ok; else bad "$name"; fi
+}
 lacks() { # lacks NAME FILE TEXT
   if ! grep -qF -- "$3" "$2"; then ok; else
     bad "$1: '$3' in $2"

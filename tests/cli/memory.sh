@@ -86,5 +86,20 @@ for good in 1M 1024K 1.5G 2g 1048576; do
   check "--max-memory $good is a size" 0 "$plant" check --max-memory "$good" "$tmp/tiny.plant"
 done
 
+# with --seeds, --max-memory bounds the process: each of the --jobs J variants has a 1/J share
+# (docs/batch.md). A 2^20-module string with a parameter (about 20 MB) fits the 32 MB its string
+# may take on one job of 64M, not the 16 MB of a half share on two jobs.
+cat >"$tmp/share.plant" <<'G'
+derive 20;
+axiom: A(20);
+rules { A(n) : n > 0 -> A(n - 1) A(n - 1); }
+G
+check "one job has the whole --max-memory" 0 "$plant" run "$tmp/share.plant" --seeds 1..2 --jobs 1 \
+  --max-memory 64M -o "$tmp/one_{seed}.txt"
+check "two jobs have half of it each" 1 "$plant" run "$tmp/share.plant" --seeds 1..2 --jobs 2 \
+  --max-memory 64M -o "$tmp/two_{seed}.txt"
+contains "a variant's share is named" "$tmp/stderr" "more than the 16 MB it may take"
+contains "and what to do" "$tmp/stderr" "with --jobs 2 each variant has a 1/2 share of --max-memory: lower --jobs or raise --max-memory"
+
 echo "memory: $pass passed, $fail failed"
 [ $fail -eq 0 ]

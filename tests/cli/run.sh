@@ -3,39 +3,11 @@
 # unreadable input, and exit codes.
 set -u
 plant=$(realpath "${1:?usage: run.sh PLANT}")
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-pass=0
-fail=0
-
-check() { # check NAME EXPECTED_EXIT COMMAND... ; output saved in $tmp/stdout and $tmp/stderr
-  local name=$1 want=$2
-  shift 2
-  "$@" >"$tmp/stdout" 2>"$tmp/stderr"
-  local got=$?
-  if [ "$got" -eq "$want" ]; then pass=$((pass + 1)); else
-    fail=$((fail + 1))
-    echo "FAIL $name: exit $got, expected $want"
-    sed 's/^/  /' "$tmp/stderr" | head -5
-  fi
-}
-lacks() { # lacks NAME FILE TEXT
-  if ! grep -qF -- "$3" "$2"; then pass=$((pass + 1)); else
-    fail=$((fail + 1))
-    echo "FAIL $1: '$3' in output"
-  fi
-}
+. "$(dirname "$0")/checks.sh"
 differ() { # differ NAME FILE1 FILE2
   if ! cmp -s "$2" "$3"; then pass=$((pass + 1)); else
     fail=$((fail + 1))
     echo "FAIL $1: $2 and $3 are the same"
-  fi
-}
-contains() { # contains NAME FILE TEXT
-  if grep -qF -- "$3" "$2"; then pass=$((pass + 1)); else
-    fail=$((fail + 1))
-    echo "FAIL $1: '$3' not in output"
-    sed 's/^/  /' "$2" | head -5
   fi
 }
 

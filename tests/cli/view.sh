@@ -5,19 +5,14 @@
 set -uo pipefail
 plant="$1"
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
-tmp=$(mktemp -d)
+. "$(dirname "${BASH_SOURCE[0]}")/checks.sh"
 pids=()
 trap 'for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done; rm -rf "$tmp"' EXIT
-fail=0
-check() { # check NAME COND...
-    local name="$1"; shift
-    if "$@"; then echo "ok - $name"; else echo "not ok - $name"; fail=1; fi
-}
 
 "$plant" view --help > "$tmp/help" 2>&1
-check "--help lists --port and --open" grep -q -- "--open" "$tmp/help"
+holds "--help lists --port and --open" grep -q -- "--open" "$tmp/help"
 "$plant" view "$tmp/missing.plant" --port 0 > /dev/null 2> "$tmp/err"; code=$?
-check "a missing grammar is exit 66" test "$code" = 66
+holds "a missing grammar is exit 66" test "$code" = 66
 
 cp "$root/grammars/abop/fig1_24a.plant" "$tmp/g.plant"
 mkdir "$tmp/scratch"
@@ -26,7 +21,7 @@ pid=$!; pids+=("$pid")
 for _ in $(seq 50); do grep -qs "http://" "$tmp/out" && break; sleep 0.1; done
 url=$(grep -o 'http://127.0.0.1:[0-9]*/' "$tmp/out")
 port=${url#http://127.0.0.1:}; port=${port%/}
-check "prints the URL on 127.0.0.1" test -n "$url"
+holds "prints the URL on 127.0.0.1" test -n "$url"
 status() { curl -s -o /dev/null -w '%{http_code}' "$@"; }
 # eventually CMD...: whether CMD succeeds within 10 s (tried every 50 ms)
 eventually() {
@@ -34,19 +29,19 @@ eventually() {
     return 1
 }
 state_has() { curl -s "${url}api/state" | grep -q "$@"; }
-check "serves the page" test "$(status "$url")" = 200
-check "the page loads its script" grep -q 'src="/viewer.js"' <(curl -s "$url")
-check "serves three.js" test "$(status "${url}three/three.module.js")" = 200
-check "serves the model as GLB" test "$(curl -s "${url}api/model.glb" | head -c 4)" = glTF
-check "a foreign Host is refused" test "$(status -H "Host: attacker.example:$port" "$url")" = 403
-check "a foreign Origin is refused" test "$(status -H "Origin: http://attacker.example" "${url}api/state")" = 403
-check "a path with .. is refused" test "$(status --path-as-is "${url}../../etc/passwd")" = 400
-check "an encoded .. is refused" test "$(status --path-as-is "${url}%2e%2e/%2e%2e/etc/passwd")" = 400
-check "a file system path is not served" test "$(status "${url}etc/passwd")" = 404
-check "only declared params may be set" test "$(status -X POST -d '{"params":{"nope":1}}' "${url}api/controls")" = 400
-check "a malformed request is refused" test "$(status -X POST -d 'run rm -rf /' "${url}api/controls")" = 400
-check "the seed must be digits" test "$(status -X POST -d '{"seed":"1;ls"}' "${url}api/controls")" = 400
-check "a huge request is refused" test "$(head -c 200000 /dev/zero | tr '\0' 'x' | curl -s -o /dev/null -w '%{http_code}' -X POST --data-binary @- "${url}api/controls")" = 413
+holds "serves the page" test "$(status "$url")" = 200
+holds "the page loads its script" grep -q 'src="/viewer.js"' <(curl -s "$url")
+holds "serves three.js" test "$(status "${url}three/three.module.js")" = 200
+holds "serves the model as GLB" test "$(curl -s "${url}api/model.glb" | head -c 4)" = glTF
+holds "a foreign Host is refused" test "$(status -H "Host: attacker.example:$port" "$url")" = 403
+holds "a foreign Origin is refused" test "$(status -H "Origin: http://attacker.example" "${url}api/state")" = 403
+holds "a path with .. is refused" test "$(status --path-as-is "${url}../../etc/passwd")" = 400
+holds "an encoded .. is refused" test "$(status --path-as-is "${url}%2e%2e/%2e%2e/etc/passwd")" = 400
+holds "a file system path is not served" test "$(status "${url}etc/passwd")" = 404
+holds "only declared params may be set" test "$(status -X POST -d '{"params":{"nope":1}}' "${url}api/controls")" = 400
+holds "a malformed request is refused" test "$(status -X POST -d 'run rm -rf /' "${url}api/controls")" = 400
+holds "the seed must be digits" test "$(status -X POST -d '{"seed":"1;ls"}' "${url}api/controls")" = 400
+holds "a huge request is refused" test "$(head -c 200000 /dev/zero | tr '\0' 'x' | curl -s -o /dev/null -w '%{http_code}' -X POST --data-binary @- "${url}api/controls")" = 413
 v0=$(curl -s "${url}api/state" | grep -o '"version":[0-9]*')
 m0=$(curl -s "${url}api/state" | grep -o '"modules":\[[0-9,]*\]')
 sed -i 's/derive 5;/derive 3;/; s/^derive .*/derive 3;/' "$tmp/g.plant"
@@ -56,24 +51,24 @@ for _ in $(seq 200); do
     [ "$m" != "$m0" ] && { seen=1; break; }
     sleep 0.05
 done
-check "a save derives again (within 10 s here; the browser test holds it to 2 s) ($v0; $m0 -> $m)" test -n "$seen"
-check "the seed set on the page derives again" test "$(status -X POST -d '{"params":{},"seed":"7"}' "${url}api/controls")" = 200
+holds "a save derives again (within 10 s here; the browser test holds it to 2 s) ($v0; $m0 -> $m)" test -n "$seen"
+holds "the seed set on the page derives again" test "$(status -X POST -d '{"params":{},"seed":"7"}' "${url}api/controls")" = 200
 # a param's range (`param n = 3 in 1 .. 8;`) reaches the page, and a value outside it is an error
 printf 'param n = 3 in 1 .. 8;\naxiom: A(n);\nderive 4;\nrules { A(x) : x > 0 -> F A(x - 1); }\n' > "$tmp/g.plant"
-check "a param's range is in the state" eventually state_has '"high":8.0,"low":1.0,"name":"n"\|"low":1.0,"name":"n"'
-check "a value outside the range is accepted as a request" test "$(status -X POST -d '{"params":{"n":9}}' "${url}api/controls")" = 200
-check "and derives to an error naming the range" eventually state_has "outside its range 1 .. 8"
-check "an edit names an environment the grammar declares" grep -q "no environment 'ivy'" <(curl -s -X POST -d '{"step":1,"env":"ivy","method":"cut","args":[3]}' "${url}api/edit")
-check "an edit is a call, not source text" test "$(status -X POST -d '{"step":1,"call":"ivy.cut(3); system()"}' "${url}api/edit")" = 400
-check "undo without an edit is refused" test "$(status -X POST -d '{"undo":true}' "${url}api/edit")" = 400
-check "the export's scratch folder is under TMPDIR" test "$(ls "$tmp/scratch" | wc -l)" = 1
+holds "a param's range is in the state" eventually state_has '"high":8.0,"low":1.0,"name":"n"\|"low":1.0,"name":"n"'
+holds "a value outside the range is accepted as a request" test "$(status -X POST -d '{"params":{"n":9}}' "${url}api/controls")" = 200
+holds "and derives to an error naming the range" eventually state_has "outside its range 1 .. 8"
+holds "an edit names an environment the grammar declares" grep -q "no environment 'ivy'" <(curl -s -X POST -d '{"step":1,"env":"ivy","method":"cut","args":[3]}' "${url}api/edit")
+holds "an edit is a call, not source text" test "$(status -X POST -d '{"step":1,"call":"ivy.cut(3); system()"}' "${url}api/edit")" = 400
+holds "undo without an edit is refused" test "$(status -X POST -d '{"undo":true}' "${url}api/edit")" = 400
+holds "the export's scratch folder is under TMPDIR" test "$(ls "$tmp/scratch" | wc -l)" = 1
 "$plant" view "$tmp/g.plant" --port "$port" > /dev/null 2> "$tmp/err2"; code=$?
-check "a port in use is exit 70 with advice" test "$code" = 70 -a -n "$(grep -- '--port 0' "$tmp/err2")"
+holds "a port in use is exit 70 with advice" test "$code" = 70 -a -n "$(grep -- '--port 0' "$tmp/err2")"
 kill -INT "$pid"
 for _ in $(seq 40); do kill -0 "$pid" 2>/dev/null || break; sleep 0.05; done
 wait "$pid"; code=$?
-check "Ctrl-C stops it cleanly (exit 0)" test "$code" = 0
-check "and removes its scratch folder" test "$(ls "$tmp/scratch" | wc -l)" = 0
+holds "Ctrl-C stops it cleanly (exit 0)" test "$code" = 0
+holds "and removes its scratch folder" test "$(ls "$tmp/scratch" | wc -l)" = 0
 
 # picking (/api/pick): a bonsai branch's segment names the branch's graph node, not the root's
 "$plant" view "$root/grammars/bonsai/chokkan.plant" --port 0 > "$tmp/out2" 2>&1 &
@@ -81,12 +76,12 @@ pid=$!; pids+=("$pid")
 for _ in $(seq 100); do grep -qs "http://" "$tmp/out2" && break; sleep 0.1; done
 url=$(grep -o 'http://127.0.0.1:[0-9]*/' "$tmp/out2")
 curl -s "${url}api/pick?kind=tube&x=0&y=0.1&z=0" > "$tmp/trunk.json"
-check "a click on the trunk is the root node" grep -q '"node":{"by":"axis","path":"/",' "$tmp/trunk.json"
+holds "a click on the trunk is the root node" grep -q '"node":{"by":"axis","path":"/",' "$tmp/trunk.json"
 curl -s "${url}api/pick?kind=tube&x=0.11&y=0.49&z=0.02" > "$tmp/branch.json"
-check "a click on a branch is the branch's node" grep -q '"node":{"by":"axis","path":"/0\.[0-9]*",' "$tmp/branch.json"
-check "a pick needs three finite numbers" test "$(status "${url}api/pick?x=nan&y=0&z=0")" = 400
-check "an organ pick needs its placement" test "$(status "${url}api/pick?kind=organ&x=0&y=0&z=0")" = 400
-check "a pick's kind is tube or organ" test "$(status "${url}api/pick?kind=file&x=0&y=0&z=0")" = 400
+holds "a click on a branch is the branch's node" grep -q '"node":{"by":"axis","path":"/0\.[0-9]*",' "$tmp/branch.json"
+holds "a pick needs three finite numbers" test "$(status "${url}api/pick?x=nan&y=0&z=0")" = 400
+holds "an organ pick needs its placement" test "$(status "${url}api/pick?kind=organ&x=0&y=0&z=0")" = 400
+holds "a pick's kind is tube or organ" test "$(status "${url}api/pick?kind=file&x=0&y=0&z=0")" = 400
 kill -INT "$pid"; wait "$pid"
 
 # a climber edit at the last step derives one step more; a shorter grammar then is not lengthened
@@ -100,14 +95,14 @@ pid=$!; pids+=("$pid")
 for _ in $(seq 100); do grep -qs "http://" "$tmp/out3" && break; sleep 0.1; done
 url=$(grep -o 'http://127.0.0.1:[0-9]*/' "$tmp/out3")
 steps_of() { curl -s "${url}api/state" | python3 -c 'import json, sys; print(len(json.load(sys.stdin)["modules"]) - 1)'; }
-check "the climber derives its 6 steps" test "$(steps_of)" = 6
+holds "the climber derives its 6 steps" test "$(steps_of)" = 6
 curl -s -X POST -d '{"step":6,"env":"ivy","method":"wind","args":[[3, 0, 0]]}' "${url}api/edit" > "$tmp/edit.json"
-check "an edit at the last step derives one step more" grep -q '"command":"plant run [^"]* -n 7"' "$tmp/edit.json"
-check "a step past the last is refused" test "$(status -X POST -d '{"step":9,"env":"ivy","method":"cut","args":[3]}' "${url}api/edit")" = 400
-check "a fractional step is refused" test "$(status -X POST -d '{"step":2.5,"env":"ivy","method":"cut","args":[3]}' "${url}api/edit")" = 400
-check "args must be a list" test "$(status -X POST -d '{"step":2,"env":"ivy","method":"cut","args":{"a":3}}' "${url}api/edit")" = 400
+holds "an edit at the last step derives one step more" grep -q '"command":"plant run [^"]* -n 7"' "$tmp/edit.json"
+holds "a step past the last is refused" test "$(status -X POST -d '{"step":9,"env":"ivy","method":"cut","args":[3]}' "${url}api/edit")" = 400
+holds "a fractional step is refused" test "$(status -X POST -d '{"step":2.5,"env":"ivy","method":"cut","args":[3]}' "${url}api/edit")" = 400
+holds "args must be a list" test "$(status -X POST -d '{"step":2,"env":"ivy","method":"cut","args":{"a":3}}' "${url}api/edit")" = 400
 sed -i 's/steps = 6/steps = 4/' "$tmp/cl.plant"
 four_steps() { [ "$(steps_of)" = 4 ]; }
-check "a shorter grammar after it is not lengthened" eventually four_steps
+holds "a shorter grammar after it is not lengthened" eventually four_steps
 kill -INT "$pid"; wait "$pid"
-exit $fail
+[ "$fail" -eq 0 ]

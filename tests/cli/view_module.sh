@@ -11,52 +11,47 @@ plant="$1"
 build=$(dirname "$plant")
 module="$build/plant-view-server.so"
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
-tmp=$(realpath "$(mktemp -d)")
+. "$(dirname "${BASH_SOURCE[0]}")/checks.sh"
 pids=()
 trap 'for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done; rm -rf "$tmp"' EXIT
-fail=0
-check() { # check NAME COND...
-    local name="$1"; shift
-    if "$@"; then echo "ok - $name"; else echo "not ok - $name"; fail=1; fi
-}
 lacks() { ! grep -q "$@"; }
 
 readelf -d "$plant" > "$tmp/needed" || fail=1
 ldd "$plant" > "$tmp/ldd" || fail=1
 for lib in libcpp-httplib libssl libcrypto libbrotli; do
-    check "plant does not link $lib" lacks "$lib" "$tmp/needed"
-    check "plant loads no $lib at start" lacks "$lib" "$tmp/ldd"
+    holds "plant does not link $lib" lacks "$lib" "$tmp/needed"
+    holds "plant loads no $lib at start" lacks "$lib" "$tmp/ldd"
 done
-check "the module is built beside plant" test -f "$module"
+holds "the module is built beside plant" test -f "$module"
 readelf -d "$module" > "$tmp/module-needed" || fail=1
-check "the module links cpp-httplib" grep -q 'NEEDED.*libcpp-httplib' "$tmp/module-needed"
+holds "the module links cpp-httplib" grep -q 'NEEDED.*libcpp-httplib' "$tmp/module-needed"
 nm -D --defined-only "$module" | awk '$2 ~ /^[TtWDBRV]$/ { print $3 }' > "$tmp/exports"
-check "the module exports its entry point" grep -qx 'plant_view_http_serve_v1' "$tmp/exports"
-check "and nothing else of its own ($(tr '\n' ' ' < "$tmp/exports"))" test "$(grep -vc -e '^_init$' -e '^_fini$' "$tmp/exports")" = 1
+holds "the module exports its entry point" grep -qx 'plant_view_http_serve_v1' "$tmp/exports"
+holds "and nothing else of its own ($(tr '\n' ' ' < "$tmp/exports"))" test "$(grep -vc -e '^_init$' -e '^_fini$' "$tmp/exports")" = 1
 
 printf 'axiom: F;\nderive 1;\n' > "$tmp/g.plant"
 # without the module: everything but view works; view fails before doing any work
 mkdir -p "$tmp/alone/bin"
 cp "$plant" "$tmp/alone/bin/"
-check "a plant without the module still checks" "$tmp/alone/bin/plant" check "$tmp/g.plant"
+holds "a plant without the module still checks" "$tmp/alone/bin/plant" check "$tmp/g.plant"
 "$tmp/alone/bin/plant" view "$tmp/g.plant" --port 0 > "$tmp/out" 2> "$tmp/err"; code=$?
-check "view without the module is exit 66 (got $code)" test "$code" = 66
-check "it says the module is missing" grep -q "needs its HTTP server module, which is missing" "$tmp/err"
-check "naming the install's place" grep -qF "'$tmp/alone/lib/plant/plant-view-server.so'" "$tmp/err"
-check "and the program's folder" grep -qF "'$tmp/alone/bin/plant-view-server.so'" "$tmp/err"
-check "and serves nothing" test ! -s "$tmp/out"
+holds "view without the module is exit 66 (got $code)" test "$code" = 66
+holds "it says the module is missing" grep -q "needs its HTTP server module, which is missing" "$tmp/err"
+holds "naming the install's place" grep -qF "'$tmp/alone/lib/plant/plant-view-server.so'" "$tmp/err"
+holds "and the program's folder" grep -qF "'$tmp/alone/bin/plant-view-server.so'" "$tmp/err"
+holds "and serves nothing" test ! -s "$tmp/out"
 
 # a file of that name that is not a loadable module, or a library without the entry point: 70
 mkdir -p "$tmp/alone/lib/plant"
 echo "not a library" > "$tmp/alone/lib/plant/plant-view-server.so"
 "$tmp/alone/bin/plant" view "$tmp/g.plant" --port 0 > /dev/null 2> "$tmp/err"; code=$?
-check "an unloadable module is exit 70 (got $code)" test "$code" = 70
-check "it says why it cannot load it" grep -q "cannot load plant view's HTTP server module '$tmp/alone/lib/plant/plant-view-server.so'" "$tmp/err"
+holds "an unloadable module is exit 70 (got $code)" test "$code" = 70
+holds "it says why it cannot load it" grep -q "cannot load plant view's HTTP server module '$tmp/alone/lib/plant/plant-view-server.so'" "$tmp/err"
 other=$(ldd "$plant" | awk '/libfmt/ { print $3 }')
 cp "$other" "$tmp/alone/lib/plant/plant-view-server.so"
 "$tmp/alone/bin/plant" view "$tmp/g.plant" --port 0 > /dev/null 2> "$tmp/err"; code=$?
-check "a library without the entry point is exit 70 (got $code)" test "$code" = 70
-check "it names the entry point" grep -q "it has no plant_view_http_serve_v1" "$tmp/err"
+holds "a library without the entry point is exit 70 (got $code)" test "$code" = 70
+holds "it names the entry point" grep -q "it has no plant_view_http_serve_v1" "$tmp/err"
 
 # the installed layout: PREFIX/bin/plant loads PREFIX/lib/plant/plant-view-server.so and serves
 cp "$module" "$tmp/alone/lib/plant/plant-view-server.so"
@@ -64,9 +59,9 @@ cp "$module" "$tmp/alone/lib/plant/plant-view-server.so"
 pid=$!; pids+=("$pid")
 for _ in $(seq 100); do grep -qs "http://" "$tmp/out" && break; sleep 0.1; done
 url=$(grep -o 'http://127.0.0.1:[0-9]*/' "$tmp/out")
-check "the installed layout serves" test -n "$url"
-check "the state" grep -q '"version"' <(curl -s "${url}api/state")
+holds "the installed layout serves" test -n "$url"
+holds "the state" grep -q '"version"' <(curl -s "${url}api/state")
 kill -INT "$pid"
 wait "$pid"; code=$?
-check "and stops cleanly" test "$code" = 0
-exit $fail
+holds "and stops cleanly" test "$code" = 0
+[ "$fail" -eq 0 ]

@@ -74,6 +74,11 @@ struct DeriveOptions {
     // Instructions one evaluation may run (a hook call; a production's condition, weight or
     // body for one module; a setting): the VM's budget (vm.hpp, EvalEnv::max_steps).
     std::uint64_t max_steps = kDefaultMaxSteps;
+    // The work the whole derivation may do, from start() on (--max-work): every VM instruction of
+    // its settings, axiom, hooks, productions and decomposition, plus every module its rewrites
+    // and decomposition write (docs/language.md, "One work budget per run"). Past it: a
+    // RuntimeError of kind WorkLimit naming the step (and the hook), the same on any thread count.
+    std::uint64_t max_work = kDefaultMaxWork;
     // Whether the string keeps module identities (docs/language.md, module identity). Without them a
     // derivation writes 8 bytes less per module; they are kept anyway when the program can
     // observe them (it calls id(), or has query modules or environments).
@@ -120,6 +125,10 @@ class Derivation {
     int active_group() const { return group_; }
     void use_group(int group) { group_ = group; } // -1: none (the REPL's :use)
     ModuleId next_id() const;
+    // The work done since start() (see DeriveOptions::max_work).
+    std::uint64_t work_done() const;
+    // Starts a fresh work budget without changing the derivation (the REPL: one per command).
+    void reset_work();
     const Program& program() const { return prog_; }
     const DeriveOptions& options() const { return opt_; }
     // The live environments, made from the program's declarations by start().
@@ -135,6 +144,10 @@ class Derivation {
     friend struct Engine; // reads the program, options, settings and string it rewrites
 
     void run_hook(HookKind kind);
+    // Adds the instructions `env` ran to the run's work, stopping past --max-work.
+    void charge_work(const EvalEnv& env);
+    // What an evaluation of the derivation's own (a setting, the axiom, a hook) may still run.
+    void limit_work(EvalEnv& env) const;
     // Commits the graph nodes made in the pass that just ended (no-op without a graph).
     void commit_graph();
 

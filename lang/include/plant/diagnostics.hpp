@@ -65,9 +65,11 @@ inline std::string excerpt(std::string_view text, std::size_t max = 40) {
 
 // `file:line:col: error: message`, the source line, and a caret under the span.
 // Text from a grammar, a file or a file name made safe to print to a terminal: the C0 control
-// characters (but newline and tab when `keep_lines`), DEL, the C1 controls (U+0080 to U+009F)
-// and bytes that are not UTF-8 become visible escapes (`\x1b`, `\u009b`, `\xff`), so no escape
-// sequence reaches the terminal; all other text is kept as it is.
+// characters (but newline and tab when `keep_lines`), DEL, the C1 controls (U+0080 to U+009F),
+// the invisible format characters that reorder or hide text (U+200B to U+200F, U+202A to U+202E,
+// U+2060 to U+2064, U+2066 to U+2069, U+FEFF) and bytes that are not UTF-8 become visible
+// escapes (`\x1b`, `\u009b`, `\u202e`, `\xff`), so no escape sequence reaches the terminal and
+// no text is shown reordered; all other text is kept as it is.
 std::string escape_controls(std::string_view text, bool keep_lines = false);
 
 std::string render(const Diagnostic& d, const SourceManager& sources, bool color = false);
@@ -80,6 +82,7 @@ enum class RuntimeErrorKind {
     ModuleLimit, // the string outgrew --max-modules or --max-bytes
     Interrupted, // the derivation was asked to stop (Ctrl-C in the REPL)
     StepLimit,   // one evaluation ran more instructions than --max-steps allows
+    WorkLimit,   // the whole run did more work than --max-work allows
     Setting,     // a setting (derive, seed) out of its range
     Turtle,      // the turtle cannot interpret the string (unbalanced ']', leaving finite space)
     Geometry,    // the plant cannot be meshed (a surface that cannot be loaded, out-of-range points)

@@ -25,17 +25,34 @@ void charge(std::size_t bytes);
 void release(std::size_t bytes) noexcept;
 
 // What is running, as the message names it ("the derivation", "meshing", "physics", "writing
-// 'tree.glb'"): set for as long as the Stage lives, then the one before it is back. Set on the
-// thread that runs the command; charges from other threads name it too.
+// 'tree.glb'"): set for as long as the Stage lives, then the one before it is back. Per thread:
+// a charge names the stage of the thread that makes it, so commands running side by side (the
+// view server's requests, --jobs variants) never name each other's. A thread with none set names
+// "the derivation"; a worker thread takes its starter's with InStage.
 class Stage {
   public:
     explicit Stage(std::string what);
     ~Stage();
     Stage(const Stage&) = delete;
     Stage& operator=(const Stage&) = delete;
+    // This thread's innermost stage (null: none), for InStage on a worker it starts.
+    static const std::string* current() noexcept;
 
   private:
-    std::string previous_;
+    std::string what_;
+    const std::string* previous_;
+};
+// On a worker thread: names `stage` (Stage::current() of the thread that started it, which
+// outlives the worker) for as long as it lives.
+class InStage {
+  public:
+    explicit InStage(const std::string* stage) noexcept;
+    ~InStage();
+    InStage(const InStage&) = delete;
+    InStage& operator=(const InStage&) = delete;
+
+  private:
+    const std::string* previous_;
 };
 std::string stage();
 

@@ -26,6 +26,15 @@ struct HookEffects {
 // 10 instructions a turn), and a runaway evaluation stops within a second.
 inline constexpr std::uint64_t kDefaultMaxSteps = 200'000'000;
 
+// The default of DeriveOptions::max_work (--max-work): the work a whole derivation may do, counted
+// as VM instructions plus modules written (docs/language.md, "One work budget per run"). The
+// busiest shipped grammar or test does about 3e8; 1e11 is a few minutes of running, not days.
+inline constexpr std::uint64_t kDefaultMaxWork = 100'000'000'000;
+
+// Throws the RuntimeError (kind WorkLimit, no position) for a run past `max_work`: the same
+// words on any thread count, so the message names no module.
+[[noreturn]] void throw_work_limit(std::uint64_t max_work);
+
 // Marks an identity as "new in this step"; the engine replaces it with a real identity after
 // the step so identities do not depend on how the string was split between threads.
 inline constexpr ModuleId kNewIdBit = ModuleId{1} << 63;
@@ -58,6 +67,13 @@ struct EvalEnv {
     std::uint64_t steps_left = 0; // of the running evaluation, beyond the current slice
     std::int64_t slice = 0;       // instructions left in the current slice
     int function = -1;            // the function being run, -1: none (for messages)
+    // The run's work budget (DeriveOptions::max_work): `work` counts the instructions run() has
+    // executed with this env, over all its evaluations; an evaluation stops once `work` passes
+    // `work_limit` (looked at every kStepSlice instructions and when each evaluation ends, so
+    // the hot loop pays nothing). max_work is the run's whole budget, for the message.
+    std::uint64_t work = 0;
+    std::uint64_t work_limit = ~std::uint64_t{0};
+    std::uint64_t max_work = ~std::uint64_t{0};
 
     // Output of production bodies.
     ModuleString* out = nullptr;

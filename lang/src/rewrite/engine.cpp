@@ -6,6 +6,7 @@
 // identities are numbered in string order, so the result is the same for any number of threads.
 #include "engine.hpp"
 
+#include "plant/memory_budget.hpp"
 #include "plant/streams.hpp"
 #include "rewriter.hpp"
 
@@ -100,6 +101,10 @@ void Engine::rewrite(const Derivation& d, const ModuleString& in, ModuleString& 
         w.env.interrupt = d.opt_.interrupt;
         w.env.max_steps = d.opt_.max_steps;
         w.env.graph_records = !interpreting; // interpretation makes no node that lives on
+        if (!interpreting) {                 // (the turtle's view is not the derivation's work)
+            w.env.max_work = d.opt_.max_work;
+            w.env.work_limit = d.opt_.max_work - std::min(d.opt_.max_work, work);
+        }
         w.out.keep_ids = in.keep_ids;
         w.out.use_kinds(in.kind_table);
     };
@@ -130,6 +135,10 @@ void Engine::rewrite(const Derivation& d, const ModuleString& in, ModuleString& 
                 : std::max(0.5, std::min(16.0, double(out.params.size()) / double(in.params.size())));
     }
     check_limits(d, out);
+    if (!interpreting) { // the workers' instructions were added as they finished; now the modules
+        work += out.size();
+        if (work > d.opt_.max_work) throw_work_limit(d.opt_.max_work);
+    }
 }
 
 // The whole string on one thread, which numbers new modules in string order as it writes them.
@@ -161,6 +170,7 @@ void Engine::rewrite_one_thread(const Derivation& d, Rewriter& rw, const ModuleS
         throw;
     }
     next_id += w.env.new_count;
+    if (!interpreting) work += w.env.work;
 }
 
 // Worker 0 writes into buffers sized for the whole output and numbers its new modules directly;
@@ -171,10 +181,12 @@ void Engine::rewrite_parallel(const Derivation& d, Rewriter& rw, const ModuleStr
                               int threads, const Setup& setup) {
     const std::size_t n = in.size();
     std::vector<Worker> workers(static_cast<std::size_t>(threads));
+    const std::string* stage = memory::Stage::current(); // (interpretation's, say, not the derivation's)
     {
         std::vector<std::jthread> pool;
         for (int t = 0; t < threads; ++t) {
             pool.emplace_back([&, t] {
+                memory::InStage named(stage);
                 Worker& w = workers[static_cast<std::size_t>(t)];
                 setup(w);
                 std::size_t b = n * static_cast<std::size_t>(t) / static_cast<std::size_t>(threads);
@@ -205,6 +217,7 @@ void Engine::rewrite_parallel(const Derivation& d, Rewriter& rw, const ModuleStr
         }
         total += w.out.size();
         total_params += w.out.params.size();
+        if (!interpreting) work += w.env.work;
     }
     if (total > d.opt_.max_modules) {
         check_limits(d, total, total_params);
@@ -314,8 +327,10 @@ bool Engine::rewrite_direct(const Derivation& d, Rewriter& rw, const ModuleStrin
             w.error = err;
         }
     });
-    for (auto& w : workers)
+    for (auto& w : workers) {
         if (w.error) throw *w.error;
+        if (!interpreting) work += w.env.work;
+    }
     if (sized) { // the counts were exact or a bound: cut to what was written
         const Rewriter::Counts& c = counts_at[0];
         out.kinds.resize(c.modules);

@@ -22,7 +22,7 @@ struct Engine {
     // counter and the growth estimates. The buffers are scratch, rebuilt by every rewrite, and
     // the spare string is not copied: copies start without one.
     Engine(const Engine& o)
-        : next_id(o.next_id), growth(o.growth), param_growth(o.param_growth), plans(o.plans),
+        : next_id(o.next_id), work(o.work), growth(o.growth), param_growth(o.param_growth), plans(o.plans),
           step_plans(o.step_plans) {}
     Engine& operator=(const Engine&) = delete;
 
@@ -46,6 +46,7 @@ struct Engine {
     const RulePlan& step_plan(const Derivation& d);
 
     ModuleId next_id = 1;                    // the identity the next new module gets
+    std::uint64_t work = 0;                  // the run's work so far (DeriveOptions::max_work)
     bool interpreting = false;               // within interpreted(): child() records no node
     double growth = 2.0, param_growth = 2.0; // last step's growth, for reserving memory
     std::vector<std::shared_ptr<const RulePlan>> plans;

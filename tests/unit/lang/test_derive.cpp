@@ -189,6 +189,50 @@ TEST_CASE("one evaluation has one budget of instructions, calls and loops includ
     CHECK_NOTHROW(fits.run());
 }
 
+TEST_CASE("the whole run has one work budget, counted alike on any thread count", "[derive][limits]") {
+    // the string reaches 32768 modules (the rewrite is split between threads from 20000), each
+    // evaluating a loop; then it is copied
+    auto c =
+        test::compile("axiom: A(15); derive 30;\n"
+                      "rules { A(n) : n > 0 -> A(n - 1) A(n - 1); A(n) { for i in 0..20 { } produce B; } }");
+    std::uint64_t work[2] = {0, 0};
+    for (int t : {1, 3}) {
+        DeriveOptions o;
+        o.threads = t;
+        Derivation d(*c->program, o);
+        d.run();
+        work[t == 1 ? 0 : 1] = d.work_done();
+    }
+    CHECK(work[0] == work[1]);
+    // the symbols copied count too: at least one unit per module written
+    CHECK(work[0] > 15 * 32768);
+    for (int t : {1, 3}) {
+        DeriveOptions o;
+        o.threads = t;
+        o.max_work = work[0] - 1;
+        Derivation d(*c->program, o);
+        try {
+            d.run();
+            FAIL("expected an error");
+        } catch (const RuntimeError& e) {
+            CHECK(e.kind == RuntimeErrorKind::WorkLimit);
+            CHECK(e.message.find("step 30: the run did more than") == 0);
+            CHECK(e.message.find("raise --max-work") != std::string::npos);
+        }
+        o.max_work = work[0];
+        Derivation fits(*c->program, o);
+        CHECK_NOTHROW(fits.run());
+    }
+    // a hook's loop stops at its budget, and the message names the hook
+    auto hook =
+        test::compile("var n = 0; derive 1000000; on before_step { for i in 0..1e6 { n += 1; } }\naxiom: F;");
+    DeriveOptions o;
+    o.max_work = 50'000'000;
+    Derivation d(*hook->program, o);
+    CHECK_THROWS_WITH(d.run(), Catch::StartsWith("step ") &&
+                                   Catch::Contains("on before_step: the run did more than 50000000"));
+}
+
 TEST_CASE("the interrupt stops a runaway hook inside its budget", "[derive][limits]") {
     auto c =
         test::compile("var n = 0; on start { for i in 0..1e7 { for j in 0..1e7 { n += 1; } } }\naxiom: F;");
