@@ -54,8 +54,11 @@ constexpr EnvMethod kClimberMethods[] = {
     env_method(M::ClearDir, "clear_dir", {V, V, N}, V, Pure, false,
                "unit heading of v, turned as little as keeps the segment p to p + v (radius r) out of "
                "every obstacle"),
+    env_method(M::Thickness, "thickness", {N}, N, Pure, false,
+               "radius of module id's particle (0: none): with `strand`, thickened by secondary growth "
+               "to sqrt(r0^2 + strand^2 n), r0 its radius at birth and n the segments beyond it"),
 };
-static_assert(method_table(kClimberMethods, M::ClearDir));
+static_assert(method_table(kClimberMethods, M::Thickness));
 
 } // namespace
 
@@ -107,6 +110,9 @@ void Climber::query(std::size_t method, const double* a, double* r) const {
         return;
     case M::Seeded:
         r[0] = seeded_.count(id_of(a[0])) ? 1 : 0;
+        return;
+    case M::Thickness:
+        r[0] = thickness(id_of(a[0]));
         return;
     default: // edits: not queries
         r[0] = 0;
@@ -194,11 +200,17 @@ void Climber::geometry(std::vector<glm::dvec3>& triangles, const glm::dvec3& lo,
 void Climber::begin_segments() {
     seen_.clear();
     pending_.clear();
+    rethickened_.clear();
 }
 
 void Climber::segment(const BoundSegment& s) {
-    if (particle_of_.count(s.id)) {
+    if (auto it = particle_of_.find(s.id); it != particle_of_.end()) {
         seen_.insert(s.id);
+        // a segment the grammar thickened (secondary growth) thickens its particle too, so
+        // collisions and its mass (Eq. 2) follow the stem drawn
+        if (world_.alive(it->second) && std::isfinite(s.radius) && s.radius > 0 &&
+            std::abs(std::clamp(s.radius, 1e-4, 1e6) - world_.radii(it->second).x) > 1e-12)
+            rethickened_.emplace_back(it->second, s);
         return;
     }
     pending_.push_back(s);
@@ -216,17 +228,7 @@ void Climber::charge_particles(std::size_t air) {
     memory_.resize((world_.size() + 2 * pending_.size()) * kBytesPerParticle + air * kBytesPerAirParticle);
 }
 
-void Climber::advance(std::set<ModuleId>& left) {
-    charge_particles(fluid_.size());
-    // particles whose modules the grammar removed go too
-    for (auto it = particle_of_.begin(); it != particle_of_.end();) {
-        if (seen_.count(it->first)) {
-            ++it;
-            continue;
-        }
-        world_.remove(it->second);
-        it = particle_of_.erase(it);
-    }
+void Climber::place_pending() {
     // new bound modules become particles where the turtle drew them
     for (const BoundSegment& p : pending_) {
         const double r = std::isfinite(p.radius) ? std::clamp(p.radius, 1e-4, 1e6) : 1e-4;
@@ -240,6 +242,8 @@ void Climber::advance(std::set<ModuleId>& left) {
         }
         physics::Handle h = world_.add_grown(parent, p.to, q, radii);
         particle_of_[p.id] = h;
+        if (born_radius_.size() <= h.index) born_radius_.resize(h.index + 1, 0.0);
+        born_radius_[h.index] = r;
         // Eq. 5: a particle born near a surface holds on to it
         if (config_.anchor > 0) {
             double best = 0;
@@ -250,6 +254,20 @@ void Climber::advance(std::set<ModuleId>& left) {
             }
         }
     }
+}
+
+void Climber::advance(std::set<ModuleId>& left) {
+    charge_particles(fluid_.size());
+    // particles whose modules the grammar removed go too
+    for (auto it = particle_of_.begin(); it != particle_of_.end();) {
+        if (seen_.count(it->first)) {
+            ++it;
+            continue;
+        }
+        world_.remove(it->second);
+        it = particle_of_.erase(it);
+    }
+    place_pending();
     // painted samples a new particle reached are used up, so shoots move on across the region
     // instead of circling a sample (as a space-colonization attractor is removed once reached)
     if (!attractors_.empty()) {
@@ -261,6 +279,16 @@ void Climber::advance(std::set<ModuleId>& left) {
             });
     }
     pending_.clear();
+    for (const auto& [h, s] : rethickened_) {
+        if (!world_.alive(h)) continue;
+        const double r = std::clamp(s.radius, 1e-4, 1e6);
+        const double length = std::isfinite(s.length) ? std::clamp(s.length, 0.0, 1e6) : 0.0;
+        world_.set_radii(h, glm::dvec3(r, std::max(length / 2, r), r));
+    }
+    rethickened_.clear();
+    // secondary growth, before the physics, so the step collides the stems as thick as drawn
+    count_beyond();
+    thicken();
     // edits from hooks
     for (ModuleId id : cuts_) {
         physics::Handle h = particle(id);
@@ -335,6 +363,55 @@ void Climber::advance(std::set<ModuleId>& left) {
         it = roots_.erase(it);
     }
     rebuild_occupancy();
+}
+
+void Climber::count_beyond() {
+    // a parent's slot is below its children's, so one sweep from the last slot down adds every
+    // particle's count into its parent's
+    beyond_.assign(world_.size(), 0);
+    for (std::uint32_t i = static_cast<std::uint32_t>(world_.size()); i-- > 0;) {
+        const physics::Handle h = world_.handle(i);
+        const std::uint32_t parent = world_.parent(h);
+        if (!world_.alive(h) || parent >= beyond_.size()) continue;
+        beyond_[parent] += beyond_[i] + 1;
+    }
+}
+
+double Climber::thickness(ModuleId id) const {
+    const physics::Handle h = particle(id);
+    return h.valid() && world_.alive(h) ? world_.radii(h).x : 0.0;
+}
+
+double Climber::clearance(const glm::dvec3& p) const {
+    double d = 1e300;
+    for (const auto& o : world_.obstacles()) d = std::min(d, o.distance(p));
+    return d;
+}
+
+void Climber::thicken() {
+    if (!(config_.strand > 0)) return;
+    const double t2 = config_.strand * config_.strand;
+    for (std::uint32_t i = 0; i < born_radius_.size() && i < world_.size(); ++i) {
+        const physics::Handle h = world_.handle(i);
+        if (!(born_radius_[i] > 0) || !world_.alive(h)) continue;
+        // the pipe model (Shinozaki et al. 1964; Holton 1994's strands, which Hädrich et al. 2017,
+        // section 4, name for secondary growth): a stem's cross-section is the one it was born
+        // with plus one strand's for every segment beyond it
+        double r = std::sqrt(born_radius_[i] * born_radius_[i] + t2 * beyond_[i]);
+        // a plant's first segment hangs from a fixed root, which no contact moves: it is as thick
+        // as the room it has along its length allows (0.5 mm kept free), never thinner than at
+        // birth, so it does not grow into the support beside the seed
+        const std::uint32_t parent = world_.parent(h);
+        if (parent < world_.size() && world_.parent(world_.handle(parent)) == ~0u) {
+            const glm::dvec3 a = world_.position(world_.handle(parent)), b = world_.position(h);
+            double room = 1e300;
+            for (double t : {0.25, 0.5, 0.75, 1.0}) room = std::min(room, clearance(a + (b - a) * t) - 5e-4);
+            r = std::max(born_radius_[i], std::min(r, room));
+        }
+        const glm::dvec3 radii = world_.radii(h);
+        if (std::abs(r - radii.x) > 1e-12)
+            world_.set_radii(h, glm::dvec3(r, radii.y > radii.x ? std::max(radii.y, r) : r, r));
+    }
 }
 
 void Climber::rebuild_occupancy() {
@@ -465,7 +542,7 @@ bool ClimberArgs::read(const EnvArg& a, std::string& error) {
         "response",     "anchor",           "anchor_range",       "anchor_release",  "friction",
         "elasticity",   "attractor_radius", "attractor_strength", "threads",         "light_cell",
         "opacity",      "air_spacing",      "air_density",        "air_viscosity",   "air_stiffness",
-        "air_coupling", "mesh_cell",        "attractor_reach",    "emitter_radius"};
+        "air_coupling", "mesh_cell",        "attractor_reach",    "emitter_radius",  "strand"};
     static const char* vectors[] = {"gravity", "light",   "wind",    "attractor",
                                     "air_min", "air_max", "emitter", "emitter_velocity"};
     if (a.key == "mesh") {
@@ -570,6 +647,8 @@ bool ClimberArgs::read(const EnvArg& a, std::string& error) {
         mesh_cell = std::max(x, 1e-3);
     else if (a.key == "attractor_reach")
         c.attractor_reach = std::max(x, 0.0);
+    else if (a.key == "strand")
+        c.strand = std::clamp(x, 0.0, 1.0); // a strand wider than 1 m is no stem
     return true;
 }
 

@@ -18,7 +18,9 @@
 // Methods (ClimberMethod and its table in climber.cpp): grow_dir(p, h) (h turned by surface
 // adaption, Eq. 6, by painted attractors and by phototropism weighted by occlusion, Eq. 7),
 // occlusion(p), anchored(id), particles(), seeded(id), clear_dir(p, v, r) (v's direction turned
-// as little as keeps the segment from p to p + v, a capsule of radius r, out of every obstacle);
+// as little as keeps the segment from p to p + v, a capsule of radius r, out of every obstacle),
+// thickness(id) (its particle's radius: with the argument `strand`, grown by secondary growth,
+// the pipe model, by one strand of that radius for every segment beyond it);
 // edits, in hooks only: pull(id, target),
 // cut(id), wind(a), move(k, delta), seed(id), emit(k, velocity).
 //
@@ -63,8 +65,9 @@ enum class ClimberMethod : std::uint8_t {
     Move,
     Seed,
     Emit,
-    // a query, after the edits so that their numbers stay
+    // queries, after the edits so that their numbers stay
     ClearDir,
+    Thickness,
 };
 
 const EnvironmentKind& climber_kind();
@@ -89,6 +92,7 @@ class Climber : public Environment {
         double opacity = 0.15;   // occlusion 1 - exp(-opacity * particles between p and the light)
         std::vector<Attractor> attractors;
         double attractor_reach = 0.1; // a painted sample a particle comes this near is used up
+        double strand = 0;            // secondary growth: a pipe's radius per segment beyond (0: none)
         bool air = false;             // SPH air fills [air_min, air_max] (section 5.3)
         physics::FluidSettings fluid;
     };
@@ -140,6 +144,13 @@ class Climber : public Environment {
     glm::dvec3 grow_dir(const glm::dvec3& p, const glm::dvec3& h) const;
     glm::dvec3 clear_dir(const glm::dvec3& p, const glm::dvec3& v, double r) const;
     void rebuild_occupancy();
+    // Secondary growth (docs/physics.md, "Growth rate and secondary growth"): the segments beyond
+    // every particle, counted after each advance, and the radius each segment was born with.
+    void place_pending(); // the new bound modules become particles
+    void count_beyond();
+    void thicken();
+    double thickness(ModuleId id) const;
+    double clearance(const glm::dvec3& p) const; // to the nearest obstacle
 
     std::vector<Attractor> attractors_; // the painted samples not yet reached
     physics::World world_;
@@ -159,7 +170,11 @@ class Climber : public Environment {
     std::set<ModuleId> seeded_;
     glm::dvec3 wind_{0.0};
     bool wind_changed_ = false;
-    physics::LightGrid light_; // the particles, for occlusion
+    physics::LightGrid light_;          // the particles, for occlusion
+    std::vector<std::uint32_t> beyond_; // per world slot: the alive particles hanging from it
+    std::vector<double> born_radius_;   // per world slot: the radius its segment was born with
+    // bound modules drawn with another radius than their particle's (thickened by the grammar)
+    std::vector<std::pair<physics::Handle, BoundSegment>> rethickened_;
     // The particles' arrays (world and air) as charged against --max-memory, ahead of growing them.
     memory::Reservation memory_;
     void charge_particles(std::size_t air);

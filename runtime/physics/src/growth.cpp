@@ -53,6 +53,14 @@ Handle World::add_grown(Handle parent, const glm::dvec3& position_in, const glm:
     return h;
 }
 
+void World::set_radii(Handle h, const glm::dvec3& radii) {
+    if (!alive(h)) return;
+    radii_[h.index] = radii;
+    // Hädrich et al., Eq. 2: the mass of an ellipsoid
+    m_[h.index] = 4.0 * std::numbers::pi * radii.x * radii.y * radii.z * settings_.density / 3.0;
+    groups_stale_ = true;
+}
+
 namespace {
 
 // Counter-based random numbers (plant/random.hpp): a draw depends on (seed, particle, draw).

@@ -252,7 +252,7 @@ TEST_CASE("climber figures: Fig. 5's branching probability and variance show", "
 }
 
 TEST_CASE("climber figures: Fig. 6's dragged branch breaks off and leaves the plant", "[climber]") {
-    // fig06_break.plant drags segment #306 from step 28 on
+    // fig06_break.plant drags segment #67 from step 28 on
     auto before = grow("fig06_break.plant", {}, 28);
     auto broken = grow("fig06_break.plant", {}, 31);
     auto undisturbed = grow("fig06_break.plant", {{"drag", "0"}}, 31);

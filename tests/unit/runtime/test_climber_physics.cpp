@@ -166,13 +166,15 @@ std::unique_ptr<Run> derive(const std::string& text, const std::filesystem::path
 }
 
 // issue 18's free shoot: one plant, no branching, light from above tilted 3 degrees, Ph 0.5, on
-// the ground (so Eq. 6 could pull it flat), 40 segments of 0.05 m
+// the ground (so Eq. 6 could pull it flat), 40 segments of 0.05 m. Without shade (opacity 0): an
+// arched soft shoot shades its own tip and grows more slowly (growth by light,
+// test_climber_growth.cpp), and this test compares stiffnesses at one length
 std::string free_shoot(const std::string& stiffness) {
     return fmt::format(R"(
 import climber with {{ N = 1, BP = 0, Ph = 0.5, shoot_length = 40, steps = 40, leaf_size = 0 }};
 env ivy = climber(plane_point: vec3(0, 0, 0), plane_normal: vec3(0, 1, 0),
                   light: vec3(0.0523, 0.9986, 0), phototropism: Ph, adaption: 0.6, adaption_range: 0.2,
-                  anchor: 0.4, anchor_range: 0.03, stiffness: {});
+                  anchor: 0.4, anchor_range: 0.03, stiffness: {}, opacity: 0);
 seed 1;
 )",
                        stiffness);

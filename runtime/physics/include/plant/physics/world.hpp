@@ -144,6 +144,9 @@ class World {
     // Full grown: at full stiffness (with a fixed stiffness, always). Only these meet the fluid.
     bool full_grown(Handle h) const { return stiffness(h.index) >= 1.0 || settings_.fixed_stiffness >= 0; }
     glm::dvec3 radii(Handle h) const { return radii_[h.index]; }
+    // Secondary growth: a particle's radii change as its stem thickens, and its mass with them
+    // (Eq. 2); its groups are rebuilt before the next step (growth.cpp).
+    void set_radii(Handle h, const glm::dvec3& radii);
 
     // Apical growth: every apex (a particle without children) lengthens; each segment_length a
     // new particle continues it, turned by surface adaption and phototropism weighted by the

@@ -1,0 +1,117 @@
+// Growth by the paper's rules (issue 18 item 4; docs/physics.md, "Growth rate and secondary
+// growth"): an apex grows by the light it receives, and stems thicken with age by the pipe model.
+#include "helpers.hpp"
+#include "plant/climber.hpp"
+#include "plant/environment_phase.hpp"
+#include "plant/environments.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <regex>
+#include <string>
+#include <vector>
+
+using namespace plant;
+
+namespace {
+
+struct Grown {
+    std::unique_ptr<test::Compiled> compiled;
+    TurtleEnvironmentPhase phase;
+    DeriveOptions options;
+    std::unique_ptr<Derivation> d;
+};
+
+std::unique_ptr<Grown> start(const std::string& text) {
+    auto g = std::make_unique<Grown>();
+    CompileOptions opts;
+    opts.environments = runtime_environments();
+    g->compiled = test::compile(text, opts);
+    INFO(g->compiled->rendered());
+    REQUIRE(g->compiled->program);
+    g->options.environment_phase = &g->phase;
+    g->d = std::make_unique<Derivation>(*g->compiled->program, g->options);
+    g->d->start();
+    return g;
+}
+
+const Climber& climber_of(const Derivation& d) {
+    const Environment* env = d.run_state().environment(0);
+    REQUIRE(env);
+    REQUIRE(&env->kind() == &climber_kind());
+    return static_cast<const Climber&>(*env);
+}
+
+// The radii of each plant's main shoot, base first: the Seg modules directly inside each plant's
+// outermost brackets, in the derived string.
+std::vector<std::vector<double>> main_shoots(const Grown& g) {
+    const std::string s = format_string(*g.compiled->program, g.d->string(), false);
+    std::vector<std::vector<double>> plants;
+    int depth = 0;
+    static const std::regex token(R"(\[|\]|Seg\(([^,]*),([^)]*)\))");
+    for (auto it = std::sregex_iterator(s.begin(), s.end(), token); it != std::sregex_iterator(); ++it) {
+        const std::string t = (*it)[0];
+        if (t == "[") {
+            if (++depth == 1) plants.emplace_back();
+        } else if (t == "]") {
+            --depth;
+        } else if (depth == 1) {
+            plants.back().push_back(std::stod((*it)[2]));
+        }
+    }
+    return plants;
+}
+
+} // namespace
+
+TEST_CASE("climber growth: a lit shoot grows faster than a shaded one of the same age", "[climber]") {
+    // two unbranched shoots 0.4 m apart, weightless, not turning; the light comes from the left,
+    // nearly level, so the right shoot's light passes through the left shoot
+    auto g = start(R"(
+import climber with { N = 2, BP = 0, Ph = 0, spacing = 0.4, steps = 30, leaf_size = 0 };
+env ivy = climber(gravity: vec3(0, 0, 0), light: vec3(-1, 0.1, 0), phototropism: Ph, adaption: 0,
+                  stiffness: 1, strand: strand);
+seed 1;
+)");
+    while (g->d->step()) {
+    }
+    const auto plants = main_shoots(*g);
+    REQUIRE(plants.size() == 2);
+    const std::size_t lit = plants[0].size(), shaded = plants[1].size();
+    INFO("segments: lit " << lit << ", shaded " << shaded);
+    CHECK(lit == 30); // fully lit: a segment a step after the step that seeds it
+    CHECK(shaded + 5 < lit);
+    CHECK(shaded > 5); // shaded, not dark: it still grows
+}
+
+TEST_CASE("climber growth: stems thicken with age by the pipe model, base thicker than tip", "[climber]") {
+    auto g = start(R"(
+import climber with { N = 1, BP = 0.3, V = 0.5, Ph = 0, steps = 24, leaf_size = 0 };
+env ivy = climber(gravity: vec3(0, 0, 0), phototropism: Ph, adaption: 0, stiffness: 1, strand: strand);
+seed 3;
+)");
+    std::vector<double> base; // the first segment's drawn radius, step by step
+    while (g->d->step()) {
+        const auto plants = main_shoots(*g);
+        REQUIRE(plants.size() == 1);
+        base.push_back(plants[0].front());
+    }
+    const auto shoot = main_shoots(*g)[0];
+    INFO("base radius " << shoot.front() << ", tip " << shoot.back() << ", after 8 steps " << base[7]);
+    // a segment's radius increases over the steps, and never decreases
+    for (std::size_t k = 1; k < base.size(); ++k) CHECK(base[k] >= base[k - 1]);
+    CHECK(base.back() > base[7] + 0.002);
+    // the base is thicker than the tip, which has its birth radius (the library's `radius`)
+    CHECK(shoot.back() == Approx(0.006));
+    CHECK(shoot.front() > 2 * shoot.back());
+    // the pipe model exactly: r^2 = r0^2 + strand^2 n, n the particles beyond the first (all the
+    // plant's particles but its root and itself, counted as the last physics ran)
+    const physics::World& w = climber_of(*g->d).world();
+    std::size_t particles = 0;
+    for (std::uint32_t i = 0; i < w.size(); ++i) particles += w.alive(w.handle(i)) ? 1 : 0;
+    const double n = static_cast<double>(particles) - 2;
+    CHECK(shoot.front() * shoot.front() == Approx(0.006 * 0.006 + 0.001 * 0.001 * n));
+    // the physics collides the stem as thick as it is drawn: the first particle (slot 1, after
+    // its root) has the drawn radius
+    CHECK(w.radii(w.handle(1)).x == Approx(shoot.front()));
+}
