@@ -87,18 +87,20 @@ for good in 1M 1024K 1.5G 2g 1048576; do
 done
 
 # with --seeds, --max-memory bounds the process: each of the --jobs J variants has a 1/J share
-# (docs/batch.md). A 2^20-module string with a parameter (about 20 MB) fits the 32 MB its string
-# may take on one job of 64M, not the 16 MB of a half share on two jobs.
+# (docs/batch.md). A 2^22-module string with a parameter (about 80 MB) fits the 128 MB its string
+# may take on one job of 256M, not the 64 MB of a half share on two jobs. (256M rather than less:
+# a sanitizer build's resident baseline alone is over 100 MB, and the resident-memory backstop
+# allows the budget plus 96 MB.) The .svg output draws nothing (A is no turtle command).
 cat >"$tmp/share.plant" <<'G'
-derive 20;
-axiom: A(20);
+derive 22;
+axiom: A(22);
 rules { A(n) : n > 0 -> A(n - 1) A(n - 1); }
 G
 check "one job has the whole --max-memory" 0 "$plant" run "$tmp/share.plant" --seeds 1..2 --jobs 1 \
-  --max-memory 64M -o "$tmp/one_{seed}.txt"
+  --max-memory 256M -o "$tmp/one_{seed}.svg"
 check "two jobs have half of it each" 1 "$plant" run "$tmp/share.plant" --seeds 1..2 --jobs 2 \
-  --max-memory 64M -o "$tmp/two_{seed}.txt"
-contains "a variant's share is named" "$tmp/stderr" "more than the 16 MB it may take"
+  --max-memory 256M -o "$tmp/two_{seed}.svg"
+contains "a variant's share is named" "$tmp/stderr" "more than the 64 MB it may take"
 contains "and what to do" "$tmp/stderr" "with --jobs 2 each variant has a 1/2 share of --max-memory: lower --jobs or raise --max-memory"
 
 echo "memory: $pass passed, $fail failed"
