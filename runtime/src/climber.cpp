@@ -261,8 +261,7 @@ void Climber::advance(std::set<ModuleId>& left) {
             });
     }
     pending_.clear();
-    // edits from hooks
-    for (ModuleId id : cuts_) {
+    for (ModuleId id : cuts_) { // edits from hooks
         physics::Handle h = particle(id);
         if (h.valid() && world_.alive(h)) world_.remove(h);
     }
