@@ -137,6 +137,10 @@ void World::step() {
     t0 = clock::now();
     integrate();
     collision_ms += ms(clock::now() - t0).count();
+    double fastest = 0; // squared
+    for (std::size_t i = 0; i < x_.size(); ++i)
+        if (alive_[i]) fastest = std::max(fastest, glm::dot(v_[i], v_[i]));
+    peak_speed_ = std::max(peak_speed_, std::sqrt(fastest));
     if (break_threshold_ > 0) break_overstretched();
     pulls_.clear();
     times_.collision = collision_ms;

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -114,6 +115,7 @@ struct Run {
     Crossings drawn_crossings, world_crossings; // of the skeleton drawn, and of the world's links
     bool each_step = false;                     // whether to measure the world's links every step:
     Crossings step_crossings;                   // summed over the steps
+    std::vector<double> peak_speed;             // per derivation step, its physics steps' fastest particle
     std::unique_ptr<Derivation> d;
 };
 
@@ -141,6 +143,7 @@ std::unique_ptr<Run> derive(const std::string& text, const std::filesystem::path
     for (bool more = true; more;) {
         more = d.step();
         const Links l = links_of(climber_in(d).world());
+        r->peak_speed.push_back(climber_in(d).world().peak_speed());
         if (l.worst > r->worst_step.worst) r->worst_step = l;
         if (l.rest > 0) CHECK(std::fabs(l.length / l.rest - 1) < 0.1);
         // a link can end off its length only where obstacles pinch it (docs/physics.md)
@@ -180,7 +183,61 @@ seed 1;
                        stiffness);
 }
 
+// The fastest a particle of a climber grammar may move in derivation step k (its physics steps'
+// fastest particle): 1 m/s, twenty times the growth speed of 5 cm a step (a 5 cm segment falling
+// freely its own length reaches 1 m/s), except where a figure moves the plant on purpose:
+// fig06_break drags a particle (3 and 5 cm further each derivation step, a 5.8 cm jump in one
+// 25 ms physics step: 2.3 m/s, and what its neighbours take from it), and fig07_editing's emitter
+// blows the air at 4 m/s from step 26 (the gust lingers in the closed box after it stops).
+double whip_bound(const std::string& grammar, std::size_t k) {
+    if (grammar == "fig06_break" && k >= 28 && k < 36) return 2.5;
+    if (grammar == "fig07_editing" && k >= 26) return 4.0;
+    return 1.0;
+}
+
+// The grammars whose free shoots whip on the present physics (docs/physics.md, "Whipping free
+// shoots"): 1.1-25 m/s. Checked by the test marked to fail below, until the whipping is fixed.
+// Growth by light without the old shoot caps sent shoots further from their supports: fig01's,
+// fig08's and fig10's whip since (1.1-17 m/s), fig14_right's no longer do (0.36 m/s).
+bool whips(const std::string& grammar) {
+    for (const char* g : {"fig01_car", "fig01_column", "fig05_branching", "fig07_editing",
+                          "fig08_painted_wall", "fig09_boxes", "fig10_dome", "fig11_fence", "fig14_left"})
+        if (grammar == g) return true;
+    return false;
+}
+
+// every derivation step's fastest particle under its bound, the step furthest over it reported
+void check_whip_speeds(const std::string& name, const Run& r) {
+    REQUIRE(!r.peak_speed.empty());
+    std::size_t worst = 0;
+    for (std::size_t k = 1; k < r.peak_speed.size(); ++k)
+        if (r.peak_speed[k] / whip_bound(name, k) > r.peak_speed[worst] / whip_bound(name, worst)) worst = k;
+    const double fastest = *std::max_element(r.peak_speed.begin(), r.peak_speed.end());
+    INFO(name << ": fastest particle " << fastest << " m/s; derivation step " << worst << ": "
+              << r.peak_speed[worst] << " m/s, bound " << whip_bound(name, worst));
+    CHECK(r.peak_speed[worst] < whip_bound(name, worst));
+    if (std::getenv("PLANT_WHIP_REPORT"))
+        fmt::print("{}: fastest {:.3f} m/s; step {}: {:.3f} m/s of {}\n", name, fastest, worst,
+                   r.peak_speed[worst], whip_bound(name, worst));
+}
+
 } // namespace
+
+// Issue 18, not fixed yet (docs/physics.md, "Whipping free shoots"): the figure grammars whose
+// free shoots whip, and the lone free shoot at stiffness 0.8 and 0.5 (13.8 and 21.5 m/s), held to
+// the same bound as every other grammar. Catch's [!shouldfail]: this passes while they whip; when
+// a fix lands it fails, and these grammars go back into the test above.
+TEST_CASE("climber: the free shoots that whip today still whip (remove when fixed)",
+          "[climber][!shouldfail]") {
+    const std::filesystem::path dir = std::filesystem::path(PLANT_SOURCE_DIR) / "grammars" / "climbers";
+    for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+        const std::string name = entry.path().stem().string();
+        if (entry.path().extension() != ".plant" || !whips(name)) continue;
+        check_whip_speeds(name, *derive("", entry.path()));
+    }
+    for (const char* s : {"0.8", "0.5"})
+        check_whip_speeds(std::string("free shoot ") + s, *derive(free_shoot(s)));
+}
 
 TEST_CASE("climber: a free shoot stands when stiff, droops when soft, and keeps its length", "[climber]") {
     double last = 1e9;
@@ -191,6 +248,14 @@ TEST_CASE("climber: a free shoot stands when stiff, droops when soft, and keeps 
         REQUIRE(r->segments == 40);
         CHECK(r->drawn == Approx(2.0).epsilon(0.1));
         CHECK(r->worst_step.worst < 1.1);
+        // no whipping (docs/physics.md) where it stands free; at 0.8 and 0.5 it still whips (the
+        // test below, which is expected to fail until that is fixed)
+        const double fastest = *std::max_element(r->peak_speed.begin(), r->peak_speed.end());
+        if (std::string(s) == "1") CHECK(fastest < 1.0);
+        if (std::getenv("PLANT_WHIP_REPORT"))
+            fmt::print("free shoot, stiffness {}: height {:.3f} m, drawn {:.3f} m, worst link {:.3f}, "
+                       "fastest {:.3f} m/s\n",
+                       s, r->height, r->drawn, r->worst_step.worst, fastest);
         CHECK(r->height <= last); // monotonic in the stiffness
         last = r->height;
         if (std::string(s) == "1") CHECK(r->height > 0.8 * 2.0);    // stands free (Fig. 12)
@@ -202,17 +267,22 @@ TEST_CASE("climber: a free shoot stands when stiff, droops when soft, and keeps 
     CHECK(aged->worst_step.worst < 1.1);
 }
 
-TEST_CASE("climber: every climber grammar keeps each stem within 10 % of its rest length at every step",
+TEST_CASE("climber: every climber grammar keeps each stem within 10 % of its rest length at every step, "
+          "and no shoot whips that did not",
           "[climber]") {
     const std::filesystem::path dir = std::filesystem::path(PLANT_SOURCE_DIR) / "grammars" / "climbers";
     std::size_t grammars = 0;
     for (const auto& entry : std::filesystem::directory_iterator(dir)) {
         if (entry.path().extension() != ".plant") continue;
-        INFO(entry.path().filename().string());
+        const std::string name = entry.path().stem().string();
+        INFO(name);
         auto r = derive("", entry.path());
         INFO("worst link " << r->worst_step.worst);
         CHECK(r->worst_step.worst < 1.25);
         CHECK(r->segments > 0);
+        // issue 18, whipping: the fastest particle of every physics step, in the grammars whose
+        // shoots do not whip yet (the others: the next test)
+        if (!whips(name)) check_whip_speeds(name, *r);
         ++grammars;
     }
     CHECK(grammars >= 9);

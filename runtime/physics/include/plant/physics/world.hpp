@@ -217,6 +217,10 @@ class World {
         double dynamics = 0, collision = 0;
     };
     const StepTimes& last_step_times() const { return times_; }
+    // The fastest particle's speed at the end of any step since clear_peak_speed() (m/s): a
+    // growing shoot should not move at metres a second (docs/physics.md, "Whipping").
+    double peak_speed() const { return peak_speed_; }
+    void clear_peak_speed() { peak_speed_ = 0; }
 
     // A hash of the whole state, for determinism tests.
     std::uint64_t state_hash() const;
@@ -341,6 +345,7 @@ class World {
         return a.obstacle < obstacles_.size() ? a.point + (obstacles_[a.obstacle].a - a.origin) : a.point;
     }
     std::vector<Anchor> anchors_;
+    double peak_speed_ = 0;
     std::vector<Obstacle> obstacles_;
     std::vector<std::pair<std::uint32_t, glm::dvec3>> pulls_;
     double break_threshold_ = 0;
