@@ -116,8 +116,8 @@ void Compiler::finish_rule_set(RuleSet& set) {
 // (every number stored, the kind's id the symbol's): a module without constants, and every
 // query or communication module, whose numbers the environment phase writes in place.
 void Compiler::assign_kinds() {
-    P_.kinds = KindTable{};
-    P_.kinds.plain = static_cast<std::uint32_t>(P_.symbols.size());
+    P_.kinds.reset(static_cast<std::uint32_t>(P_.symbols.size()));
+    for (const auto& [s, n] : emitted_) P_.kinds.add_plain(s, n);
     std::map<std::vector<std::uint64_t>, KindId> known;
     auto each = [&](RuleSet& rs) {
         for (Production& pr : rs.productions)
@@ -146,12 +146,17 @@ void Compiler::assign_kinds(SuccessorTemplate& t, std::map<std::vector<std::uint
         for (std::uint32_t k = from; k < end; ++k) constants |= hole[k] == 0;
         const std::size_t first = t.stored.size();
         if (!constants || info.query || info.turtle_op == TurtleOp::Communicate ||
-            T.plain + T.size() >= kNoSymbol) { // plain
+            T.kinds() + 1 >= kNoSymbol) { // plain
             for (std::uint32_t k = from; k < end; ++k) {
                 where[k] = static_cast<std::uint32_t>(t.stored.size());
                 t.stored.push_back(t.params[k]);
             }
-            t.kinds.push_back(s);
+            const std::uint32_t kind = T.add_plain(s, n);
+            if (kind == KindTable::kNoKind) { // the table is full: the body writes the successor
+                t.valid = false;
+                return;
+            }
+            t.kinds.push_back(static_cast<KindId>(kind));
             t.stored_nargs.push_back(static_cast<std::uint8_t>(n));
             continue;
         }
@@ -164,10 +169,11 @@ void Compiler::assign_kinds(SuccessorTemplate& t, std::map<std::vector<std::uint
                 t.stored.push_back(0.0);
             }
         }
-        auto [it, fresh] = known.try_emplace(std::move(key), static_cast<KindId>(T.plain + T.size()));
+        auto [it, fresh] = known.try_emplace(std::move(key), static_cast<KindId>(T.kinds()));
         if (fresh) {
             T.symbol.push_back(s);
             T.arity.push_back(static_cast<std::uint8_t>(n));
+            T.stored.push_back(static_cast<std::uint8_t>(t.stored.size() - first));
             T.layout_at.push_back(static_cast<std::uint32_t>(T.slot.size()));
             std::int16_t at = 0;
             for (std::uint32_t k = from; k < end; ++k) {
@@ -260,6 +266,7 @@ void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list) {
                 if (nargs > turtle_symbol(info.turtle_op)->max_params)
                     diags_->error(m.span, "brackets take no parameters");
                 emit(c, Op::Emit, static_cast<std::int32_t>(sym), 0, m.span);
+                emitted_.emplace(sym, 0);
                 continue;
             }
             std::vector<Span> arg_spans;
@@ -315,6 +322,7 @@ void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list) {
             }
             emit(c, Op::Emit, static_cast<std::int32_t>(sym), width, last ? m.span : parts[k].second,
                  spans_index);
+            emitted_.emplace(sym, static_cast<std::uint32_t>(width));
         }
     }
 }

@@ -220,6 +220,8 @@ class Compiler {
     std::set<std::string> curve_names_;
     std::set<std::string> used_groups_;
     std::set<SymbolId> produced_;
+    // (symbol, count of numbers) of every Emit compiled: each gets a plain kind (assign_kinds)
+    std::set<std::pair<SymbolId, std::uint32_t>> emitted_;
     std::vector<RawRun> raw_runs_;
     std::size_t max_declared_len_ = 1;
     std::map<std::string, std::pair<ast::ExprPtr, std::uint32_t>> defines_; // -D name -> expr, source

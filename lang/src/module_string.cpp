@@ -10,8 +10,27 @@
 
 namespace plant {
 
+const KindTable* KindTable::none() {
+    static const KindTable t = [] {
+        KindTable k;
+        k.reset(0x8000);
+        return k;
+    }();
+    return &t;
+}
+
+std::uint32_t ModuleString::grow_kinds(SymbolId s, std::uint32_t k) {
+    if (!own_table || own_table.get() != kind_table || own_table.use_count() > 1) {
+        own_table = std::make_shared<KindTable>(*kind_table);
+        use_kinds(own_table.get());
+    }
+    const std::uint32_t kind = own_table->add_plain(s, k);
+    if (kind == KindTable::kNoKind) throw std::length_error("too many kinds of module in one string");
+    return kind;
+}
+
 bool ModuleString::has_table_kinds() const {
-    if (!kind_table || kind_table->size() == 0) return false;
+    if (kind_table->size() == 0) return false;
     const KindId* k = kinds.data();
     std::uint32_t any = 0;
     for (std::size_t i = 0, n = size(); i < n; ++i) any |= k[i] >= plain_below;
@@ -32,12 +51,24 @@ bool ModuleString::same_modules(const ModuleString& o) const {
 
 void ModuleString::append_range(const ModuleString& o, std::size_t b, std::size_t e) {
     if (b >= e) return;
-    if (!kind_table && o.kind_table) use_kinds(o.kind_table);
+    if (kind_table != o.kind_table) {
+        if (empty()) {
+            use_kinds(o.kind_table);
+            own_table = o.own_table;
+        } else { // another table's kinds: module by module, as plain kinds of this one
+            double v[kMaxArity];
+            for (std::size_t i = b, at = o.offset(b); i < e; at += o.stored(i), ++i) {
+                const ModuleArgs a = o.args_at(i, o.params.data() + at);
+                a.copy_to(v);
+                push(o.symbol(i), v, a.size(), o.id(i));
+            }
+            return;
+        }
+    }
     const std::size_t m0 = kinds.size(), p0 = params.size();
     if (e - b == 1) { // the common case in context-sensitive grammars: one module between rewrites
         if ((m0 & (kBlock - 1)) == 0) block_at.push_back(static_cast<std::uint32_t>(p0));
         kinds.push_back(o.kinds[b]);
-        nargs.push_back(o.nargs[b]);
         if (keep_ids) ids.push_back(o.ids[b]);
         const double* a = o.params.data() + o.offset(b);
         for (std::uint32_t k = 0; k < o.stored(b); ++k) params.push_back(a[k]);
@@ -45,11 +76,9 @@ void ModuleString::append_range(const ModuleString& o, std::size_t b, std::size_
     }
     const std::size_t n = e - b, pb = o.offset(b), pe = o.offset(e);
     kinds.resize(m0 + n);
-    nargs.resize(m0 + n);
     if (keep_ids) ids.resize(m0 + n);
     params.resize(p0 + (pe - pb));
     std::memcpy(kinds.data() + m0, o.kinds.data() + b, n * sizeof(KindId));
-    std::memcpy(nargs.data() + m0, o.nargs.data() + b, n);
     if (keep_ids) std::memcpy(ids.data() + m0, o.ids.data() + b, n * sizeof(ModuleId));
     if (pe > pb) std::memcpy(params.data() + p0, o.params.data() + pb, (pe - pb) * sizeof(double));
     index_from(m0, p0);
@@ -59,22 +88,22 @@ void ModuleString::truncate(std::size_t m) {
     if (m >= size()) return;
     params.resize(offset(m));
     kinds.resize(m);
-    nargs.resize(m);
     if (keep_ids) ids.resize(m);
     block_at.resize((m + kBlock - 1) >> kBlockShift);
 }
 
 void ModuleString::index_range(std::size_t b, std::size_t e, std::size_t p) {
-    const std::uint8_t* a = nargs.data();
+    const KindId* k = kinds.data();
+    const std::uint8_t* st = kind_table->stored.data();
     std::size_t i = b;
     // up to the first block start at or after b
-    for (; i < e && (i & (kBlock - 1)) != 0; ++i) p += a[i];
-    // whole blocks: one entry, then a sum of kBlock bytes (which the compiler vectorises)
+    for (; i < e && (i & (kBlock - 1)) != 0; ++i) p += st[k[i]];
+    // whole blocks: one entry, then a sum of kBlock counts looked up by kind
     for (; i < e; i += kBlock) {
         block_at[i >> kBlockShift] = static_cast<std::uint32_t>(p);
         const std::size_t end = std::min(e, i + kBlock);
         std::uint32_t sum = 0;
-        for (std::size_t j = i; j < end; ++j) sum += a[j];
+        for (std::size_t j = i; j < end; ++j) sum += st[k[j]];
         p += sum;
     }
 }
@@ -139,8 +168,8 @@ std::string format_string(const Program& program, const ModuleString& s, bool wi
     const std::string* prev = nullptr; // name of the previous module when it ends in a letter run
     const SymbolReader sym_of = s.symbols();
     const double* at = s.params.data(); // module i's stored numbers (the string is read in order)
-    const std::uint8_t* stored = s.nargs.data();
-    for (std::size_t i = 0; i < s.size() && out.size() <= max_chars; at += stored[i], ++i) {
+    const std::uint8_t* stored = s.kind_table->stored.data();
+    for (std::size_t i = 0; i < s.size() && out.size() <= max_chars; at += stored[sym_of.kinds[i]], ++i) {
         const std::string& name = program.symbols[sym_of(i)].name;
         bool letter_start =
             !name.empty() && (std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_');
@@ -150,7 +179,7 @@ std::string format_string(const Program& program, const ModuleString& s, bool wi
         }
         out += name;
         const KindId kind = sym_of.kinds[i];
-        const std::uint32_t k = kind < sym_of.plain ? stored[i] : s.kind_table->arity[kind - sym_of.plain];
+        const std::uint32_t k = kind < sym_of.plain ? 0 : s.kind_table->arity[kind - sym_of.plain];
         if (k > 0 || name == ";") { // a bare ';' would end the statement when read back
             out += '(';
             const ModuleArgs a = s.args_at(i, at);
@@ -173,7 +202,7 @@ void cut_branches(ModuleString& s, SymbolId open, SymbolId close,
                   const std::function<bool(std::size_t)>& cuts) {
     ModuleString out;
     out.keep_ids = s.keep_ids;
-    out.use_kinds(s.kind_table);
+    out.use_kinds_of(s);
     const std::size_t n = s.size();
     std::size_t i = 0;
     while (i < n) {

@@ -1,7 +1,7 @@
 // The module string: flat arrays, no per-module heap objects (docs/design.md, the module
-// string). Module i has the kind kinds[i] (today its symbol: symbol(i)), nargs[i] parameters
-// from params[offset(i)] and the identity ids[i] (docs/language.md, module identity). Vec3
-// parameters occupy three consecutive doubles.
+// string). Module i has the kind kinds[i] (its symbol, arity and the count of numbers stored,
+// from the KindTable), its stored numbers from params[offset(i)] and the identity ids[i] (docs/language.md,
+// module identity). Vec3 parameters occupy three consecutive doubles.
 //
 // Readers go through symbol(i) and args(i) (or args_at for one that walks the string in order,
 // keeping its own position in `params`, advanced by stored(i)), never through `kinds` and
@@ -18,6 +18,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <span>
 #include <stdexcept>
 #include <utility>
@@ -38,14 +39,54 @@ using ModuleId = std::uint64_t;
 using KindId = std::uint16_t;
 
 struct KindTable {
-    // Kinds below `plain` are plain; kind k >= plain is entry k - plain of the arrays below.
-    std::uint32_t plain = 0x10000;
+    static constexpr std::uint32_t kAllStored = 0xFFFFFFFF;
+    // Kinds below `plain` are their symbol's, without numbers. Kind k >= plain is entry
+    // k - plain of the arrays below: a plain kind of some arity (layout_at kAllStored: the
+    // string stores all its numbers) or a template kind (its layout in `slot` and `value`).
+    std::uint32_t plain = 0x8000;
     std::vector<SymbolId> symbol;
     std::vector<std::uint8_t> arity;
     std::vector<std::uint32_t> layout_at; // its numbers' entries in `slot` and `value`
     std::vector<std::int16_t> slot;       // per number: its place among the stored ones, or -1
     std::vector<double> value;            // per number: the constant (when slot is -1)
+    // Per kind, every kind (indexed by the kind itself, plain + size() entries): how many
+    // numbers the string stores for a module of that kind.
+    std::vector<std::uint8_t> stored;
+    // Per symbol: its plain kinds of arity above 0 (or of a symbol at or past `plain`), as
+    // (arity, kind).
+    std::vector<std::vector<std::pair<std::uint8_t, KindId>>> by_symbol;
     std::size_t size() const { return symbol.size(); }
+    std::size_t kinds() const { return plain + size(); }
+    // Starts a table whose kinds below p are the symbols'.
+    void reset(std::uint32_t p) {
+        *this = KindTable{};
+        plain = p;
+        stored.assign(p, 0);
+    }
+    // The plain kind of symbol s with n numbers, or kNoKind when the table has none.
+    static constexpr std::uint32_t kNoKind = 0x10000;
+    std::uint32_t find_plain(SymbolId s, std::uint32_t n) const {
+        if (n == 0 && s < plain) return s;
+        if (s >= by_symbol.size()) return kNoKind;
+        for (const auto& [a, k] : by_symbol[s])
+            if (a == n) return k;
+        return kNoKind;
+    }
+    // Adds (or finds) the plain kind of symbol s with n numbers; kNoKind when the table is full.
+    std::uint32_t add_plain(SymbolId s, std::uint32_t n) {
+        if (const std::uint32_t k = find_plain(s, n); k != kNoKind) return k;
+        if (kinds() >= kNoSymbol) return kNoKind;
+        const auto k = static_cast<KindId>(kinds());
+        symbol.push_back(s);
+        arity.push_back(static_cast<std::uint8_t>(n));
+        layout_at.push_back(kAllStored);
+        stored.push_back(static_cast<std::uint8_t>(n));
+        if (by_symbol.size() <= s) by_symbol.resize(std::size_t{s} + 1);
+        by_symbol[s].emplace_back(static_cast<std::uint8_t>(n), k);
+        return k;
+    }
+    // The table of a string made without a program: every symbol below 0x8000 plain.
+    static const KindTable* none();
 };
 
 // Module symbols for a loop over many modules: the string's arrays read through copies the
@@ -90,61 +131,68 @@ class ModuleArgs {
     const double* value_;
 };
 
-// Module i's parameters start at the sum of the arities before it. No per-module offset is
-// stored (it was 4 of the 12.2 bytes a module cost on the parametric tree, issue 22): `nargs`
-// holds each arity in a byte (the compiler allows at most 255 numbers a module), and `block_at`
-// the offset of every kBlock-th module, so that a random access adds at most kBlock - 1 bytes.
-// Sequential readers keep a running offset instead (`offset` once, then `+= arity(i)`).
+// Module i's parameters start at the sum of the numbers stored before it. No per-module offset
+// or count is stored (4 and then 1 of the 12.2 bytes a module cost on the parametric tree, issue
+// 22): a module's kind gives how many numbers it stores (KindTable::stored), and `block_at` holds
+// the offset of every kBlock-th module, so that a random access adds at most kBlock - 1 counts.
+// Sequential readers keep a running offset instead (`offset` once, then `+= stored(i)`).
 struct ModuleString {
     static constexpr std::size_t kBlockShift = 6;
     static constexpr std::size_t kBlock = std::size_t{1} << kBlockShift;
     static constexpr std::uint32_t kMaxArity = 255;
 
     BigVector<KindId> kinds;
-    BigVector<std::uint8_t> nargs; // numbers stored for each module (its arity, for a plain kind)
     BigVector<double> params;
     BigVector<std::uint32_t> block_at; // block_at[j]: where module j * kBlock's parameters start
     BigVector<ModuleId> ids;           // empty when !keep_ids
     bool keep_ids = true;
-    const KindTable* kind_table = nullptr; // none: every kind is plain
-    std::uint32_t plain_below = 0x10000;   // kinds below are plain (kind_table->plain)
+    const KindTable* kind_table = KindTable::none();
+    std::uint32_t plain_below = 0x8000; // kinds below are symbols without numbers
+    // A table of this string's own, grown by push for kinds its program's table lacks (a string
+    // made without a program); never shared with another string while it grows.
+    std::shared_ptr<KindTable> own_table;
 
     void use_kinds(const KindTable* t) {
-        kind_table = t;
-        plain_below = t ? t->plain : 0x10000;
+        kind_table = t ? t : KindTable::none();
+        plain_below = kind_table->plain;
     }
-    // Whether some module has a kind that is not plain.
+    // Takes another string's kinds (and shares its own table, if it has one).
+    void use_kinds_of(const ModuleString& o) {
+        use_kinds(o.kind_table);
+        own_table = o.own_table;
+    }
+    // Whether some module has a kind that is not a symbol's without numbers.
     bool has_table_kinds() const;
 
     std::size_t size() const { return kinds.size(); }
     ModuleId id(std::size_t i) const { return keep_ids ? ids[i] : 0; }
     bool empty() const { return kinds.empty(); }
-    SymbolReader symbols() const {
-        return {kinds.data(), plain_below, kind_table ? kind_table->symbol.data() : nullptr};
-    }
+    SymbolReader symbols() const { return {kinds.data(), plain_below, kind_table->symbol.data()}; }
     SymbolId symbol(std::size_t i) const {
         const KindId k = kinds[i];
         return k < plain_below ? k : kind_table->symbol[k - plain_below];
     }
     std::uint32_t arity(std::size_t i) const {
         const KindId k = kinds[i];
-        return k < plain_below ? nargs[i] : kind_table->arity[k - plain_below];
+        return k < plain_below ? 0 : kind_table->arity[k - plain_below];
     }
     // How many of module i's numbers `params` holds.
-    std::uint32_t stored(std::size_t i) const { return nargs[i]; }
+    std::uint32_t stored(std::size_t i) const { return kind_table->stored[kinds[i]]; }
     // Where module i's parameters start (i == size(): the end of the parameters).
     std::size_t offset(std::size_t i) const {
         if (i >= size()) return params.size();
         std::size_t at = block_at[i >> kBlockShift];
-        for (std::size_t j = i & ~(kBlock - 1); j < i; ++j) at += nargs[j];
+        const std::uint8_t* st = kind_table->stored.data();
+        for (std::size_t j = i & ~(kBlock - 1); j < i; ++j) at += st[kinds[j]];
         return at;
     }
     ModuleArgs args(std::size_t i) const { return args_at(i, params.data() + offset(i)); }
     // Module i's numbers for a reader whose own position in `params` is `at` (offset(i)).
     ModuleArgs args_at(std::size_t i, const double* at) const {
         const KindId k = kinds[i];
-        if (k < plain_below) return {at, nargs[i]};
+        if (k < plain_below) return {at, 0};
         const std::size_t e = k - plain_below, l = kind_table->layout_at[e];
+        if (l == KindTable::kAllStored) return {at, kind_table->arity[e]};
         return {at, kind_table->arity[e], kind_table->slot.data() + l, kind_table->value.data() + l};
     }
     // Where module i's stored numbers can be written in place (all its numbers for a plain kind:
@@ -155,7 +203,6 @@ struct ModuleString {
 
     void clear() {
         kinds.clear();
-        nargs.clear();
         params.clear();
         block_at.clear();
         ids.clear();
@@ -163,18 +210,19 @@ struct ModuleString {
     // Appends a module of symbol s (a plain kind) and its k numbers.
     void push(SymbolId s, const double* p, std::uint32_t k, ModuleId id) {
         if (k > kMaxArity) throw std::length_error("a module can carry at most 255 numbers");
-        push_kind(s, p, k, id);
+        std::uint32_t kind = kind_table->find_plain(s, k);
+        if (kind == KindTable::kNoKind) kind = grow_kinds(s, k);
+        push_kind(static_cast<KindId>(kind), p, k, id);
     }
     // Appends a module of kind `kind` whose k stored numbers are p[0 .. k).
     void push_kind(KindId kind, const double* p, std::uint32_t k, ModuleId id) {
         if ((kinds.size() & (kBlock - 1)) == 0) block_at.push_back(static_cast<std::uint32_t>(params.size()));
         kinds.push_back(kind);
-        nargs.push_back(static_cast<std::uint8_t>(k));
         for (std::uint32_t i = 0; i < k; ++i) params.push_back(p[i]);
         if (keep_ids) ids.push_back(id);
     }
     // Appends modules [b, e) of another string (which keeps identities if this one does, and
-    // whose kinds this one's table knows: a string without a table takes the other's).
+    // whose kinds this one's table knows: a string without modules takes the other's table).
     void append_range(const ModuleString& o, std::size_t b, std::size_t e);
     void append(const ModuleString& o) { append_range(o, 0, o.size()); }
     // Cuts the string to its first m modules.
@@ -182,18 +230,18 @@ struct ModuleString {
     // The number of parameters modules [b, e) carry.
     std::size_t params_of(std::size_t b, std::size_t e) const {
         std::size_t sum = 0;
-        for (std::size_t j = b; j < e; ++j) sum += nargs[j];
+        const std::uint8_t* st = kind_table->stored.data();
+        for (std::size_t j = b; j < e; ++j) sum += st[kinds[j]];
         return sum;
     }
     // Sizes the arrays for m modules and p parameters without indexing them (for writers that
     // fill them directly, then call index_from or index_range).
     void resize_arrays(std::size_t m, std::size_t p) {
         kinds.resize(m);
-        nargs.resize(m);
         if (keep_ids) ids.resize(m);
         params.resize(p);
     }
-    // After kinds, nargs and params were written directly: sizes block_at for size() modules and
+    // After kinds and params were written directly: sizes block_at for size() modules and
     // fills its entries for modules from b on, module b's parameters starting at p. index_range
     // fills those of modules [b, e) only, block_at being sized already (a thread's stretch).
     // index_upto sizes block_at for e modules and fills those of [b, e) (a writer whose arrays
@@ -206,19 +254,23 @@ struct ModuleString {
     void index_range(std::size_t b, std::size_t e, std::size_t p);
     // Bytes held by the arrays (capacity, not size: what the process really pays).
     std::size_t bytes() const {
-        return kinds.capacity() * sizeof(KindId) + nargs.capacity() + params.capacity() * sizeof(double) +
+        return kinds.capacity() * sizeof(KindId) + params.capacity() * sizeof(double) +
                block_at.capacity() * sizeof(std::uint32_t) + ids.capacity() * sizeof(ModuleId);
     }
     void swap(ModuleString& o) noexcept {
         kinds.swap(o.kinds);
-        nargs.swap(o.nargs);
         params.swap(o.params);
         block_at.swap(o.block_at);
         ids.swap(o.ids);
         std::swap(keep_ids, o.keep_ids);
         std::swap(kind_table, o.kind_table);
         std::swap(plain_below, o.plain_below);
+        own_table.swap(o.own_table);
     }
+
+  private:
+    // Gives the string a table of its own that has a plain kind for (s, k) (push's slow path).
+    std::uint32_t grow_kinds(SymbolId s, std::uint32_t k);
 };
 
 // Fills `match` (resized to s.size()): for each '[' the index of its ']' and for each ']' the

@@ -137,7 +137,7 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
     };
     KindId* S = out.kinds.data() + m_at;
     ModuleId* ID = Ids ? out.ids.data() + m_at : nullptr;
-    std::uint8_t* NA = out.nargs.data() + m_at;
+    const std::uint8_t* stored_of = in.kind_table->stored.data();
     double* PA = out.params.data() + p_at;
     std::size_t q = in.offset(b); // where module i's parameters start
     const std::uint32_t* at = plan.outcome_at.data();
@@ -169,7 +169,7 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
             std::uint32_t np = 0;
             for (std::size_t k = i; k < j; ++k) {
                 ++tally[at[sym_of(k)]];
-                np += in.nargs[k];
+                np += stored_of[reader.kinds[k]];
             }
             if (n <= 8 && np <= 8) {
                 // the usual run between two rewritten modules is a few turtle symbols: plain
@@ -177,18 +177,15 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
                 for (std::size_t k = 0; k < n; ++k) {
                     S[k] = in.kinds[i + k];
                     if constexpr (Ids) ID[k] = in.ids[i + k];
-                    NA[k] = in.nargs[i + k];
                 }
                 for (std::uint32_t k = 0; k < np; ++k) PA[k] = in.params[q + k];
             } else {
                 std::memcpy(S, in.kinds.data() + i, n * sizeof(KindId));
                 if constexpr (Ids) std::memcpy(ID, in.ids.data() + i, n * sizeof(ModuleId));
-                std::memcpy(NA, in.nargs.data() + i, n);
                 if (np) std::memcpy(PA, in.params.data() + q, np * sizeof(double));
             }
             S += n;
             if constexpr (Ids) ID += n;
-            NA += n;
             PA += np;
             p += np;
             q += np;
@@ -208,14 +205,12 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
             check_holes(t, values);
         }
         const std::size_t m = t.syms.size();
-        put_template<Ids>(t, plan.outcome_nargs.data() + plan.outcome_nargs_at[outcome], values,
-                          Ids ? in.ids[i] : 0, id_at, S, NA, PA, ID);
+        put_template<Ids>(t, values, Ids ? in.ids[i] : 0, id_at, S, PA, ID);
         if constexpr (Ids) ID += m;
         S += m;
-        NA += m;
         PA += t.stored.size();
         p += t.stored.size();
-        q += in.nargs[i];
+        q += stored_of[reader.kinds[i]];
         ++i;
     }
     Counts c;

@@ -106,11 +106,11 @@ void Engine::rewrite(const Derivation& d, const ModuleString& in, ModuleString& 
             w.env.work_limit = d.opt_.max_work - std::min(d.opt_.max_work, work);
         }
         w.out.keep_ids = in.keep_ids;
-        w.out.use_kinds(in.kind_table);
+        w.out.use_kinds_of(in);
     };
     out.clear();
     out.keep_ids = in.keep_ids;
-    out.use_kinds(in.kind_table);
+    out.use_kinds_of(in);
     // The direct path needs every module's successor to be a direct template: a plan with
     // symbols rewritten otherwise would find one in nearly every string, after counting up to it.
     // (interpretation rewrites a copy of the string and leaves the counts to the string itself)
@@ -151,7 +151,6 @@ void Engine::rewrite_one_thread(const Derivation& d, Rewriter& rw, const ModuleS
     auto room = [](std::size_t want) { return want < 65536 ? 2 * want : want; };
     w.out.kinds.reserve(room(static_cast<std::size_t>(n * growth * 1.02) + 16));
     if (w.out.keep_ids) w.out.ids.reserve(w.out.kinds.capacity());
-    w.out.nargs.reserve(w.out.kinds.capacity());
     w.out.params.reserve(room(static_cast<std::size_t>(in.params.size() * param_growth * 1.02) + 16));
     try {
         if (plan.right_new) {
@@ -199,7 +198,6 @@ void Engine::rewrite_parallel(const Derivation& d, Rewriter& rw, const ModuleStr
                 }
                 w.out.kinds.reserve(static_cast<std::size_t>(modules * growth * 1.02) + 16);
                 if (w.out.keep_ids) w.out.ids.reserve(w.out.kinds.capacity());
-                w.out.nargs.reserve(w.out.kinds.capacity());
                 w.out.params.reserve(static_cast<std::size_t>(params * param_growth * 1.02) + 16);
                 try {
                     rw.run_range(w, b, e);
@@ -237,7 +235,6 @@ void Engine::rewrite_parallel(const Derivation& d, Rewriter& rw, const ModuleStr
     out.swap(workers[0].out);
     const std::size_t m0 = out.size(), p0 = out.params.size(); // worker 0's part
     out.kinds.resize(total);
-    out.nargs.resize(total);
     if (out.keep_ids) out.ids.resize(total);
     out.params.resize(total_params);
     {
@@ -247,8 +244,6 @@ void Engine::rewrite_parallel(const Derivation& d, Rewriter& rw, const ModuleStr
                 ModuleString& src = workers[t].out;
                 std::copy(src.kinds.begin(), src.kinds.end(),
                           out.kinds.begin() + static_cast<std::ptrdiff_t>(mod_at[t]));
-                std::copy(src.nargs.begin(), src.nargs.end(),
-                          out.nargs.begin() + static_cast<std::ptrdiff_t>(mod_at[t]));
                 std::copy(src.params.begin(), src.params.end(),
                           out.params.begin() + static_cast<std::ptrdiff_t>(par_at[t]));
                 for (std::size_t i = 0; out.keep_ids && i < src.size(); ++i) {
@@ -300,7 +295,6 @@ bool Engine::rewrite_direct(const Derivation& d, Rewriter& rw, const ModuleStrin
         check_limits(d, modules, params); // before allocating anything
     }
     out.kinds.resize(modules);
-    out.nargs.resize(modules);
     if (out.keep_ids) out.ids.resize(modules);
     out.params.resize(params);
     out.block_at.resize((modules + ModuleString::kBlock - 1) >> ModuleString::kBlockShift);
@@ -334,7 +328,6 @@ bool Engine::rewrite_direct(const Derivation& d, Rewriter& rw, const ModuleStrin
     if (sized) { // the counts were exact or a bound: cut to what was written
         const Rewriter::Counts& c = counts_at[0];
         out.kinds.resize(c.modules);
-        out.nargs.resize(c.modules);
         if (out.keep_ids) out.ids.resize(c.modules);
         out.params.resize(c.params);
         out.block_at.resize((c.modules + ModuleString::kBlock - 1) >> ModuleString::kBlockShift);

@@ -147,15 +147,12 @@ std::size_t Rewriter::apply_template(Worker& w, std::size_t i, const Production&
     const std::size_t m0 = out.kinds.size();
     const std::size_t p0 = out.params.size();
     out.kinds.resize(m0 + m);
-    out.nargs.resize(m0 + m);
     if (out.keep_ids) out.ids.resize(m0 + m);
     out.params.resize(p0 + t.stored.size());
     std::copy(t.kinds.begin(), t.kinds.end(), out.kinds.begin() + static_cast<std::ptrdiff_t>(m0));
     double* pp = out.params.data() + p0;
     std::copy(t.stored.begin(), t.stored.end(), pp);
     for (std::size_t h = 0; h < t.holes.size(); ++h) pp[t.stored_holes[h]] = values[h];
-    std::copy(t.stored_nargs.begin(), t.stored_nargs.end(),
-              out.nargs.begin() + static_cast<std::ptrdiff_t>(m0));
     out.index_from(m0, p0);
     if (out.keep_ids) {
         ModuleId* ids = out.ids.data() + m0;

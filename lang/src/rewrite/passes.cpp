@@ -51,7 +51,7 @@ void Rewriter::run_backward(Worker& w) {
 ModuleString Rewriter::assemble_backward(const ModuleString& pieces) const {
     ModuleString out;
     out.keep_ids = pieces.keep_ids;
-    out.use_kinds(pieces.kind_table);
+    out.use_kinds_of(pieces);
     for (std::size_t p = piece_starts.size() - 1; p-- > 0;)
         out.append_range(pieces, piece_starts[p], piece_starts[p + 1]);
     return out;

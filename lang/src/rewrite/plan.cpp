@@ -180,10 +180,6 @@ void RulePlan::build_outcomes() {
             outcome_sym.push_back(s);
         }
     }
-    for (const SuccessorTemplate* t : outcome_tmpl) {
-        outcome_nargs_at.push_back(static_cast<std::uint32_t>(outcome_nargs.size()));
-        if (t) outcome_nargs.insert(outcome_nargs.end(), t->stored_nargs.begin(), t->stored_nargs.end());
-    }
 }
 
 // The symbol kernel's tables. It needs every rewritten symbol to be parameterless: a direct

@@ -83,11 +83,6 @@ struct RulePlan {
     std::vector<std::uint32_t> outcome_at;
     std::vector<const SuccessorTemplate*> outcome_tmpl; // nullptr: the copy
     std::vector<SymbolId> outcome_sym;
-    // How many numbers the string stores for each of an outcome's template modules, ready to
-    // copy into the string's `nargs`:
-    // from outcome_nargs_at[o] (one entry per module of outcome_tmpl[o]; none for the copy).
-    std::vector<std::uint32_t> outcome_nargs_at;
-    std::vector<std::uint8_t> outcome_nargs;
     // Whether a step must rewrite on one thread, left to right (or right to left for `>>`).
     bool sequential() const { return multi || left_new || right_new; }
     std::size_t max_modules_out = 1; // the longest template's modules (at least 1: a copy)

@@ -121,39 +121,14 @@ class Rewriter {
     [[noreturn]] void limit_error() const;
     [[noreturn]] void hole_error(const SuccessorTemplate& t, std::size_t h, double value) const;
 
-    // Copies n bytes without a library call for the short runs templates have (their arities):
-    // two overlapping fixed-size copies cover 4 to 16 bytes.
-    static void copy_bytes(std::uint8_t* d, const std::uint8_t* s, std::size_t n) {
-        if (n > 16) {
-            std::memcpy(d, s, n);
-        } else if (n >= 8) {
-            std::uint64_t a, b;
-            std::memcpy(&a, s, 8);
-            std::memcpy(&b, s + n - 8, 8);
-            std::memcpy(d, &a, 8);
-            std::memcpy(d + n - 8, &b, 8);
-        } else if (n >= 4) {
-            std::uint32_t a, b;
-            std::memcpy(&a, s, 4);
-            std::memcpy(&b, s + n - 4, 4);
-            std::memcpy(d, &a, 4);
-            std::memcpy(d + n - 4, &b, 4);
-        } else {
-            for (std::size_t j = 0; j < n; ++j) d[j] = s[j];
-        }
-    }
-
-    // Writes successor template t, its computed numbers in `values`, at S (kinds), NA (numbers
-    // stored), PA and ID: its kinds and stored numbers (SuccessorTemplate::kinds). Module t.keep
-    // gets the identity `kept` (the predecessor's), the others new ones counted on from
-    // `next_new`. Identities are written only when Ids. `stored`: the template's counts of
-    // stored numbers ready to copy (RulePlan::outcome_nargs), or nullptr to take them from
-    // t.stored_nargs. The caller indexes the parameters (ModuleString::index_range) once the
-    // stretch is written.
+    // Writes successor template t, its computed numbers in `values`, at S (kinds), PA and ID:
+    // its kinds and stored numbers (SuccessorTemplate::kinds). Module t.keep gets the identity
+    // `kept` (the predecessor's), the others new ones counted on from `next_new`. Identities are
+    // written only when Ids. The caller indexes the parameters (ModuleString::index_range) once
+    // the stretch is written.
     template <bool Ids>
-    static void put_template(const SuccessorTemplate& t, const std::uint8_t* stored, const double* values,
-                             ModuleId kept, ModuleId& next_new, KindId* S, std::uint8_t* NA, double* PA,
-                             ModuleId* ID) {
+    static void put_template(const SuccessorTemplate& t, const double* values, ModuleId kept,
+                             ModuleId& next_new, KindId* S, double* PA, ModuleId* ID) {
         const std::size_t m = t.syms.size();
         if (m != 0) std::memcpy(S, t.kinds.data(), m * sizeof(KindId));
         // An erasing or parameterless successor has no parameter storage;
@@ -162,7 +137,6 @@ class Rewriter {
         if (t.stored.size() != t.holes.size())
             std::memcpy(PA, t.stored.data(), t.stored.size() * sizeof(double));
         for (std::size_t h = 0; h < t.holes.size(); ++h) PA[t.stored_holes[h]] = values[h];
-        copy_bytes(NA, stored ? stored : t.stored_nargs.data(), m);
         if constexpr (Ids) {
             for (std::size_t j = 0; j < m; ++j) ID[j] = static_cast<int>(j) == t.keep ? kept : next_new++;
         } else {

@@ -122,9 +122,6 @@ template <bool Whole> void Rewriter::run_symbols(Worker& w, std::size_t b, std::
         }
     }
     resize(out.kinds, m);
-    const std::size_t m0 = out.nargs.size();
-    resize(out.nargs, m);
-    std::fill(out.nargs.begin() + static_cast<std::ptrdiff_t>(m0), out.nargs.end(), std::uint8_t{0});
     const std::size_t b0 = out.block_at.size();
     resize(out.block_at, (m + ModuleString::kBlock - 1) >> ModuleString::kBlockShift);
     std::fill(out.block_at.begin() + static_cast<std::ptrdiff_t>(b0), out.block_at.end(),

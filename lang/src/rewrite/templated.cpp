@@ -28,7 +28,6 @@ template <bool Ids> void Rewriter::run_templates(Worker& w, std::size_t b, std::
     std::size_t mcap = 0, pcap = 0;
     std::size_t m_open = m, p_open = p; // the string is indexed (block_at) up to module m_open
     KindId* S = nullptr;
-    std::uint8_t* NA = nullptr;
     double* PA = nullptr;
     ModuleId* ID = nullptr;
     auto open = [&](std::size_t need_m, std::size_t need_p) {
@@ -39,7 +38,6 @@ template <bool Ids> void Rewriter::run_templates(Worker& w, std::size_t b, std::
         p_open = p;
         out.resize_arrays(mcap, pcap);
         S = out.kinds.data();
-        NA = out.nargs.data();
         PA = out.params.data();
         if constexpr (Ids) ID = out.ids.data();
     };
@@ -72,13 +70,13 @@ template <bool Ids> void Rewriter::run_templates(Worker& w, std::size_t b, std::
             }
             std::size_t k = run_length();
             if (k == 0) {
-                open(m + per_module, p + in.nargs[i] + Pmax);
+                open(m + per_module, p + in.stored(i) + Pmax);
                 k = run_length(); // at least 1 now
             }
             next_check = i + k;
         }
         const SymbolId sym = sym_of(i);
-        const std::uint32_t arity = in.arity(i), stored = in.nargs[i];
+        const std::uint32_t arity = in.arity(i), stored = in.stored(i);
         const Production* pr = nullptr;
         if (plan.has_prod[sym]) {
             pr = plan.direct[sym];
@@ -105,7 +103,6 @@ template <bool Ids> void Rewriter::run_templates(Worker& w, std::size_t b, std::
         if (!pr) { // copied as it is
             S[m] = in.kinds[i];
             if constexpr (Ids) ID[m] = in.ids[i];
-            NA[m] = static_cast<std::uint8_t>(stored);
             for (std::uint32_t k = 0; k < stored; ++k) PA[p++] = in.params[q + k];
             q += stored;
             ++m;
@@ -122,8 +119,7 @@ template <bool Ids> void Rewriter::run_templates(Worker& w, std::size_t b, std::
             check_holes(t, values);
         }
         ModuleId next_new = env.id_base + env.new_count;
-        put_template<Ids>(t, nullptr, values, Ids ? in.ids[i] : 0, next_new, S + m, NA + m, PA + p,
-                          Ids ? ID + m : nullptr);
+        put_template<Ids>(t, values, Ids ? in.ids[i] : 0, next_new, S + m, PA + p, Ids ? ID + m : nullptr);
         env.new_count = next_new - env.id_base;
         m += t.syms.size();
         p += t.stored.size();

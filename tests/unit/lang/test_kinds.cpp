@@ -23,6 +23,18 @@ std::size_t all_numbers(const ModuleString& s) {
     return n;
 }
 
+// Whether module i has its symbol's plain kind for its arity (all its numbers stored).
+bool plain_kind(const ModuleString& s, std::size_t i) {
+    return s.kinds[i] == s.kind_table->find_plain(s.symbol(i), s.arity(i)) && s.stored(i) == s.arity(i);
+}
+
+// The table's kinds of constant numbers.
+std::size_t constant_kinds(const KindTable& t) {
+    std::size_t n = 0;
+    for (std::uint32_t l : t.layout_at) n += l != KindTable::kAllStored;
+    return n;
+}
+
 } // namespace
 
 TEST_CASE("kinds: constants of a template are kept in the kind table", "[kinds]") {
@@ -39,14 +51,16 @@ TEST_CASE("kinds: constants of a template are kept in the kind table", "[kinds]"
     REQUIRE(s.size() == 10);
     CHECK(s.params.size() == 6); // F, A and A: two each; &, / and & store nothing
     CHECK(all_numbers(s) == 9);
-    CHECK(p.kinds.size() == 3); // &(30), /(137.5), &(-30)
+    CHECK(constant_kinds(p.kinds) == 3); // &(30), /(137.5), &(-30)
     CHECK(p.symbols[s.symbol(2)].name == "&");
     CHECK(s.kinds[2] >= p.symbols.size());
     CHECK(s.arity(2) == 1);
     CHECK(s.stored(2) == 0);
     CHECK(s.args(2)[0] == 30);
     CHECK(s.args(7)[0] == -30);
-    CHECK(s.kinds[0] == s.symbol(0)); // F(l, w): every number computed, a plain kind
+    CHECK(plain_kind(s, 0));               // F(l, w): every number computed, a plain kind
+    CHECK(s.kinds[0] >= p.symbols.size()); // of arity 2, not the symbol's id
+    CHECK(s.kinds[1] == s.symbol(1));      // '[' without numbers: the symbol's id
     CHECK(s.args(3)[1] == 10);
 }
 
@@ -62,13 +76,13 @@ TEST_CASE("kinds: a module of computed numbers stores them all, a query module t
     CHECK(text_of(p, d) == "B(1,5)B(7,3)F?P(0,0,0)");
     const ModuleString& s = d.string();
     CHECK(s.stored(0) == 2);
-    CHECK(s.kinds[0] == s.symbol(0));
+    CHECK(plain_kind(s, 0));
     CHECK(s.stored(1) == 0); // B(7, 3): all constants
     CHECK(s.args(1)[0] == 7);
     CHECK(s.args(1)[1] == 3);
     CHECK(s.kinds[1] != s.kinds[0]);
     CHECK(s.stored(3) == 3); // ?P(0, 0, 0): the environment phase writes its numbers in place
-    CHECK(s.kinds[3] == s.symbol(3));
+    CHECK(plain_kind(s, 3));
     CHECK(s.params.size() == 5);
 }
 
@@ -99,7 +113,7 @@ TEST_CASE("kinds: every route reads and writes constant kinds alike", "[kinds]")
         INFO(k.grammar);
         REQUIRE(c->program);
         const Program& p = *c->program;
-        CHECK(p.kinds.size() > 0);
+        CHECK(constant_kinds(p.kinds) > 0);
         std::string longer;
         for (int threads : {1, 2}) {
             for (bool ids : {false, true}) {
@@ -120,4 +134,55 @@ TEST_CASE("kinds: every route reads and writes constant kinds alike", "[kinds]")
             }
         }
     }
+}
+
+TEST_CASE("kinds: a string made without a program grows a table of its own", "[kinds]") {
+    ModuleString s;
+    const double v[3] = {1, 2, 3};
+    s.push(4, nullptr, 0, 0);
+    CHECK(s.kinds[0] == 4); // no numbers: the symbol's id, no table needed
+    CHECK(!s.own_table);
+    s.push(4, v, 2, 0);
+    s.push(5, v, 3, 0);
+    s.push(4, v + 1, 2, 0);
+    REQUIRE(s.own_table);
+    CHECK(s.kinds[1] == s.kinds[3]);
+    CHECK(s.kinds[1] != s.kinds[2]);
+    CHECK(s.symbol(2) == 5);
+    CHECK(s.arity(2) == 3);
+    CHECK(s.stored(1) == 2);
+    CHECK(s.offset(3) == 5);
+    CHECK(s.args(3)[1] == 3);
+    // a copy shares the table; growing either gives it a table of its own
+    ModuleString t = s;
+    t.push(6, v, 1, 0);
+    CHECK(t.kind_table != s.kind_table);
+    CHECK(s.kind_table->find_plain(6, 1) == KindTable::kNoKind);
+    CHECK(t.symbol(4) == 6);
+    CHECK(t.args(3)[0] == 2);
+    // appending from a string of another table translates the kinds
+    ModuleString u;
+    u.push(7, v, 1, 0);
+    u.append(s);
+    REQUIRE(u.size() == 5);
+    CHECK(u.symbol(3) == 5);
+    CHECK(u.arity(3) == 3);
+    CHECK(u.args(4)[0] == 2);
+    CHECK(u.offset(4) == 1 + 2 + 3);
+}
+
+TEST_CASE("kinds: every module a program can write has a kind at compile time", "[kinds]") {
+    // bodies and the axiom write through the VM: their (symbol, arity) pairs are known
+    const char* g = "derive 2; module A(x); module B(x, y); axiom: A(1) B(1, 2) C; "
+                    "rules { A(x) { produce A(x + 1) C(x); } B(x, y) -> B(y, x) C; }";
+    auto c = test::compile(g);
+    REQUIRE(c->program);
+    const Program& p = *c->program;
+    Derivation d(p, DeriveOptions{});
+    d.run();
+    const ModuleString& s = d.string();
+    CHECK(s.kind_table == &p.kinds);
+    CHECK(!s.own_table);
+    for (std::size_t i = 0; i < s.size(); ++i) CHECK(plain_kind(s, i));
+    CHECK(text_of(p, d) == "A(3)C(2)C(1)B(1,2)CCC");
 }

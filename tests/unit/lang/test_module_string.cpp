@@ -58,7 +58,7 @@ void check_blocks(const ModuleString& s) {
     std::size_t sum = 0;
     for (std::size_t i = 0; i < s.size(); ++i) {
         if (i % ModuleString::kBlock == 0) REQUIRE(s.block_at[i / ModuleString::kBlock] == sum);
-        sum += s.nargs[i];
+        sum += s.stored(i);
     }
     REQUIRE(sum == s.params.size());
 }
@@ -100,7 +100,7 @@ TEST_CASE("module string: parameters found from arities and block offsets", "[mo
         ModuleString t;
         t.keep_ids = false;
         t.kinds = s.kinds;
-        t.nargs = s.nargs;
+        t.use_kinds_of(s); // the counts of numbers come from the kinds
         t.params = s.params;
         t.block_at.assign((t.size() + ModuleString::kBlock - 1) / ModuleString::kBlock, 0xdead);
         // two stretches, the second starting inside a block
@@ -146,7 +146,7 @@ TEST_CASE("module string: indexing stretches, arity 0 and not at block starts", 
         t.keep_ids = false;
         t.resize_arrays(s.size(), s.params.size());
         std::copy(s.kinds.begin(), s.kinds.end(), t.kinds.begin());
-        std::copy(s.nargs.begin(), s.nargs.end(), t.nargs.begin());
+        t.use_kinds_of(s);
         std::copy(s.params.begin(), s.params.end(), t.params.begin());
         t.block_at.assign((t.size() + ModuleString::kBlock - 1) / ModuleString::kBlock, 0xdead);
         t.index_range(0, c, 0);
