@@ -151,8 +151,11 @@ bool RulePlan::build_guards(SymbolId sym) {
     entry.first = static_cast<std::uint32_t>(guards.size());
     entry.count = static_cast<std::uint32_t>(gs.size());
     entry.width = width;
-    // (a module of sym stores all its numbers unless some template gives it a kind of constants)
-    entry.uniform = std::find(P.kinds.symbol.begin(), P.kinds.symbol.end(), sym) == P.kinds.symbol.end();
+    // (a module of sym stores all its numbers unless some template gives it a kind of constants;
+    // its plain kinds, of any arity, store them all)
+    entry.uniform = true;
+    for (std::size_t k = 0; k < P.kinds.size(); ++k)
+        if (P.kinds.symbol[k] == sym && P.kinds.layout_at[k] != KindTable::kAllStored) entry.uniform = false;
     for (const Guard& g : gs) {
         const SuccessorTemplate& t = g.pr->tmpl;
         entry.uniform = entry.uniform && t.syms.size() == 1 && t.stored.size() == width && t.keep == 0;
