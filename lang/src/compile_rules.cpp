@@ -171,10 +171,8 @@ void Compiler::assign_kinds(SuccessorTemplate& t, std::map<std::vector<std::uint
         }
         auto [it, fresh] = known.try_emplace(std::move(key), static_cast<KindId>(T.kinds()));
         if (fresh) {
-            T.symbol.push_back(s);
-            T.arity.push_back(static_cast<std::uint8_t>(n));
-            T.stored.push_back(static_cast<std::uint8_t>(t.stored.size() - first));
-            T.layout_at.push_back(static_cast<std::uint32_t>(T.slot.size()));
+            T.append(s, n, static_cast<std::uint32_t>(t.stored.size() - first),
+                     static_cast<std::uint32_t>(T.slot.size()));
             std::int16_t at = 0;
             for (std::uint32_t k = from; k < end; ++k) {
                 T.slot.push_back(hole[k] ? at++ : std::int16_t{-1});

@@ -53,8 +53,7 @@ void ModuleString::append_range(const ModuleString& o, std::size_t b, std::size_
     if (b >= e) return;
     if (kind_table != o.kind_table) {
         if (empty()) {
-            use_kinds(o.kind_table);
-            own_table = o.own_table;
+            use_kinds_of(o);
         } else { // another table's kinds: module by module, as plain kinds of this one
             double v[kMaxArity];
             for (std::size_t i = b, at = o.offset(b); i < e; at += o.stored(i), ++i) {

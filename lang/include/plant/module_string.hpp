@@ -72,15 +72,22 @@ struct KindTable {
             if (a == n) return k;
         return kNoKind;
     }
+    // Appends a kind of symbol s with n numbers, `count` of them stored, its layout at `layout`
+    // in `slot` and `value` (kAllStored: none); the caller checks there is room (kinds() below
+    // kNoSymbol).
+    KindId append(SymbolId s, std::uint32_t n, std::uint32_t count, std::uint32_t layout) {
+        const auto k = static_cast<KindId>(kinds());
+        symbol.push_back(s);
+        arity.push_back(static_cast<std::uint8_t>(n));
+        layout_at.push_back(layout);
+        stored.push_back(static_cast<std::uint8_t>(count));
+        return k;
+    }
     // Adds (or finds) the plain kind of symbol s with n numbers; kNoKind when the table is full.
     std::uint32_t add_plain(SymbolId s, std::uint32_t n) {
         if (const std::uint32_t k = find_plain(s, n); k != kNoKind) return k;
         if (kinds() >= kNoSymbol) return kNoKind;
-        const auto k = static_cast<KindId>(kinds());
-        symbol.push_back(s);
-        arity.push_back(static_cast<std::uint8_t>(n));
-        layout_at.push_back(kAllStored);
-        stored.push_back(static_cast<std::uint8_t>(n));
+        const KindId k = append(s, n, n, kAllStored);
         if (by_symbol.size() <= s) by_symbol.resize(std::size_t{s} + 1);
         by_symbol[s].emplace_back(static_cast<std::uint8_t>(n), k);
         return k;

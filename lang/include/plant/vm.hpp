@@ -28,7 +28,7 @@ inline constexpr std::uint64_t kDefaultMaxSteps = 200'000'000;
 
 // The default of DeriveOptions::max_work (--max-work): the work a whole derivation may do, counted
 // as VM instructions plus modules written (docs/language.md, "One work budget per run"). The
-// busiest shipped grammar or test does about 3e8; 1e11 is a few minutes of running, not days.
+// busiest shipped grammar or benchmark does about 1.9e7; 1e11 is a few minutes of running, not days.
 inline constexpr std::uint64_t kDefaultMaxWork = 100'000'000'000;
 
 // Throws the RuntimeError (kind WorkLimit, no position) for a run past `max_work`: the same

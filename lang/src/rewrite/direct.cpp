@@ -114,8 +114,8 @@ Rewriter::Counts Rewriter::count_direct(std::size_t b, std::size_t e) const {
 Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out,
                                         std::size_t m_at, std::size_t p_at, ModuleId id_at,
                                         std::uint64_t* tally) {
-    // Kinds: whether the program has kinds of constant numbers (otherwise every kind is its
-    // symbol, and the loop does without the test)
+    // Kinds: whether the table has kinds past the symbols' own (plain kinds with numbers, kinds
+    // of constants); otherwise every kind is its symbol, and the loop does without the test
     const bool kinds = in.kind_table && in.kind_table->size() > 0;
     if (out.keep_ids)
         return kinds ? write_direct<true, true>(w, b, e, out, m_at, p_at, id_at, tally)

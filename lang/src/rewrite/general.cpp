@@ -68,12 +68,7 @@ void Rewriter::run_range(Worker& w, std::size_t b, std::size_t e) {
         }
         if (const Production* pr = plan.direct[in.symbol(i)]; pr && in.arity(i) == pr->strict[0].width) {
             if (!pr->tmpl.holes.empty()) {
-                const ModuleArgs a = in.args(i);
-                std::size_t at = 0;
-                for (const auto& pa : pr->strict[0].args) {
-                    for (int k = 0; k < pa.width; ++k) w.frame[pa.slot + k] = a[at + k];
-                    at += pa.width;
-                }
+                bind_args(w, i, in.params.data() + in.offset(i), pr->strict[0]);
                 w.env.position = i;
                 w.env.draw = 0;
                 w.env.id = in.id(i);
