@@ -286,9 +286,7 @@ void Climber::advance(std::set<ModuleId>& left) {
         world_.set_radii(h, glm::dvec3(r, std::max(length / 2, r), r));
     }
     rethickened_.clear();
-    // secondary growth, before the physics, so the step collides the stems as thick as drawn
-    count_beyond();
-    thicken();
+    thicken(); // secondary growth, before the physics, so the step collides the stems as thick as drawn
     for (ModuleId id : cuts_) { // edits from hooks
         physics::Handle h = particle(id);
         if (h.valid() && world_.alive(h)) world_.remove(h);
@@ -383,13 +381,14 @@ double Climber::thickness(ModuleId id) const {
 }
 
 double Climber::clearance(const glm::dvec3& p) const {
-    double d = 1e300;
-    for (const auto& o : world_.obstacles()) d = std::min(d, o.distance(p));
+    double d = 0;
+    nearest_obstacle(p, 1e300, d);
     return d;
 }
 
 void Climber::thicken() {
     if (!(config_.strand > 0)) return;
+    count_beyond();
     const double t2 = config_.strand * config_.strand;
     for (std::uint32_t i = 0; i < born_radius_.size() && i < world_.size(); ++i) {
         const physics::Handle h = world_.handle(i);

@@ -144,8 +144,9 @@ class Climber : public Environment {
     glm::dvec3 grow_dir(const glm::dvec3& p, const glm::dvec3& h) const;
     glm::dvec3 clear_dir(const glm::dvec3& p, const glm::dvec3& v, double r) const;
     void rebuild_occupancy();
-    // Secondary growth (docs/physics.md, "Growth rate and secondary growth"): the segments beyond
-    // every particle, counted after each advance, and the radius each segment was born with.
+    // Secondary growth (docs/physics.md, "Growth rate and secondary growth"): with a `strand`,
+    // thicken() counts the segments beyond every particle before each step's physics and widens
+    // each segment from the radius it was born with.
     void place_pending(); // the new bound modules become particles
     void count_beyond();
     void thicken();
