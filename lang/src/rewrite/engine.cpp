@@ -116,8 +116,10 @@ void Engine::rewrite(const Derivation& d, const ModuleString& in, ModuleString& 
     // (interpretation rewrites a copy of the string and leaves the counts to the string itself)
     const bool counted = !interpreting && counts.of == in.kinds.data() && counts.size == n && !in.empty();
     if (!interpreting) forget_counts();
-    if (!plan.sequential() && plan.all_direct &&
-        rewrite_direct(d, rw, in, out, plan, threads, counted, setup)) {
+    if (copies_apply(plan, in)) {
+        rewrite_copies(d, in, out, plan, counted);
+    } else if (!plan.sequential() && plan.all_direct &&
+               rewrite_direct(d, rw, in, out, plan, threads, counted, setup)) {
         // done
     } else if (threads == 1) {
         Worker w(std::move(out)); // writes into the arrays `out` has
@@ -406,6 +408,7 @@ void Engine::count_outcomes(const RulePlan& plan, const std::vector<std::vector<
             merge(s, known ? counts.arity[s] : -1, known ? counts.stored[s] : -1);
         }
     }
+    counts.kinds.clear();
     counts.modules = std::move(modules);
     counts.arity = std::move(arity);
     counts.stored = std::move(stored);

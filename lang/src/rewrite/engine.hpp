@@ -69,12 +69,19 @@ struct Engine {
         std::vector<std::uint64_t> modules; // per symbol
         std::vector<std::int32_t> arity;    // per symbol: what every module has; -1 they differ or unknown
         std::vector<std::int32_t> stored;   // per symbol: the numbers every module stores; -1 likewise
+        // per kind, when the copy kernel wrote the string (Engine::rewrite_copies); else empty
+        std::vector<std::uint64_t> kinds;
         const SymbolId* of = nullptr;
         std::size_t size = 0;
     } counts;
     void forget_counts() { counts.of = nullptr; }
 
   private:
+    // The copy kernel (RulePlan::copy_kernel, copies.cpp): whether it applies to `in`, and the
+    // rewrite by it.
+    static bool copies_apply(const RulePlan& plan, const ModuleString& in);
+    void rewrite_copies(const Derivation& d, const ModuleString& in, ModuleString& out, const RulePlan& plan,
+                        bool counted);
     void rewrite_one_thread(const Derivation& d, Rewriter& rw, const ModuleString& in, Worker& w,
                             const RulePlan& plan);
     template <typename Setup>

@@ -39,6 +39,20 @@ struct RulePlan {
     std::vector<std::uint32_t> succ_at; // blocks of indices into succs
     std::vector<SymbolSucc> succs;
 
+    // The copy kernel (Engine::rewrite_copies, copies.cpp): when every module of a string
+    // without numbers is copied or rewritten by a direct template that stores no numbers (ABOP's
+    // Fig. 1.24), a step only copies each kind's successor kinds. Per kind of the program's
+    // table: its successor padded to kMax kinds (so that writing one is one fixed-size copy),
+    // its length and how many of them get new identities.
+    struct KindSucc {
+        static constexpr std::size_t kMax = 16;
+        KindId kinds[kMax] = {};
+    };
+    bool copy_kernel = false;
+    std::vector<KindSucc> copy_succ;
+    std::vector<std::uint8_t> copy_len, copy_fresh;
+    std::size_t copy_longest = 1; // the longest successor (at least 1: a copy)
+
     const Program& P;
     std::vector<const RuleSet*> sets;
     std::vector<std::uint8_t> has_prod;
@@ -90,6 +104,7 @@ struct RulePlan {
 
   private:
     void build_symbol_kernel();
+    void build_copy_kernel();
     bool build_guards(SymbolId sym);
     void build_outcomes();
     void build_context_table();
