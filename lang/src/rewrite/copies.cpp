@@ -76,20 +76,6 @@ std::size_t write_copies(const RulePlan& plan, const KindId* in, std::size_t n, 
     return m;
 }
 
-// Sizes the cleared array `v` for n elements. A new block is taken whole: a block of
-// BigAllocator::kMapped bytes or more is mapped in whole 2 MiB pages anyway, and with its whole
-// room as capacity the string kept for a later step (Engine::spare) takes that step's output
-// without a fresh block (on 1.24d, n = 10, steps 8 to 10 each mapped and cleared a fresh 2 MiB
-// page). The old block is freed first, so that its pages can be moved into the new one.
-template <typename T> void size_cleared(BigVector<T>& v, std::size_t n) {
-    if (n > v.capacity()) {
-        BigVector<T>().swap(v);
-        const std::size_t bytes = n * sizeof(T);
-        v.reserve(bytes >= BigAllocator<T>::kMapped ? big_pages::rounded(bytes) / sizeof(T) : n);
-    }
-    v.resize(n);
-}
-
 } // namespace
 
 void Engine::rewrite_copies(const Derivation& d, const ModuleString& in, ModuleString& out,
@@ -116,8 +102,10 @@ void Engine::rewrite_copies(const Derivation& d, const ModuleString& in, ModuleS
             for (std::size_t j = 0; j < plan.copy_len[k]; ++j) next[plan.copy_succ[k].kinds[j]] += c;
         }
         check_limits(d, modules, 0); // before allocating anything
+        // (on 1.24d, n = 10, steps 8 to 10 each mapped and cleared a fresh 2 MiB page before
+        // the kept string took whole blocks, see size_whole)
         out.kinds.clear();
-        size_cleared(out.kinds, modules);
+        size_whole(out.kinds, modules);
         return write_copies(plan, in.kinds.data(), in.size(), out.kinds.data(), modules, d.opt_.interrupt);
     };
     if (tally() != modules) {

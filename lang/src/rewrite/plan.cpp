@@ -266,7 +266,13 @@ void RulePlan::build_symbol_kernel() {
                 succ_at.push_back(pr ? add_production(*pr) : self_at);
             }
         }
+        row.open = row.shape == kOpen;
+        row.close = row.shape == kClose;
+        row.seen = row.shape == 0 ? row.key : 0;
+        row.keep_left = row.shape == kIgnored || row.shape == kOpen ? 0xffff : 0;
+        row.keep_right = row.shape == kIgnored ? 0xffff : 0;
     }
+    for (std::uint32_t at : succ_at) succ_flat.push_back(succs[at]);
     symbol_kernel = true;
 }
 
