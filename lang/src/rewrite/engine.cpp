@@ -6,10 +6,10 @@
 // identities are numbered in string order, so the result is the same for any number of threads.
 #include "engine.hpp"
 
-#include "crew.hpp"
 #include "plant/memory_budget.hpp"
 #include "plant/streams.hpp"
 #include "rewriter.hpp"
+#include <plant/crew.hpp>
 
 #include <fmt/format.h>
 

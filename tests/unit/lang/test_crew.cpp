@@ -1,8 +1,8 @@
-// The derivation's kept threads (lang/src/rewrite/crew.hpp): every part of a call runs exactly
-// once on its own thread, call after call on the same kept threads, from inside a part (which
-// falls back to threads of its own) and from two callers at once; what a part throws reaches
-// the caller.
-#include "rewrite/crew.hpp"
+// The kept threads (common/include/plant/crew.hpp, shared by the derivation and the physics):
+// every part of a call runs exactly once on its own thread, call after call on the same kept
+// threads, from inside a part (which falls back to threads of its own) and from two callers at
+// once; what a part throws reaches the caller.
+#include <plant/crew.hpp>
 
 #include <catch2/catch.hpp>
 
