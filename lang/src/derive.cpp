@@ -30,8 +30,8 @@ bool observes_identities(const Program& p) {
     return false;
 }
 
-// What a step's tables take a module, besides the strings: 4 bytes of bracket table, 2 of the
-// symbol kernel's keys, 2 to spare for the workers' match tables.
+// What a step's tables take a module, besides the strings: 4 bytes of bracket table, 4 to spare
+// for the workers' match tables. (The symbol kernel's keys, a BigVector, charge for themselves.)
 constexpr std::size_t kTableBytesPerModule = 8;
 
 double now_ms() {

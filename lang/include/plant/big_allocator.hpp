@@ -82,4 +82,19 @@ template <typename T> struct BigAllocator {
 
 template <typename T> using BigVector = std::vector<T, BigAllocator<T>>;
 
+// Sizes v for n elements for a writer that overwrites them all: what v held is discarded when it
+// must grow. A new block is taken whole (a block of kMapped bytes or more is mapped in whole
+// 2 MiB pages anyway): with its whole room as capacity, a buffer kept from step to step (the
+// symbol kernel's keys, a string kept for a later step) takes the next steps' larger sizes
+// without a fresh block; a smaller one is taken twice as large as asked, for the same reason.
+// The old block is freed first, so that its pages move into the new one.
+template <typename T> void size_whole(BigVector<T>& v, std::size_t n) {
+    if (n > v.capacity()) {
+        BigVector<T>().swap(v);
+        const std::size_t bytes = n * sizeof(T);
+        v.reserve(bytes >= BigAllocator<T>::kMapped ? big_pages::rounded(bytes) / sizeof(T) : 2 * n);
+    }
+    v.resize(n);
+}
+
 } // namespace plant

@@ -81,7 +81,8 @@ class Reservation {
 // charge() when the process's resident memory (/proc/self/statm) is past the budget plus
 // kResidentSlack, the program's own baseline. Reads one small file: call it between stages, not
 // in loops. Between derivation steps, check_resident_between_steps reads it at most every 2 ms
-// (a call sooner returns at once), so that many short steps do not pay for it.
+// (a call sooner returns at once), so that many short steps do not pay for it; its first call
+// in a process only starts that clock.
 constexpr std::uint64_t kResidentSlack = std::uint64_t{96} << 20;
 void check_resident();
 void check_resident_between_steps();

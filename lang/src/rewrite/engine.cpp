@@ -9,11 +9,11 @@
 #include "plant/memory_budget.hpp"
 #include "plant/streams.hpp"
 #include "rewriter.hpp"
+#include <plant/crew.hpp>
 
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <thread>
 
 namespace plant {
 
@@ -116,8 +116,10 @@ void Engine::rewrite(const Derivation& d, const ModuleString& in, ModuleString& 
     // (interpretation rewrites a copy of the string and leaves the counts to the string itself)
     const bool counted = !interpreting && counts.of == in.kinds.data() && counts.size == n && !in.empty();
     if (!interpreting) forget_counts();
-    if (!plan.sequential() && plan.all_direct &&
-        rewrite_direct(d, rw, in, out, plan, threads, counted, setup)) {
+    if (copies_apply(plan, in)) {
+        rewrite_copies(d, in, out, plan, counted);
+    } else if (!plan.sequential() && plan.all_direct &&
+               rewrite_direct(d, rw, in, out, plan, threads, counted, setup)) {
         // done
     } else if (threads == 1) {
         Worker w(std::move(out)); // writes into the arrays `out` has
@@ -181,32 +183,28 @@ void Engine::rewrite_parallel(const Derivation& d, Rewriter& rw, const ModuleStr
     const std::size_t n = in.size();
     std::vector<Worker> workers(static_cast<std::size_t>(threads));
     const std::string* stage = memory::Stage::current(); // (interpretation's, say, not the derivation's)
-    {
-        std::vector<std::jthread> pool;
-        for (int t = 0; t < threads; ++t) {
-            pool.emplace_back([&, t] {
-                memory::InStage named(stage);
-                Worker& w = workers[static_cast<std::size_t>(t)];
-                setup(w);
-                std::size_t b = n * static_cast<std::size_t>(t) / static_cast<std::size_t>(threads);
-                std::size_t e = n * static_cast<std::size_t>(t + 1) / static_cast<std::size_t>(threads);
-                std::size_t modules = (t == 0 ? n : e - b),
-                            params = in.params.size() * (e - b) / std::max<std::size_t>(n, 1);
-                if (t == 0) {
-                    params = in.params.size();
-                    w.env.id_base = next_id;
-                }
-                w.out.kinds.reserve(static_cast<std::size_t>(modules * growth * 1.02) + 16);
-                if (w.out.keep_ids) w.out.ids.reserve(w.out.kinds.capacity());
-                w.out.params.reserve(static_cast<std::size_t>(params * param_growth * 1.02) + 16);
-                try {
-                    rw.run_range(w, b, e);
-                } catch (const RuntimeError& err) {
-                    w.error = err;
-                }
-            });
+    run_on_crew(static_cast<std::size_t>(threads), [&](std::size_t part) {
+        const int t = static_cast<int>(part);
+        memory::InStage named(stage);
+        Worker& w = workers[static_cast<std::size_t>(t)];
+        setup(w);
+        std::size_t b = n * static_cast<std::size_t>(t) / static_cast<std::size_t>(threads);
+        std::size_t e = n * static_cast<std::size_t>(t + 1) / static_cast<std::size_t>(threads);
+        std::size_t modules = (t == 0 ? n : e - b),
+                    params = in.params.size() * (e - b) / std::max<std::size_t>(n, 1);
+        if (t == 0) {
+            params = in.params.size();
+            w.env.id_base = next_id;
         }
-    }
+        w.out.kinds.reserve(static_cast<std::size_t>(modules * growth * 1.02) + 16);
+        if (w.out.keep_ids) w.out.ids.reserve(w.out.kinds.capacity());
+        w.out.params.reserve(static_cast<std::size_t>(params * param_growth * 1.02) + 16);
+        try {
+            rw.run_range(w, b, e);
+        } catch (const RuntimeError& err) {
+            w.error = err;
+        }
+    });
     std::size_t total = 0, total_params = 0;
     for (auto& w : workers) {
         if (w.error) {
@@ -237,23 +235,19 @@ void Engine::rewrite_parallel(const Derivation& d, Rewriter& rw, const ModuleStr
     out.kinds.resize(total);
     if (out.keep_ids) out.ids.resize(total);
     out.params.resize(total_params);
-    {
-        std::vector<std::jthread> pool;
-        for (std::size_t t = 1; t < workers.size(); ++t) {
-            pool.emplace_back([&, t] {
-                ModuleString& src = workers[t].out;
-                std::copy(src.kinds.begin(), src.kinds.end(),
-                          out.kinds.begin() + static_cast<std::ptrdiff_t>(mod_at[t]));
-                std::copy(src.params.begin(), src.params.end(),
-                          out.params.begin() + static_cast<std::ptrdiff_t>(par_at[t]));
-                for (std::size_t i = 0; out.keep_ids && i < src.size(); ++i) {
-                    ModuleId id = src.ids[i];
-                    out.ids[mod_at[t] + i] = (id & kNewIdBit) ? id_at[t] + (id & ~kNewIdBit) : id;
-                }
-                ModuleString().swap(src);
-            });
+    run_on_crew(workers.size() - 1, [&](std::size_t part) {
+        const std::size_t t = part + 1;
+        ModuleString& src = workers[t].out;
+        std::copy(src.kinds.begin(), src.kinds.end(),
+                  out.kinds.begin() + static_cast<std::ptrdiff_t>(mod_at[t]));
+        std::copy(src.params.begin(), src.params.end(),
+                  out.params.begin() + static_cast<std::ptrdiff_t>(par_at[t]));
+        for (std::size_t i = 0; out.keep_ids && i < src.size(); ++i) {
+            ModuleId id = src.ids[i];
+            out.ids[mod_at[t] + i] = (id & kNewIdBit) ? id_at[t] + (id & ~kNewIdBit) : id;
         }
-    }
+        ModuleString().swap(src);
+    });
     out.index_from(m0, p0);
     next_id = ids;
 }
@@ -270,14 +264,7 @@ bool Engine::rewrite_direct(const Derivation& d, Rewriter& rw, const ModuleStrin
     const auto T = static_cast<std::size_t>(threads);
     std::vector<Rewriter::Counts> counts_at(T);
     auto bounds = [&](std::size_t t) { return std::pair{n * t / T, n * (t + 1) / T}; };
-    auto parallel = [&](auto&& body) {
-        if (T == 1) {
-            body(std::size_t{0});
-            return;
-        }
-        std::vector<std::jthread> pool;
-        for (std::size_t t = 0; t < T; ++t) pool.emplace_back([&body, t] { body(t); });
-    };
+    auto parallel = [&](auto&& body) { run_on_crew(T, body); };
     std::size_t modules = 0, params = 0;
     const bool sized =
         T == 1 && counted && size_from_counts(plan, in, modules, params) && within_limits(d, modules, params);
@@ -406,6 +393,7 @@ void Engine::count_outcomes(const RulePlan& plan, const std::vector<std::vector<
             merge(s, known ? counts.arity[s] : -1, known ? counts.stored[s] : -1);
         }
     }
+    counts.kinds.clear();
     counts.modules = std::move(modules);
     counts.arity = std::move(arity);
     counts.stored = std::move(stored);

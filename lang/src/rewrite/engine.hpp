@@ -50,9 +50,9 @@ struct Engine {
     bool interpreting = false;               // within interpreted(): child() records no node
     double growth = 2.0, param_growth = 2.0; // last step's growth, for reserving memory
     std::vector<std::shared_ptr<const RulePlan>> plans;
-    std::vector<const RulePlan*> step_plans;   // per group + 1 (index 0: no group), from plans
-    std::vector<std::uint32_t> brackets;       // the bracket table, kept from step to step
-    std::vector<std::uint16_t> kernel_scratch; // the symbol kernel's right keys (Rewriter::run_symbols)
+    std::vector<const RulePlan*> step_plans; // per group + 1 (index 0: no group), from plans
+    std::vector<std::uint32_t> brackets;     // the bracket table, kept from step to step
+    BigVector<std::uint16_t> kernel_scratch; // the symbol kernel's right keys (Rewriter::run_symbols)
     // The string a step replaced, when small, kept for the next step to write its output into:
     // small strings would otherwise pay a round of allocations a step.
     ModuleString spare;
@@ -69,12 +69,19 @@ struct Engine {
         std::vector<std::uint64_t> modules; // per symbol
         std::vector<std::int32_t> arity;    // per symbol: what every module has; -1 they differ or unknown
         std::vector<std::int32_t> stored;   // per symbol: the numbers every module stores; -1 likewise
+        // per kind, when the copy kernel wrote the string (Engine::rewrite_copies); else empty
+        std::vector<std::uint64_t> kinds;
         const SymbolId* of = nullptr;
         std::size_t size = 0;
     } counts;
     void forget_counts() { counts.of = nullptr; }
 
   private:
+    // The copy kernel (RulePlan::copy_kernel, copies.cpp): whether it applies to `in`, and the
+    // rewrite by it.
+    static bool copies_apply(const RulePlan& plan, const ModuleString& in);
+    void rewrite_copies(const Derivation& d, const ModuleString& in, ModuleString& out, const RulePlan& plan,
+                        bool counted);
     void rewrite_one_thread(const Derivation& d, Rewriter& rw, const ModuleString& in, Worker& w,
                             const RulePlan& plan);
     template <typename Setup>

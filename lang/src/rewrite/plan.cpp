@@ -80,6 +80,38 @@ RulePlan::RulePlan(const Program& p, std::vector<const RuleSet*> rule_sets)
     }
     if (templated && max_params_out == 0 && max_modules_out <= SymbolSucc::kMax && !ctx_block.empty())
         build_symbol_kernel();
+    if (!sequential()) build_copy_kernel();
+}
+
+// The copy kernel's tables (see copy_kernel), when every kind a string without numbers can hold
+// is copied or has a direct template of the same arity that stores no numbers.
+void RulePlan::build_copy_kernel() {
+    const KindTable& kt = P.kinds;
+    const std::size_t K = kt.kinds();
+    if (K > kNoSymbol) return;
+    copy_succ.assign(K, KindSucc{});
+    copy_len.assign(K, 1);
+    copy_fresh.assign(K, 0);
+    for (std::size_t k = 0; k < K; ++k) {
+        copy_succ[k].kinds[0] = static_cast<KindId>(k);
+        if (kt.stored[k] != 0) continue; // never in a string without numbers
+        const bool plain = k < kt.plain;
+        const std::size_t sym = plain ? k : kt.symbol[k - kt.plain];
+        if (sym >= has_prod.size() || !has_prod[sym]) continue; // copied
+        const Production* pr = direct[sym];
+        const std::uint32_t arity = plain ? 0 : kt.arity[k - kt.plain];
+        if (!pr || pr->strict[0].width != arity || !pr->tmpl.stored.empty() || !pr->tmpl.holes.empty() ||
+            pr->tmpl.kinds.size() > KindSucc::kMax) {
+            copy_succ.clear();
+            return;
+        }
+        const SuccessorTemplate& t = pr->tmpl;
+        std::copy(t.kinds.begin(), t.kinds.end(), copy_succ[k].kinds);
+        copy_len[k] = static_cast<std::uint8_t>(t.kinds.size());
+        copy_fresh[k] = static_cast<std::uint8_t>(t.kinds.size() - (t.keep >= 0 ? 1 : 0));
+        copy_longest = std::max(copy_longest, t.kinds.size());
+    }
+    copy_kernel = true;
 }
 
 namespace {
@@ -234,7 +266,13 @@ void RulePlan::build_symbol_kernel() {
                 succ_at.push_back(pr ? add_production(*pr) : self_at);
             }
         }
+        row.open = row.shape == kOpen;
+        row.close = row.shape == kClose;
+        row.seen = row.shape == 0 ? row.key : 0;
+        row.keep_left = row.shape == kIgnored || row.shape == kOpen ? 0xffff : 0;
+        row.keep_right = row.shape == kIgnored ? 0xffff : 0;
     }
+    for (std::uint32_t at : succ_at) succ_flat.push_back(succs[at]);
     symbol_kernel = true;
 }
 

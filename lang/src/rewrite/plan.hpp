@@ -33,11 +33,33 @@ struct RulePlan {
         std::uint8_t lmask = 0, rmask = 0; // 0xff: the block is indexed by that neighbour's key
         std::uint8_t shape = 0;
         std::uint8_t key = 0; // ctx_key
+        // The same, for the whole-string passes, which carry the neighbours' keys without a
+        // branch: the key a pass holds after this module is (key & keep) | seen, or the key
+        // saved at the matching bracket when it pops one.
+        std::uint16_t keep_left = 0, keep_right = 0; // 0xffff: the pass keeps its key (ignored, and
+                                                     // '[' going right, none going left)
+        std::uint16_t seen = 0;                      // key when context sees the module, else 0
+        std::uint8_t open = 0, close = 0;            // 1: a '[' or a ']'
     };
     bool symbol_kernel = false; // Rewriter::run_symbols can rewrite strings without parameters
     std::vector<SymbolRow> sym_rows;
     std::vector<std::uint32_t> succ_at; // blocks of indices into succs
     std::vector<SymbolSucc> succs;
+    std::vector<SymbolSucc> succ_flat; // succs[succ_at[k]] at k: one load fewer a module
+
+    // The copy kernel (Engine::rewrite_copies, copies.cpp): when every module of a string
+    // without numbers is copied or rewritten by a direct template that stores no numbers (ABOP's
+    // Fig. 1.24), a step only copies each kind's successor kinds. Per kind of the program's
+    // table: its successor padded to kMax kinds (so that writing one is one fixed-size copy),
+    // its length and how many of them get new identities.
+    struct KindSucc {
+        static constexpr std::size_t kMax = 16;
+        KindId kinds[kMax] = {};
+    };
+    bool copy_kernel = false;
+    std::vector<KindSucc> copy_succ;
+    std::vector<std::uint8_t> copy_len, copy_fresh;
+    std::size_t copy_longest = 1; // the longest successor (at least 1: a copy)
 
     const Program& P;
     std::vector<const RuleSet*> sets;
@@ -90,6 +112,7 @@ struct RulePlan {
 
   private:
     void build_symbol_kernel();
+    void build_copy_kernel();
     bool build_guards(SymbolId sym);
     void build_outcomes();
     void build_context_table();

@@ -35,7 +35,7 @@ struct Worker {
     // context neighbours of the module at ctx_at, found once for all its productions
     std::size_t ctx_at = ~std::size_t{0};
     std::int64_t ctx_left = kUnknown, ctx_right = kUnknown;
-    std::vector<std::uint16_t>
+    BigVector<std::uint16_t>
         scratch; // Rewriter::run_symbols's keys, when the rewriter has no buffer for them
 };
 
@@ -46,7 +46,7 @@ class Rewriter {
     // `whole`: run_range will be called once, for the whole string, by one thread. Then the
     // symbol kernel needs no bracket table, and keeps its right keys in `scratch`.
     Rewriter(const RulePlan& rule_plan, const ModuleString& in,
-             std::vector<std::uint32_t>* brackets = nullptr, std::vector<std::uint16_t>* scratch = nullptr,
+             std::vector<std::uint32_t>* brackets = nullptr, BigVector<std::uint16_t>* scratch = nullptr,
              bool whole = false);
 
     // The production the context table gives for module i, which has a table and no parameters.
@@ -301,8 +301,8 @@ class Rewriter {
     bool table_kinds = false; // some module of `in` has a kind of constant numbers
     const std::size_t n;
     std::vector<std::uint32_t> own_match;
-    std::vector<std::uint16_t>* kernel_scratch = nullptr; // run_symbols's right keys, kept from step to step
-    const std::uint32_t* match = nullptr;                 // the bracket table (see bracket_table)
+    BigVector<std::uint16_t>* kernel_scratch = nullptr; // run_symbols's right keys, kept from step to step
+    const std::uint32_t* match = nullptr;               // the bracket table (see bracket_table)
     std::vector<std::size_t> piece_starts; // run_backward: where each piece of the new string starts
 };
 

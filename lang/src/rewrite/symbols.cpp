@@ -33,8 +33,7 @@ template <bool Whole> void Rewriter::run_symbols(Worker& w, std::size_t b, std::
     EvalEnv& env = w.env;
     const SymbolId* in_sym = in.kinds.data();
     const Plan::SymbolRow* rows = plan.sym_rows.data();
-    const std::uint32_t* succ_at = plan.succ_at.data();
-    const Plan::SymbolSucc* succs = plan.succs.data();
+    const Plan::SymbolSucc* succs = plan.succ_flat.data();
     const std::size_t K = plan.ctx_keys;
     const std::size_t Mmax = plan.max_modules_out;
     constexpr std::size_t kPad = Plan::SymbolSucc::kMax;
@@ -47,8 +46,8 @@ template <bool Whole> void Rewriter::run_symbols(Worker& w, std::size_t b, std::
     const std::uint16_t* rkey = nullptr;
     std::uint16_t* stack = nullptr;
     if constexpr (Whole) {
-        std::vector<std::uint16_t>& scratch = kernel_scratch ? *kernel_scratch : w.scratch;
-        scratch.resize(2 * n + 1);
+        BigVector<std::uint16_t>& scratch = kernel_scratch ? *kernel_scratch : w.scratch;
+        size_whole(scratch, 2 * n + 1);
         std::uint16_t* keys = scratch.data();
         stack = keys + n;
         std::uint16_t right = 0;
@@ -67,7 +66,7 @@ template <bool Whole> void Rewriter::run_symbols(Worker& w, std::size_t b, std::
         }
         rkey = keys;
     } else {
-        w.scratch.resize(e - b + 1);
+        size_whole(w.scratch, e - b + 1);
         stack = w.scratch.data();
     }
 
@@ -105,7 +104,7 @@ template <bool Whole> void Rewriter::run_symbols(Worker& w, std::size_t b, std::
                 const std::size_t j = row.rmask ? right_step(i + 1) : n;
                 at += (left & row.lmask) * K + (j < n ? rows[in_sym[j]].key : 0);
             }
-            const Plan::SymbolSucc& su = succs[succ_at[at]];
+            const Plan::SymbolSucc& su = succs[at];
             std::memcpy(S + m, su.syms, sizeof su.syms);
             m += su.len;
             fresh += su.fresh;

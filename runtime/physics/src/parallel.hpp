@@ -1,17 +1,12 @@
 // Splitting a loop over threads without changing its result (internal to plant_physics).
 #pragma once
 
+#include <plant/crew.hpp>
+
 #include <cstddef>
 #include <type_traits>
 
 namespace plant::physics {
-
-// Runs job(context, k) for k in [0, parts): part 0 on the calling thread, the others on threads
-// kept alive between calls (a step calls this about a dozen times; starting threads each time
-// cost more than the work they shared). When the kept threads are busy (a call from inside a
-// job, or from two threads at once), the parts run on threads started for this call instead.
-// Returns when every part has finished; if parts threw, rethrows what the first to throw threw.
-void run_parts(std::size_t parts, void (*job)(void* context, std::size_t k), void* context);
 
 // Runs f(begin, end) over [0, n) split into at most `threads` contiguous ranges of at least
 // `grain` indices (one range when n is below twice the grain). Each index is handled by exactly
@@ -28,7 +23,7 @@ template <class F> void parallel_ranges(std::size_t n, int threads, std::size_t 
         std::remove_reference_t<F>* f;
         std::size_t n, t;
     } context{&f, n, t};
-    run_parts(
+    plant::run_on_crew(
         t,
         [](void* c, std::size_t k) {
             const auto& x = *static_cast<Context*>(c);

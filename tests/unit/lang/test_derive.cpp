@@ -445,6 +445,45 @@ TEST_CASE("the symbol kernel writes the same for any split of the string", "[der
     }
 }
 
+// Strings without parameters under rules that are all direct templates storing no numbers go
+// through the copy kernel (Engine::rewrite_copies) when identities are dropped, and through the
+// direct route when they are kept: the two must agree module for module, new identities counted.
+TEST_CASE("the copy kernel writes what the direct route writes", "[derive][ids][kernel]") {
+    const char* grammars[] = {
+        // ABOP Fig. 1.24d, and an erasing production
+        "derive 9; axiom: X; rules { X -> F [ + X ] F [ - X ] + X; F -> F F; }",
+        "derive 12; axiom: A B; rules { A -> A B C; B -> ; C -> B A; }",
+        // kinds of constant numbers (the string stores none): &(30) and /(137.5) are table kinds
+        "derive 8; axiom: X; rules { X -> F [ &(30) X ] /(137.5) [ &(-30) X ]; F -> F F; }",
+        // the longest successor the kernel takes (16 modules), decomposition, a cut
+        "derive 5; axiom: A; rules { A -> A F F F F F F F F F F F F F F B; B -> %; } decompose { F -> G; }",
+        // a group switch between two plans, and interpretation rules
+        "var k = 0; derive 9; axiom: A; rules { A -> A B; B -> A; } rules two { A -> B B A; } "
+        "interpret { B -> F; } on after_step { k += 1; if (k == 4) { use two; } }",
+    };
+    for (const char* g : grammars)
+        for (int threads : {1, 2}) {
+            INFO(g << " threads " << threads);
+            auto c = test::compile(g);
+            REQUIRE(c->program);
+            RulePlan plan(*c->program, {&c->program->rules});
+            CHECK(plan.copy_kernel);
+            DeriveOptions o;
+            o.threads = threads;
+            same_without_identities(*c->program, o);
+        }
+    // a successor of 17 modules, a pattern with parameters, a condition: not the copy kernel's
+    for (const char* g :
+         {"axiom: A; rules { A -> A F F F F F F F F F F F F F F F B; }",
+          "module A(x); axiom: A(1); rules { A(x) -> A(x) B; }", "axiom: A; rules { A : 1 < 2 -> A B; }"}) {
+        INFO(g);
+        auto c = test::compile(g);
+        REQUIRE(c->program);
+        RulePlan plan(*c->program, {&c->program->rules});
+        CHECK_FALSE(plan.copy_kernel);
+    }
+}
+
 TEST_CASE("identities are kept when the program reads them, whatever the options say", "[derive][ids]") {
     auto c = test::compile("module A(x); axiom: A(0) B; derive 3; rules { A(x) -> A(id()) B; B -> B B; }");
     REQUIRE(c->program);

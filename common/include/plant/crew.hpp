@@ -1,16 +1,22 @@
-#include "parallel.hpp"
+// Threads kept for the process, shared by the derivation's parallel passes and the physics'
+// parallel loops (both call a split many times a step; starting threads for each call cost more
+// than the work they shared). Header-only, like the rest of plant_common, so that the physics
+// library stays usable without the language; not part of the public API.
+#pragma once
 
 #include <atomic>
 #include <condition_variable>
+#include <cstddef>
 #include <cstdint>
 #include <exception>
 #include <mutex>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
-namespace plant::physics {
+namespace plant {
 
-namespace {
+namespace crew_detail {
 
 inline void cpu_relax() {
 #if defined(__x86_64__) || defined(__i386__)
@@ -19,8 +25,8 @@ inline void cpu_relax() {
 }
 
 // Runs one part, keeping what it throws in `error` (the first part to throw wins).
-void run_part(void (*job)(void*, std::size_t), void* context, std::size_t k, std::exception_ptr& error,
-              std::mutex& error_mutex) {
+inline void run_part(void (*job)(void*, std::size_t), void* context, std::size_t k, std::exception_ptr& error,
+                     std::mutex& error_mutex) {
     try {
         job(context, k);
     } catch (...) {
@@ -115,29 +121,41 @@ class Crew {
     std::exception_ptr error_; // what the first part to throw threw, this call
 };
 
-Crew& crew() {
+inline Crew& crew() {
     static Crew* c = new Crew; // never destroyed (see Crew)
     return *c;
 }
 
-} // namespace
+} // namespace crew_detail
 
-void run_parts(std::size_t parts, void (*job)(void*, std::size_t), void* context) {
+// Runs job(context, k) for k in [0, parts): part 0 on the calling thread, the others on the kept
+// threads. When those are busy (a call from inside a part, or from two threads at once: the view
+// server's requests, --jobs variants) the parts run on threads started for this call instead.
+// Returns when every part has finished; if parts threw, rethrows what the first to throw threw.
+inline void run_on_crew(std::size_t parts, void (*job)(void*, std::size_t), void* context) {
     if (parts <= 1) {
         if (parts == 1) job(context, 0);
         return;
     }
-    if (crew().run(parts, job, context)) return;
+    if (crew_detail::crew().run(parts, job, context)) return;
     std::exception_ptr error;
     std::mutex error_mutex;
     {
         std::vector<std::jthread> pool;
         pool.reserve(parts - 1);
         for (std::size_t k = 1; k < parts; ++k)
-            pool.emplace_back([&, k] { run_part(job, context, k, error, error_mutex); });
-        run_part(job, context, 0, error, error_mutex);
+            pool.emplace_back([&, k] { crew_detail::run_part(job, context, k, error, error_mutex); });
+        crew_detail::run_part(job, context, 0, error, error_mutex);
     } // joined here
     if (error) std::rethrow_exception(error);
 }
 
-} // namespace plant::physics
+// run_on_crew for a callable f(k).
+template <class F> void run_on_crew(std::size_t parts, F&& f) {
+    using Fn = std::remove_reference_t<F>;
+    run_on_crew(
+        parts, [](void* c, std::size_t k) { (*static_cast<Fn*>(c))(k); },
+        const_cast<void*>(static_cast<const void*>(&f)));
+}
+
+} // namespace plant
