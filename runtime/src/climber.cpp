@@ -392,12 +392,6 @@ double Climber::thickness(ModuleId id) const {
     return h.valid() && world_.alive(h) ? world_.radii(h).x : 0.0;
 }
 
-double Climber::clearance(const glm::dvec3& p) const {
-    double d = 0;
-    nearest_obstacle(p, 1e300, d);
-    return d;
-}
-
 void Climber::thicken() {
     if (!(config_.strand > 0)) return;
     count_beyond();
@@ -408,18 +402,22 @@ void Climber::thicken() {
         // the pipe model (Shinozaki et al. 1964; Holton 1994's strands, which Hädrich et al. 2017,
         // section 4, name for secondary growth): a stem's cross-section is the one it was born
         // with plus one strand's for every segment beyond it
-        double r = std::sqrt(born_radius_[i] * born_radius_[i] + t2 * beyond_[i]);
-        // a plant's first segment hangs from a fixed root, which no contact moves: it is as thick
-        // as the room it has along its length allows (0.5 mm kept free), never thinner than at
-        // birth, so it does not grow into the support beside the seed
+        // wood does not shrink: a segment keeps its girth when what it carried is cut or breaks off
+        const glm::dvec3 radii = world_.radii(h);
+        double r = std::max(std::sqrt(born_radius_[i] * born_radius_[i] + t2 * beyond_[i]), radii.x);
+        // a plant's first segment hangs from a fixed root, which no contact moves: it is only as
+        // thick as the room around its root and along it allows (0.5 mm kept free), never thinner
+        // than at birth. The root counts: a capsule leaning from a root in the ground enters the
+        // ground by r (1 - sin of its lean) just beyond one radius from the root, and the lean
+        // changes after the radius is set (docs/physics.md, "Secondary growth in the figures")
         const std::uint32_t parent = world_.parent(h);
         if (parent < world_.size() && world_.parent(world_.handle(parent)) == ~0u) {
             const glm::dvec3 a = world_.position(world_.handle(parent)), b = world_.position(h);
-            double room = 1e300;
-            for (double t : {0.25, 0.5, 0.75, 1.0}) room = std::min(room, clearance(a + (b - a) * t) - 5e-4);
+            double room = 1e300, d = 0;
+            for (double t : {0.0, 0.25, 0.5, 0.75, 1.0})
+                if (nearest_obstacle(a + (b - a) * t, 1e300, d)) room = std::min(room, d - 5e-4);
             r = std::max(born_radius_[i], std::min(r, room));
         }
-        const glm::dvec3 radii = world_.radii(h);
         if (std::abs(r - radii.x) > 1e-12)
             world_.set_radii(h, glm::dvec3(r, radii.y > radii.x ? std::max(radii.y, r) : r, r));
     }

@@ -155,7 +155,6 @@ class Climber : public Environment {
     void count_beyond();
     void thicken();
     double thickness(ModuleId id) const;
-    double clearance(const glm::dvec3& p) const; // to the nearest obstacle
 
     std::vector<Attractor> attractors_; // the painted samples not yet reached
     physics::World world_;
