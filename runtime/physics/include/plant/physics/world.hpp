@@ -3,7 +3,8 @@
 // with ellipsoid moments, goals, age-dependent stiffness, roots, anchors, growth, obstacles,
 // collisions, breaking and wind. The sources go by concept: world.cpp (particles, edits and the
 // step's phases in order), shape_matching.cpp (groups, moments, goals, the passes), frames.cpp
-// (group rotations), collisions.cpp (obstacles and contacts), growth.cpp (growth and branching).
+// (group rotations), collisions.cpp (obstacles and contacts), growth.cpp (growth and branching),
+// grab.cpp (a hand pulling a stem), shadow.cpp (the obstacles' shade, declared in light.hpp).
 //
 // Particles are stored one array per field (PositionBasedDynamics' habit); a particle is named by
 // a {index, generation} handle (Box2D's), and a parent's index is always below its children's.
