@@ -35,7 +35,7 @@ constexpr EnvMethod kClimberMethods[] = {
     env_method(M::GrowDir, "grow_dir", {V, V}, V, Pure, false,
                "heading h at p turned by surface adaption (Eq. 6), attractors and phototropism (Eq. 7)"),
     env_method(M::Occlusion, "occlusion", {V}, N, Pure, true,
-               "light occlusion at p by the plant's particles, 0 to 1"),
+               "light occlusion at p, 0 to 1: 1 behind an obstacle, else by the plant's particles"),
     env_method(M::Anchored, "anchored", {N}, N, Pure, false,
                "1 when module id's particle is anchored to a surface"),
     env_method(M::Particles, "particles", {}, N, Pure, false, "particles in the world"),
@@ -57,8 +57,11 @@ constexpr EnvMethod kClimberMethods[] = {
     env_method(M::Thickness, "thickness", {N}, N, Pure, false,
                "radius of module id's particle (0: none): with `strand`, thickened by secondary growth "
                "to sqrt(r0^2 + strand^2 n), r0 its radius at birth and n the segments beyond it"),
+    env_method(M::Grab, "grab", {N, V}, N, Edit, false,
+               "pull module id's particle toward a point at grab_speed through the next step, its stem "
+               "following within its length and coming off its supports"),
 };
-static_assert(method_table(kClimberMethods, M::Thickness));
+static_assert(method_table(kClimberMethods, M::Grab));
 
 } // namespace
 
@@ -132,11 +135,14 @@ double emit_speed(const glm::dvec3& v) {
 void Climber::edit(std::size_t method, const double* a) {
     const auto m = static_cast<M>(method);
     // edits with a non-finite vector are ignored: they would poison the world
-    const bool vector = m == M::Pull || m == M::Wind || m == M::Move || m == M::Emit;
+    const bool vector = m == M::Pull || m == M::Grab || m == M::Wind || m == M::Move || m == M::Emit;
     if (vector && !finite(vec(m == M::Wind ? a : a + 1))) return;
     switch (m) {
     case M::Pull:
         pulls_.emplace_back(id_of(a[0]), vec(a + 1));
+        return;
+    case M::Grab:
+        grabs_.emplace_back(id_of(a[0]), vec(a + 1));
         return;
     case M::Cut:
         cuts_.push_back(id_of(a[0]));
@@ -317,6 +323,11 @@ void Climber::advance(std::set<ModuleId>& left) {
             physics::Handle h = particle(id);
             if (h.valid() && world_.alive(h)) world_.pull(h, target);
         }
+        for (const auto& [id, target] : grabs_) {
+            physics::Handle h = particle(id);
+            if (h.valid() && world_.alive(h))
+                world_.grab(h, target, config_.grab_speed * world_.settings().dt);
+        }
         try {
             for (int a = 0; a < air_steps; ++a) fluid_.step(&world_);
         } catch (const physics::AirCrowded& e) {
@@ -327,6 +338,7 @@ void Climber::advance(std::set<ModuleId>& left) {
         world_.step();
     }
     pulls_.clear();
+    grabs_.clear();
     // a wind, pull or segment far beyond any scene can push particles out of finite space; the
     // plant cannot be drawn from there, so the derivation ends (the caller names the climber)
     for (const auto& [id, h] : particle_of_)
@@ -380,12 +392,6 @@ double Climber::thickness(ModuleId id) const {
     return h.valid() && world_.alive(h) ? world_.radii(h).x : 0.0;
 }
 
-double Climber::clearance(const glm::dvec3& p) const {
-    double d = 0;
-    nearest_obstacle(p, 1e300, d);
-    return d;
-}
-
 void Climber::thicken() {
     if (!(config_.strand > 0)) return;
     count_beyond();
@@ -396,18 +402,22 @@ void Climber::thicken() {
         // the pipe model (Shinozaki et al. 1964; Holton 1994's strands, which Hädrich et al. 2017,
         // section 4, name for secondary growth): a stem's cross-section is the one it was born
         // with plus one strand's for every segment beyond it
-        double r = std::sqrt(born_radius_[i] * born_radius_[i] + t2 * beyond_[i]);
-        // a plant's first segment hangs from a fixed root, which no contact moves: it is as thick
-        // as the room it has along its length allows (0.5 mm kept free), never thinner than at
-        // birth, so it does not grow into the support beside the seed
+        // wood does not shrink: a segment keeps its girth when what it carried is cut or breaks off
+        const glm::dvec3 radii = world_.radii(h);
+        double r = std::max(std::sqrt(born_radius_[i] * born_radius_[i] + t2 * beyond_[i]), radii.x);
+        // a plant's first segment hangs from a fixed root, which no contact moves: it is only as
+        // thick as the room around its root and along it allows (0.5 mm kept free), never thinner
+        // than at birth. The root counts: a capsule leaning from a root in the ground enters the
+        // ground by r (1 - sin of its lean) just beyond one radius from the root, and the lean
+        // changes after the radius is set (docs/physics.md, "Secondary growth in the figures")
         const std::uint32_t parent = world_.parent(h);
         if (parent < world_.size() && world_.parent(world_.handle(parent)) == ~0u) {
             const glm::dvec3 a = world_.position(world_.handle(parent)), b = world_.position(h);
-            double room = 1e300;
-            for (double t : {0.25, 0.5, 0.75, 1.0}) room = std::min(room, clearance(a + (b - a) * t) - 5e-4);
+            double room = 1e300, d = 0;
+            for (double t : {0.0, 0.25, 0.5, 0.75, 1.0})
+                if (nearest_obstacle(a + (b - a) * t, 1e300, d)) room = std::min(room, d - 5e-4);
             r = std::max(born_radius_[i], std::min(r, room));
         }
-        const glm::dvec3 radii = world_.radii(h);
         if (std::abs(r - radii.x) > 1e-12)
             world_.set_radii(h, glm::dvec3(r, radii.y > radii.x ? std::max(radii.y, r) : r, r));
     }
@@ -421,8 +431,11 @@ void Climber::rebuild_occupancy() {
 }
 
 double Climber::occlusion(const glm::dvec3& p) const {
-    // Eq. 7's O from the particles in the cells between p and the light
-    return light_.occlusion(p, glm::normalize(config_.light), config_.opacity);
+    // Eq. 7's O: an obstacle between p and the light is opaque, a full shade (the paper's shadow
+    // maps include the scene); else the particles in the cells between p and the light
+    const glm::dvec3 to_light = glm::normalize(config_.light);
+    if (config_.obstacle_shade && physics::in_shadow(world_.obstacles(), p, to_light)) return 1.0;
+    return light_.occlusion(p, to_light, config_.opacity);
 }
 
 glm::dvec3 Climber::grow_dir(const glm::dvec3& p, const glm::dvec3& h) const {
@@ -499,6 +512,7 @@ struct ClimberArgs {
 
     ClimberArgs() { s.fixed_stiffness = 1.0; } // the paper used s = 1 for most results
     bool read(const EnvArg& a, std::string& error);
+    void set(const std::string& key, double x, const glm::dvec3& v); // a checked argument's value
     bool check(std::string& error);
 };
 
@@ -536,12 +550,13 @@ std::string bounded(const std::string& key, double x, const glm::dvec3& v, std::
 bool ClimberArgs::read(const EnvArg& a, std::string& error) {
     // besides the obstacle shapes (ObstacleArgs) and meshes
     static const char* numbers[] = {
-        "substeps",     "iterations",       "stiffness",          "stiffening_time", "break_threshold",
-        "damping",      "density",          "phototropism",       "adaption",        "adaption_range",
-        "response",     "anchor",           "anchor_range",       "anchor_release",  "friction",
-        "elasticity",   "attractor_radius", "attractor_strength", "threads",         "light_cell",
-        "opacity",      "air_spacing",      "air_density",        "air_viscosity",   "air_stiffness",
-        "air_coupling", "mesh_cell",        "attractor_reach",    "emitter_radius",  "strand"};
+        "substeps",       "iterations",       "stiffness",          "stiffening_time", "break_threshold",
+        "damping",        "density",          "phototropism",       "adaption",        "adaption_range",
+        "response",       "anchor",           "anchor_range",       "anchor_release",  "friction",
+        "elasticity",     "attractor_radius", "attractor_strength", "threads",         "light_cell",
+        "opacity",        "air_spacing",      "air_density",        "air_viscosity",   "air_stiffness",
+        "air_coupling",   "mesh_cell",        "attractor_reach",    "emitter_radius",  "strand",
+        "obstacle_shade", "grab_speed"};
     static const char* vectors[] = {"gravity", "light",   "wind",    "attractor",
                                     "air_min", "air_max", "emitter", "emitter_velocity"};
     if (a.key == "mesh") {
@@ -572,83 +587,91 @@ bool ClimberArgs::read(const EnvArg& a, std::string& error) {
     // the numbers that size work or memory have bounds (the distance grid of a mesh spans the
     // mesh grown by 4 mesh_cell + adaption_range)
     if (error = bounded(a.key, x, v, emit_at.size(), attract.size()); !error.empty()) return false;
-    if (a.key == "substeps")
-        c.substeps = static_cast<int>(std::clamp(x, 0.0, 1000.0));
-    else if (a.key == "iterations")
-        s.iterations = static_cast<int>(std::clamp(x, 1.0, 100.0));
-    else if (a.key == "stiffness")
-        s.fixed_stiffness = x; // negative: grows with age, s = t_l / t_m
-    else if (a.key == "stiffening_time")
-        s.stiffening_time = std::max(x, 1e-6);
-    else if (a.key == "break_threshold")
-        break_threshold = std::max(x, 0.0);
-    else if (a.key == "damping")
-        s.damping = std::clamp(x, 0.0, 1.0);
-    else if (a.key == "density")
-        s.density = std::max(x, 1e-9);
-    else if (a.key == "phototropism")
-        c.phototropism = std::max(x, 0.0);
-    else if (a.key == "adaption")
-        c.adaption = std::clamp(x, 0.0, 1.0);
-    else if (a.key == "adaption_range")
-        c.adaption_range = std::max(x, 0.0);
-    else if (a.key == "response")
-        c.response = std::max(x, 0.0);
-    else if (a.key == "anchor")
-        c.anchor = std::clamp(x, 0.0, 1.0);
-    else if (a.key == "anchor_range")
-        c.anchor_range = std::max(x, 0.0);
-    else if (a.key == "anchor_release")
-        c.anchor_release = std::max(x, 0.0);
-    else if (a.key == "friction")
-        friction = std::clamp(x, 0.0, 1.0);
-    else if (a.key == "elasticity")
-        elasticity = std::clamp(x, 0.0, 1.0);
-    else if (a.key == "attractor_radius")
-        attract_r.push_back(x);
-    else if (a.key == "attractor_strength")
-        attract_s.push_back(x);
-    else if (a.key == "threads")
-        s.threads = static_cast<int>(std::clamp(x, 1.0, 256.0));
-    else if (a.key == "light_cell")
-        c.light_cell = std::max(x, 1e-3);
-    else if (a.key == "opacity")
-        c.opacity = std::max(x, 0.0);
-    else if (a.key == "gravity")
-        s.gravity = v;
-    else if (a.key == "light")
-        c.light = v;
-    else if (a.key == "wind")
-        wind = v;
-    else if (a.key == "attractor")
-        attract.push_back(v);
-    else if (a.key == "emitter")
-        emit_at.push_back(v);
-    else if (a.key == "emitter_velocity")
-        emit_v.push_back(v);
-    else if (a.key == "emitter_radius")
-        emit_r.push_back(std::max(x, 1e-3));
-    else if (a.key == "air_min")
-        c.fluid.domain_lo = v, air_min = true;
-    else if (a.key == "air_max")
-        c.fluid.domain_hi = v, air_max = true;
-    else if (a.key == "air_spacing")
-        c.fluid.spacing = std::max(x, 1e-3), c.fluid.support = 2 * c.fluid.spacing;
-    else if (a.key == "air_density")
-        c.fluid.rest_density = std::max(x, 1e-6);
-    else if (a.key == "air_viscosity")
-        c.fluid.viscosity = std::max(x, 0.0);
-    else if (a.key == "air_stiffness")
-        c.fluid.stiffness = std::max(x, 1e-6);
-    else if (a.key == "air_coupling")
-        c.fluid.coupling = std::max(x, 0.0);
-    else if (a.key == "mesh_cell")
-        mesh_cell = std::max(x, 1e-3);
-    else if (a.key == "attractor_reach")
-        c.attractor_reach = std::max(x, 0.0);
-    else if (a.key == "strand")
-        c.strand = std::clamp(x, 0.0, 1.0); // a strand wider than 1 m is no stem
+    set(a.key, x, v);
     return true;
+}
+
+void ClimberArgs::set(const std::string& key, double x, const glm::dvec3& v) {
+    if (key == "substeps")
+        c.substeps = static_cast<int>(std::clamp(x, 0.0, 1000.0));
+    else if (key == "iterations")
+        s.iterations = static_cast<int>(std::clamp(x, 1.0, 100.0));
+    else if (key == "stiffness")
+        s.fixed_stiffness = x; // negative: grows with age, s = t_l / t_m
+    else if (key == "stiffening_time")
+        s.stiffening_time = std::max(x, 1e-6);
+    else if (key == "break_threshold")
+        break_threshold = std::max(x, 0.0);
+    else if (key == "damping")
+        s.damping = std::clamp(x, 0.0, 1.0);
+    else if (key == "density")
+        s.density = std::max(x, 1e-9);
+    else if (key == "phototropism")
+        c.phototropism = std::max(x, 0.0);
+    else if (key == "adaption")
+        c.adaption = std::clamp(x, 0.0, 1.0);
+    else if (key == "adaption_range")
+        c.adaption_range = std::max(x, 0.0);
+    else if (key == "response")
+        c.response = std::max(x, 0.0);
+    else if (key == "anchor")
+        c.anchor = std::clamp(x, 0.0, 1.0);
+    else if (key == "anchor_range")
+        c.anchor_range = std::max(x, 0.0);
+    else if (key == "anchor_release")
+        c.anchor_release = std::max(x, 0.0);
+    else if (key == "friction")
+        friction = std::clamp(x, 0.0, 1.0);
+    else if (key == "elasticity")
+        elasticity = std::clamp(x, 0.0, 1.0);
+    else if (key == "attractor_radius")
+        attract_r.push_back(x);
+    else if (key == "attractor_strength")
+        attract_s.push_back(x);
+    else if (key == "threads")
+        s.threads = static_cast<int>(std::clamp(x, 1.0, 256.0));
+    else if (key == "light_cell")
+        c.light_cell = std::max(x, 1e-3);
+    else if (key == "opacity")
+        c.opacity = std::max(x, 0.0);
+    else if (key == "gravity")
+        s.gravity = v;
+    else if (key == "light")
+        c.light = v;
+    else if (key == "wind")
+        wind = v;
+    else if (key == "attractor")
+        attract.push_back(v);
+    else if (key == "emitter")
+        emit_at.push_back(v);
+    else if (key == "emitter_velocity")
+        emit_v.push_back(v);
+    else if (key == "emitter_radius")
+        emit_r.push_back(std::max(x, 1e-3));
+    else if (key == "air_min")
+        c.fluid.domain_lo = v, air_min = true;
+    else if (key == "air_max")
+        c.fluid.domain_hi = v, air_max = true;
+    else if (key == "air_spacing")
+        c.fluid.spacing = std::max(x, 1e-3), c.fluid.support = 2 * c.fluid.spacing;
+    else if (key == "air_density")
+        c.fluid.rest_density = std::max(x, 1e-6);
+    else if (key == "air_viscosity")
+        c.fluid.viscosity = std::max(x, 0.0);
+    else if (key == "air_stiffness")
+        c.fluid.stiffness = std::max(x, 1e-6);
+    else if (key == "air_coupling")
+        c.fluid.coupling = std::max(x, 0.0);
+    else if (key == "mesh_cell")
+        mesh_cell = std::max(x, 1e-3);
+    else if (key == "attractor_reach")
+        c.attractor_reach = std::max(x, 0.0);
+    else if (key == "strand")
+        c.strand = std::clamp(x, 0.0, 1.0); // a strand wider than 1 m is no stem
+    else if (key == "grab_speed")
+        c.grab_speed = std::clamp(x, 0.0, 1e3); // a hand faster than 1 km/s is no hand
+    else if (key == "obstacle_shade")
+        c.obstacle_shade = x != 0;
 }
 
 bool ClimberArgs::check(std::string& error) {

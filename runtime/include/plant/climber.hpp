@@ -21,7 +21,8 @@
 // as little as keeps the segment from p to p + v, a capsule of radius r, out of every obstacle),
 // thickness(id) (its particle's radius: with the argument `strand`, grown by secondary growth,
 // the pipe model, by one strand of that radius for every segment beyond it);
-// edits, in hooks only: pull(id, target),
+// edits, in hooks only: pull(id, target), grab(id, target) (a hand pulling the branch toward the
+// target at grab_speed, its stem following within its length: physics::World::grab),
 // cut(id), wind(a), move(k, delta), seed(id), emit(k, velocity).
 //
 // With air_min and air_max the climber also runs SPH air in that box (section 5.3): each 25 ms
@@ -68,6 +69,7 @@ enum class ClimberMethod : std::uint8_t {
     // queries, after the edits so that their numbers stay
     ClearDir,
     Thickness,
+    Grab, // an edit, after the queries so that their numbers stay
 };
 
 const EnvironmentKind& climber_kind();
@@ -88,11 +90,13 @@ class Climber : public Environment {
         double anchor = 0;          // phi of Eq. 5 for new particles near a surface (0: no anchors)
         double anchor_range = 0.05; // how near (beyond the particle's radius)
         double anchor_release = 0.3;
-        double light_cell = 0.1; // occupancy grid for occlusion
-        double opacity = 0.15;   // occlusion 1 - exp(-opacity * particles between p and the light)
+        double light_cell = 0.1;    // occupancy grid for occlusion
+        double opacity = 0.15;      // occlusion 1 - exp(-opacity * particles between p and the light)
+        bool obstacle_shade = true; // an obstacle between p and the light: occlusion 1 (full shade)
         std::vector<Attractor> attractors;
         double attractor_reach = 0.1; // a painted sample a particle comes this near is used up
         double strand = 0;            // secondary growth: a pipe's radius per segment beyond (0: none)
+        double grab_speed = 1;        // m/s: how fast grab(id, target) pulls a particle toward its target
         bool air = false;             // SPH air fills [air_min, air_max] (section 5.3)
         physics::FluidSettings fluid;
     };
@@ -151,7 +155,6 @@ class Climber : public Environment {
     void count_beyond();
     void thicken();
     double thickness(ModuleId id) const;
-    double clearance(const glm::dvec3& p) const; // to the nearest obstacle
 
     std::vector<Attractor> attractors_; // the painted samples not yet reached
     physics::World world_;
@@ -163,7 +166,7 @@ class Climber : public Environment {
     std::set<ModuleId> seen_;
     std::vector<BoundSegment> pending_; // bound modules without a particle yet
     // edits asked for by hooks since the last advance
-    std::vector<std::pair<ModuleId, glm::dvec3>> pulls_;
+    std::vector<std::pair<ModuleId, glm::dvec3>> pulls_, grabs_;
     std::vector<ModuleId> cuts_;
     std::vector<std::pair<std::size_t, glm::dvec3>> moves_;
     std::vector<ModuleId> seed_requests_;

@@ -38,13 +38,14 @@ struct Figure {
     double deepest = 0;     // metres inside an obstacle, the worst particle centre of any step
     std::string deepest_at; // which step and obstacle
 
-    const physics::World& world() const {
+    const Climber& climber() const {
         REQUIRE(d->run_state().size() > 0);
         const Environment* env = d->run_state().environment(0);
         REQUIRE(env);
         REQUIRE(&env->kind() == &climber_kind());
-        return static_cast<const Climber&>(*env).world();
+        return static_cast<const Climber&>(*env);
     }
+    const physics::World& world() const { return climber().world(); }
     Skeleton skeleton() const {
         return build_skeleton(*program, d->interpreted(d->string()), turtle_options(*d));
     }
@@ -162,21 +163,95 @@ TEST_CASE("climber figures: Fig. 7's gust of wind moves the plant more than 5 cm
     CHECK(after_cut->count("Seg") + 10 < before_cut->count("Seg"));
 }
 
+// The largest |length / rest length - 1| of any link of the world.
+double worst_stretch(const physics::World& w) {
+    double worst = 0;
+    for (std::uint32_t i = 0; i < w.size(); ++i) {
+        const physics::Handle h = w.handle(i);
+        if (!w.alive(h) || w.parent(h) == ~0u) continue;
+        const physics::Handle p = w.handle(w.parent(h));
+        const double rest = glm::distance(w.rest_position(h), w.rest_position(p));
+        if (rest > 0)
+            worst = std::max(worst, std::fabs(glm::distance(w.position(h), w.position(p)) / rest - 1));
+    }
+    return worst;
+}
+
+TEST_CASE("climber figures: Fig. 7's grabbed branch follows the hand off the wall, links intact",
+          "[climber]") {
+    // fig07_editing.plant grabs segment #68 (the main shoot, 0.45 m up) in steps 16 to 19
+    auto left_alone = grow("fig07_editing.plant", {{"grab", "0"}}, 20);
+    auto grabbed = grow("fig07_editing.plant", {}, 20);
+    const physics::Handle still = left_alone->climber().particle(68), held = grabbed->climber().particle(68);
+    REQUIRE(still.valid());
+    REQUIRE(held.valid());
+    const glm::dvec3 a = left_alone->world().position(still), b = grabbed->world().position(held);
+    INFO("segment #68 ends at z = " << a.z << " left alone, " << b.z << " grabbed, " << glm::distance(a, b)
+                                    << " m apart; worst link " << worst_stretch(grabbed->world()));
+    CHECK(glm::distance(a, b) > 0.05);
+    CHECK(b.z > 0.05);                            // off the wall's face (z = 0)
+    CHECK(left_alone->world().anchored(still));   // clinging, left alone
+    CHECK(!grabbed->world().anchored(held));      // its anchor let go
+    CHECK(worst_stretch(grabbed->world()) < 0.1); // the stem followed within its length
+    // nothing broke off (a broken-off part leaves the string): the grabbed plant, in more light,
+    // has grown as much or more
+    CHECK(grabbed->count("Seg") >= left_alone->count("Seg"));
+}
+
+TEST_CASE("climber figures: stems thicken with age in the figures, drawn as thick as the physics holds them",
+          "[climber]") {
+    // secondary growth (`strand: strand`) is on in these; fig01_car's pruning group keeps its
+    // segments' radii from its particles too (with the radius it was given, a pruned plant's
+    // stems were drawn up to 8 mm thicker than collided, through the car's body)
+    for (const char* name : {"fig01_car.plant", "fig10_dome.plant"}) {
+        auto f = grow(name);
+        const Skeleton s = f->skeleton();
+        const physics::World& w = f->world();
+        double thickest = 0, worst = 0;
+        std::size_t bound = 0;
+        for (const auto& axis : s.axes)
+            for (const auto& p : axis.points) {
+                const physics::Handle h = f->climber().particle(p.id);
+                if (!h.valid() || !w.alive(h)) continue;
+                ++bound;
+                thickest = std::max(thickest, p.radius);
+                worst = std::max(worst, std::fabs(p.radius - w.radii(h).x));
+            }
+        INFO(name << ": thickest stem radius " << thickest << " m; drawn and physical radii differ by up to "
+                  << worst << " m over " << bound << " segments");
+        CHECK(bound > 300);
+        CHECK(thickest > 2.5 * 0.006); // the library's birth radius
+        CHECK(worst < 1e-9);
+    }
+}
+
 TEST_CASE("climber figures: Fig. 14 right's plants favour the building's lit side", "[climber]") {
-    auto stem_length = [](const Figure& f, double side) {
+    // stem length with its segment's midpoint on one side of x = at (side +1: x > at, -1: x < -at)
+    auto stem_length = [](const Figure& f, double side, double at = 0) {
         double l = 0;
         for (const Segment& s : segments(f.skeleton()))
-            if (s.mid().x * side > 0) l += s.length();
+            if (s.mid().x * side > at) l += s.length();
         return l;
     };
     auto lit = grow("fig14_right.plant");
     const double right = stem_length(*lit, 1), left = stem_length(*lit, -1);
+    // the side walls' faces are x = -2.5 (dark: the building is between it and the light) and 2.5
+    const double lit_wall = stem_length(*lit, 1, 2.5), dark_wall = stem_length(*lit, -1, 2.5);
+    auto unshaded = grow("fig14_right.plant", {{"shade", "0"}});
+    const double unshaded_dark = stem_length(*unshaded, -1, 2.5);
     auto above = grow("fig14_right.plant", {{"light_x", "0"}});
     const double even_right = stem_length(*above, 1), even_left = stem_length(*above, -1);
-    INFO("lit from the right: " << right << " m right, " << left << " m left; from above: " << even_right
-                                << " m, " << even_left << " m");
+    INFO("lit from the right: " << right << " m right, " << left << " m left; side walls: " << lit_wall
+                                << " m lit, " << dark_wall << " m dark (" << unshaded_dark
+                                << " m without the building's shade); from above: " << even_right << " m, "
+                                << even_left << " m");
     CHECK(right > 1.5 * left);
     CHECK(even_right < 1.3 * even_left); // the light does it, not the seeding
+    // the building's shade: its dark side wall's plants do not grow past their seeds (four 5 cm
+    // segments), and do without the shade
+    CHECK(lit_wall > 20);
+    CHECK(dark_wall < 0.5);
+    CHECK(unshaded_dark > 20);
 }
 
 TEST_CASE("climber figures: Fig. 14 left's shoots past the water tank bend down under gravity", "[climber]") {

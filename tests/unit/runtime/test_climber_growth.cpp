@@ -84,6 +84,48 @@ seed 1;
     CHECK(shaded > 5); // shaded, not dark: it still grows
 }
 
+TEST_CASE("climber growth: an obstacle between an apex and the light shades it", "[climber]") {
+    // two unbranched weightless shoots 0.6 m apart, a wall between them, the light level from the
+    // right: the left shoot is behind the wall from the light, the right one in the open. The
+    // plants' own shade is off (opacity 0), so only the wall can shade.
+    const std::string scene = R"(
+import climber with { N = 2, BP = 0, Ph = 0, spacing = 0.6, steps = 20, leaf_size = 0 };
+env ivy = climber(gravity: vec3(0, 0, 0), light: vec3(1, 0.05, 0), phototropism: Ph, adaption: 0,
+                  stiffness: 1, opacity: 0, obstacle_shade: SHADE,
+                  box_min: vec3(-0.1, 0, -0.3), box_max: vec3(0.1, 3, 0.3));
+seed 1;
+)";
+    auto grown = [&](const char* shade) {
+        std::string text = scene;
+        text.replace(text.find("SHADE"), 5, shade);
+        auto g = start(text);
+        while (g->d->step()) {
+        }
+        return g;
+    };
+    auto g = grown("1");
+    const auto plants = main_shoots(*g);
+    REQUIRE(plants.size() == 2);
+    INFO("segments: behind the wall " << plants[0].size() << ", in the open " << plants[1].size());
+    CHECK(plants[1].size() == 20); // lit: a segment a step
+    CHECK(plants[0].size() == 1);  // O = 1 behind the wall: it does not grow past its seed
+    // Eq. 7's occlusion as the grammar reads it
+    const Climber& c = climber_of(*g->d);
+    auto occlusion = [&](glm::dvec3 p) {
+        double r = -1;
+        c.query(static_cast<std::size_t>(ClimberMethod::Occlusion), &p.x, &r);
+        return r;
+    };
+    CHECK(occlusion({-0.3, 0.5, 0.015}) == 1.0); // behind the wall
+    CHECK(occlusion({0.3, 0.5, 0.015}) == 0.0);  // in the open
+    CHECK(occlusion({-0.3, 0.5, 0.5}) == 0.0);   // beside the wall
+    // obstacle_shade: 0, as before: the wall casts no shade and both grow alike
+    const auto unshaded = main_shoots(*grown("0"));
+    REQUIRE(unshaded.size() == 2);
+    CHECK(unshaded[0].size() == 20);
+    CHECK(unshaded[1].size() == 20);
+}
+
 TEST_CASE("climber growth: stems thicken with age by the pipe model, base thicker than tip", "[climber]") {
     auto g = start(R"(
 import climber with { N = 1, BP = 0.3, V = 0.5, Ph = 0, steps = 24, leaf_size = 0 };

@@ -1,7 +1,10 @@
 // Self-shading for phototropism (Hädrich et al. 2017, Eq. 7's occlusion O): the plant's particles
 // counted in a grid of cubic cells, and the count along a ray from a point toward the light. Both
-// the runtime's own growth (World::grow) and the climber binding use it.
+// the runtime's own growth (World::grow) and the climber binding use it. The scene's obstacles
+// shade too (shadow.cpp): a point whose ray toward the light enters one is in full shade.
 #pragma once
+
+#include "plant/physics/world.hpp"
 
 #include <glm/glm.hpp>
 
@@ -27,5 +30,14 @@ class LightGrid {
     glm::ivec3 n_{0};
     std::vector<std::uint32_t> count_;
 };
+
+// Whether the ray from p toward `to_light` (unit) enters obstacle o: the paper's light includes
+// the scene (its shadow maps, Hädrich et al. 2017, section 4.2). Exact for spheres, boxes and
+// planes; a sampled grid is marched by its distance (at least half a cell a step, so a part
+// thinner than that may let light through), at most 4096 steps. A point inside o is not shaded
+// by it (the ray never enters it), nor is one whose ray only grazes a face.
+bool blocks_light(const Obstacle& o, const glm::dvec3& p, const glm::dvec3& to_light);
+// Whether any of the obstacles blocks the light at p.
+bool in_shadow(const std::vector<Obstacle>& obstacles, const glm::dvec3& p, const glm::dvec3& to_light);
 
 } // namespace plant::physics

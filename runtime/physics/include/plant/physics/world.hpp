@@ -3,7 +3,8 @@
 // with ellipsoid moments, goals, age-dependent stiffness, roots, anchors, growth, obstacles,
 // collisions, breaking and wind. The sources go by concept: world.cpp (particles, edits and the
 // step's phases in order), shape_matching.cpp (groups, moments, goals, the passes), frames.cpp
-// (group rotations), collisions.cpp (obstacles and contacts), growth.cpp (growth and branching).
+// (group rotations), collisions.cpp (obstacles and contacts), growth.cpp (growth and branching),
+// grab.cpp (a hand pulling a stem), shadow.cpp (the obstacles' shade, declared in light.hpp).
 //
 // Particles are stored one array per field (PositionBasedDynamics' habit); a particle is named by
 // a {index, generation} handle (Box2D's), and a parent's index is always below its children's.
@@ -40,6 +41,7 @@ struct Growth {
     double adaption_range = 0.3; // obstacles nearer than this steer the apex
     double opacity = 0.15;       // Eq. 7's O = 1 - exp(-opacity * particles between the apex and the light)
     double light_cell = 0.1;     // the cells those particles are counted in
+    bool obstacle_shade = true;  // an obstacle between the apex and the light: O = 1 (shadow.cpp)
     std::uint64_t seed = 1;
 };
 
@@ -203,6 +205,13 @@ class World {
     void set_position(Handle h, const glm::dvec3& p) { x_[h.index] = p; }
     // Holds a particle at `target` through the next step, as a user dragging it would.
     void pull(Handle h, const glm::dvec3& target) { pulls_.push_back({h.index, target}); }
+    // A hand grabbing particle h and pulling it toward `target`, by at most `reach` this step
+    // (grab.cpp; Fig. 7 c): the stem between it and its root follows within its length (an
+    // ancestor moves while its link is taut, and a hand beyond the stem's length from its root
+    // gets as far as the stem reaches), clear of the obstacles; the particles moved are held
+    // there through the next step, and an anchor lets go once its particle is past the anchor's
+    // release distance. Call it before each step the hand holds on.
+    void grab(Handle h, const glm::dvec3& target, double reach);
     void set_orientation(Handle h, const glm::dquat& q) { q_[h.index] = q; }
 
     // The goal positions the shape matching gives for the current positions (Eq. 4), without

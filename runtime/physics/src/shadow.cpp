@@ -1,0 +1,88 @@
+// The scene's shade: a ray from a point toward the light, tested against each obstacle
+// (light.hpp). Hädrich et al. 2017 light their scenes with shadow maps (section 4.2), so the
+// obstacles shade the plant as well as its own leaves; docs/physics.md, "Growth rate".
+#include "plant/physics/light.hpp"
+
+#include "obstacle_field.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace plant::physics {
+
+namespace {
+
+bool finite(const glm::dvec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+// The ray p + t d (t > 0) against the box [lo, hi] by slabs: the interval of t inside it, empty
+// when t_in > t_out. A ray parallel to a slab it starts outside of misses.
+bool slab_interval(const glm::dvec3& lo, const glm::dvec3& hi, const glm::dvec3& p, const glm::dvec3& d,
+                   double& t_in, double& t_out) {
+    t_in = -1e300;
+    t_out = 1e300;
+    for (int k = 0; k < 3; ++k) {
+        if (d[k] == 0) {
+            if (p[k] <= lo[k] || p[k] >= hi[k]) return false;
+            continue;
+        }
+        double a = (lo[k] - p[k]) / d[k], b = (hi[k] - p[k]) / d[k];
+        if (a > b) std::swap(a, b);
+        t_in = std::max(t_in, a);
+        t_out = std::min(t_out, b);
+    }
+    return t_in < t_out;
+}
+
+// a sampled grid: marched by its distance from where the ray meets the grid's box to where it
+// leaves it; inside (a negative sample) is a hit
+bool grid_blocks(const Obstacle& o, const glm::dvec3& p, const glm::dvec3& d) {
+    if (!o.grid || o.grid->d.empty()) return false;
+    const DistanceGrid& g = *o.grid;
+    const glm::dvec3 lo = g.lo + o.a, hi = lo + glm::dvec3(g.n - 1) * g.cell;
+    double t_in = 0, t_out = 0;
+    if (!slab_interval(lo, hi, p, d, t_in, t_out) || t_out <= 0) return false;
+    if (signed_distance(o, p) <= 0) return false; // inside: not shaded by it
+    double t = std::max(t_in, 0.0);
+    const double least = g.cell / 2;
+    for (int k = 0; k < 4096 && t <= t_out; ++k) {
+        const double s = signed_distance(o, p + d * t);
+        if (s < 0) return true;
+        t += std::max(s, least);
+    }
+    return false;
+}
+
+} // namespace
+
+bool blocks_light(const Obstacle& o, const glm::dvec3& p, const glm::dvec3& to_light) {
+    if (!finite(p) || !finite(to_light)) return false;
+    const glm::dvec3& d = to_light;
+    switch (o.kind) {
+    case Obstacle::Sphere: { // |p + t d - c|^2 = r^2 has a root t > 0, p outside
+        const glm::dvec3 m = p - o.a;
+        const double c = glm::dot(m, m) - o.b.x * o.b.x, b = glm::dot(m, d);
+        return c > 0 && b < 0 && b * b - c > 0;
+    }
+    case Obstacle::Box: {
+        if (signed_distance(o, p) <= 0) return false;
+        double t_in = 0, t_out = 0;
+        return slab_interval(o.a, o.b, p, d, t_in, t_out) && t_in > 0;
+    }
+    case Obstacle::Plane: { // above it and the light below its horizon
+        const glm::dvec3 n = glm::normalize(o.b);
+        return glm::dot(p - o.a, n) > 0 && glm::dot(d, n) < 0;
+    }
+    case Obstacle::Grid:
+        return grid_blocks(o, p, d);
+    }
+    return false;
+}
+
+bool in_shadow(const std::vector<Obstacle>& obstacles, const glm::dvec3& p, const glm::dvec3& to_light) {
+    return std::any_of(obstacles.begin(), obstacles.end(),
+                       [&](const Obstacle& o) { return blocks_light(o, p, to_light); });
+}
+
+} // namespace plant::physics

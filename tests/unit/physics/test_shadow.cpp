@@ -1,0 +1,79 @@
+// The scene's shade (runtime/physics/src/shadow.cpp; docs/physics.md, "Growth rate and secondary
+// growth"): a ray from a point toward the light, against each kind of obstacle.
+#include "plant/physics/light.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <memory>
+
+using namespace plant::physics;
+
+namespace {
+
+Obstacle box(glm::dvec3 lo, glm::dvec3 hi) {
+    Obstacle o;
+    o.kind = Obstacle::Box;
+    o.a = lo;
+    o.b = hi;
+    return o;
+}
+
+// a sphere of radius 0.5 about the origin sampled on a grid of 5 cm cells, as a mesh would be
+Obstacle sampled_sphere() {
+    auto g = std::make_shared<DistanceGrid>();
+    g->cell = 0.05;
+    g->lo = glm::dvec3(-1.0);
+    g->n = glm::ivec3(41);
+    for (int z = 0; z < 41; ++z)
+        for (int y = 0; y < 41; ++y)
+            for (int x = 0; x < 41; ++x)
+                g->d.push_back(glm::length(g->lo + glm::dvec3(x, y, z) * g->cell) - 0.5);
+    Obstacle o;
+    o.kind = Obstacle::Grid;
+    o.grid = g;
+    return o;
+}
+
+} // namespace
+
+TEST_CASE("shadow: a box between a point and the light shades it, beside it does not", "[physics]") {
+    const Obstacle wall = box({0.0, 0.0, -0.5}, {0.1, 2.0, 0.5});
+    const glm::dvec3 from_right = glm::normalize(glm::dvec3(1, 0.2, 0));
+    CHECK(blocks_light(wall, {-0.3, 0.5, 0.0}, from_right));   // behind it
+    CHECK(!blocks_light(wall, {0.4, 0.5, 0.0}, from_right));   // on its lit side
+    CHECK(!blocks_light(wall, {-0.3, 0.5, 0.8}, from_right));  // beside it
+    CHECK(!blocks_light(wall, {-0.3, 1.95, 0.0}, from_right)); // the ray passes over it
+    CHECK(!blocks_light(wall, {0.05, 0.5, 0.0}, from_right));  // inside it: not shaded by it
+    // a point on a face the light grazes (parallel to the face) is lit
+    CHECK(!blocks_light(wall, {0.05, 2.006, 0.0}, glm::dvec3(1, 0, 0)));
+    // several obstacles: any one of them shades
+    const std::vector<Obstacle> scene = {box({5, 5, 5}, {6, 6, 6}), wall};
+    CHECK(in_shadow(scene, {-0.3, 0.5, 0.0}, from_right));
+    CHECK(!in_shadow(scene, {0.4, 0.5, 0.0}, from_right));
+}
+
+TEST_CASE("shadow: spheres, planes and sampled grids shade the points behind them", "[physics]") {
+    Obstacle ball;
+    ball.kind = Obstacle::Sphere;
+    ball.a = glm::dvec3(0, 1, 0);
+    ball.b = glm::dvec3(0.5, 0, 0);
+    const glm::dvec3 up(0, 1, 0);
+    CHECK(blocks_light(ball, {0.1, 0.2, 0}, up));  // under it
+    CHECK(!blocks_light(ball, {0.6, 0.2, 0}, up)); // beside it
+    CHECK(!blocks_light(ball, {0.1, 1.8, 0}, up)); // above it
+    Obstacle ground;                               // the plane y = 0, facing up
+    CHECK(!blocks_light(ground, {0, 0.1, 0}, up));
+    CHECK(blocks_light(ground, {0, 0.1, 0},
+                       glm::normalize(glm::dvec3(1, -0.1, 0)))); // a light below the horizon
+    const Obstacle grid = sampled_sphere();
+    CHECK(blocks_light(grid, {0.1, -0.8, 0}, up));                   // under it
+    CHECK(!blocks_light(grid, {0.7, -0.8, 0}, up));                  // beside it
+    CHECK(!blocks_light(grid, {0.1, 0.8, 0}, up));                   // above it
+    CHECK(!blocks_light(grid, {0.1, -2.5, 0}, glm::dvec3(1, 0, 0))); // its ray misses the grid
+    CHECK(blocks_light(grid, {-3, 0.1, 0}, glm::dvec3(1, 0, 0)));    // from outside the grid
+    // moved with the obstacle (a grid's `a` is its offset)
+    Obstacle moved = grid;
+    moved.a = glm::dvec3(2, 0, 0);
+    CHECK(!blocks_light(moved, {0.1, -0.8, 0}, up));
+    CHECK(blocks_light(moved, {2.1, -0.8, 0}, up));
+}
