@@ -183,6 +183,7 @@ void World::refresh_groups() {
         if (alive_[j]) rest_moments[j] = rest_moment(static_cast<std::uint32_t>(j));
     build_groups(scratch_.groups);
     build_links();
+    build_plants();
     groups_stale_ = false;
 }
 

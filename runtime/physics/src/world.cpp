@@ -133,6 +133,8 @@ void World::step() {
     keep_shape(false, false);
     // and the links between particles, as capsules, out of the obstacles (segment_contacts.cpp)
     resolve_segments();
+    // and the links of different plants, as capsules, apart (link_contacts.cpp)
+    if (settings_.collisions && settings_.link_collisions) separate_links();
     double collision_ms = ms(clock::now() - t0).count();
     t0 = clock::now();
     integrate();

@@ -14,8 +14,10 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
+#include <tuple>
 
 using namespace plant;
 
@@ -105,6 +107,73 @@ Crossings crossings(const physics::World& w) {
     return c;
 }
 
+// The deepest overlap between links of different plants (0 when none), each link a capsule of its
+// particle's thinnest radius: every pair of links of different plants whose midpoints are near
+// enough to touch, from a grid of midpoints (not the physics' own broad phase), its closest points
+// found by sampling both segments every 0.5 mm.
+double plant_overlap(const physics::World& w) {
+    struct Link {
+        glm::dvec3 a, b;
+        double r;
+        std::uint32_t plant;
+    };
+    std::vector<Link> links;
+    std::vector<std::uint32_t> plant(w.size(), ~0u);
+    double reach = 0; // the farthest two touching links' midpoints can be apart, halved
+    for (std::uint32_t i = 0; i < w.size(); ++i) {
+        const physics::Handle h = w.handle(i);
+        if (!w.alive(h)) continue;
+        const std::uint32_t p = w.parent(h);
+        plant[i] = p == ~0u ? i : plant[p];
+        if (p == ~0u) continue;
+        const glm::dvec3 r = w.radii(h);
+        links.push_back({w.position(w.handle(p)), w.position(h), std::min({r.x, r.y, r.z}), plant[i]});
+        reach = std::max(reach, 0.5 * glm::distance(links.back().a, links.back().b) + links.back().r);
+    }
+    if (links.empty() || reach <= 0) return 0;
+    const double cell = 2 * reach;
+    std::map<std::tuple<long, long, long>, std::vector<std::size_t>> grid;
+    auto cell_of = [&](const Link& l) {
+        const glm::dvec3 m = (l.a + l.b) * 0.5 / cell;
+        return std::tuple<long, long, long>(std::lround(std::floor(m.x)), std::lround(std::floor(m.y)),
+                                            std::lround(std::floor(m.z)));
+    };
+    for (std::size_t k = 0; k < links.size(); ++k) grid[cell_of(links[k])].push_back(k);
+    auto distance = [](const Link& l, const Link& m) { // l sampled every 0.5 mm, each sample to m exactly
+        const int n = std::max(2, static_cast<int>(std::ceil(glm::distance(l.a, l.b) / 0.0005)));
+        const glm::dvec3 e = m.b - m.a;
+        const double e2 = glm::dot(e, e);
+        double best = 1e300;
+        for (int i = 0; i <= n; ++i) {
+            const glm::dvec3 p = l.a + (l.b - l.a) * (static_cast<double>(i) / n);
+            const double t = e2 > 0 ? std::clamp(glm::dot(p - m.a, e) / e2, 0.0, 1.0) : 0.0;
+            best = std::min(best, glm::distance(p, m.a + e * t));
+        }
+        return best;
+    };
+    double deepest = 0;
+    for (std::size_t k = 0; k < links.size(); ++k) {
+        const auto [cx, cy, cz] = cell_of(links[k]);
+        for (long dz = -1; dz <= 1; ++dz)
+            for (long dy = -1; dy <= 1; ++dy)
+                for (long dx = -1; dx <= 1; ++dx) {
+                    const auto it = grid.find({cx + dx, cy + dy, cz + dz});
+                    if (it == grid.end()) continue;
+                    for (const std::size_t j : it->second) {
+                        const Link &l = links[k], &m = links[j];
+                        if (j <= k || l.plant == m.plant) continue;
+                        const glm::dvec3 ml = (l.a + l.b) * 0.5, mm = (m.a + m.b) * 0.5;
+                        const double touch =
+                            0.5 * glm::distance(l.a, l.b) + 0.5 * glm::distance(m.a, m.b) + l.r + m.r;
+                        if (glm::distance(ml, mm) >= touch) continue;
+                        const double o = l.r + m.r - distance(l, m);
+                        deepest = std::max(deepest, o);
+                    }
+                }
+    }
+    return deepest;
+}
+
 struct Run {
     std::unique_ptr<test::Compiled> compiled;
     TurtleEnvironmentPhase phase;
@@ -116,6 +185,8 @@ struct Run {
     bool each_step = false;                     // whether to measure the world's links every step:
     Crossings step_crossings;                   // summed over the steps
     std::vector<double> peak_speed;             // per derivation step, its physics steps' fastest particle
+    double plant_overlap = 0;                   // the deepest overlap of links of different plants, any step
+    std::size_t plant_overlap_step = 0;         // the step where it was
     std::unique_ptr<Derivation> d;
 };
 
@@ -144,6 +215,8 @@ std::unique_ptr<Run> derive(const std::string& text, const std::filesystem::path
         more = d.step();
         const Links l = links_of(climber_in(d).world());
         r->peak_speed.push_back(climber_in(d).world().peak_speed());
+        if (const double o = plant_overlap(climber_in(d).world()); o > r->plant_overlap)
+            r->plant_overlap = o, r->plant_overlap_step = r->peak_speed.size() - 1;
         if (l.worst > r->worst_step.worst) r->worst_step = l;
         if (l.rest > 0) CHECK(std::fabs(l.length / l.rest - 1) < 0.1);
         // a link can end off its length only where obstacles pinch it (docs/physics.md)
@@ -312,6 +385,30 @@ TEST_CASE("climber: no segment of any climber grammar crosses an obstacle, as a 
         ++grammars;
     }
     CHECK(grammars >= 9);
+}
+
+// Issue 18 item 4, not done in the grammars yet (docs/physics.md, "Plant-plant collision"): links
+// of different plants are collided as capsules only with Settings::link_collisions, which the
+// climber does not switch on, since with it a push carried a link of fig11_fence through a rail.
+// Without it eight climber grammars have two plants' links overlapping by 2.2-12 mm; with it all
+// but fig10_dome (4.8 mm: stems of several plants piled on one attractor) and fig14_left (3.5 mm:
+// whipping shoots) stay within kCapsuleTolerance. Catch's [!shouldfail]: this passes while some
+// grammar's plants overlap; when it fails, make it a plain test.
+TEST_CASE(
+    "climber: links of different plants still interpenetrate in some climber grammar (remove when fixed)",
+    "[climber][!shouldfail]") {
+    const std::filesystem::path dir = std::filesystem::path(PLANT_SOURCE_DIR) / "grammars" / "climbers";
+    for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+        if (entry.path().extension() != ".plant") continue;
+        auto r = derive("", entry.path());
+        const std::string name = entry.path().stem().string();
+        INFO(name << ": deepest overlap of two plants' links " << r->plant_overlap * 1000 << " mm, step "
+                  << r->plant_overlap_step);
+        if (std::getenv("PLANT_OVERLAP_REPORT"))
+            fmt::print("{}: deepest overlap of two plants' links {:.3f} mm, step {}\n", name,
+                       r->plant_overlap * 1000, r->plant_overlap_step);
+        CHECK(r->plant_overlap < kCapsuleTolerance);
+    }
 }
 
 TEST_CASE("climber: a box slid sideways drags the plants anchored to it along (Fig. 9)", "[climber]") {

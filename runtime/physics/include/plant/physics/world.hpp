@@ -65,6 +65,10 @@ struct Settings {
     int rotation_iterations = 1;
     // Plant-plant and self collision between particles not joined to each other (section 5.2).
     bool collisions = true;
+    // Links of different plants collided as capsules (link_contacts.cpp; needs `collisions`).
+    // Off by default for now: on, a push can carry a link through a thin rail
+    // (docs/physics.md, "Plant-plant collision").
+    bool link_collisions = false;
 };
 
 // Growth directions (Hädrich et al., section 4.2). Each returns the apex's forward vector turned
@@ -329,7 +333,13 @@ class World {
     void resolve_segments();
     // the contacts of the link into i with the obstacles, ends weighted wp and wi; whether any
     bool link_contacts(std::uint32_t i, double wp, double wi);
-    void separate_particles();  // contacts between particles (section 5.2)
+    void separate_particles(); // contacts between particles (section 5.2)
+    // link_contacts.cpp: each particle's plant (its root), kept with the groups; the pairs of
+    // links of different plants whose capsules' bounds overlap (scratch_.link_pairs); and those
+    // pairs' capsules pushed apart, the four ends by their barycentric weights and inverse masses
+    void build_plants();
+    void find_link_pairs();
+    void separate_links();
     void integrate();           // Eq. 17-18 with damping, and contacts with obstacles
     void break_overstretched(); // connections stretched past the break threshold let go
 
@@ -366,6 +376,11 @@ class World {
         std::uint64_t key = 0;
         std::uint32_t begin = 0, end = 0;
     };
+    // A cell of the link grid (link_contacts.cpp): its coordinates and its links' run.
+    struct LinkCell {
+        glm::i64vec3 cell{0};
+        std::uint32_t begin = 0, count = 0, fill = 0;
+    };
     // Whether the particles, their links, rest states or masses changed since the groups and
     // the rest moments were built: growth, cuts and breaks do, a step without them does not.
     bool groups_stale_ = true;
@@ -387,6 +402,15 @@ class World {
         // its rest length and unit direction (kept with the groups), and its direction now
         std::vector<glm::dvec3> rest_link, rest_dir, dir;
         std::vector<double> rest_length;
+        // links of different plants (link_contacts.cpp): each particle's plant (root index) and
+        // how many plants have a link, kept with the groups; each link's capsule bounds, the
+        // link grid and the candidate pairs, per step
+        std::vector<std::uint32_t> plant;
+        std::size_t plants = 0;
+        std::vector<glm::dvec3> box_lo, box_hi;
+        std::vector<std::uint32_t> link_list, link_members;
+        std::vector<LinkCell> link_table;
+        std::vector<std::pair<std::uint32_t, std::uint32_t>> link_pairs;
 
         static double thin_of(std::uint32_t i, const std::vector<glm::dvec3>& radii) {
             return std::min({radii[i].x, radii[i].y, radii[i].z});

@@ -1,0 +1,273 @@
+// Links of different plants against each other (docs/physics.md, "Plant-plant collision"; issue
+// 18 item 4). The particles of two plants collide as spheres (collisions.cpp), but a link is
+// longer than its stem is thick, so two stems crossing between their particles went through each
+// other (up to 7 mm deep with 6 mm stems). Here every link is a capsule of its particle's
+// thinnest radius, as against obstacles (segment_contacts.cpp), and two capsules of different
+// plants that overlap are pushed apart at their closest points: the four end particles move by
+// their barycentric weights and inverse masses, as position-based dynamics projects a collision
+// constraint (Müller et al. 2007, section 3.3, the constraint |a(s) - b(t)| - r_a - r_b >= 0).
+// Links of one plant are left to the particles' own contacts and the shape matching.
+#include "plant/physics/world.hpp"
+
+#include "obstacle_field.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace plant::physics {
+
+namespace {
+
+// The parameters s, t in [0, 1] of the closest points of segments p1 + s d1 and p2 + t d2
+// (Ericson 2005, "Real-Time Collision Detection", section 5.1.9).
+void closest_on_segments(const glm::dvec3& p1, const glm::dvec3& d1, const glm::dvec3& p2,
+                         const glm::dvec3& d2, double& s, double& t) {
+    const glm::dvec3 r = p1 - p2;
+    const double a = glm::dot(d1, d1), e = glm::dot(d2, d2), f = glm::dot(d2, r);
+    constexpr double tiny = 1e-18;
+    if (a <= tiny && e <= tiny) {
+        s = t = 0;
+        return;
+    }
+    if (a <= tiny) {
+        s = 0;
+        t = std::clamp(f / e, 0.0, 1.0);
+        return;
+    }
+    const double c = glm::dot(d1, r);
+    if (e <= tiny) {
+        t = 0;
+        s = std::clamp(-c / a, 0.0, 1.0);
+        return;
+    }
+    const double b = glm::dot(d1, d2), denom = a * e - b * b;
+    s = denom > tiny * a * e ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0; // parallel: any s
+    t = (b * s + f) / e;
+    if (t < 0) {
+        t = 0;
+        s = std::clamp(-c / a, 0.0, 1.0);
+    } else if (t > 1) {
+        t = 1;
+        s = std::clamp((b - c) / a, 0.0, 1.0);
+    }
+}
+
+// how far this pass may stretch (or squash) a link it pushes: the every-grammar length test
+// allows 10 %
+constexpr double kStretch = 1.02;
+
+// sweeps over the pairs a step at most
+constexpr int kSweeps = 16;
+
+// a coordinate's cell, clamped so that a particle blown far away (or a NaN) cannot overflow
+std::int64_t cell_coordinate(double u) {
+    constexpr double far = 0x1p40;
+    u = u < far ? (u > -far ? u : -far) : far;
+    return static_cast<std::int64_t>(std::floor(u));
+}
+
+std::uint64_t cell_key(const glm::i64vec3& c) {
+    return (static_cast<std::uint64_t>(c.x) * 73856093u) ^ (static_cast<std::uint64_t>(c.y) * 19349663u) ^
+           (static_cast<std::uint64_t>(c.z) * 83492791u);
+}
+
+} // namespace
+
+void World::build_plants() {
+    // the plant of each particle: its root's index (a parent's index is below its children's),
+    // and how many plants have a link
+    const std::size_t n = x_.size();
+    auto& plant = scratch_.plant;
+    plant.assign(n, kNone);
+    std::size_t with_links = 0;
+    for (std::uint32_t i = 0; i < n; ++i) {
+        if (!alive_[i]) continue;
+        const std::uint32_t p = parent_[i];
+        plant[i] = p == kNone ? i : plant[p];
+        if (p == kNone && !children_[i].empty()) ++with_links;
+    }
+    scratch_.plants = with_links;
+}
+
+void World::find_link_pairs() {
+    // Broad phase: each link's box (its capsule's bounds) goes into every cell of a hashed grid it
+    // touches; two links are a candidate where their boxes overlap, found once, in the cell that
+    // holds the lower corner of the boxes' overlap. Cells are about a link long, and never
+    // smaller than a quarter of the largest box, so no link spans more than a few.
+    const std::size_t n = x_.size();
+    auto& sc = scratch_;
+    auto& links = sc.link_list;
+    links.clear();
+    sc.link_pairs.clear();
+    auto& lo = sc.box_lo;
+    auto& hi = sc.box_hi;
+    lo.resize(n);
+    hi.resize(n);
+    double total = 0, largest = 0, widest = 0;
+    for (std::uint32_t i = 0; i < n; ++i) {
+        const std::uint32_t p = parent_[i];
+        if (!alive_[i] || p == kNone) continue;
+        // three radii round the capsule: a push of this pass can bring in a pair apart before it
+        const double r = 3 * sc.thin_of(i, radii_);
+        lo[i] = glm::min(x_[i], x_[p]) - r;
+        hi[i] = glm::max(x_[i], x_[p]) + r;
+        const glm::dvec3 e = hi[i] - lo[i];
+        if (!std::isfinite(e.x + e.y + e.z)) continue; // a NaN never collides
+        links.push_back(i);
+        total += glm::length(x_[i] - x_[p]);
+        largest = std::max({largest, e.x, e.y, e.z});
+        widest = std::max(widest, r);
+    }
+    if (links.size() < 2) return;
+    const double cell = std::max({total / static_cast<double>(links.size()) + 2 * widest, largest / 4, 1e-6});
+    auto range = [&](std::uint32_t i, glm::i64vec3& a, glm::i64vec3& b) {
+        for (int k = 0; k < 3; ++k)
+            a[k] = cell_coordinate(lo[i][k] / cell), b[k] = cell_coordinate(hi[i][k] / cell);
+    };
+    // an open-addressing table from a cell to its run of links, filled by counting (no sort)
+    std::size_t entries = 0;
+    for (const std::uint32_t i : links) {
+        glm::i64vec3 a, b;
+        range(i, a, b);
+        entries += static_cast<std::size_t>((b.x - a.x + 1) * (b.y - a.y + 1) * (b.z - a.z + 1));
+    }
+    std::size_t size = 16;
+    while (size < 4 * entries) size *= 2; // a quarter full at most
+    auto& table = sc.link_table;
+    table.assign(size, LinkCell{});
+    auto slot_of = [&](const glm::i64vec3& c) {
+        std::size_t slot = cell_key(c) & (size - 1);
+        while (table[slot].count != 0 && table[slot].cell != c) slot = (slot + 1) & (size - 1);
+        return slot;
+    };
+    auto each_cell = [&](std::uint32_t i, auto&& f) {
+        glm::i64vec3 a, b;
+        range(i, a, b);
+        for (std::int64_t z = a.z; z <= b.z; ++z)
+            for (std::int64_t y = a.y; y <= b.y; ++y)
+                for (std::int64_t x = a.x; x <= b.x; ++x) f(glm::i64vec3(x, y, z));
+    };
+    for (const std::uint32_t i : links)
+        each_cell(i, [&](const glm::i64vec3& c) {
+            LinkCell& s = table[slot_of(c)];
+            s.cell = c;
+            ++s.count;
+        });
+    std::uint32_t running = 0;
+    for (LinkCell& s : table) {
+        s.begin = s.fill = running;
+        running += s.count;
+    }
+    auto& members = sc.link_members;
+    members.resize(running);
+    for (const std::uint32_t i : links)
+        each_cell(i, [&](const glm::i64vec3& c) { members[table[slot_of(c)].fill++] = i; });
+    const auto& plant = sc.plant;
+    for (const LinkCell& s : table) {
+        for (std::uint32_t u = s.begin; u < s.begin + s.count; ++u)
+            for (std::uint32_t v = u + 1; v < s.begin + s.count; ++v) {
+                const std::uint32_t a = members[u], b = members[v];
+                if (plant[a] == plant[b]) continue;
+                const glm::dvec3 low = glm::max(lo[a], lo[b]), high = glm::min(hi[a], hi[b]);
+                if (low.x > high.x || low.y > high.y || low.z > high.z) continue;
+                const glm::i64vec3 owner(cell_coordinate(low.x / cell), cell_coordinate(low.y / cell),
+                                         cell_coordinate(low.z / cell));
+                if (owner != s.cell) continue; // found in the cell that owns it
+                sc.link_pairs.push_back({std::min(a, b), std::max(a, b)});
+            }
+    }
+    std::sort(sc.link_pairs.begin(), sc.link_pairs.end()); // index order, whatever the table's
+}
+
+void World::separate_links() {
+    if (scratch_.plants < 2 || x_.size() < 4) return; // one plant: nothing of another to meet
+    find_link_pairs();
+    const auto& pairs = scratch_.link_pairs;
+    if (pairs.empty()) return;
+    auto weight = [&](std::uint32_t j, const glm::dvec3& dir) {
+        if (fixed_[j]) return 0.0;
+        for (const auto& pull : pulls_)
+            if (pull.first == j) return 0.0; // a dragged particle stays where it is dragged
+        // a particle lying on a support (within a millimetre) is not pushed into it: the other
+        // link gives way (two stems crossing on a wall: the one on top lifts)
+        const double r = scratch_.thin_of(j, radii_) + 0.001;
+        for (const Obstacle& o : obstacles_)
+            if (signed_distance(o, x_[j]) < r && glm::dot(dir, surface_normal(o, x_[j])) < 0) return 0.0;
+        return 1.0 / std::max(m_[j], 1e-12);
+    };
+    auto keep_length = [&](std::uint32_t j) {
+        const std::uint32_t p = parent_[j];
+        if (p == kNone) return;
+        const double wp = weight(p, glm::dvec3(0.0)), wj = weight(j, glm::dvec3(0.0));
+        const glm::dvec3 e = x_[j] - x_[p];
+        const double len = glm::length(e), rest = scratch_.rest_length[j];
+        if (wp + wj <= 0 || len < 1e-12 || rest < 1e-12) return;
+        const double to = std::clamp(len, rest / kStretch, rest * kStretch);
+        if (to == len) return;
+        const glm::dvec3 fix = e * ((len - to) / (len * (wp + wj)));
+        x_[p] += fix * wp;
+        x_[j] -= fix * wj;
+    };
+    auto out_of_obstacles = [&](std::uint32_t j) {
+        const std::uint32_t p = parent_[j];
+        if (p == kNone) return;
+        const double wp = weight(p, glm::dvec3(0.0)), wj = weight(j, glm::dvec3(0.0));
+        if (wp + wj > 0) link_contacts(j, wp, wj);
+    };
+    // Gauss-Seidel over the pairs in index order, on one thread (the same result on any thread
+    // count), sweeps until no pair overlaps by 0.1 mm, at most 16: stems piled three deep
+    // where several plants meet need several
+    for (int sweep = 0; sweep < kSweeps; ++sweep) {
+        double worst = 0;
+        for (const auto& [a, b] : pairs) {
+            const std::uint32_t pa = parent_[a], pb = parent_[b];
+            const glm::dvec3 da = x_[a] - x_[pa], db = x_[b] - x_[pb];
+            double s = 0, t = 0;
+            closest_on_segments(x_[pa], da, x_[pb], db, s, t);
+            const glm::dvec3 d = (x_[pa] + da * s) - (x_[pb] + db * t);
+            const double want = scratch_.thin_of(a, radii_) + scratch_.thin_of(b, radii_);
+            const double dist2 = glm::dot(d, d);
+            if (dist2 >= want * want) continue; // apart
+            const double dist = std::sqrt(dist2);
+            worst = std::max(worst, want - dist);
+            // the way from b to a; where the axes meet (two stems crossing on one surface), across both
+            glm::dvec3 nrm = dist > 1e-12 ? d / dist : glm::cross(da, db);
+            if (dist <= 1e-12 && glm::dot(nrm, nrm) < 1e-24)
+                nrm = glm::cross(da, std::fabs(da.x) < 0.9 * glm::length(da) ? glm::dvec3(1, 0, 0)
+                                                                             : glm::dvec3(0, 1, 0));
+            if (dist <= 1e-12) {
+                if (glm::dot(nrm, nrm) < 1e-24) continue; // a link of no length: nothing to part
+                nrm = glm::normalize(nrm);
+            }
+            // the constraint's gradients are (1 - s) n, s n, -(1 - t) n, -t n
+            const double w0 = weight(pa, nrm), w1 = weight(a, nrm), w2 = weight(pb, -nrm),
+                         w3 = weight(b, -nrm);
+            const double sum = w0 * (1 - s) * (1 - s) + w1 * s * s + w2 * (1 - t) * (1 - t) + w3 * t * t;
+            if (sum <= 0) continue;
+            double lambda = (want - dist) / sum;
+            // a closest point near an end that cannot move would swing the other end far: no end
+            // moves more than twice the overlap in one push (as segment_contacts.cpp bounds it)
+            const double most = lambda * std::max({w0 * (1 - s), w1 * s, w2 * (1 - t), w3 * t});
+            if (most > 2 * (want - dist)) lambda *= 2 * (want - dist) / most;
+            x_[pa] += nrm * (lambda * w0 * (1 - s));
+            x_[a] += nrm * (lambda * w1 * s);
+            x_[pb] -= nrm * (lambda * w2 * (1 - t));
+            x_[b] -= nrm * (lambda * w3 * t);
+            // the pushed links, the links into their parents and out of their particles within kStretch of
+            // their rest lengths (a distance constraint, both ends by inverse mass), as the pushes add up
+            for (const std::uint32_t j : {a, pa, b, pb}) {
+                keep_length(j);
+                for (const std::uint32_t c : children_[j]) keep_length(c);
+            }
+            // and those links out of the obstacles again, so that the obstacles keep the last word
+            if (!obstacles_.empty())
+                for (const std::uint32_t j : {a, pa, b, pb}) {
+                    out_of_obstacles(j);
+                    for (const std::uint32_t c : children_[j]) out_of_obstacles(c);
+                }
+        }
+        if (worst < 1e-4) break;
+    }
+}
+
+} // namespace plant::physics
