@@ -556,7 +556,7 @@ bool ClimberArgs::read(const EnvArg& a, std::string& error) {
         "elasticity",     "attractor_radius", "attractor_strength", "threads",         "light_cell",
         "opacity",        "air_spacing",      "air_density",        "air_viscosity",   "air_stiffness",
         "air_coupling",   "mesh_cell",        "attractor_reach",    "emitter_radius",  "strand",
-        "obstacle_shade", "grab_speed"};
+        "obstacle_shade", "grab_speed",       "plant_contacts"};
     static const char* vectors[] = {"gravity", "light",   "wind",    "attractor",
                                     "air_min", "air_max", "emitter", "emitter_velocity"};
     if (a.key == "mesh") {
@@ -672,6 +672,8 @@ void ClimberArgs::set(const std::string& key, double x, const glm::dvec3& v) {
         c.grab_speed = std::clamp(x, 0.0, 1e3); // a hand faster than 1 km/s is no hand
     else if (key == "obstacle_shade")
         c.obstacle_shade = x != 0;
+    else if (key == "plant_contacts")
+        s.link_collisions = x != 0; // links of different plants collided as capsules (off: see docs)
 }
 
 bool ClimberArgs::check(std::string& error) {

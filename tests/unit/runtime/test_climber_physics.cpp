@@ -411,6 +411,28 @@ TEST_CASE(
     }
 }
 
+// `plant_contacts: 1` switches the capsule contacts on from a grammar: fig08_painted_wall's
+// plants, whose links overlap by over 10 mm without it, stay within kCapsuleTolerance, with every
+// link check of derive() holding.
+TEST_CASE("climber: plant_contacts: 1 keeps the links of different plants apart", "[climber]") {
+    std::ifstream in(std::filesystem::path(PLANT_SOURCE_DIR) / "grammars" / "climbers" /
+                     "fig08_painted_wall.plant");
+    std::stringstream text;
+    text << in.rdbuf();
+    const std::string on = text.str();
+    const std::string arg = "plant_contacts: 1";
+    std::string off = on;
+    REQUIRE(off.find(arg) != std::string::npos);
+    off.replace(off.find(arg), arg.size(), "plant_contacts: 0");
+    auto without = derive(off);
+    auto with = derive(on);
+    INFO("deepest overlap of two plants' links: " << without->plant_overlap * 1000 << " mm without, "
+                                                  << with->plant_overlap * 1000 << " mm with");
+    CHECK(without->plant_overlap > 2 * kCapsuleTolerance);
+    CHECK(with->plant_overlap < kCapsuleTolerance);
+    CHECK(with->world_crossings.crossing == 0);
+}
+
 TEST_CASE("climber: a box slid sideways drags the plants anchored to it along (Fig. 9)", "[climber]") {
     // grammars/climbers/fig09_boxes.plant slides box 2 (the low one on the right) by 0.25 m from
     // step 24: every particle anchored to it before stays within 2 cm of it
