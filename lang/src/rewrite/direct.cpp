@@ -145,12 +145,17 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
     std::size_t p = p_at;
     double values[256];
     std::size_t i = b;
-    std::size_t next_check = b + 65536;
+    std::size_t next_check = b + kSnapEvery;
+    const std::size_t outcomes = plan.outcome_tmpl.size();
+    w.snaps.clear();
     while (i < e) {
         if (i >= next_check) { // a long step can be interrupted (Ctrl-C in the REPL)
-            next_check = i + 65536;
+            next_check = i + kSnapEvery;
             if (w.env.interrupt && w.env.interrupt->load())
                 throw RuntimeError{RuntimeErrorKind::Interrupted, Span{}, "interrupted"};
+            // the snapshot from which the next step sizes its threads' stretches
+            w.snaps.push_back(static_cast<std::uint64_t>(S - (out.kinds.data() + m_at)));
+            w.snaps.insert(w.snaps.end(), tally, tally + outcomes);
         }
         const SymbolId s = sym_of(i);
         const Production* prp = plan.direct[s];
