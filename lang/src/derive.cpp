@@ -60,6 +60,10 @@ std::uint64_t Derivation::work_done() const {
     return engine_->work;
 }
 
+std::uint64_t Derivation::modules_counted() const {
+    return engine_->modules_counted;
+}
+
 void Derivation::reset_work() {
     engine_->work = 0;
 }

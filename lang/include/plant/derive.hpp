@@ -127,6 +127,9 @@ class Derivation {
     ModuleId next_id() const;
     // The work done since start() (see DeriveOptions::max_work).
     std::uint64_t work_done() const;
+    // The modules the direct path read only to size its output, since the derivation was made
+    // (a measure for tests: the counts carried from step to step should keep it small).
+    std::uint64_t modules_counted() const;
     // Starts a fresh work budget without changing the derivation (the REPL: one per command).
     void reset_work();
     const Program& program() const { return prog_; }

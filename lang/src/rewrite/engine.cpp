@@ -35,6 +35,26 @@ bool any_candidate(const ModuleString& s, const RuleSet& rs) {
     return false;
 }
 
+// After a write sized from the counts: whether each thread's stretch ended where the next one's
+// began (its bound was exact) and the identities they numbered follow on (also when no
+// identities are kept: the counter moves on as on one thread); if so, cuts `out` to
+// what was written (the last stretch's bound may exceed it).
+bool cut_to_written(ModuleString& out, const std::vector<Rewriter::Counts>& written,
+                    const std::vector<std::size_t>& m_at, const std::vector<std::size_t>& p_at,
+                    const std::vector<ModuleId>& id_at) {
+    const std::size_t T = written.size();
+    for (std::size_t t = 0; t + 1 < T; ++t)
+        if (m_at[t] + written[t].modules != m_at[t + 1] || p_at[t] + written[t].params != p_at[t + 1] ||
+            id_at[t] + written[t].new_ids != id_at[t + 1])
+            return false;
+    const std::size_t m = m_at[T - 1] + written[T - 1].modules;
+    out.kinds.resize(m);
+    if (out.keep_ids) out.ids.resize(m);
+    out.params.resize(p_at[T - 1] + written[T - 1].params);
+    out.block_at.resize((m + ModuleString::kBlock - 1) >> ModuleString::kBlockShift);
+    return true;
+}
+
 } // namespace
 
 void Engine::check_limits(const Derivation& d, const ModuleString& s) const {
@@ -266,37 +286,43 @@ bool Engine::rewrite_direct(const Derivation& d, Rewriter& rw, const ModuleStrin
     auto bounds = [&](std::size_t t) { return std::pair{n * t / T, n * (t + 1) / T}; };
     auto parallel = [&](auto&& body) { run_on_crew(T, body); };
     std::size_t modules = 0, params = 0;
-    const bool sized =
-        T == 1 && counted && size_from_counts(plan, in, modules, params) && within_limits(d, modules, params);
+    std::vector<std::size_t> m_at(T), p_at(T);
+    std::vector<ModuleId> id_at(T);
+    // sized: from the counts, without reading the string (exact, or bounds when a guarded
+    // symbol's outcomes differ in size; then each thread's stretch starts at a bound)
+    const bool sized = counted && (T == 1 || !slices_missed) && size_from_counts(plan, in, modules, params) &&
+                       within_limits(d, modules, params) &&
+                       (T == 1 || size_slices(plan, in, T, m_at, p_at, id_at));
     if (!sized) {
         modules = params = 0; // (size_from_counts may have left a partial sum)
         parallel([&](std::size_t t) {
             auto [b, e] = bounds(t);
             counts_at[t] = rw.count_direct(b, e);
         });
+        modules_counted += n;
         for (const auto& c : counts_at) {
             if (!c.ok) return false;
             modules += c.modules;
             params += c.params;
         }
         check_limits(d, modules, params); // before allocating anything
+        ModuleId ids = next_id;
+        for (std::size_t t = 0, m = 0, p = 0; t < T; ++t) {
+            m_at[t] = m;
+            p_at[t] = p;
+            id_at[t] = ids;
+            m += counts_at[t].modules;
+            p += counts_at[t].params;
+            ids += counts_at[t].new_ids;
+        }
+    } else if (T == 1) {
+        id_at[0] = next_id;
     }
     out.kinds.resize(modules);
     if (out.keep_ids) out.ids.resize(modules);
     out.params.resize(params);
     out.block_at.resize((modules + ModuleString::kBlock - 1) >> ModuleString::kBlockShift);
     std::vector<Worker> workers(T);
-    std::vector<std::size_t> m_at(T), p_at(T);
-    std::vector<ModuleId> id_at(T);
-    ModuleId ids = next_id;
-    for (std::size_t t = 0, m = 0, p = 0; t < T; ++t) {
-        m_at[t] = m;
-        p_at[t] = p;
-        id_at[t] = ids;
-        m += counts_at[t].modules;
-        p += counts_at[t].params;
-        ids += counts_at[t].new_ids;
-    }
     std::vector<std::vector<std::uint64_t>> tallies(T, std::vector<std::uint64_t>(plan.outcome_tmpl.size()));
     parallel([&](std::size_t t) {
         Worker& w = workers[t];
@@ -308,20 +334,19 @@ bool Engine::rewrite_direct(const Derivation& d, Rewriter& rw, const ModuleStrin
             w.error = err;
         }
     });
-    for (auto& w : workers) {
+    for (auto& w : workers)
         if (w.error) throw *w.error;
+    if (sized && !cut_to_written(out, counts_at, m_at, p_at, id_at)) {
+        slices_missed = true; // the stretches left gaps: count, and write again
+        return rewrite_direct(d, rw, in, out, plan, threads, counted, setup);
+    }
+    for (auto& w : workers)
         if (!interpreting) work += w.env.work;
+    next_id = id_at[T - 1] + counts_at[T - 1].new_ids;
+    if (!interpreting) {
+        count_outcomes(plan, tallies, counted, out);
+        keep_snapshots(plan, workers, tallies, m_at);
     }
-    if (sized) { // the counts were exact or a bound: cut to what was written
-        const Rewriter::Counts& c = counts_at[0];
-        out.kinds.resize(c.modules);
-        if (out.keep_ids) out.ids.resize(c.modules);
-        out.params.resize(c.params);
-        out.block_at.resize((c.modules + ModuleString::kBlock - 1) >> ModuleString::kBlockShift);
-        ids = next_id + c.new_ids;
-    }
-    next_id = ids;
-    if (!interpreting) count_outcomes(plan, tallies, counted, out);
     return true;
 }
 
@@ -330,39 +355,6 @@ bool Engine::within_limits(const Derivation& d, std::size_t modules, std::size_t
         check_limits(d, modules, params);
     } catch (const RuntimeError&) {
         return false;
-    }
-    return true;
-}
-
-bool Engine::size_from_counts(const RulePlan& plan, const ModuleString& in, std::size_t& modules,
-                              std::size_t& params) const {
-    modules = 0;
-    params = in.params.size();
-    const std::size_t S = plan.has_prod.size();
-    if (counts.modules.size() != S) return false;
-    for (std::size_t s = 0; s < S; ++s) {
-        const std::uint64_t c = counts.modules[s];
-        if (c == 0) continue;
-        if (!plan.has_prod[s]) {
-            modules += c;
-        } else if (const Production* pr = plan.direct[s]) {
-            if (counts.arity[s] != static_cast<std::int32_t>(pr->strict[0].width) || counts.stored[s] < 0)
-                return false;
-            modules += c * pr->tmpl.syms.size();
-            params += c * pr->tmpl.stored.size();
-            params -= c * static_cast<std::size_t>(counts.stored[s]);
-        } else {
-            const RulePlan::Guarded& g = plan.guarded[static_cast<std::size_t>(plan.guarded_at[s])];
-            std::size_t most_m = 1, most_p = 0; // the copy keeps its own parameters, already counted
-            if (!g.uniform)
-                for (std::uint32_t k = 0; k < g.count; ++k) {
-                    const SuccessorTemplate& t = plan.guards[g.first + k].pr->tmpl;
-                    most_m = std::max(most_m, t.syms.size());
-                    most_p = std::max(most_p, t.stored.size());
-                }
-            modules += c * most_m;
-            params += c * most_p;
-        }
     }
     return true;
 }

@@ -71,9 +71,20 @@ struct Engine {
         std::vector<std::int32_t> stored;   // per symbol: the numbers every module stores; -1 likewise
         // per kind, when the copy kernel wrote the string (Engine::rewrite_copies); else empty
         std::vector<std::uint64_t> kinds;
+        // Snapshots the direct path's writers took as they wrote the string (Worker::snaps):
+        // at module snap_pos[j], the outcomes of snap_plan so far were snap_tally[j * outcomes
+        // + o], counted from the string's start. From them a step on several threads finds where
+        // each thread writes without reading the whole string (Engine::size_slices).
+        std::vector<std::size_t> snap_pos; // ascending
+        std::vector<std::uint64_t> snap_tally;
+        const RulePlan* snap_plan = nullptr;
         const SymbolId* of = nullptr;
         std::size_t size = 0;
     } counts;
+    // A step on several threads found its stretches' sizes from the counts only bounds that the
+    // writers did not fill (a guarded symbol copied): later steps count instead.
+    bool slices_missed = false;
+    std::uint64_t modules_counted = 0; // read only to size an output (Derivation::modules_counted)
     void forget_counts() { counts.of = nullptr; }
 
   private:
@@ -95,6 +106,21 @@ struct Engine {
     // unknown (a symbol's modules may not all have the width its template takes).
     bool size_from_counts(const RulePlan& plan, const ModuleString& in, std::size_t& modules,
                           std::size_t& params) const;
+    // The same for modules whose symbols are counted in `per_symbol` (the string's own arities,
+    // `counts`) and which store `params_in` numbers; also the new identities, at most.
+    bool size_from(const RulePlan& plan, const std::vector<std::uint64_t>& per_symbol, std::size_t params_in,
+                   std::size_t& modules, std::size_t& params, std::size_t& new_ids) const;
+    // slices.cpp: where each of T threads writes the output of its stretch of `in`, a string
+    // `counts` describes, from the snapshots: exact or bounds as size_from_counts. False when
+    // the counts have no snapshots or cannot size the output.
+    bool size_slices(const RulePlan& plan, const ModuleString& in, std::size_t T,
+                     std::vector<std::size_t>& m_at, std::vector<std::size_t>& p_at,
+                     std::vector<ModuleId>& id_at);
+    // Keeps the writers' snapshots in `counts` (after count_outcomes), thread t's output
+    // having started at module m_at[t].
+    void keep_snapshots(const RulePlan& plan, const std::vector<Worker>& workers,
+                        const std::vector<std::vector<std::uint64_t>>& tallies,
+                        const std::vector<std::size_t>& m_at);
     // Makes `counts` describe `out` from the outcomes the writers tallied.
     void count_outcomes(const RulePlan& plan, const std::vector<std::vector<std::uint64_t>>& tallies,
                         bool counted, const ModuleString& out);

@@ -37,6 +37,9 @@ struct Worker {
     std::int64_t ctx_left = kUnknown, ctx_right = kUnknown;
     BigVector<std::uint16_t>
         scratch; // Rewriter::run_symbols's keys, when the rewriter has no buffer for them
+    // write_direct's snapshots, one every kSnapEvery modules read: where the output stood
+    // (modules written so far), then the tally of every outcome so far (Engine::counts).
+    std::vector<std::uint64_t> snaps;
 };
 
 class Rewriter {
@@ -89,6 +92,8 @@ class Rewriter {
         bool ok = true;
     };
     Counts count_direct(std::size_t b, std::size_t e) const;
+    // How often write_direct records its snapshot (Worker::snaps), in modules read.
+    static constexpr std::size_t kSnapEvery = 8192;
     // Writes the output of modules [b, e) at module m_at and parameter p_at of `out`, whose
     // arrays are large enough; new identities are numbered from id_at. Adds each module's
     // outcome to `tally` (indexed as RulePlan::outcome_at). Returns what it wrote.
