@@ -106,7 +106,11 @@ void Engine::rewrite(const Derivation& d, const ModuleString& in, ModuleString& 
     const std::size_t n = in.size();
     int threads = std::max(1, d.opt_.threads);
     if (plan.sequential() || n < 20000) threads = 1;
-    Rewriter rw(plan, in, &brackets, &kernel_scratch, threads == 1);
+    // The symbol kernel runs on one thread (Rewriter::run_symbols): a string it can rewrite is
+    // rewritten whole, whatever the thread count.
+    const bool kernel_may = plan.symbol_kernel && in.params.empty() && !in.keep_ids;
+    Rewriter rw(plan, in, &brackets, &kernel_scratch, threads == 1 || kernel_may);
+    if (rw.kernel_applies()) threads = 1;
     rw.seed = d.seed_;
     rw.phase = phase;
     auto setup = [&](Worker& w) {

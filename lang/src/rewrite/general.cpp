@@ -14,9 +14,10 @@ namespace plant {
 
 Rewriter::Rewriter(const RulePlan& rule_plan, const ModuleString& in, std::vector<std::uint32_t>* brackets,
                    BigVector<std::uint16_t>* scratch, bool whole)
-    : plan(rule_plan), P(rule_plan.P), in(in), n(in.size()), kernel_scratch(whole ? scratch : nullptr) {
-    table_kinds = plan.symbol_kernel && in.params.empty() && in.has_table_kinds();
-    if (whole && kernel_applies()) return;
+    : plan(rule_plan), P(rule_plan.P), in(in), n(in.size()), whole(whole),
+      kernel_scratch(whole ? scratch : nullptr) {
+    table_kinds = whole && plan.symbol_kernel && in.params.empty() && in.has_table_kinds();
+    if (kernel_applies()) return;
     if (plan.brackets) {
         std::vector<std::uint32_t>& table = brackets ? *brackets : own_match;
         bracket_table(in, P.symbols.open_bracket, P.symbols.close_bracket, table);
@@ -41,11 +42,8 @@ void Rewriter::hole_error(const SuccessorTemplate& t, std::size_t h, double valu
 
 // Rewrites modules [b, e) into w.out.
 void Rewriter::run_range(Worker& w, std::size_t b, std::size_t e) {
-    if (kernel_applies()) {
-        if (match)
-            run_symbols<false>(w, b, e);
-        else
-            run_symbols<true>(w, b, e); // the whole string, with no bracket table
+    if (kernel_applies()) { // then [b, e) is the whole string
+        run_symbols(w);
         return;
     }
     if (plan.templated) {

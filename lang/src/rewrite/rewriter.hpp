@@ -46,8 +46,9 @@ class Rewriter {
   public:
     // `brackets`: where to build the bracket table (a buffer kept from step to step saves an
     // allocation each step); null: a buffer of the rewriter's own.
-    // `whole`: run_range will be called once, for the whole string, by one thread. Then the
-    // symbol kernel needs no bracket table, and keeps its right keys in `scratch`.
+    // `whole`: run_range will be called once, for the whole string, by one thread. Only then
+    // does the symbol kernel apply (it needs no bracket table, and keeps its right keys in
+    // `scratch`).
     Rewriter(const RulePlan& rule_plan, const ModuleString& in,
              std::vector<std::uint32_t>* brackets = nullptr, BigVector<std::uint16_t>* scratch = nullptr,
              bool whole = false);
@@ -69,10 +70,11 @@ class Rewriter {
         return plan.ctx_entries[static_cast<std::size_t>(plan.ctx_block[sym]) + lk * plan.ctx_keys + rk];
     }
 
-    // Whether run_range rewrites this string with the symbol kernel (run_symbols).
-    // (its tables are the symbols': not for a string with kinds of constant numbers)
+    // Whether run_range rewrites this string with the symbol kernel (run_symbols): one thread
+    // over the whole string (its tables are the symbols': not for a string with kinds of
+    // constant numbers).
     bool kernel_applies() const {
-        return plan.symbol_kernel && in.params.empty() && !in.keep_ids && !table_kinds;
+        return whole && plan.symbol_kernel && in.params.empty() && !in.keep_ids && !table_kinds;
     }
 
     // Whether production `pr` (pattern, context and condition) matches at module i: the REPL's
@@ -116,7 +118,7 @@ class Rewriter {
     Counts write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at,
                         std::size_t p_at, ModuleId id_at, std::uint64_t* tally);
     template <bool Ids> void run_templates(Worker& w, std::size_t b, std::size_t e);
-    template <bool Whole> void run_symbols(Worker& w, std::size_t b, std::size_t e);
+    void run_symbols(Worker& w);
 
     // general.cpp: trying productions, running their successors
     std::size_t apply(Worker& w, std::size_t i);
@@ -305,6 +307,7 @@ class Rewriter {
     const ModuleString& in;
     bool table_kinds = false; // some module of `in` has a kind of constant numbers
     const std::size_t n;
+    const bool whole; // see the constructor
     std::vector<std::uint32_t> own_match;
     BigVector<std::uint16_t>* kernel_scratch = nullptr; // run_symbols's right keys, kept from step to step
     const std::uint32_t* match = nullptr;               // the bracket table (see bracket_table)

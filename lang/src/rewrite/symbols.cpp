@@ -24,10 +24,12 @@ template <typename Vector> [[gnu::noinline]] void resize(Vector& v, std::size_t 
 // for its neighbours' keys; it is written as one fixed-size copy of padded symbols, and
 // parameter offsets are all zero. Neighbours are carried along rather than searched for:
 // - the left key: the key of the last module context sees, saved at each '[' and taken back
-//   at its ']' (left_step settles a ']' whose '[' lies before b);
-// - over the whole string (Whole), the right keys come from one right-to-left pass that does
-//   the same mirrored, and there is no bracket table; on a stretch, right_step finds them.
-template <bool Whole> void Rewriter::run_symbols(Worker& w, std::size_t b, std::size_t e) {
+//   at its ']';
+// - the right keys come from one right-to-left pass that does the same mirrored, so there is no
+//   bracket table. The kernel runs on one thread over the whole string (Engine::rewrite): split
+//   over two threads it needed the bracket table, a search for each right neighbour and a join,
+//   and ran 1.4x slower on 1.31a at n = 50 (docs/architecture.md).
+void Rewriter::run_symbols(Worker& w) {
     using Plan = RulePlan;
     ModuleString& out = w.out;
     EvalEnv& env = w.env;
@@ -37,24 +39,21 @@ template <bool Whole> void Rewriter::run_symbols(Worker& w, std::size_t b, std::
     const std::size_t K = plan.ctx_keys;
     const std::size_t Mmax = plan.max_modules_out;
     constexpr std::size_t kPad = Plan::SymbolSucc::kMax;
-    auto key_of = [&](std::int64_t j) -> std::size_t { return j < 0 ? 0 : rows[in_sym[j]].key; };
 
     // The right-to-left pass: the key of the last module context sees, saved at each ']'
     // and taken back at its '[' (going leftwards, a branch is entered at its ']'). A bracket
     // without a partner has none.
     // Both passes keep their saved keys on `stack`, which is as deep as the stretch is long.
-    const std::uint16_t* rkey = nullptr;
-    std::uint16_t* stack = nullptr;
-    if constexpr (Whole) {
-        BigVector<std::uint16_t>& scratch = kernel_scratch ? *kernel_scratch : w.scratch;
-        size_whole(scratch, 2 * n + 1);
-        std::uint16_t* keys = scratch.data();
-        stack = keys + n;
+    BigVector<std::uint16_t>& scratch = kernel_scratch ? *kernel_scratch : w.scratch;
+    size_whole(scratch, 2 * n + 1);
+    std::uint16_t* const rkey = scratch.data();
+    std::uint16_t* const stack = rkey + n;
+    {
         std::uint16_t right = 0;
         std::size_t depth = 0;
         for (std::size_t j = n; j-- > 0;) {
             const Plan::SymbolRow r = rows[in_sym[j]];
-            keys[j] = right;
+            rkey[j] = right;
             if (r.shape == 0) {
                 right = r.key;
             } else if (r.shape == Plan::kClose) {
@@ -64,20 +63,16 @@ template <bool Whole> void Rewriter::run_symbols(Worker& w, std::size_t b, std::
                 right = depth ? stack[--depth] : 0;
             }
         }
-        rkey = keys;
-    } else {
-        size_whole(w.scratch, e - b + 1);
-        stack = w.scratch.data();
     }
 
     const std::size_t p_end = out.params.size(); // every module written here has none
     std::size_t m = out.size();
-    std::size_t left = b > 0 ? key_of(left_step(static_cast<std::int64_t>(b) - 1)) : 0;
+    std::size_t left = 0;
     std::size_t depth = 0; // the left keys at the open '['s are on the stack
     std::uint64_t fresh = 0;
-    std::size_t i = b, next_check = b + 65536;
+    std::size_t i = 0, next_check = 65536;
     resize(out.kinds, std::max(out.kinds.capacity(), m)); // the room reserved is written in place
-    while (i < e) {
+    while (i < n) {
         // the modules that fit: each writes at most Mmax, and a copy writes kPad
         std::size_t room = out.kinds.size() >= m + kPad ? (out.kinds.size() - m - kPad) / Mmax : 0;
         if (room == 0) {
@@ -93,18 +88,11 @@ template <bool Whole> void Rewriter::run_symbols(Worker& w, std::size_t b, std::
                 limit_error();
             }
         }
-        const std::size_t stop = std::min({e, i + room, next_check});
+        const std::size_t stop = std::min({n, i + room, next_check});
         KindId* S = out.kinds.data();
         for (; i < stop; ++i) {
             const Plan::SymbolRow row = rows[in_sym[i]];
-            std::size_t at = row.block;
-            if constexpr (Whole) {
-                at += (left & row.lmask) * K + (rkey[i] & row.rmask);
-            } else if (row.lmask | row.rmask) {
-                const std::size_t j = row.rmask ? right_step(i + 1) : n;
-                at += (left & row.lmask) * K + (j < n ? rows[in_sym[j]].key : 0);
-            }
-            const Plan::SymbolSucc& su = succs[at];
+            const Plan::SymbolSucc& su = succs[row.block + (left & row.lmask) * K + (rkey[i] & row.rmask)];
             std::memcpy(S + m, su.syms, sizeof su.syms);
             m += su.len;
             fresh += su.fresh;
@@ -113,10 +101,7 @@ template <bool Whole> void Rewriter::run_symbols(Worker& w, std::size_t b, std::
             } else if (row.shape == Plan::kOpen) {
                 stack[depth++] = static_cast<std::uint16_t>(left);
             } else if (row.shape == Plan::kClose) {
-                if (depth == 0) // a branch opened before b, or never
-                    left = Whole ? 0 : key_of(left_step(static_cast<std::int64_t>(i)));
-                else
-                    left = stack[--depth];
+                left = depth == 0 ? 0 : stack[--depth]; // a ']' without its '[': no left key
             }
         }
     }
@@ -128,8 +113,5 @@ template <bool Whole> void Rewriter::run_symbols(Worker& w, std::size_t b, std::
     if (m > env.max_output) limit_error();
     env.new_count += static_cast<ModuleId>(fresh);
 }
-
-template void Rewriter::run_symbols<true>(Worker&, std::size_t, std::size_t);
-template void Rewriter::run_symbols<false>(Worker&, std::size_t, std::size_t);
 
 } // namespace plant
