@@ -167,6 +167,8 @@ struct SuccessorTemplate {
     std::vector<std::uint32_t> holes;     // parameter index of each computed number
     std::vector<Span> hole_spans;
     int keep = -1; // module that keeps the predecessor's identity
+    // how many of its modules get new identities (all but the one that keeps the predecessor's)
+    std::size_t fresh() const { return syms.size() - (keep >= 0 ? 1 : 0); }
     // What the string stores of it (see KindTable; Compiler::assign_kinds): each module's kind,
     // the numbers stored (constants of plain kinds and the holes), where each hole goes among
     // them, and each module's count of them.

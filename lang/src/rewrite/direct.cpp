@@ -110,7 +110,7 @@ Rewriter::Counts Rewriter::count_direct(std::size_t b, std::size_t e) const {
         }
         c.modules += pr->tmpl.syms.size();
         c.params += pr->tmpl.stored.size();
-        c.new_ids += pr->tmpl.syms.size() - (pr->tmpl.keep >= 0 ? 1 : 0);
+        c.new_ids += pr->tmpl.fresh();
     }
     return c;
 }

@@ -294,8 +294,8 @@ bool Engine::rewrite_direct(const Derivation& d, Rewriter& rw, const ModuleStrin
     std::vector<ModuleId> id_at(T);
     // sized: from the counts, without reading the string (exact, or bounds when a guarded
     // symbol's outcomes differ in size; then each thread's stretch starts at a bound)
-    const bool sized = counted && (T == 1 || !slices_missed) && size_from_counts(plan, in, modules, params) &&
-                       within_limits(d, modules, params) &&
+    const bool sized = counted && (T == 1 || slices_missed != &plan) &&
+                       size_from_counts(plan, in, modules, params) && within_limits(d, modules, params) &&
                        (T == 1 || size_slices(plan, in, T, m_at, p_at, id_at));
     if (!sized) {
         modules = params = 0; // (size_from_counts may have left a partial sum)
@@ -341,7 +341,7 @@ bool Engine::rewrite_direct(const Derivation& d, Rewriter& rw, const ModuleStrin
     for (auto& w : workers)
         if (w.error) throw *w.error;
     if (sized && !cut_to_written(out, counts_at, m_at, p_at, id_at)) {
-        slices_missed = true; // the stretches left gaps: count, and write again
+        slices_missed = &plan; // the stretches left gaps: count, and write again
         return rewrite_direct(d, rw, in, out, plan, threads, counted, setup);
     }
     for (auto& w : workers)

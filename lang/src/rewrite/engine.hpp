@@ -81,9 +81,10 @@ struct Engine {
         const SymbolId* of = nullptr;
         std::size_t size = 0;
     } counts;
-    // A step on several threads found its stretches' sizes from the counts only bounds that the
-    // writers did not fill (a guarded symbol copied): later steps count instead.
-    bool slices_missed = false;
+    // The plan under which a step on several threads found its stretches' sizes from the counts
+    // only bounds that the writers did not fill (a guarded symbol copied): later steps under it
+    // count instead (another plan, after a group switch, tries the counts again).
+    const RulePlan* slices_missed = nullptr;
     std::uint64_t modules_counted = 0; // read only to size an output (Derivation::modules_counted)
     void forget_counts() { counts.of = nullptr; }
 

@@ -152,7 +152,7 @@ std::size_t Rewriter::apply_template(Worker& w, std::size_t i, const Production&
         for (std::size_t j = 0; j < m; ++j)
             ids[j] = static_cast<int>(j) == t.keep ? in.ids[i] : env.id_base + env.new_count++;
     } else {
-        env.new_count += m - (t.keep >= 0 ? 1 : 0);
+        env.new_count += t.fresh();
     }
     if (out.size() > env.max_output) limit_error();
     return 1;

@@ -108,7 +108,7 @@ void RulePlan::build_copy_kernel() {
         const SuccessorTemplate& t = pr->tmpl;
         std::copy(t.kinds.begin(), t.kinds.end(), copy_succ[k].kinds);
         copy_len[k] = static_cast<std::uint8_t>(t.kinds.size());
-        copy_fresh[k] = static_cast<std::uint8_t>(t.kinds.size() - (t.keep >= 0 ? 1 : 0));
+        copy_fresh[k] = static_cast<std::uint8_t>(t.fresh());
         copy_longest = std::max(copy_longest, t.kinds.size());
     }
     copy_kernel = true;
@@ -224,11 +224,15 @@ void RulePlan::build_symbol_kernel() {
     for (SymbolId sym = 0; sym < S; ++sym)
         if (has_prod[sym] && direct[sym] && direct[sym]->strict[0].width != 0)
             return; // a pattern with parameters
+    // built as distinct successors (succs) and each block's indices into them (succ_at), then
+    // flattened into succ_flat, which is all the kernel reads
+    std::vector<SymbolSucc> succs;
+    std::vector<std::uint32_t> succ_at;
     auto add = [&](const SuccessorTemplate& t) {
         SymbolSucc su;
         std::copy(t.syms.begin(), t.syms.end(), su.syms);
         su.len = static_cast<std::uint32_t>(t.syms.size());
-        su.fresh = su.len - (t.keep >= 0 ? 1 : 0);
+        su.fresh = static_cast<std::uint32_t>(t.fresh());
         succs.push_back(su);
         return static_cast<std::uint32_t>(succs.size() - 1);
     };
@@ -266,12 +270,8 @@ void RulePlan::build_symbol_kernel() {
                 succ_at.push_back(pr ? add_production(*pr) : self_at);
             }
         }
-        row.open = row.shape == kOpen;
-        row.close = row.shape == kClose;
-        row.seen = row.shape == 0 ? row.key : 0;
-        row.keep_left = row.shape == kIgnored || row.shape == kOpen ? 0xffff : 0;
-        row.keep_right = row.shape == kIgnored ? 0xffff : 0;
     }
+    succ_flat.reserve(succ_at.size());
     for (std::uint32_t at : succ_at) succ_flat.push_back(succs[at]);
     symbol_kernel = true;
 }

@@ -29,23 +29,14 @@ struct RulePlan {
     };
     static constexpr std::uint8_t kIgnored = 1, kOpen = 2, kClose = 3; // shapes; 0: context sees it
     struct SymbolRow {
-        std::uint32_t block = 0;           // its successors start at succ_at[block]
+        std::uint32_t block = 0;           // its successors start at succ_flat[block]
         std::uint8_t lmask = 0, rmask = 0; // 0xff: the block is indexed by that neighbour's key
         std::uint8_t shape = 0;
         std::uint8_t key = 0; // ctx_key
-        // The same, for the whole-string passes, which carry the neighbours' keys without a
-        // branch: the key a pass holds after this module is (key & keep) | seen, or the key
-        // saved at the matching bracket when it pops one.
-        std::uint16_t keep_left = 0, keep_right = 0; // 0xffff: the pass keeps its key (ignored, and
-                                                     // '[' going right, none going left)
-        std::uint16_t seen = 0;                      // key when context sees the module, else 0
-        std::uint8_t open = 0, close = 0;            // 1: a '[' or a ']'
     };
     bool symbol_kernel = false; // Rewriter::run_symbols can rewrite strings without parameters
     std::vector<SymbolRow> sym_rows;
-    std::vector<std::uint32_t> succ_at; // blocks of indices into succs
-    std::vector<SymbolSucc> succs;
-    std::vector<SymbolSucc> succ_flat; // succs[succ_at[k]] at k: one load fewer a module
+    std::vector<SymbolSucc> succ_flat; // each symbol's block of successors, one after another
 
     // The copy kernel (Engine::rewrite_copies, copies.cpp): when every module of a string
     // without numbers is copied or rewritten by a direct template that stores no numbers (ABOP's

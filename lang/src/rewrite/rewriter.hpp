@@ -147,7 +147,7 @@ class Rewriter {
         if constexpr (Ids) {
             for (std::size_t j = 0; j < m; ++j) ID[j] = static_cast<int>(j) == t.keep ? kept : next_new++;
         } else {
-            next_new += m - (t.keep >= 0 ? 1 : 0);
+            next_new += t.fresh();
         }
     }
 

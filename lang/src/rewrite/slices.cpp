@@ -34,7 +34,7 @@ bool Engine::size_from(const RulePlan& plan, const std::vector<std::uint64_t>& p
             modules += c * pr->tmpl.syms.size();
             params += c * pr->tmpl.stored.size();
             params -= c * static_cast<std::size_t>(counts.stored[s]);
-            new_ids += c * (pr->tmpl.syms.size() - (pr->tmpl.keep >= 0 ? 1 : 0));
+            new_ids += c * pr->tmpl.fresh();
         } else {
             const RulePlan::Guarded& g = plan.guarded[static_cast<std::size_t>(plan.guarded_at[s])];
             std::size_t most_m = 1, most_p = 0, most_new = 0; // (the copy's own parameters are in params_in)
@@ -43,7 +43,7 @@ bool Engine::size_from(const RulePlan& plan, const std::vector<std::uint64_t>& p
                     const SuccessorTemplate& t = plan.guards[g.first + k].pr->tmpl;
                     most_m = std::max(most_m, t.syms.size());
                     most_p = std::max(most_p, t.stored.size());
-                    most_new = std::max(most_new, t.syms.size() - (t.keep >= 0 ? 1 : 0));
+                    most_new = std::max(most_new, t.fresh());
                 }
             modules += c * most_m;
             new_ids += c * most_new;

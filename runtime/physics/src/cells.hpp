@@ -7,6 +7,10 @@
 
 namespace plant::physics {
 
+inline bool finite(const glm::dvec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
 // floor(u) as an int, clamped to [lo, hi]. The clamp happens before the conversion, so a
 // particle blown far away cannot overflow it (converting a double beyond int's range is
 // undefined); NaN goes to lo. Within the range this is exactly clamp(int(floor(u)), lo, hi).

@@ -7,16 +7,14 @@
 // a held particle alone did (docs/physics.md, "Dragging and breaking").
 #include "plant/physics/world.hpp"
 
+#include "cells.hpp"
+
 #include <algorithm>
 #include <cmath>
 
 namespace plant::physics {
 
 namespace {
-
-bool finite(const glm::dvec3& v) {
-    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
 
 // `to` moved onto the sphere of radius `length` about `from` when it lies beyond it
 glm::dvec3 within(const glm::dvec3& from, const glm::dvec3& to, double length) {

@@ -6,12 +6,6 @@
 
 namespace plant::physics {
 
-namespace {
-bool finite(const glm::dvec3& v) {
-    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-} // namespace
-
 void LightGrid::clear() {
     count_.clear();
     n_ = glm::ivec3(0);

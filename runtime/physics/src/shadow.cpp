@@ -5,16 +5,14 @@
 
 #include "obstacle_field.hpp"
 
+#include "cells.hpp"
+
 #include <algorithm>
 #include <cmath>
 
 namespace plant::physics {
 
 namespace {
-
-bool finite(const glm::dvec3& v) {
-    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
 
 // The ray p + t d (t > 0) against the box [lo, hi] by slabs: the interval of t inside it, empty
 // when t_in > t_out. A ray parallel to a slab it starts outside of misses.

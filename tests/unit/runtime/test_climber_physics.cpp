@@ -387,9 +387,10 @@ TEST_CASE("climber: no segment of any climber grammar crosses an obstacle, as a 
     CHECK(grammars >= 9);
 }
 
-// Issue 18 item 4, not done in the grammars yet (docs/physics.md, "Plant-plant collision"): links
-// of different plants are collided as capsules only with Settings::link_collisions, which the
-// climber does not switch on, since with it a push carried a link of fig11_fence through a rail.
+// Issue 18 item 4, not done in every grammar yet (docs/physics.md, "Plant-plant collision"): links
+// of different plants are collided as capsules only with `plant_contacts: 1`, which only
+// fig08_painted_wall and fig14_right set, since with it a push carried a link of fig11_fence
+// through a rail.
 // Without it eight climber grammars have two plants' links overlapping by 2.2-12 mm; with it all
 // but fig10_dome (4.8 mm: stems of several plants piled on one attractor) and fig14_left (3.5 mm:
 // whipping shoots) stay within kCapsuleTolerance. Catch's [!shouldfail]: this passes while some
