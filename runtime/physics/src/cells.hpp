@@ -4,6 +4,7 @@
 #include <glm/glm.hpp>
 
 #include <cmath>
+#include <cstdint>
 
 namespace plant::physics {
 
@@ -21,6 +22,33 @@ inline int cell_index(double u, int lo, int hi) {
 
 inline glm::ivec3 cell_index(const glm::dvec3& u, const glm::ivec3& lo, const glm::ivec3& hi) {
     return glm::ivec3(cell_index(u.x, lo.x, hi.x), cell_index(u.y, lo.y, hi.y), cell_index(u.z, lo.z, hi.z));
+}
+
+// floor(u) as a 64-bit cell coordinate for a hashed grid, u first clamped to 2^52 cells either
+// way (NaN to the top), so the conversion and a neighbour's c + 1 stay in range for a particle
+// blown far away; nearer ones are not changed. Floor by truncation and correction: the baseline
+// x86-64 has no rounding instruction, and std::floor is a call.
+inline std::int64_t far_floor(double u) {
+    constexpr double far = 0x1p52;
+    u = u < far ? (u > -far ? u : -far) : far;
+    const auto t = static_cast<std::int64_t>(u);
+    return t - static_cast<std::int64_t>(static_cast<double>(t) > u);
+}
+
+// A hashed grid cell's key: one term per axis, xor-ed (the particle contacts combine the terms
+// of neighbouring cells themselves). Multiplied as unsigned numbers, which wrap where a signed
+// product would overflow and give the same bits where it does not.
+inline std::uint64_t cell_term_x(std::int64_t x) {
+    return static_cast<std::uint64_t>(x) * 73856093u;
+}
+inline std::uint64_t cell_term_y(std::int64_t y) {
+    return static_cast<std::uint64_t>(y) * 19349663u;
+}
+inline std::uint64_t cell_term_z(std::int64_t z) {
+    return static_cast<std::uint64_t>(z) * 83492791u;
+}
+inline std::uint64_t cell_hash(const glm::i64vec3& c) {
+    return cell_term_x(c.x) ^ cell_term_y(c.y) ^ cell_term_z(c.z);
 }
 
 } // namespace plant::physics

@@ -2,6 +2,7 @@
 // that keeps particles out of them, and the contacts between particles.
 #include "plant/physics/world.hpp"
 
+#include "cells.hpp"
 #include "obstacle_field.hpp"
 #include "parallel.hpp"
 
@@ -84,22 +85,7 @@ void World::separate_particles() {
         }
     if (reach <= 0 || n < 2) return;
     const double cell = 2 * reach; // twice the widest contact: a 2 x 2 x 2 block of cells holds every partner
-    // a cell's key: one term per axis, xor-ed; multiplied as unsigned numbers, which wrap where
-    // a signed product would overflow and give the same bits where it does not
-    auto term_x = [](std::int64_t x) { return static_cast<std::uint64_t>(x) * 73856093u; };
-    auto term_y = [](std::int64_t y) { return static_cast<std::uint64_t>(y) * 19349663u; };
-    auto term_z = [](std::int64_t z) { return static_cast<std::uint64_t>(z) * 83492791u; };
-    auto hash = [&](const glm::i64vec3& c) { return term_x(c.x) ^ term_y(c.y) ^ term_z(c.z); };
-    // each particle's cell, once: floor by truncation and correction (the baseline x86-64 has
-    // no rounding instruction, and std::floor is a call). A coordinate is first clamped to
-    // 2^52 cells either way (NaN to the top), so the conversion and the neighbours' c + 1 stay
-    // in range for a particle blown far away; nearer ones are not changed.
-    auto floor_of = [](double u) {
-        constexpr double far = 0x1p52;
-        u = u < far ? (u > -far ? u : -far) : far;
-        const auto t = static_cast<std::int64_t>(u);
-        return t - static_cast<std::int64_t>(static_cast<double>(t) > u);
-    };
+    // (cell keys and coordinates: cell_hash, far_floor in cells.hpp)
     // an open-addressing table from a cell's key to its run of particles in `members` (in index
     // order), built by counting: no sort. A slot holds the key and the run's bounds together, so
     // a lookup touches one cache line.
@@ -114,8 +100,8 @@ void World::separate_particles() {
     for (std::uint32_t i = 0; i < n; ++i) {
         if (!alive_[i]) continue;
         const glm::dvec3 u = x_[i] / cell;
-        cell_of[i] = glm::i64vec3(floor_of(u.x), floor_of(u.y), floor_of(u.z));
-        const std::uint64_t k = hash(cell_of[i]);
+        cell_of[i] = glm::i64vec3(far_floor(u.x), far_floor(u.y), far_floor(u.z));
+        const std::uint64_t k = cell_hash(cell_of[i]);
         std::size_t slot = k & (size - 1);
         while (table[slot].end != 0 && table[slot].key != k) slot = (slot + 1) & (size - 1);
         table[slot].key = k;
@@ -145,9 +131,9 @@ void World::separate_particles() {
             const glm::dvec3 frac = xi / cell - glm::dvec3(c);
             const glm::i64vec3 side(frac.x < 0.5 ? -1 : 1, frac.y < 0.5 ? -1 : 1, frac.z < 0.5 ? -1 : 1);
             // the hash's three terms for the two cells along each axis
-            const std::uint64_t hx[2] = {term_x(c.x), term_x(c.x + side.x)};
-            const std::uint64_t hy[2] = {term_y(c.y), term_y(c.y + side.y)};
-            const std::uint64_t hz[2] = {term_z(c.z), term_z(c.z + side.z)};
+            const std::uint64_t hx[2] = {cell_term_x(c.x), cell_term_x(c.x + side.x)};
+            const std::uint64_t hy[2] = {cell_term_y(c.y), cell_term_y(c.y + side.y)};
+            const std::uint64_t hz[2] = {cell_term_z(c.z), cell_term_z(c.z + side.z)};
             // the block's eight keys, z slowest (the order the pushes are summed in)
             std::uint64_t keys[8];
             for (int q = 0; q < 8; ++q) keys[q] = hx[q & 1] ^ hy[(q >> 1) & 1] ^ hz[q >> 2];

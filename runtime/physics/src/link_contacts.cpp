@@ -9,6 +9,7 @@
 // Links of one plant are left to the particles' own contacts and the shape matching.
 #include "plant/physics/world.hpp"
 
+#include "cells.hpp"
 #include "obstacle_field.hpp"
 
 #include <algorithm>
@@ -58,18 +59,6 @@ constexpr double kStretch = 1.02;
 
 // sweeps over the pairs a step at most
 constexpr int kSweeps = 16;
-
-// a coordinate's cell, clamped so that a particle blown far away (or a NaN) cannot overflow
-std::int64_t cell_coordinate(double u) {
-    constexpr double far = 0x1p40;
-    u = u < far ? (u > -far ? u : -far) : far;
-    return static_cast<std::int64_t>(std::floor(u));
-}
-
-std::uint64_t cell_key(const glm::i64vec3& c) {
-    return (static_cast<std::uint64_t>(c.x) * 73856093u) ^ (static_cast<std::uint64_t>(c.y) * 19349663u) ^
-           (static_cast<std::uint64_t>(c.z) * 83492791u);
-}
 
 } // namespace
 
@@ -121,8 +110,7 @@ void World::find_link_pairs() {
     if (links.size() < 2) return;
     const double cell = std::max({total / static_cast<double>(links.size()) + 2 * widest, largest / 4, 1e-6});
     auto range = [&](std::uint32_t i, glm::i64vec3& a, glm::i64vec3& b) {
-        for (int k = 0; k < 3; ++k)
-            a[k] = cell_coordinate(lo[i][k] / cell), b[k] = cell_coordinate(hi[i][k] / cell);
+        for (int k = 0; k < 3; ++k) a[k] = far_floor(lo[i][k] / cell), b[k] = far_floor(hi[i][k] / cell);
     };
     // an open-addressing table from a cell to its run of links, filled by counting (no sort)
     std::size_t entries = 0;
@@ -136,7 +124,7 @@ void World::find_link_pairs() {
     auto& table = sc.link_table;
     table.assign(size, LinkCell{});
     auto slot_of = [&](const glm::i64vec3& c) {
-        std::size_t slot = cell_key(c) & (size - 1);
+        std::size_t slot = cell_hash(c) & (size - 1);
         while (table[slot].count != 0 && table[slot].cell != c) slot = (slot + 1) & (size - 1);
         return slot;
     };
@@ -170,8 +158,8 @@ void World::find_link_pairs() {
                 if (plant[a] == plant[b]) continue;
                 const glm::dvec3 low = glm::max(lo[a], lo[b]), high = glm::min(hi[a], hi[b]);
                 if (low.x > high.x || low.y > high.y || low.z > high.z) continue;
-                const glm::i64vec3 owner(cell_coordinate(low.x / cell), cell_coordinate(low.y / cell),
-                                         cell_coordinate(low.z / cell));
+                const glm::i64vec3 owner(far_floor(low.x / cell), far_floor(low.y / cell),
+                                         far_floor(low.z / cell));
                 if (owner != s.cell) continue; // found in the cell that owns it
                 sc.link_pairs.push_back({std::min(a, b), std::max(a, b)});
             }
