@@ -433,9 +433,8 @@ void Climber::rebuild_occupancy() {
 double Climber::occlusion(const glm::dvec3& p) const {
     // Eq. 7's O: an obstacle between p and the light is opaque, a full shade (the paper's shadow
     // maps include the scene); else the particles in the cells between p and the light
-    const glm::dvec3 to_light = glm::normalize(config_.light);
-    if (config_.obstacle_shade && physics::in_shadow(world_.obstacles(), p, to_light)) return 1.0;
-    return light_.occlusion(p, to_light, config_.opacity);
+    return physics::scene_occlusion(light_, world_.obstacles(), config_.obstacle_shade, p,
+                                    glm::normalize(config_.light), config_.opacity);
 }
 
 glm::dvec3 Climber::grow_dir(const glm::dvec3& p, const glm::dvec3& h) const {

@@ -89,9 +89,7 @@ void World::grow() {
             shade.build(points, g.light_cell);
             shade_counted = true;
         }
-        const glm::dvec3 to_light = glm::normalize(g.to_light);
-        if (g.obstacle_shade && in_shadow(obstacles_, p, to_light)) return 1.0; // the scene's shade
-        return shade.occlusion(p, to_light, g.opacity);
+        return scene_occlusion(shade, obstacles_, g.obstacle_shade, p, glm::normalize(g.to_light), g.opacity);
     };
     for (std::uint32_t i = 0; i < n && x_.size() < g.max_particles; ++i) {
         if (!alive_[i] || !children_[i].empty()) continue;

@@ -83,4 +83,10 @@ bool in_shadow(const std::vector<Obstacle>& obstacles, const glm::dvec3& p, cons
                        [&](const Obstacle& o) { return blocks_light(o, p, to_light); });
 }
 
+double scene_occlusion(const LightGrid& grid, const std::vector<Obstacle>& obstacles, bool obstacles_shade,
+                       const glm::dvec3& p, const glm::dvec3& to_light, double opacity) {
+    if (obstacles_shade && in_shadow(obstacles, p, to_light)) return 1.0; // an obstacle is opaque
+    return grid.occlusion(p, to_light, opacity);
+}
+
 } // namespace plant::physics

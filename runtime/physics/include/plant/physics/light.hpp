@@ -40,4 +40,10 @@ bool blocks_light(const Obstacle& o, const glm::dvec3& p, const glm::dvec3& to_l
 // Whether any of the obstacles blocks the light at p.
 bool in_shadow(const std::vector<Obstacle>& obstacles, const glm::dvec3& p, const glm::dvec3& to_light);
 
+// Eq. 7's O at p in a scene: 1 where an obstacle blocks the light (with `obstacles_shade`), else
+// the plant's particles counted in `grid` (LightGrid::occlusion). World::grow and the climber's
+// occlusion() both use it.
+double scene_occlusion(const LightGrid& grid, const std::vector<Obstacle>& obstacles, bool obstacles_shade,
+                       const glm::dvec3& p, const glm::dvec3& to_light, double opacity);
+
 } // namespace plant::physics
