@@ -27,11 +27,20 @@ inline std::uint64_t finish(std::uint64_t h, std::uint64_t draw) {
 }
 } // namespace random_detail
 
+// The part of the language's draws that depends on (seed, phase) alone: a loop drawing for many
+// positions of one phase computes it once (random_bits_at).
+inline std::uint64_t random_phase(std::uint64_t seed, std::uint64_t phase) {
+    return random_detail::start(seed, phase);
+}
+// random_bits(seed, phase, position, draw) for h = random_phase(seed, phase).
+inline std::uint64_t random_bits_at(std::uint64_t h, std::uint64_t position, std::uint64_t draw) {
+    return random_detail::finish(mix64(h ^ (position * 0xabc98388fb8fac03ULL)), draw);
+}
+
 // The language's draws: a pure function of (seed, phase, position in the string, draw index).
 inline std::uint64_t random_bits(std::uint64_t seed, std::uint64_t phase, std::uint64_t position,
                                  std::uint64_t draw) {
-    const std::uint64_t h = random_detail::start(seed, phase);
-    return random_detail::finish(mix64(h ^ (position * 0xabc98388fb8fac03ULL)), draw);
+    return random_bits_at(random_phase(seed, phase), position, draw);
 }
 
 // Draws keyed by one number besides the seed (the physics world's: a particle).

@@ -70,7 +70,7 @@ const RulePlan::Guard* Rewriter::pick_guarded(std::size_t i, const ModuleArgs& a
         total = 0;
         for (std::size_t j = 0; j < count; ++j) total += options[j]->weight * scale;
     }
-    double u = random_unit(random_bits(seed, phase, i, stream::kChoiceDraw)) * total;
+    double u = random_unit(random_bits_at(draw_phase, i, stream::kChoiceDraw)) * total;
     std::size_t pick = count - 1;
     for (std::size_t j = 0; j < count; ++j) {
         const double weight = options[j]->weight * scale;
@@ -207,17 +207,22 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
         ++tally[outcome];
         const Production& pr = *prp;
         const SuccessorTemplate& t = pr.tmpl;
-        if (!t.holes.empty()) {
-            bind_args(w, i, in.params.data() + q, pr.strict[0]);
-            w.env.position = i;
-            w.env.draw = 0;
-            w.env.id = in.id(i);
-            w.env.out = nullptr;
-            compute_holes(w, t, values);
-            check_holes(t, values);
+        if (const std::int32_t affine = plan.outcome_args[outcome]; affine >= 0) {
+            put_affine<Ids>(t, plan.args.data() + affine, in.args_at(i, in.params.data() + q),
+                            Ids ? in.ids[i] : 0, id_at, S, PA, ID);
+        } else {
+            if (!t.holes.empty()) {
+                bind_args(w, i, in.params.data() + q, pr.strict[0]);
+                w.env.position = i;
+                w.env.draw = 0;
+                w.env.id = in.id(i);
+                w.env.out = nullptr;
+                compute_holes(w, t, values);
+                check_holes(t, values);
+            }
+            put_template<Ids>(t, values, Ids ? in.ids[i] : 0, id_at, S, PA, ID);
         }
         const std::size_t m = t.syms.size();
-        put_template<Ids>(t, values, Ids ? in.ids[i] : 0, id_at, S, PA, ID);
         if constexpr (Ids) ID += m;
         S += m;
         PA += t.stored.size();

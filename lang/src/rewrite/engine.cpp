@@ -111,8 +111,7 @@ void Engine::rewrite(const Derivation& d, const ModuleString& in, ModuleString& 
     const bool kernel_may = plan.symbol_kernel && in.params.empty() && !in.keep_ids;
     Rewriter rw(plan, in, &brackets, &kernel_scratch, threads == 1 || kernel_may);
     if (rw.kernel_applies()) threads = 1;
-    rw.seed = d.seed_;
-    rw.phase = phase;
+    rw.set_draws(d.seed_, phase);
     auto setup = [&](Worker& w) {
         w.env.prog = &d.prog_;
         w.env.run = &d.run_;

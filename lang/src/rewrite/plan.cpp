@@ -199,22 +199,52 @@ bool RulePlan::build_guards(SymbolId sym) {
 }
 
 void RulePlan::build_outcomes() {
+    auto add = [&](const Production* pr, SymbolId s) {
+        outcome_tmpl.push_back(pr ? &pr->tmpl : nullptr);
+        outcome_sym.push_back(s);
+        outcome_args.push_back(pr ? add_args(*pr) : -1);
+    };
     for (SymbolId s = 0; s < P.symbols.size(); ++s) {
         outcome_at.push_back(static_cast<std::uint32_t>(outcome_tmpl.size()));
-        outcome_tmpl.push_back(nullptr);
-        outcome_sym.push_back(s);
+        add(nullptr, s);
         if (!has_prod[s]) continue;
         if (direct[s]) {
-            outcome_tmpl.push_back(&direct[s]->tmpl);
-            outcome_sym.push_back(s);
+            add(direct[s], s);
             continue;
         }
         const Guarded& g = guarded[static_cast<std::size_t>(guarded_at[s])];
-        for (std::uint32_t k = 0; k < g.count; ++k) {
-            outcome_tmpl.push_back(&guards[g.first + k].pr->tmpl);
-            outcome_sym.push_back(s);
-        }
+        for (std::uint32_t k = 0; k < g.count; ++k) add(guards[g.first + k].pr, s);
     }
+}
+
+// The entries of `args` for production pr's template (see outcome_args), or -1 when one of its
+// numbers is not an affine function of one of the module's own.
+std::int32_t RulePlan::add_args(const Production& pr) {
+    const SuccessorTemplate& t = pr.tmpl;
+    if (t.affine.size() != t.holes.size()) return -1;
+    const auto first = static_cast<std::int32_t>(args.size());
+    for (std::size_t h = 0; h < t.affine.size(); ++h) {
+        const SuccessorTemplate::Affine& a = t.affine[h];
+        // the module's number bound to the slot (bind_args writes them in order: the last wins)
+        std::int64_t from = -1;
+        std::uint32_t at = 0;
+        for (const auto& pa : pr.strict[0].args) {
+            if (pa.slot <= a.slot && a.slot < pa.slot + static_cast<std::uint32_t>(pa.width))
+                from = at + (a.slot - pa.slot);
+            at += static_cast<std::uint32_t>(pa.width);
+        }
+        if (from < 0) {
+            args.resize(static_cast<std::size_t>(first));
+            return -1;
+        }
+        ArgHole hole;
+        hole.from = static_cast<std::uint32_t>(from);
+        hole.to = t.stored_holes[h];
+        hole.add = a.kind == SuccessorTemplate::Affine::Add;
+        hole.constant = a.kind == SuccessorTemplate::Affine::Copy ? 1.0 : a.constant;
+        args.push_back(hole);
+    }
+    return first;
 }
 
 // The symbol kernel's tables. It needs every rewritten symbol to be parameterless: a direct

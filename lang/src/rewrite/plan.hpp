@@ -96,6 +96,18 @@ struct RulePlan {
     std::vector<std::uint32_t> outcome_at;
     std::vector<const SuccessorTemplate*> outcome_tmpl; // nullptr: the copy
     std::vector<SymbolId> outcome_sym;
+    // Per outcome, how the direct writer computes its template's numbers without binding the
+    // frame (Rewriter::put_args): when every computed number is one of the module's own, times
+    // or plus a constant (SuccessorTemplate::affine), each number's source among the module's
+    // numbers, its place among the stored ones and its constant, from args_first on in `args`.
+    struct ArgHole {
+        std::uint32_t from = 0; // the predecessor's number it reads
+        std::uint32_t to = 0;   // its place among the template's stored numbers
+        double constant = 1;    // the factor (a plain copy is a factor of 1), or the addend
+        bool add = false;
+    };
+    std::vector<std::int32_t> outcome_args; // its first entry in `args`; -1: run the frame
+    std::vector<ArgHole> args;
     // Whether a step must rewrite on one thread, left to right (or right to left for `>>`).
     bool sequential() const { return multi || left_new || right_new; }
     std::size_t max_modules_out = 1; // the longest template's modules (at least 1: a copy)
@@ -106,6 +118,7 @@ struct RulePlan {
     void build_copy_kernel();
     bool build_guards(SymbolId sym);
     void build_outcomes();
+    std::int32_t add_args(const Production& pr);
     void build_context_table();
 };
 

@@ -13,6 +13,7 @@
 
 #include "plan.hpp"
 #include "plant/derive.hpp"
+#include "plant/random.hpp"
 #include "plant/vm.hpp"
 
 #include <cmath>
@@ -107,7 +108,7 @@ class Rewriter {
     // a: module i's parameters
     const RulePlan::Guard* pick_guarded(std::size_t i, const ModuleArgs& a, const RulePlan::Guarded& g) const;
     // The seed and phase of the step's random draws (weighted choice on the direct path).
-    std::uint64_t seed = 0, phase = 0;
+    void set_draws(std::uint64_t seed, std::uint64_t phase) { draw_phase = random_phase(seed, phase); }
 
     // ---- backward processing for `>>` (passes.cpp)
     void run_backward(Worker& w);
@@ -144,6 +145,35 @@ class Rewriter {
         if (t.stored.size() != t.holes.size())
             std::memcpy(PA, t.stored.data(), t.stored.size() * sizeof(double));
         for (std::size_t h = 0; h < t.holes.size(); ++h) PA[t.stored_holes[h]] = values[h];
+        if constexpr (Ids) {
+            for (std::size_t j = 0; j < m; ++j) ID[j] = static_cast<int>(j) == t.keep ? kept : next_new++;
+        } else {
+            next_new += t.fresh();
+        }
+    }
+
+    // put_template for a template whose numbers are affine functions of the predecessor's own
+    // (RulePlan::outcome_args): each computed from `a` (the module's numbers) and written in its
+    // place, without the frame. Numbers that are not finite are an error, as with check_holes;
+    // the test is folded into the loop (check_holes reads back values just stored one by one,
+    // which the processor cannot forward to its paired loads).
+    template <bool Ids>
+    void put_affine(const SuccessorTemplate& t, const RulePlan::ArgHole* hs, const ModuleArgs& a,
+                    ModuleId kept, ModuleId& next_new, KindId* S, double* PA, ModuleId* ID) const {
+        const std::size_t m = t.syms.size();
+        if (m != 0) std::memcpy(S, t.kinds.data(), m * sizeof(KindId));
+        const std::size_t holes = t.holes.size();
+        if (t.stored.size() != holes) std::memcpy(PA, t.stored.data(), t.stored.size() * sizeof(double));
+        double sum = 0;
+        for (std::size_t h = 0; h < holes; ++h) {
+            const double x = a[hs[h].from];
+            const double v = hs[h].add ? x + hs[h].constant : x * hs[h].constant;
+            sum += v * 0.0;
+            PA[hs[h].to] = v;
+        }
+        if (sum != sum) [[unlikely]]
+            for (std::size_t h = 0; h < holes; ++h)
+                if (!std::isfinite(PA[hs[h].to])) hole_error(t, h, PA[hs[h].to]);
         if constexpr (Ids) {
             for (std::size_t j = 0; j < m; ++j) ID[j] = static_cast<int>(j) == t.keep ? kept : next_new++;
         } else {
@@ -301,6 +331,8 @@ class Rewriter {
         if (!pr.condition.empty() && eval_number(pr.condition, frame, w.env) == 0) return false;
         return true;
     }
+
+    std::uint64_t draw_phase = random_phase(0, 0); // see set_draws
 
     const RulePlan& plan;
     const Program& P;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 using namespace plant;
 using plant::test::derive;
@@ -174,4 +175,60 @@ TEST_CASE("output sized from the last step's tallies matches the general path", 
     const std::string a = run_with(direct, 5, 1);
     CHECK(a.size() > 10000);
     CHECK(a == run_with(general.c_str(), 5, 1));
+}
+
+TEST_CASE("the direct path computes a template's numbers from the module's own, in any order", "[derive]") {
+    // A's numbers reach its successors swapped, repeated, scaled and shifted, -0 among them: the
+    // direct path reads them straight from the module (RulePlan::outcome_args); with a condition
+    // the plan cannot read (`a == a`), the general path binds them by name first and runs the
+    // template's code. Both must give the same numbers, bit for bit.
+    const std::string rules = R"(
+          A(a, b, c) COND -> B(c) A(b + 0.5, a * 1.5, c) [ A(c, c * -1, a + -2) ];
+          B(x) -> B(x * 0.5);
+        })";
+    const std::string head = R"(
+        derive 9;
+        module A(a, b, c);
+        axiom: A(1, -0, 3) B(2);
+        rules {)";
+    auto make = [&](const std::string& cond) {
+        std::string r = rules;
+        r.replace(r.find("COND"), 4, cond);
+        return test::compile(head + r);
+    };
+    auto direct = make(""), general = make(": a == a");
+    REQUIRE(direct->program);
+    REQUIRE(general->program);
+    Derivation d1(*direct->program, {}), d2(*general->program, {});
+    d1.run();
+    d2.run();
+    const ModuleString &s1 = d1.string(), &s2 = d2.string();
+    REQUIRE(s1.size() == s2.size());
+    REQUIRE(s1.size() > 1000);
+    CHECK(s1.same_modules(s2));
+    std::size_t negative_zeros = 0;
+    for (std::size_t i = 0; i < s1.size(); ++i)
+        for (std::uint32_t k = 0; k < s1.arity(i); ++k) {
+            const double x = s1.args(i)[k], y = s2.args(i)[k];
+            CHECK(std::memcmp(&x, &y, sizeof x) == 0);
+            negative_zeros += x == 0 && std::signbit(x);
+        }
+    CHECK(negative_zeros > 0);
+}
+
+TEST_CASE("a number that overflows on the direct path is named as on the general path", "[derive][limits]") {
+    // Each successor's first computed number stays finite and a later one overflows (a product,
+    // then a sum): the error names the first number that is not finite, on either path.
+    for (const char* cond : {"", ": x == x "}) {
+        const std::string product = std::string("axiom: A(1e300, 1); derive 3; rules { A(x, y) ") + cond +
+                                    "-> B(y) A(x * 1e5, y + 1); }";
+        const std::string sum = std::string("axiom: A(1e300, 1); derive 4; rules { A(x, y) ") + cond +
+                                "-> B(x) A(y, x + 1.7e308); }";
+        auto c1 = test::compile(product), c2 = test::compile(sum);
+        REQUIRE(c1->program);
+        REQUIRE(c2->program);
+        Derivation d1(*c1->program, {}), d2(*c2->program, {});
+        CHECK_THROWS_WITH(d1.run(), "step 2: parameter 1 of 'A' is infinite");
+        CHECK_THROWS_WITH(d2.run(), "step 3: parameter 2 of 'A' is infinite");
+    }
 }
