@@ -36,6 +36,22 @@ bool holds(Op op, double x, double y) {
     snaps.insert(snaps.end(), tally, tally + outcomes);
 }
 
+// Fills the block offsets (ModuleString::block_at) of the kBlock-th modules among the n just
+// written at `from`, module index `at` of `out`, whose parameters start at p; returns the
+// index of the next such module after them. Out of line: the writer calls it once in kBlock
+// modules, while the kinds it sums are still in cache (instead of a pass over the whole output
+// after writing it, ModuleString::index_range).
+[[gnu::noinline]] std::size_t mark_blocks(ModuleString& out, const KindId* from, std::size_t n,
+                                          std::size_t at, std::size_t p, std::size_t next,
+                                          const std::uint8_t* stored_of) {
+    constexpr std::size_t B = ModuleString::kBlock;
+    for (std::size_t j = 0; next < at + n; next += B) {
+        for (; j < next - at; ++j) p += stored_of[from[j]];
+        out.block_at[next >> ModuleString::kBlockShift] = static_cast<std::uint32_t>(p);
+    }
+    return next;
+}
+
 } // namespace
 
 // The first production whose condition holds applies; when it is weighted, every weighted
@@ -156,6 +172,18 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
     std::size_t next_check = b + kSnapEvery;
     const std::size_t outcomes = plan.outcome_tmpl.size();
     w.snaps.clear();
+    // the next module that starts a block (ModuleString::block_at), as a position in `out`
+    constexpr std::size_t B = ModuleString::kBlock;
+    std::size_t next_block = (m_at + B - 1) & ~(B - 1);
+    KindId* const S0 = out.kinds.data();
+    KindId* block_mark = S0 + next_block;
+    auto marks = [&](const KindId* from, std::size_t n, std::size_t p_from) {
+        if (from + n > block_mark) [[unlikely]] {
+            next_block =
+                mark_blocks(out, from, n, static_cast<std::size_t>(from - S0), p_from, next_block, stored_of);
+            block_mark = S0 + next_block;
+        }
+    };
     while (i < e) {
         if (i >= next_check) { // a long step can be interrupted (Ctrl-C in the REPL)
             next_check = i + kSnapEvery;
@@ -196,6 +224,7 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
                 if constexpr (Ids) std::memcpy(ID, in.ids.data() + i, n * sizeof(ModuleId));
                 if (np) std::memcpy(PA, in.params.data() + q, np * sizeof(double));
             }
+            marks(S, n, p);
             S += n;
             if constexpr (Ids) ID += n;
             PA += np;
@@ -223,6 +252,7 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
             put_template<Ids>(t, values, Ids ? in.ids[i] : 0, id_at, S, PA, ID);
         }
         const std::size_t m = t.syms.size();
+        marks(S, m, p);
         if constexpr (Ids) ID += m;
         S += m;
         PA += t.stored.size();
@@ -234,7 +264,7 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
     c.modules = static_cast<std::size_t>(S - (out.kinds.data() + m_at));
     c.params = p - p_at;
     c.new_ids = id_at - id0;
-    out.index_range(m_at, m_at + c.modules, p_at); // block_at is sized by the caller
+    // (block_at, sized by the caller, was filled as the modules were written)
     return c;
 }
 

@@ -30,7 +30,22 @@ Run run(const Program& program, int threads, bool ids) {
     return {d.string(), d.next_id(), d.modules_counted()};
 }
 
+// The block offsets, which the writers fill as they write (ModuleString::block_at), are the
+// numbers stored before each block's first module.
+void indexed(const ModuleString& s) {
+    REQUIRE(s.block_at.size() == (s.size() + ModuleString::kBlock - 1) / ModuleString::kBlock);
+    std::size_t sum = 0, wrong = 0;
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        if (i % ModuleString::kBlock == 0 && s.block_at[i / ModuleString::kBlock] != sum) ++wrong;
+        sum += s.stored(i);
+    }
+    CHECK(wrong == 0);
+    CHECK(sum == s.params.size());
+}
+
 void same(const Run& a, const Run& b) {
+    indexed(a.string);
+    indexed(b.string);
     REQUIRE(a.string.size() == b.string.size());
     CHECK(std::equal(a.string.kinds.begin(), a.string.kinds.end(), b.string.kinds.begin()));
     CHECK(std::equal(a.string.block_at.begin(), a.string.block_at.end(), b.string.block_at.begin()));
