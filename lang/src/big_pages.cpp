@@ -7,6 +7,12 @@
 // covers is filled by moving kept pages in with mremap(MREMAP_FIXED), which remaps them without
 // copying or clearing. Only the rest of the block is faulted in fresh. The pages a run touches
 // are then about its peak footprint instead of the sum of all its strings.
+//
+// Blocks of 64 KiB to 1 MiB (map_shared) are parts of 2 MiB pages, split in halves as buddies
+// until one is the size asked for. Without that, each small string of a derivation's early steps
+// took a page of its own, and the first touch of a 2 MiB page costs the kernel clearing all of
+// it: ABOP's Fig. 1.24d at n = 10 faulted in two pages for strings of 84 KB and 254 KB, about
+// 0.3 ms each on a VM, most of its derivation time (docs/architecture.md).
 #include "plant/big_allocator.hpp"
 
 #include <algorithm>
@@ -29,6 +35,37 @@ std::mutex lock;
 std::vector<Block> kept; // guarded by lock
 std::size_t kept_total = 0;
 
+// The free parts of shared pages by size, kShareFrom << k for k = 0..kClasses-1 (guarded by lock).
+constexpr int kClasses = 5;
+static_assert((kShareFrom << (kClasses - 1)) == kShareTo);
+std::vector<char*> free_parts[kClasses];
+std::size_t free_parts_total = 0;
+
+int size_class(std::size_t bytes) {
+    int k = 0;
+    while ((kShareFrom << k) < bytes) ++k;
+    return k;
+}
+
+// Takes `p` out of the free parts of class k if it is there.
+bool take_free(int k, char* p) {
+    auto& list = free_parts[k];
+    const auto at = std::find(list.begin(), list.end(), p);
+    if (at == list.end()) return false;
+    *at = list.back();
+    list.pop_back();
+    free_parts_total -= kShareFrom << k;
+    return true;
+}
+
+void give_free(int k, char* p) {
+    free_parts[k].push_back(p);
+    free_parts_total += kShareFrom << k;
+}
+
+void* map_locked(std::size_t bytes);
+void unmap_locked(void* p, std::size_t bytes);
+
 // Fresh address space for `bytes`, 2 MiB aligned, marked for transparent huge pages.
 char* reserve(std::size_t bytes) {
     void* raw = ::mmap(nullptr, bytes + kHuge, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
@@ -47,6 +84,64 @@ char* reserve(std::size_t bytes) {
 
 void* map(std::size_t bytes) {
     std::lock_guard<std::mutex> guard(lock);
+    return map_locked(bytes);
+}
+
+void unmap(void* p, std::size_t bytes) {
+    std::lock_guard<std::mutex> guard(lock);
+    unmap_locked(p, bytes);
+}
+
+void* map_shared(std::size_t bytes) {
+    std::lock_guard<std::mutex> guard(lock);
+    const int want = size_class(bytes);
+    // the smallest free part that is large enough, halved down to the size asked for; the upper
+    // halves stay free
+    int k = want;
+    while (k < kClasses && free_parts[k].empty()) ++k;
+    char* p = nullptr;
+    if (k < kClasses) {
+        p = free_parts[k].back();
+        free_parts[k].pop_back();
+        free_parts_total -= kShareFrom << k;
+    } else {
+        p = static_cast<char*>(map_locked(kHuge)); // a kept page when there is one
+        if (!p) return nullptr;
+        give_free(kClasses - 1, p + kShareTo);
+        k = kClasses - 1;
+    }
+    while (k > want) {
+        --k;
+        give_free(k, p + (kShareFrom << k));
+    }
+    return p;
+}
+
+void unmap_shared(void* p, std::size_t bytes) {
+    std::lock_guard<std::mutex> guard(lock);
+    int k = size_class(bytes);
+    auto at = reinterpret_cast<std::uintptr_t>(p);
+    // pages are 2 MiB aligned, so a part's buddy differs from it in the bit of its size
+    while (k < kClasses) {
+        const std::uintptr_t buddy = at ^ (kShareFrom << k);
+        if (!take_free(k, reinterpret_cast<char*>(buddy))) break;
+        at = std::min(at, buddy);
+        ++k;
+    }
+    if (k == kClasses)
+        unmap_locked(reinterpret_cast<void*>(at), kHuge); // the whole page is free again
+    else
+        give_free(k, reinterpret_cast<char*>(at));
+}
+
+std::size_t shared_free_bytes() {
+    std::lock_guard<std::mutex> guard(lock);
+    return free_parts_total;
+}
+
+namespace {
+
+void* map_locked(std::size_t bytes) {
     // a kept block large enough is used as it is (its tail stays kept)
     auto fit = std::find_if(kept.begin(), kept.end(), [&](const Block& b) { return b.bytes >= bytes; });
     if (fit != kept.end()) {
@@ -81,8 +176,7 @@ void* map(std::size_t bytes) {
     return p;
 }
 
-void unmap(void* p, std::size_t bytes) {
-    std::lock_guard<std::mutex> guard(lock);
+void unmap_locked(void* p, std::size_t bytes) {
     if (kept_total + bytes > kKeepAtMost) {
         ::munmap(p, bytes);
         return;
@@ -90,6 +184,8 @@ void unmap(void* p, std::size_t bytes) {
     kept.push_back(Block{static_cast<char*>(p), bytes});
     kept_total += bytes;
 }
+
+} // namespace
 
 void trim() {
     std::lock_guard<std::mutex> guard(lock);

@@ -3,7 +3,9 @@
 //   construct() without arguments default-initialises (leaves numbers as they are);
 // - page faults: a step writes its whole output into fresh memory, so blocks of 64 KiB and more
 //   are whole 2 MiB pages, aligned and marked for transparent huge pages: one fault per 2 MiB
-//   instead of one per 4 KiB. Measured on the parametric tree (n = 16): 15 ms -> 6 ms;
+//   instead of one per 4 KiB. Measured on the parametric tree (n = 16): 15 ms -> 6 ms. Blocks
+//   of 64 KiB to 1 MiB share 2 MiB pages (a power of two each, split and merged as buddies),
+//   so a derivation's small strings fault in one page between them instead of one each;
 // - zeroing: the kernel clears every page it hands out, and a growing derivation frees a string
 //   every step. Freed blocks are kept (see big_pages) and their pages moved into the next blocks,
 //   so a page is cleared once per run, not once per step.
@@ -35,6 +37,23 @@ void* map(std::size_t bytes);           // bytes: a multiple of kHuge; nullptr w
 void unmap(void* p, std::size_t bytes); // a block from map(), whole
 void trim();                            // gives every kept page back to the system
 std::size_t kept_bytes();
+
+// Blocks of kShareFrom to kShareTo bytes share 2 MiB pages: each is a power of two at an offset
+// that is a multiple of its size, split from a larger free one and merged with its free buddy
+// when freed; a page whose parts are all free again goes back to the kept blocks.
+constexpr std::size_t kShareFrom = std::size_t{64} << 10;
+constexpr std::size_t kShareTo = kHuge / 2;
+// The bytes a block asked for takes: a power of two from kShareFrom up to kShareTo, whole 2 MiB
+// pages beyond. Only for bytes >= kShareFrom.
+inline std::size_t block_bytes(std::size_t bytes) {
+    if (bytes > kShareTo) return rounded(bytes);
+    std::size_t b = kShareFrom;
+    while (b < bytes) b *= 2;
+    return b;
+}
+void* map_shared(std::size_t bytes);           // bytes: block_bytes of at most kShareTo
+void unmap_shared(void* p, std::size_t bytes); // a block from map_shared(), whole
+std::size_t shared_free_bytes();               // free parts of pages that are partly in use
 } // namespace big_pages
 
 template <typename T> struct BigAllocator {
@@ -44,30 +63,36 @@ template <typename T> struct BigAllocator {
     BigAllocator() noexcept = default;
     template <typename U> BigAllocator(const BigAllocator<U>&) noexcept {}
 
+    static_assert(kMapped == big_pages::kShareFrom);
+
     // The bytes a block of n takes, as charged.
     static std::size_t charged_bytes(std::size_t n) {
         const std::size_t bytes = n * sizeof(T);
-        return bytes >= kMapped ? big_pages::rounded(bytes) : bytes;
+        return bytes >= kMapped ? big_pages::block_bytes(bytes) : bytes;
     }
 
     T* allocate(std::size_t n) {
         if (n > std::size_t(-1) / sizeof(T) / 2) throw std::bad_alloc();
-        const std::size_t bytes = n * sizeof(T);
-        memory::charge(charged_bytes(n));
-        void* p =
-            bytes >= kMapped ? big_pages::map(big_pages::rounded(bytes)) : std::malloc(bytes ? bytes : 1);
+        const std::size_t bytes = n * sizeof(T), block = charged_bytes(n);
+        memory::charge(block);
+        void* p = bytes < kMapped                ? std::malloc(bytes ? bytes : 1)
+                  : block <= big_pages::kShareTo ? big_pages::map_shared(block)
+                                                 : big_pages::map(block);
         if (!p) {
-            memory::release(charged_bytes(n));
+            memory::release(block);
             throw std::bad_alloc();
         }
         return static_cast<T*>(p);
     }
     void deallocate(T* p, std::size_t n) noexcept {
-        memory::release(charged_bytes(n));
-        if (n * sizeof(T) >= kMapped)
-            big_pages::unmap(p, big_pages::rounded(n * sizeof(T)));
-        else
+        const std::size_t block = charged_bytes(n);
+        memory::release(block);
+        if (n * sizeof(T) < kMapped)
             std::free(p);
+        else if (block <= big_pages::kShareTo)
+            big_pages::unmap_shared(p, block);
+        else
+            big_pages::unmap(p, block);
     }
 
     template <typename U> void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
@@ -83,8 +108,8 @@ template <typename T> struct BigAllocator {
 template <typename T> using BigVector = std::vector<T, BigAllocator<T>>;
 
 // Sizes v for n elements for a writer that overwrites them all: what v held is discarded when it
-// must grow. A new block is taken whole (a block of kMapped bytes or more is mapped in whole
-// 2 MiB pages anyway): with its whole room as capacity, a buffer kept from step to step (the
+// must grow. A new block is taken whole (a block of kMapped bytes or more is a power of two or
+// whole 2 MiB pages anyway): with its whole room as capacity, a buffer kept from step to step (the
 // symbol kernel's keys, a string kept for a later step) takes the next steps' larger sizes
 // without a fresh block; a smaller one is taken twice as large as asked, for the same reason.
 // The old block is freed first, so that its pages move into the new one.
@@ -92,7 +117,7 @@ template <typename T> void size_whole(BigVector<T>& v, std::size_t n) {
     if (n > v.capacity()) {
         BigVector<T>().swap(v);
         const std::size_t bytes = n * sizeof(T);
-        v.reserve(bytes >= BigAllocator<T>::kMapped ? big_pages::rounded(bytes) / sizeof(T) : 2 * n);
+        v.reserve(bytes >= BigAllocator<T>::kMapped ? big_pages::block_bytes(bytes) / sizeof(T) : 2 * n);
     }
     v.resize(n);
 }

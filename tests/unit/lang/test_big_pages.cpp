@@ -37,3 +37,43 @@ TEST_CASE("freed string blocks lend their pages to later ones, which read and wr
     big_pages::trim();
     CHECK(big_pages::kept_bytes() == 0);
 }
+
+TEST_CASE("blocks of 64 KiB to 1 MiB share 2 MiB pages as buddies and give the page back whole", "[derive]") {
+    big_pages::trim();
+    const std::size_t kib = std::size_t{1} << 10, page = big_pages::kHuge;
+    REQUIRE(big_pages::shared_free_bytes() == 0);
+    CHECK(big_pages::block_bytes(64 * kib) == 64 * kib);
+    CHECK(big_pages::block_bytes(65 * kib) == 128 * kib);
+    CHECK(big_pages::block_bytes(1024 * kib) == 1024 * kib);
+    CHECK(big_pages::block_bytes(1025 * kib) == page);
+    CHECK(BigAllocator<double>::charged_bytes(100 * kib / 8) == 128 * kib);
+    auto page_of = [&](const void* p) { return reinterpret_cast<std::uintptr_t>(p) / page; };
+    auto offset = [&](const void* p) { return reinterpret_cast<std::uintptr_t>(p) % page; };
+    {
+        // 84 KB, 254 KB and 764 KB: 1.24d's strings at steps 8 to 10, all in one page
+        BigVector<std::uint16_t> a(84 * kib / 2), b(254 * kib / 2), c(764 * kib / 2);
+        CHECK(page_of(a.data()) == page_of(b.data()));
+        CHECK(page_of(a.data()) == page_of(c.data()));
+        CHECK(offset(a.data()) % (128 * kib) == 0);
+        CHECK(offset(b.data()) % (256 * kib) == 0);
+        CHECK(offset(c.data()) % (1024 * kib) == 0);
+        // 2 MiB less 128 + 256 + 1024 KiB is free for the next small blocks
+        CHECK(big_pages::shared_free_bytes() == page - 1408 * kib);
+        for (std::size_t i = 0; i < a.size(); ++i) a[i] = static_cast<std::uint16_t>(i);
+        for (std::size_t i = 0; i < b.size(); ++i) b[i] = static_cast<std::uint16_t>(3 * i);
+        for (std::size_t i = 0; i < c.size(); ++i) c[i] = static_cast<std::uint16_t>(7 * i);
+        std::size_t bad = 0;
+        for (std::size_t i = 0; i < a.size(); ++i) bad += a[i] != static_cast<std::uint16_t>(i);
+        for (std::size_t i = 0; i < b.size(); ++i) bad += b[i] != static_cast<std::uint16_t>(3 * i);
+        CHECK(bad == 0);
+        {
+            BigVector<std::uint16_t> d(600 * kib / 2); // no 1 MiB part left: a page of its own
+            CHECK(page_of(d.data()) != page_of(a.data()));
+        }
+    }
+    // every part freed: the buddies merged back into whole pages, kept for later blocks
+    CHECK(big_pages::shared_free_bytes() == 0);
+    CHECK(big_pages::kept_bytes() == 2 * page);
+    big_pages::trim();
+    CHECK(big_pages::kept_bytes() == 0);
+}
