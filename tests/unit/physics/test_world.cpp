@@ -503,3 +503,49 @@ TEST_CASE("collisions: particles far beyond int64 cells (or not finite) keep the
     for (int k = 0; k < 3; ++k) w.step();
     CHECK(w.position(near[1]).y == Approx(0.05).margin(1e-6));
 }
+
+TEST_CASE("collisions: a particle far wider than the rest is tested against each particle, and the others' "
+          "contacts stay as they were",
+          "[physics]") {
+    // a crowd of 40 plants of 6 particles, 1.5 cm apart with 2 cm radii, so that a particle touches
+    // up to four others (the order they are summed in then shows in the last bits);
+    // with `big`, a free particle of radius `big_r` at `big_at` (once a grammar could make one of
+    // 1 km, the contact grid's cells were sized from it: every particle in one cell, a quadratic
+    // step; tests/hostile/t23_05_climber_huge_radius.plant times that case)
+    const glm::dvec3 r(0.02, 0.025, 0.02);
+    const glm::dquat up(1, 0, 0, 0);
+    auto crowd = [&](World& w) {
+        std::vector<Handle> all;
+        for (int p = 0; p < 40; ++p) {
+            const double x = 0.015 * p, z = 0.01 * (p % 3);
+            Handle h = w.add_root({x, 0, z}, up, r);
+            all.push_back(h);
+            for (int k = 1; k < 6; ++k) all.push_back(h = w.add_particle(h, {x, 0.05 * k, z}, up, r));
+        }
+        return all;
+    };
+    Settings s;
+    s.gravity = glm::dvec3(0.0); // nothing but the contacts moves a particle
+    s.fixed_stiffness = 0.5;
+    auto run = [&](bool big, const glm::dvec3& big_at, double big_r) {
+        World w(s);
+        const std::vector<Handle> all = crowd(w);
+        if (big) w.add_root(big_at, up, glm::dvec3(big_r), false);
+        for (int step = 0; step < 10; ++step) w.step();
+        std::vector<glm::dvec3> at;
+        for (Handle p : all) at.push_back(w.position(p));
+        return at;
+    };
+    // far away, it touches nothing: the crowd moves exactly as without it (same cells, same sums)
+    const std::vector<glm::dvec3> alone = run(false, {}, 0);
+    const std::vector<glm::dvec3> beside = run(true, {0, 0, 5000}, 1000);
+    REQUIRE(alone.size() == beside.size());
+    std::size_t differ = 0;
+    for (std::size_t k = 0; k < alone.size(); ++k) differ += alone[k] != beside[k];
+    CHECK(differ == 0);
+    // and the crowd's own contacts act: the plants push each other apart
+    double spread = 0;
+    for (std::size_t k = 0; k < alone.size(); k += 6)
+        spread = std::max(spread, std::fabs(alone[k + 5].x - 0.015 * static_cast<double>(k / 6)));
+    CHECK(spread > 1e-4);
+}

@@ -392,6 +392,7 @@ class World {
         std::vector<std::uint32_t> slot_of, members; // particles grouped by table slot
         std::vector<glm::i64vec3> cell_of;           // each particle's collision cell
         std::vector<double> thin;                    // each particle's thinnest radius
+        std::vector<std::uint32_t> oversized;        // contacts: particles too wide for the grid
         std::vector<glm::dmat3> rest_moment;         // 0.2 m D R̄ᵀ, while the groups are current
         std::vector<glm::dvec3> push;
         std::vector<std::uint8_t> near;           // links near an obstacle (resolve_segments)
