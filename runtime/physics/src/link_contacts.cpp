@@ -82,7 +82,11 @@ void World::find_link_pairs() {
     // Broad phase: each link's box (its capsule's bounds) goes into every cell of a hashed grid it
     // touches; two links are a candidate where their boxes overlap, found once, in the cell that
     // holds the lower corner of the boxes' overlap. Cells are about a link long, and never
-    // smaller than a quarter of the largest box, so no link spans more than a few.
+    // smaller than a quarter of the largest box, so no link spans more than a few. A box over
+    // kOversized times a typical one (the median of at most 65 spread over the links; a grammar
+    // may give a segment a radius of up to 1e6 m) stays out of the grid, which it would make one
+    // cell, and is tested against every link instead; without one the cells are as before.
+    constexpr double kOversized = 64;
     const std::size_t n = x_.size();
     auto& sc = scratch_;
     auto& links = sc.link_list;
@@ -92,7 +96,6 @@ void World::find_link_pairs() {
     auto& hi = sc.box_hi;
     lo.resize(n);
     hi.resize(n);
-    double total = 0, largest = 0, widest = 0;
     for (std::uint32_t i = 0; i < n; ++i) {
         const std::uint32_t p = parent_[i];
         if (!alive_[i] || p == kNone) continue;
@@ -103,11 +106,52 @@ void World::find_link_pairs() {
         const glm::dvec3 e = hi[i] - lo[i];
         if (!std::isfinite(e.x + e.y + e.z)) continue; // a NaN never collides
         links.push_back(i);
-        total += glm::length(x_[i] - x_[p]);
-        largest = std::max({largest, e.x, e.y, e.z});
-        widest = std::max(widest, r);
     }
     if (links.size() < 2) return;
+    auto extent = [&](std::uint32_t i) {
+        const glm::dvec3 e = hi[i] - lo[i];
+        return std::max({e.x, e.y, e.z});
+    };
+    double sample[65];
+    std::size_t sampled = 0;
+    for (std::size_t k = 0; k < links.size() && sampled < 65;
+         k += std::max<std::size_t>(1, links.size() / 64))
+        sample[sampled++] = extent(links[k]);
+    std::nth_element(sample, sample + sampled / 2, sample + sampled);
+    const double limit = kOversized * sample[sampled / 2];
+    auto& big = sc.link_big;
+    big.clear();
+    double total = 0, largest = 0, widest = 0;
+    std::size_t kept = 0;
+    for (const std::uint32_t i : links) {
+        if (extent(i) > limit) {
+            big.push_back(i);
+            continue;
+        }
+        links[kept++] = i;
+        total += glm::length(x_[i] - x_[parent_[i]]);
+        largest = std::max(largest, extent(i));
+        widest = std::max(widest, 3 * sc.thin_of(i, radii_));
+    }
+    links.resize(kept);
+    const auto& plant = sc.plant;
+    auto overlap = [&](std::uint32_t a, std::uint32_t b) {
+        const glm::dvec3 low = glm::max(lo[a], lo[b]), high = glm::min(hi[a], hi[b]);
+        return !(low.x > high.x || low.y > high.y || low.z > high.z);
+    };
+    for (std::size_t u = 0; u < big.size(); ++u) { // each oversized link against every other
+        const std::uint32_t a = big[u];
+        auto consider = [&](std::uint32_t b) {
+            if (plant[a] != plant[b] && overlap(a, b))
+                sc.link_pairs.push_back({std::min(a, b), std::max(a, b)});
+        };
+        for (const std::uint32_t b : links) consider(b);
+        for (std::size_t v = u + 1; v < big.size(); ++v) consider(big[v]);
+    }
+    if (links.size() < 2) {
+        std::sort(sc.link_pairs.begin(), sc.link_pairs.end());
+        return;
+    }
     const double cell = std::max({total / static_cast<double>(links.size()) + 2 * widest, largest / 4, 1e-6});
     auto range = [&](std::uint32_t i, glm::i64vec3& a, glm::i64vec3& b) {
         for (int k = 0; k < 3; ++k) a[k] = far_floor(lo[i][k] / cell), b[k] = far_floor(hi[i][k] / cell);
@@ -150,7 +194,6 @@ void World::find_link_pairs() {
     members.resize(running);
     for (const std::uint32_t i : links)
         each_cell(i, [&](const glm::i64vec3& c) { members[table[slot_of(c)].fill++] = i; });
-    const auto& plant = sc.plant;
     for (const LinkCell& s : table) {
         for (std::uint32_t u = s.begin; u < s.begin + s.count; ++u)
             for (std::uint32_t v = u + 1; v < s.begin + s.count; ++v) {

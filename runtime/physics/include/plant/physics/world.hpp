@@ -412,6 +412,7 @@ class World {
         std::vector<std::uint32_t> link_list, link_members;
         std::vector<LinkCell> link_table;
         std::vector<std::pair<std::uint32_t, std::uint32_t>> link_pairs;
+        std::vector<std::uint32_t> link_big; // link contacts: boxes too large for the grid
 
         static double thin_of(std::uint32_t i, const std::vector<glm::dvec3>& radii) {
             return std::min({radii[i].x, radii[i].y, radii[i].z});
