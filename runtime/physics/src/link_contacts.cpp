@@ -60,6 +60,24 @@ constexpr double kStretch = 1.02;
 // sweeps over the pairs a step at most
 constexpr int kSweeps = 16;
 
+// Lists each oversized link (find_link_pairs) with every other link of another plant whose bounds
+// it meets.
+void pair_oversized(const std::vector<std::uint32_t>& big, const std::vector<std::uint32_t>& links,
+                    const std::vector<glm::dvec3>& lo, const std::vector<glm::dvec3>& hi,
+                    const std::vector<std::uint32_t>& plant,
+                    std::vector<std::pair<std::uint32_t, std::uint32_t>>& pairs) {
+    for (std::size_t u = 0; u < big.size(); ++u) {
+        const std::uint32_t a = big[u];
+        auto consider = [&](std::uint32_t b) {
+            const glm::dvec3 low = glm::max(lo[a], lo[b]), high = glm::min(hi[a], hi[b]);
+            if (plant[a] != plant[b] && !(low.x > high.x || low.y > high.y || low.z > high.z))
+                pairs.push_back({std::min(a, b), std::max(a, b)});
+        };
+        for (const std::uint32_t b : links) consider(b);
+        for (std::size_t v = u + 1; v < big.size(); ++v) consider(big[v]);
+    }
+}
+
 } // namespace
 
 void World::build_plants() {
@@ -135,19 +153,7 @@ void World::find_link_pairs() {
     }
     links.resize(kept);
     const auto& plant = sc.plant;
-    auto overlap = [&](std::uint32_t a, std::uint32_t b) {
-        const glm::dvec3 low = glm::max(lo[a], lo[b]), high = glm::min(hi[a], hi[b]);
-        return !(low.x > high.x || low.y > high.y || low.z > high.z);
-    };
-    for (std::size_t u = 0; u < big.size(); ++u) { // each oversized link against every other
-        const std::uint32_t a = big[u];
-        auto consider = [&](std::uint32_t b) {
-            if (plant[a] != plant[b] && overlap(a, b))
-                sc.link_pairs.push_back({std::min(a, b), std::max(a, b)});
-        };
-        for (const std::uint32_t b : links) consider(b);
-        for (std::size_t v = u + 1; v < big.size(); ++v) consider(big[v]);
-    }
+    pair_oversized(big, links, lo, hi, plant, sc.link_pairs);
     if (links.size() < 2) {
         std::sort(sc.link_pairs.begin(), sc.link_pairs.end());
         return;
