@@ -172,22 +172,15 @@ class Proximity : public Environment {
             dims_ = glm::ivec3(0);
             return;
         }
-        for (;;) {
-            glm::dvec3 n = glm::floor((hi - lo_) / cell_) + 1.0;
-            if (n.x * n.y * n.z <= 8e6) {
-                dims_ = glm::ivec3(n);
-                break;
-            }
-            cell_ *= 2;
-        }
-        const std::size_t cells = static_cast<std::size_t>(dims_.x) * dims_.y * dims_.z;
-        offsets_.assign(cells + 1, 0);
-        // the cells a segment passes through: the boxes of its pieces, each at most a cell long, so
-        // a long slanting segment is listed along its length, not in every cell of its bounding
-        // box (512 diagonals 141 m long in a grid of 1 m cells were 1.9 GB of entries and 23 s);
-        // a cell of the last piece's box is not listed again
+        // the cells a segment passes through: the boxes of its pieces, each at most a cell across
+        // on every axis, so a long slanting segment is listed along its length, not in every cell
+        // of its bounding box (512 diagonals 141 m long in a grid of 1 m cells were 1.9 GB of
+        // entries and 23 s); a cell of the last piece's box is not listed again. The pieces are
+        // counted from the largest of the segment's spans along the axes, which unlike its length
+        // cannot overflow for a segment inside the (finite) box.
         auto each_cell = [&](const Segment& s, auto&& f) {
-            const double pieces_wanted = std::ceil(glm::length(s.b - s.a) / cell_);
+            const glm::dvec3 span = glm::abs(s.b - s.a);
+            const double pieces_wanted = std::ceil(std::max({span.x, span.y, span.z}) / cell_);
             const std::size_t pieces =
                 pieces_wanted >= 1 && pieces_wanted < 1e9 ? static_cast<std::size_t>(pieces_wanted) : 1;
             glm::ivec3 last_a(1), last_b(0); // empty
@@ -208,7 +201,22 @@ class Proximity : public Environment {
                 last_a = a, last_b = b;
             }
         };
-        for (const auto& s : segments_) each_cell(s, [&](std::size_t c) { ++offsets_[c + 1]; });
+        // the grid: at most 8 million cells and 2^28 entries (cells twice as wide until both hold)
+        std::size_t cells = 0;
+        for (;;) {
+            glm::dvec3 n = glm::floor((hi - lo_) / cell_) + 1.0;
+            if (n.x * n.y * n.z > 8e6) {
+                cell_ *= 2;
+                continue;
+            }
+            dims_ = glm::ivec3(n);
+            cells = static_cast<std::size_t>(dims_.x) * dims_.y * dims_.z;
+            offsets_.assign(cells + 1, 0);
+            std::size_t total = 0;
+            for (const auto& s : segments_) each_cell(s, [&](std::size_t c) { ++offsets_[c + 1], ++total; });
+            if (total <= kMaxEntries) break;
+            cell_ *= 2;
+        }
         for (std::size_t c = 0; c < cells; ++c) offsets_[c + 1] += offsets_[c];
         entries_.assign(offsets_[cells], 0);
         std::vector<std::uint32_t> fill(offsets_.begin(), offsets_.end() - 1);
@@ -305,6 +313,7 @@ class Proximity : public Environment {
     glm::dvec3 lo_{0.0};
     glm::ivec3 dims_{0};
     std::vector<Segment> segments_;
+    static constexpr std::size_t kMaxEntries = std::size_t{1} << 28;
     std::vector<std::uint32_t> offsets_, entries_;
     std::unordered_map<ModuleId, int> axis_of_;
     std::vector<glm::dvec3> base_;   // where each axis starts

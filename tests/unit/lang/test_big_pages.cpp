@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include <cstdint>
+#include <memory>
 
 using namespace plant;
 
@@ -72,6 +73,26 @@ TEST_CASE("blocks of 64 KiB to 1 MiB share 2 MiB pages as buddies and give the p
         }
     }
     // every part freed: the buddies merged back into whole pages, kept for later blocks
+    CHECK(big_pages::shared_free_bytes() == 0);
+    CHECK(big_pages::kept_bytes() == 2 * page);
+    {
+        // freed the other way round (the lower buddy first), and a 64 KiB part split from a
+        // larger free one: merged all the same, and charged as the parts they are
+        const auto charged = memory::charged();
+        auto a = std::make_unique<BigVector<std::uint8_t>>(64 * kib);
+        auto b = std::make_unique<BigVector<std::uint8_t>>(64 * kib);
+        auto c = std::make_unique<BigVector<std::uint8_t>>(300 * kib);
+        CHECK(memory::charged() == charged + 64 * kib + 64 * kib + 512 * kib);
+        CHECK(page_of(a->data()) == page_of(c->data()));
+        CHECK(reinterpret_cast<std::uintptr_t>(b->data()) ==
+              (reinterpret_cast<std::uintptr_t>(a->data()) ^ (64 * kib)));
+        CHECK(big_pages::kept_bytes() == page); // one of the two kept pages taken
+        a.reset();
+        CHECK(big_pages::shared_free_bytes() == page - 64 * kib - 512 * kib);
+        b.reset();
+        c.reset();
+        CHECK(memory::charged() == charged);
+    }
     CHECK(big_pages::shared_free_bytes() == 0);
     CHECK(big_pages::kept_bytes() == 2 * page);
     big_pages::trim();

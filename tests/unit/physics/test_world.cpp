@@ -543,6 +543,20 @@ TEST_CASE("collisions: a particle far wider than the rest is tested against each
     std::size_t differ = 0;
     for (std::size_t k = 0; k < alone.size(); ++k) differ += alone[k] != beside[k];
     CHECK(differ == 0);
+    {
+        // one that overlaps lone particles pushes them out and is pushed back (from both sides,
+        // outside the grid)
+        World w(s);
+        std::vector<Handle> lone;
+        for (int k = 0; k < 64; ++k)
+            lone.push_back(w.add_root({0.01 * k, 0, 0}, up, glm::dvec3(0.005), false));
+        const Handle wide = w.add_root({0.3, 0.5, 0}, up, glm::dvec3(0.5), false);
+        w.step();
+        CHECK(w.position(lone[30]).y < -0.001);                             // under it: pushed down
+        CHECK(w.position(lone[0]) == glm::dvec3(0, 0, 0));                  // beyond its reach
+        CHECK(w.position(wide).y > 0.5 + 0.001);                            // and it goes up
+        CHECK(glm::distance(w.position(lone[30]), w.position(wide)) > 0.5); // apart, or nearly
+    }
     // and the crowd's own contacts act: the plants push each other apart
     double spread = 0;
     for (std::size_t k = 0; k < alone.size(); k += 6)

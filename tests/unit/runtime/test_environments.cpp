@@ -79,6 +79,34 @@ TEST_CASE("proximity: distance to other stems, the asking stem and its branching
     CHECK(ask(*env, 0, {10, 10, 0, 0}) == Approx(1.5));
 }
 
+TEST_CASE("proximity: a long slanting stem is found all along it", "[environments]") {
+    // a branch 40 long, slanting on all three axes, through a grid of cells half a unit wide: it
+    // is listed in the cells along it (not its whole bounding box), so a point beside any part of
+    // it finds it
+    auto c = test::compile("module S(x); axiom: S(1) F [ &(35) +(50) F(40) ] F;");
+    REQUIRE(c->program);
+    Derivation d(*c->program, {});
+    d.run();
+    Skeleton sk = build_skeleton(*c->program, d.string(), TurtleOptions{});
+    REQUIRE(sk.axes.size() == 2);
+    REQUIRE(sk.axes[1].points.size() == 2);
+    auto env = make("proximity", {num_arg("radius", 0.5)});
+    env->see(sk);
+    const glm::dvec3 a = sk.axes[1].points[0].position, b = sk.axes[1].points[1].position;
+    const glm::dvec3 along = glm::normalize(b - a);
+    REQUIRE(std::fabs(along.x) > 0.1);
+    REQUIRE(std::fabs(along.y) > 0.1);
+    REQUIRE(std::fabs(along.z) > 0.1);
+    const glm::dvec3 across = glm::normalize(glm::cross(along, glm::dvec3(0, 1, 0)));
+    const ModuleId main_module = sk.axes[0].points[1].id; // the branch is another stem for it
+    int found = 0;
+    for (int k = 1; k < 40; ++k) {
+        const glm::dvec3 p = a + (b - a) * (k / 40.0) + across * 0.3;
+        found += ask(*env, 0, {p.x, p.y, p.z, double(main_module)}) == Approx(0.3);
+    }
+    CHECK(found == 39);
+}
+
 TEST_CASE("proximity: clearance of a stem from older stems only", "[environments]") {
     // main stem (0,0)-(0,4); branch A from (0,1) and branch B from (0,1.5), both to x = -2
     auto c = test::compile("axiom: F [ +(90) F(2) ] F(0.5) [ +(90) F(2) ] F(2.5);");
