@@ -203,8 +203,13 @@ class Proximity : public Environment {
         };
         // the grid: at most 8 million cells and 2^28 entries (cells twice as wide until both hold)
         std::size_t cells = 0;
+        const glm::dvec3 extent = hi - lo_;
+        // a box too large for a double's range (stems near +-1e308): one cell, a table of every
+        // segment
+        if (!std::isfinite(extent.x + extent.y + extent.z)) cell_ = std::numeric_limits<double>::max();
         for (;;) {
-            glm::dvec3 n = glm::floor((hi - lo_) / cell_) + 1.0;
+            glm::dvec3 n = glm::floor(extent / cell_) + 1.0;
+            if (!std::isfinite(extent.x + extent.y + extent.z)) n = glm::dvec3(1.0);
             if (n.x * n.y * n.z > 8e6) {
                 cell_ *= 2;
                 continue;
@@ -214,7 +219,7 @@ class Proximity : public Environment {
             offsets_.assign(cells + 1, 0);
             std::size_t total = 0;
             for (const auto& s : segments_) each_cell(s, [&](std::size_t c) { ++offsets_[c + 1], ++total; });
-            if (total <= kMaxEntries) break;
+            if (total <= kMaxEntries || cells == 1) break;
             cell_ *= 2;
         }
         for (std::size_t c = 0; c < cells; ++c) offsets_[c + 1] += offsets_[c];
