@@ -23,6 +23,16 @@ namespace plant {
 
 namespace {
 
+// floor(u) as an int clamped to [lo, hi], NaN to lo: a grid's cell for a point that may lie far
+// outside it (converting a double beyond int's range is undefined)
+int cell_coordinate(double u, int lo, int hi) {
+    const double f = std::floor(u);
+    return f >= lo ? (f <= hi ? static_cast<int>(f) : hi) : lo;
+}
+glm::ivec3 cell_of(const glm::dvec3& u, int lo, const glm::ivec3& hi) {
+    return {cell_coordinate(u.x, lo, hi.x), cell_coordinate(u.y, lo, hi.y), cell_coordinate(u.z, lo, hi.z)};
+}
+
 constexpr ValueType N = ValueType::Number;
 constexpr ValueType V = ValueType::Vec3;
 constexpr ValueType B = ValueType::Bool;
@@ -303,9 +313,8 @@ class Proximity : public Environment {
         return glm::dot(q, q);
     }
     glm::ivec3 cell(const glm::dvec3& p) const {
-        glm::dvec3 c = glm::floor((p - lo_) / cell_);
         // points outside the box map to just outside the grid, which the loops clip
-        return glm::ivec3(glm::clamp(c, glm::dvec3(-2.0), glm::dvec3(dims_) + 1.0));
+        return cell_of((p - lo_) / cell_, -2, dims_ + 1);
     }
     std::size_t index(int x, int y, int z) const {
         return (static_cast<std::size_t>(z) * static_cast<std::size_t>(dims_.y) +
@@ -472,7 +481,12 @@ class Light : public Environment {
         for (const auto& a : sk.axes)
             for (std::size_t k = 1; k < a.points.size(); ++k) {
                 glm::dvec3 from = a.points[k - 1].position, to = a.points[k].position;
-                int n = std::max(1, static_cast<int>(std::ceil(glm::length(to - from) / (cell_ * 0.5))));
+                // half a cell a sample; a segment inside the box is at most 2 sqrt(3) res samples long,
+                // so the cap only bounds a length that overflowed (stems near +-1e308)
+                const double samples = std::ceil(glm::length(to - from) / (cell_ * 0.5));
+                const int n = !(samples > 1)             ? 1
+                              : samples < 4.0 * res_ + 4 ? static_cast<int>(samples)
+                                                         : 4 * res_ + 4;
                 for (int j = 0; j <= n; ++j) mark(from + (to - from) * (double(j) / n));
             }
         for (const auto& o : sk.organs) mark(glm::dvec3(o.transform[3]));
@@ -493,7 +507,10 @@ class Light : public Environment {
     bool inside(const glm::ivec3& c) const {
         return c.x >= 0 && c.y >= 0 && c.z >= 0 && c.x < res_ && c.y < res_ && c.z < res_;
     }
-    glm::ivec3 cell(const glm::dvec3& p) const { return glm::ivec3(glm::floor((p - lo_) / cell_)); }
+    // (a point far outside the box maps to just outside it)
+    glm::ivec3 cell(const glm::dvec3& p) const {
+        return cell_of((p - lo_) / cell_, -2, glm::ivec3(res_ + 1));
+    }
     std::size_t index(const glm::ivec3& c) const {
         return (static_cast<std::size_t>(c.z) * res_ + static_cast<std::size_t>(c.y)) * res_ +
                static_cast<std::size_t>(c.x);
