@@ -58,9 +58,14 @@ bool take_free(int k, char* p) {
     return true;
 }
 
-void give_free(int k, char* p) {
-    free_parts[k].push_back(p);
-    free_parts_total += kShareFrom << k;
+// (map_shared makes room first; when freeing, a list that cannot grow loses the part until exit
+// rather than end the program from a destructor)
+void give_free(int k, char* p) noexcept {
+    try {
+        free_parts[k].push_back(p);
+        free_parts_total += kShareFrom << k;
+    } catch (...) {
+    }
 }
 
 void* map_locked(std::size_t bytes);
@@ -95,6 +100,12 @@ void unmap(void* p, std::size_t bytes) {
 void* map_shared(std::size_t bytes) {
     std::lock_guard<std::mutex> guard(lock);
     const int want = size_class(bytes);
+    try { // room for the halves split off below: one part of each size at most
+        for (auto& list : free_parts)
+            if (list.capacity() == list.size()) list.reserve(2 * list.size() + 8);
+    } catch (...) {
+        return nullptr;
+    }
     // the smallest free part that is large enough, halved down to the size asked for; the upper
     // halves stay free
     int k = want;
