@@ -52,6 +52,20 @@ bool holds(Op op, double x, double y) {
     return next;
 }
 
+// Per kind, the outcome of copying a module of it when its symbol has no productions, else
+// kNoCopy: write_direct reads a run of copied modules with one table load a module (the kind's)
+// instead of three for its symbol (the symbol, whether it has productions, its copy's outcome).
+constexpr std::uint32_t kNoCopy = ~std::uint32_t{0};
+const std::uint32_t* copy_outcomes(const RulePlan& plan, const SymbolReader& reader, std::size_t kinds,
+                                   std::vector<std::uint32_t>& out) {
+    out.resize(kinds);
+    for (std::size_t k = 0; k < kinds; ++k) {
+        const SymbolId s = k < reader.plain ? static_cast<SymbolId>(k) : reader.table[k - reader.plain];
+        out[k] = plan.has_prod[s] ? kNoCopy : plan.outcome_at[s];
+    }
+    return out.data();
+}
+
 } // namespace
 
 // The first production whose condition holds applies; when it is weighted, every weighted
@@ -172,6 +186,7 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
     std::size_t next_check = b + kSnapEvery;
     const std::size_t outcomes = plan.outcome_tmpl.size();
     w.snaps.clear();
+    const std::uint32_t* copy_of = copy_outcomes(plan, reader, in.kind_table->stored.size(), w.copy_outcome);
     // the next module that starts a block (ModuleString::block_at), as a position in `out`
     constexpr std::size_t B = ModuleString::kBlock;
     std::size_t next_block = (m_at + B - 1) & ~(B - 1);
@@ -203,14 +218,14 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
             }
         }
         if (!prp) { // a run of modules without productions (or none that applies): copy it
+            ++tally[at[s]];
+            std::uint32_t np = stored_of[reader.kinds[i]];
             std::size_t j = i + 1;
-            while (j < e && !plan.has_prod[sym_of(j)]) ++j;
-            const std::size_t n = j - i;
-            std::uint32_t np = 0;
-            for (std::size_t k = i; k < j; ++k) {
-                ++tally[at[sym_of(k)]];
-                np += stored_of[reader.kinds[k]];
+            for (std::uint32_t o; j < e && (o = copy_of[reader.kinds[j]]) != kNoCopy; ++j) {
+                ++tally[o];
+                np += stored_of[reader.kinds[j]];
             }
+            const std::size_t n = j - i;
             if (n <= 8 && np <= 8) {
                 // the usual run between two rewritten modules is a few turtle symbols: plain
                 // loops beat three library calls

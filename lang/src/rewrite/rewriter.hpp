@@ -41,6 +41,8 @@ struct Worker {
     // write_direct's snapshots, one every kSnapEvery modules read: where the output stood
     // (modules written so far), then the tally of every outcome so far (Engine::counts).
     std::vector<std::uint64_t> snaps;
+    // write_direct's outcome of copying each kind (kNoCopy where its symbol has productions)
+    std::vector<std::uint32_t> copy_outcome;
 };
 
 class Rewriter {
