@@ -58,11 +58,15 @@ bool holds(Op op, double x, double y) {
 constexpr std::uint32_t kNoCopy = ~std::uint32_t{0};
 const std::uint32_t* copy_outcomes(const RulePlan& plan, const SymbolReader& reader, std::size_t kinds,
                                    std::vector<std::uint32_t>& out) {
-    out.resize(kinds);
-    for (std::size_t k = 0; k < kinds; ++k) {
-        const SymbolId s = k < reader.plain ? static_cast<SymbolId>(k) : reader.table[k - reader.plain];
-        out[k] = plan.has_prod[s] ? kNoCopy : plan.outcome_at[s];
-    }
+    // (a symbol past the plan's cannot be in the string: the kinds of a string made without a
+    // program, 0x8000 plain ones, are left at kNoCopy past the plan's symbols)
+    const std::size_t symbols = plan.has_prod.size();
+    out.assign(kinds, kNoCopy);
+    for (std::size_t k = 0; k < std::min<std::size_t>(reader.plain, symbols); ++k)
+        out[k] = plan.has_prod[k] ? kNoCopy : plan.outcome_at[k];
+    for (std::size_t k = reader.plain; k < kinds; ++k)
+        if (const SymbolId s = reader.table[k - reader.plain]; s < symbols)
+            out[k] = plan.has_prod[s] ? kNoCopy : plan.outcome_at[s];
     return out.data();
 }
 
