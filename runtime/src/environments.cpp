@@ -3,6 +3,8 @@
 // and planes).
 #include "plant/environments.hpp"
 
+#include "plant/grid_cell.hpp"
+
 #include "plant/climber.hpp"
 #include "plant/silhouette.hpp"
 
@@ -23,14 +25,9 @@ namespace plant {
 
 namespace {
 
-// floor(u) as an int clamped to [lo, hi], NaN to lo: a grid's cell for a point that may lie far
-// outside it (converting a double beyond int's range is undefined)
-int cell_coordinate(double u, int lo, int hi) {
-    const double f = std::floor(u);
-    return f >= lo ? (f <= hi ? static_cast<int>(f) : hi) : lo;
-}
+// a grid's cell for a point that may lie far outside it (cell_index, plant/grid_cell.hpp)
 glm::ivec3 cell_of(const glm::dvec3& u, int lo, const glm::ivec3& hi) {
-    return {cell_coordinate(u.x, lo, hi.x), cell_coordinate(u.y, lo, hi.y), cell_coordinate(u.z, lo, hi.z)};
+    return {cell_index(u.x, lo, hi.x), cell_index(u.y, lo, hi.y), cell_index(u.z, lo, hi.z)};
 }
 
 constexpr ValueType N = ValueType::Number;
@@ -216,10 +213,10 @@ class Proximity : public Environment {
         const glm::dvec3 extent = hi - lo_;
         // a box too large for a double's range (stems near +-1e308): one cell, a table of every
         // segment
-        if (!std::isfinite(extent.x + extent.y + extent.z)) cell_ = std::numeric_limits<double>::max();
+        const bool overflows = !std::isfinite(extent.x + extent.y + extent.z);
+        if (overflows) cell_ = std::numeric_limits<double>::max();
         for (;;) {
-            glm::dvec3 n = glm::floor(extent / cell_) + 1.0;
-            if (!std::isfinite(extent.x + extent.y + extent.z)) n = glm::dvec3(1.0);
+            const glm::dvec3 n = overflows ? glm::dvec3(1.0) : glm::floor(extent / cell_) + 1.0;
             if (n.x * n.y * n.z > 8e6) {
                 cell_ *= 2;
                 continue;

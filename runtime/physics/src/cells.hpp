@@ -1,9 +1,13 @@
 // Grid cells of positions that may be far away or not a number (internal to plant_physics).
 #pragma once
 
+#include "plant/grid_cell.hpp"
+
 #include <glm/glm.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 
 namespace plant::physics {
@@ -12,13 +16,7 @@ inline bool finite(const glm::dvec3& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
-// floor(u) as an int, clamped to [lo, hi]. The clamp happens before the conversion, so a
-// particle blown far away cannot overflow it (converting a double beyond int's range is
-// undefined); NaN goes to lo. Within the range this is exactly clamp(int(floor(u)), lo, hi).
-inline int cell_index(double u, int lo, int hi) {
-    const double f = std::floor(u);
-    return f >= lo ? (f <= hi ? static_cast<int>(f) : hi) : lo;
-}
+using plant::cell_index; // (plant/grid_cell.hpp) floor(u) as an int clamped to [lo, hi], NaN to lo
 
 inline glm::ivec3 cell_index(const glm::dvec3& u, const glm::ivec3& lo, const glm::ivec3& hi) {
     return glm::ivec3(cell_index(u.x, lo.x, hi.x), cell_index(u.y, lo.y, hi.y), cell_index(u.z, lo.z, hi.z));
@@ -50,5 +48,27 @@ inline std::uint64_t cell_term_z(std::int64_t z) {
 inline std::uint64_t cell_hash(const glm::i64vec3& c) {
     return cell_term_x(c.x) ^ cell_term_y(c.y) ^ cell_term_z(c.z);
 }
+
+// The size past which an element stays out of a hashed grid whose cells are sized from the
+// largest one (docs/physics.md, "Plant-plant collision"): 64 times a typical size, the median of
+// at most 65 of `count` elements offered in order, every (count / 64)-th from the first. A grammar
+// may give a segment a radius of up to 1e6 m; one such element would make the grid one cell.
+class OversizedLimit {
+  public:
+    explicit OversizedLimit(std::size_t count) : stride_(count / 64 > 1 ? count / 64 : 1) {}
+    void offer(double size) {
+        if (seen_++ % stride_ == 0 && sampled_ < 65) sample_[sampled_++] = size;
+    }
+    // +infinity when nothing was offered
+    double limit() {
+        if (sampled_ == 0) return HUGE_VAL;
+        std::nth_element(sample_, sample_ + sampled_ / 2, sample_ + sampled_);
+        return 64 * sample_[sampled_ / 2];
+    }
+
+  private:
+    std::size_t stride_, seen_ = 0, sampled_ = 0;
+    double sample_[65];
+};
 
 } // namespace plant::physics

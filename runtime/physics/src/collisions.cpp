@@ -77,12 +77,11 @@ void World::integrate() {
 // The grid's cells are sized from the widest contact, so one particle far wider than the rest (a
 // grammar may give a segment any radius up to 1e6 m) would put every particle in one cell and
 // make each step quadratic: one such segment 40 m from 60 plants took a run from 3 s to 229 s.
-// A particle whose thinnest radius is over kOversized times a typical one (the median of at most
-// 65 live particles spread evenly over them) stays out of the grid: it is tested against every
-// particle, and every particle against it, after its grid partners. Without such a particle the
-// cells and the order of the sums are as before.
+// A particle whose thinnest radius is over 64 times a typical one (OversizedLimit, cells.hpp: the
+// median of at most 65 live particles spread evenly over them) stays out of the grid: it is tested against
+// every particle, and every particle against it, after its grid partners. Without such a particle the cells
+// and the order of the sums are as before.
 void World::separate_particles() {
-    constexpr double kOversized = 64;
     const std::size_t n = x_.size();
     auto& thin = scratch_.thin;
     thin.assign(n, 0.0);
@@ -93,15 +92,12 @@ void World::separate_particles() {
             ++live;
         }
     if (live == 0 || n < 2) return;
-    // the sample: every stride-th live particle (slots of removed ones are not reused, so the live
-    // ones may be a few anywhere among the indices)
-    double sample[65];
-    std::size_t sampled = 0;
-    const std::size_t stride = std::max<std::size_t>(1, live / 64);
-    for (std::size_t i = 0, seen = 0; i < n && sampled < 65; ++i)
-        if (alive_[i] && seen++ % stride == 0) sample[sampled++] = thin[i];
-    std::nth_element(sample, sample + sampled / 2, sample + sampled);
-    const double limit = kOversized * sample[sampled / 2];
+    // sampled over the live particles (slots of removed ones are not reused, so the live ones may
+    // be a few anywhere among the indices)
+    OversizedLimit oversized_at(live);
+    for (std::size_t i = 0; i < n; ++i)
+        if (alive_[i]) oversized_at.offer(thin[i]);
+    const double limit = oversized_at.limit();
     auto& oversized = scratch_.oversized;
     oversized.clear();
     double reach = 0;

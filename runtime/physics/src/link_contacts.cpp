@@ -100,11 +100,9 @@ void World::find_link_pairs() {
     // Broad phase: each link's box (its capsule's bounds) goes into every cell of a hashed grid it
     // touches; two links are a candidate where their boxes overlap, found once, in the cell that
     // holds the lower corner of the boxes' overlap. Cells are about a link long, and never
-    // smaller than a quarter of the largest box, so no link spans more than a few. A box over
-    // kOversized times a typical one (the median of at most 65 spread over the links; a grammar
-    // may give a segment a radius of up to 1e6 m) stays out of the grid, which it would make one
-    // cell, and is tested against every link instead; without one the cells are as before.
-    constexpr double kOversized = 64;
+    // smaller than a quarter of the largest box, so no link spans more than a few. A box over 64
+    // times a typical one (OversizedLimit, cells.hpp) stays out of the grid, which it would make
+    // one cell, and is tested against every link instead; without one the cells are as before.
     const std::size_t n = x_.size();
     auto& sc = scratch_;
     auto& links = sc.link_list;
@@ -130,25 +128,22 @@ void World::find_link_pairs() {
         const glm::dvec3 e = hi[i] - lo[i];
         return std::max({e.x, e.y, e.z});
     };
-    double sample[65];
-    std::size_t sampled = 0;
-    for (std::size_t k = 0; k < links.size() && sampled < 65;
-         k += std::max<std::size_t>(1, links.size() / 64))
-        sample[sampled++] = extent(links[k]);
-    std::nth_element(sample, sample + sampled / 2, sample + sampled);
-    const double limit = kOversized * sample[sampled / 2];
+    OversizedLimit oversized_at(links.size());
+    for (const std::uint32_t i : links) oversized_at.offer(extent(i));
+    const double limit = oversized_at.limit();
     auto& big = sc.link_big;
     big.clear();
     double total = 0, largest = 0, widest = 0;
     std::size_t kept = 0;
     for (const std::uint32_t i : links) {
-        if (extent(i) > limit) {
+        const double size = extent(i);
+        if (size > limit) {
             big.push_back(i);
             continue;
         }
         links[kept++] = i;
         total += glm::length(x_[i] - x_[parent_[i]]);
-        largest = std::max(largest, extent(i));
+        largest = std::max(largest, size);
         widest = std::max(widest, 3 * sc.thin_of(i, radii_));
     }
     links.resize(kept);

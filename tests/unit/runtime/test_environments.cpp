@@ -37,6 +37,15 @@ double ask(const Environment& e, std::size_t method, std::vector<double> args) {
     return r[0];
 }
 
+// The skeleton of `source`'s derivation.
+Skeleton skeleton_of(const std::string& source) {
+    auto c = test::compile(source);
+    REQUIRE(c->program);
+    Derivation d(*c->program, {});
+    d.run();
+    return build_skeleton(*c->program, d.string(), TurtleOptions{});
+}
+
 } // namespace
 
 TEST_CASE("ellipsoid: containment, scaled containment, level", "[environments]") {
@@ -55,11 +64,7 @@ TEST_CASE("ellipsoid: containment, scaled containment, level", "[environments]")
 
 TEST_CASE("proximity: distance to other stems, the asking stem and its branching point excluded",
           "[environments]") {
-    auto c = test::compile("module S(x); axiom: S(1) F F [ +(90) S(2) F F ] F;");
-    REQUIRE(c->program);
-    Derivation d(*c->program, {});
-    d.run();
-    Skeleton sk = build_skeleton(*c->program, d.string(), TurtleOptions{});
+    const Skeleton sk = skeleton_of("module S(x); axiom: S(1) F F [ +(90) S(2) F F ] F;");
     REQUIRE(sk.axes.size() == 2);
     auto env = make("proximity", {num_arg("radius", 1.5)});
     Environment* prox = env.get();
@@ -83,11 +88,7 @@ TEST_CASE("proximity: a long slanting stem is found all along it", "[environment
     // a branch 40 long, slanting on all three axes, through a grid of cells half a unit wide: it
     // is listed in the cells along it (not its whole bounding box), so a point beside any part of
     // it finds it
-    auto c = test::compile("module S(x); axiom: S(1) F [ &(35) +(50) F(40) ] F;");
-    REQUIRE(c->program);
-    Derivation d(*c->program, {});
-    d.run();
-    Skeleton sk = build_skeleton(*c->program, d.string(), TurtleOptions{});
+    const Skeleton sk = skeleton_of("module S(x); axiom: S(1) F [ &(35) +(50) F(40) ] F;");
     REQUIRE(sk.axes.size() == 2);
     REQUIRE(sk.axes[1].points.size() == 2);
     auto env = make("proximity", {num_arg("radius", 0.5)});
@@ -109,11 +110,7 @@ TEST_CASE("proximity: a long slanting stem is found all along it", "[environment
 
 TEST_CASE("proximity: clearance of a stem from older stems only", "[environments]") {
     // main stem (0,0)-(0,4); branch A from (0,1) and branch B from (0,1.5), both to x = -2
-    auto c = test::compile("axiom: F [ +(90) F(2) ] F(0.5) [ +(90) F(2) ] F(2.5);");
-    REQUIRE(c->program);
-    Derivation d(*c->program, {});
-    d.run();
-    Skeleton sk = build_skeleton(*c->program, d.string(), TurtleOptions{});
+    const Skeleton sk = skeleton_of("axiom: F [ +(90) F(2) ] F(0.5) [ +(90) F(2) ] F(2.5);");
     REQUIRE(sk.axes.size() == 3);
     auto env = make("proximity", {num_arg("radius", 1.5)});
     env->see(sk);
@@ -168,13 +165,9 @@ TEST_CASE("envelope: Cescatti's crown, asymmetric sides and shape coefficients",
 
 TEST_CASE("light: exposure falls behind occupied cells toward the light", "[environments]") {
     // a horizontal layer of branches at y = 5 over a stem; light from above
-    auto c = test::compile(R"(
+    const Skeleton sk = skeleton_of(R"(
         axiom: F(5) [ +(90) F(2) ] [ -(90) F(2) ] [ &(90) F(2) ] [ ^(90) F(2) ] F(5);
     )");
-    REQUIRE(c->program);
-    Derivation d(*c->program, {});
-    d.run();
-    Skeleton sk = build_skeleton(*c->program, d.string(), TurtleOptions{});
     auto env =
         make("light", {vec_arg("direction", 0, 1, 0), num_arg("resolution", 10), num_arg("opacity", 0.5)});
     env->see(sk);
