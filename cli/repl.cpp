@@ -318,9 +318,11 @@ void Session::stats() {
     const ModuleString& s = current().string();
     std::map<SymbolId, std::size_t> counts;
     int depth = 0, max_depth = 0;
+    std::size_t numbers = 0; // the modules' parameters (a constant one is stored with its kind)
     for (std::size_t i = 0; i < s.size(); ++i) {
         const SymbolId x = s.symbol(i);
         ++counts[x];
+        numbers += s.arity(i);
         if (x == program_->symbols.open_bracket) max_depth = std::max(max_depth, ++depth);
         if (x == program_->symbols.close_bracket) --depth;
     }
@@ -329,7 +331,7 @@ void Session::stats() {
     std::sort(sorted.begin(), sorted.end(),
               [](auto a, auto b) { return a.first != b.first ? a.first > b.first : a.second < b.second; });
     out_ << fmt::format("step {}, {} modules, {} parameters, branch depth {}, last step {:.3f} ms\n",
-                        current().steps_done(), s.size(), s.params.size(), max_depth, last_step_ms_);
+                        current().steps_done(), s.size(), numbers, max_depth, last_step_ms_);
     for (std::size_t k = 0; k < sorted.size() && k < 20; ++k)
         out_ << fmt::format("  {:<10} {}\n", program_->symbols[sorted[k].second].name, sorted[k].first);
 }

@@ -280,6 +280,10 @@ ValueType Compiler::compile_name(Ctx& c, const ast::Expr& e) {
     if (it != P_.global_index.end()) {
         const Global& g = P_.globals[it->second];
         if (compile_time_ && placement_params_.count(e.text)) placement_param_used(e.text, e.span);
+        if (folded_param(g)) { // its value, as a const's (see find_assigned_params)
+            for (int k = 0; k < value_width(g.type); ++k) emit_const(c, P_.global_values[g.slot + k], e.span);
+            return g.type;
+        }
         emit(c, Op::LoadGlobal, static_cast<std::int32_t>(g.slot), value_width(g.type), e.span);
         return g.type;
     }

@@ -121,6 +121,19 @@ bool Compiler::builtin_param(const std::string& name) {
     return true;
 }
 
+// A param read as a constant in the code compile_stages compiles: one no hook of this program
+// assigns (find_assigned_params), whose value is neither set per placement (an instance's own
+// params) nor read by the runtime from outside the code (view_depth, max_view_depth). Its value
+// cannot change during a derivation, so folding it changes no result; it lets the rewriting
+// engine treat `l * r1` or `&(a1)` as it treats `l * 0.9` or `&(5)` (docs/design.md).
+bool Compiler::folded_param(const Global& g) const {
+    if (!fold_params_ || compile_time_ || g.kind != GlobalKind::Param) return false;
+    if (placement_params_.count(g.name) || assigned_params_.count(g.name)) return false;
+    for (const BuiltinParam& b : kBuiltinParams)
+        if (g.name == b.name) return false;
+    return true;
+}
+
 // An instance's module takes its params, or its params and one more number: the placement scale.
 bool Compiler::instance_arity_ok(const SymbolInfo& info, std::size_t nargs) const {
     return info.instance >= 0 && static_cast<int>(nargs) == info.arity + 1;

@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 
+#include <functional>
+
 namespace plant {
 
 void Compiler::compile_block(Ctx& c, const std::vector<ast::Stmt>& body) {
@@ -255,6 +257,21 @@ void Compiler::compile_hooks(const ast::File& f) {
 }
 
 // Each hook's bodies, from every file in load order, become one piece of code.
+// The names assigned anywhere in this program's hooks (the only code that may assign a param or
+// var), nested blocks included; a name assigned as a local counts too, which only keeps a param
+// from being folded (folded_param).
+void Compiler::find_assigned_params() {
+    std::function<void(const std::vector<ast::Stmt>&)> scan = [&](const std::vector<ast::Stmt>& body) {
+        for (const ast::Stmt& s : body) {
+            if (s.kind == ast::StmtKind::Assign) assigned_params_.insert(s.name);
+            scan(s.body);
+            scan(s.else_body);
+        }
+    };
+    for (const auto& lf : order_)
+        for (const ast::Hook& h : lf.file->hooks) scan(h.body);
+}
+
 void Compiler::compile_hook_bodies() {
     for (int k = 0; k < 4; ++k) {
         if (hook_bodies_[k].empty()) continue;

@@ -103,6 +103,8 @@ std::unique_ptr<Program> Compiler::compile(std::uint32_t main_file) {
 
 // Shapes, functions, instance bodies, settings, rules and hooks, in the order data flows.
 void Compiler::compile_stages() {
+    find_assigned_params();
+    fold_params_ = true; // every param now has its final value (after -D and import overrides)
     for (const ast::ShapeDecl* s : curve_decls_) compile_curve(*s); // before the code that calls them
     compile_graph();                                                // before the code that reads it
     for (const ast::ShapeDecl* s : env_decls_) compile_environment(*s);

@@ -126,6 +126,8 @@ class Compiler {
     void declare_instances(const ast::File& f);
     void declare_builtin_params();
     bool builtin_param(const std::string& name);
+    void find_assigned_params();
+    bool folded_param(const Global& g) const;
     void inherit(const Compiler& parent, const ast::InstanceDecl& decl);
     void compile_instances();
     void check_instance_graph();
@@ -249,6 +251,11 @@ class Compiler {
     std::map<std::string, std::string> enclosing_params_;
     std::set<std::string> outer_vars_;
     const char* compile_time_ = nullptr; // while eval_const runs: what it evaluates
+    // Params that no hook assigns keep the value they were compiled with for the whole run, so
+    // the code compiled in compile_stages reads them as constants (folded_param): the names some
+    // hook of this program assigns, and whether the stages have begun.
+    std::set<std::string> assigned_params_;
+    bool fold_params_ = false;
     std::size_t inherited_surfaces_ = 0; // surfaces of the outer program, which a body may replace
     std::set<std::string> body_surfaces_;
     std::size_t inherited_functions_ = 0; // the outer program's, compiled only when called

@@ -500,3 +500,40 @@ TEST_CASE("identities are kept when the program reads them, whatever the options
     e.run();
     CHECK(format_string(*c->program, d.string(), true) == format_string(*c->program, e.string(), true));
 }
+
+TEST_CASE("a param no hook assigns is compiled as a constant, one a hook assigns is read as it changes",
+          "[derive][params]") {
+    // the successor's numbers of A(x * r) are the module's own times a constant only when r is
+    // folded: that is what puts the production on the direct writer's affine path
+    const char* fixed = R"(
+        param r = 0.5;
+        module A(x); module B(x);
+        axiom: A(8);
+        derive 2;
+        rules { A(x) -> A(x * r) B(r); })";
+    auto c = test::compile(fixed);
+    REQUIRE(c->program);
+    CHECK(c->program->rules.productions[0].tmpl.affine.size() == 1);
+    CHECK(test::derive(fixed) == "A(2)B(0.5)B(0.5)");
+
+    CompileOptions o;
+    o.defines.emplace_back("r", "0.25"); // -D r=0.25: folded with the value it overrides to
+    auto d = test::compile(fixed, o);
+    REQUIRE(d->program);
+    Derivation run(*d->program, {});
+    run.run();
+    CHECK(format_string(*d->program, run.string()) == "A(0.5)B(0.25)B(0.25)");
+
+    // a hook halves r after every step: the rules read the new value each step
+    const char* assigned = R"(
+        param r = 0.5;
+        module A(x); module B(x);
+        axiom: A(8);
+        derive 2;
+        rules { A(x) -> A(x * r) B(r); }
+        on after_step { r = r / 2; })";
+    auto e = test::compile(assigned);
+    REQUIRE(e->program);
+    CHECK(e->program->rules.productions[0].tmpl.affine.empty());
+    CHECK(test::derive(assigned) == "A(1)B(0.25)B(0.5)");
+}
