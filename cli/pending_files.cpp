@@ -183,8 +183,8 @@ void PendingFiles::commit() {
             throw ExportError("cannot write " + in_quotes(t) + ": it is a folder");
     }
     for (std::size_t k = 0; k < temps_.size(); ++k) {
-        if (::rename(temps_[k].c_str(), targets_[k].c_str()) != 0)
-            throw ExportError("cannot write " + in_quotes(targets_[k]) + ": " + std::strerror(errno));
+        if (const int e = replace_file(temps_[k].c_str(), targets_[k].c_str()); e != 0)
+            throw ExportError("cannot write " + in_quotes(targets_[k]) + ": " + std::strerror(e));
         live_[k].store(false);
     }
 }

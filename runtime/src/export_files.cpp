@@ -6,7 +6,9 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <fcntl.h>
 #include <filesystem>
+#include <sys/stat.h>
 #include <system_error>
 #include <unistd.h>
 
@@ -86,6 +88,21 @@ const Scene& exported_scene(const Scene& scene, Scene& storage, const std::strin
     return *s;
 }
 
+int replace_file(const char* temp, const char* target) {
+#ifdef RENAME_EXCHANGE
+    struct stat st {};
+    if (::lstat(target, &st) == 0 && S_ISREG(st.st_mode)) {
+        if (::renameat2(AT_FDCWD, temp, AT_FDCWD, target, RENAME_EXCHANGE) == 0) {
+            // `temp` now names the old contents (a signal handler may have removed it already)
+            if (::unlink(temp) != 0 && errno != ENOENT) return errno;
+            return 0;
+        }
+        if (errno != EINVAL && errno != ENOSYS && errno != EOPNOTSUPP && errno != ENOENT) return errno;
+    }
+#endif
+    return ::rename(temp, target) == 0 ? 0 : errno;
+}
+
 void write_file_atomically(const std::string& path, const std::string& bytes) {
     std::FILE* file = nullptr;
     const std::string temp = create_temp_beside(path, file);
@@ -98,11 +115,9 @@ void write_file_atomically(const std::string& path, const std::string& bytes) {
         remove_quietly(temp);
         throw ExportError("cannot write " + quoted(path) + ": " + std::strerror(err));
     }
-    std::error_code ec;
-    fs::rename(temp, path, ec);
-    if (ec) {
+    if (const int e = replace_file(temp.c_str(), path.c_str()); e != 0) {
         remove_quietly(temp);
-        throw ExportError("cannot write " + quoted(path) + ": " + ec.message());
+        throw ExportError("cannot write " + quoted(path) + ": " + std::strerror(e));
     }
 }
 

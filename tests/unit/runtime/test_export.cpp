@@ -13,6 +13,7 @@
 #include <memory>
 #include <sstream>
 #include <streambuf>
+#include <unistd.h>
 
 using namespace plant;
 
@@ -200,4 +201,43 @@ TEST_CASE("a scene placed as a prototype is flattened by its transforms for ever
     outer.scene_instances.push_back(Instance{3, right});
     CHECK_THROWS_AS(write_gltf(outer, dir + "/broken.glb", GltfContainer::Binary), ExportError);
     std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("a finished file takes the place of the old one in one step, leaving no temporary file",
+          "[export][replace]") {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::temp_directory_path() / ("plant-replace-" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    auto write = [](const fs::path& p, const std::string& text) { std::ofstream(p) << text; };
+    auto read = [](const fs::path& p) {
+        std::ifstream in(p);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    const fs::path target = dir / "x.glb", temp = dir / ".x.glb.tmp";
+
+    // over an existing file: the new contents, and the old ones gone with the temporary name;
+    // a reader that opened the old file still reads the old contents
+    write(target, "old");
+    std::ifstream reader(target);
+    write(temp, "new");
+    CHECK(replace_file(temp.c_str(), target.c_str()) == 0);
+    CHECK(read(target) == "new");
+    CHECK(!fs::exists(temp));
+    CHECK(std::string(std::istreambuf_iterator<char>(reader), {}) == "old");
+    CHECK(std::distance(fs::directory_iterator(dir), fs::directory_iterator()) == 1);
+
+    // where nothing was: a rename
+    write(temp, "fresh");
+    CHECK(replace_file(temp.c_str(), (dir / "y.glb").c_str()) == 0);
+    CHECK(read(dir / "y.glb") == "fresh");
+    CHECK(!fs::exists(temp));
+
+    // a folder in the way is an error, and both stay as they were
+    fs::create_directories(dir / "z.glb");
+    write(temp, "kept");
+    CHECK(replace_file(temp.c_str(), (dir / "z.glb").c_str()) != 0);
+    CHECK(fs::is_directory(dir / "z.glb"));
+    CHECK(read(temp) == "kept");
+    fs::remove_all(dir);
 }
