@@ -211,9 +211,9 @@ void World::find_link_pairs() {
     std::sort(sc.link_pairs.begin(), sc.link_pairs.end()); // index order, whatever the table's
 }
 
-void World::separate_links() {
+void World::separate_links(bool find) {
     if (scratch_.plants < 2 || x_.size() < 4) return; // one plant: nothing of another to meet
-    find_link_pairs();
+    if (find) find_link_pairs();
     const auto& pairs = scratch_.link_pairs;
     if (pairs.empty()) return;
     auto weight = [&](std::uint32_t j, const glm::dvec3& dir) {

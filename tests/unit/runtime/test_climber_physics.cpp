@@ -387,20 +387,52 @@ TEST_CASE("climber: no segment of any climber grammar crosses an obstacle, as a 
     CHECK(grammars >= 9);
 }
 
-// Issue 18 item 4, not done in every grammar yet (docs/physics.md, "Plant-plant collision"): links
-// of different plants are collided as capsules only with `plant_contacts: 1`, which only
-// fig08_painted_wall and fig14_right set, since with it a push carried a link of fig11_fence
-// through a rail.
-// Without it eight climber grammars have two plants' links overlapping by 2.2-12 mm; with it all
-// but fig10_dome (4.8 mm: stems of several plants piled on one attractor) and fig14_left (3.5 mm:
-// whipping shoots) stay within kCapsuleTolerance. Catch's [!shouldfail]: this passes while some
-// grammar's plants overlap; when it fails, make it a plain test.
+namespace {
+
+bool sets_plant_contacts(const std::filesystem::path& grammar) {
+    std::ifstream in(grammar);
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str().find("plant_contacts: 1") != std::string::npos;
+}
+
+} // namespace
+
+// Issue 18 item 2: links of different plants collided as capsules (`plant_contacts: 1`), in
+// rounds alternating with the obstacles (World::step, docs/physics.md "Plant-plant collision").
+// Every grammar that sets it keeps two plants' links within kCapsuleTolerance at every step:
+// fig01_car, fig01_column, fig05_branching, fig08_painted_wall and fig14_right (with one round a
+// step instead of four, fig01_car's, fig01_column's and fig05_branching's overlap by 2.1-4.5 mm).
+TEST_CASE("climber: the grammars with plant_contacts keep the links of different plants apart", "[climber]") {
+    const std::filesystem::path dir = std::filesystem::path(PLANT_SOURCE_DIR) / "grammars" / "climbers";
+    std::size_t grammars = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+        if (entry.path().extension() != ".plant" || !sets_plant_contacts(entry.path())) continue;
+        auto r = derive("", entry.path());
+        const std::string name = entry.path().stem().string();
+        INFO(name << ": deepest overlap of two plants' links " << r->plant_overlap * 1000 << " mm, step "
+                  << r->plant_overlap_step);
+        if (std::getenv("PLANT_OVERLAP_REPORT"))
+            fmt::print("{}: deepest overlap of two plants' links {:.3f} mm, step {}\n", name,
+                       r->plant_overlap * 1000, r->plant_overlap_step);
+        CHECK(r->plant_overlap < kCapsuleTolerance);
+        ++grammars;
+    }
+    CHECK(grammars >= 5);
+}
+
+// Not done in every grammar yet: without `plant_contacts` the links of different plants overlap
+// by 2.2-12 mm in the climber grammars that leave it off. With it, fig10_dome's stems piled on one
+// attractor still overlap by 7.2 mm and fig14_left's whipping shoots by 1.8 mm, and in fig11_fence
+// a link pinched between another plant's stem and a rail stretches to 1.28 times its rest length
+// (the every-grammar bound is 1.25). Catch's [!shouldfail]: this passes while some grammar's plants
+// overlap; when it fails, make it a plain test.
 TEST_CASE(
     "climber: links of different plants still interpenetrate in some climber grammar (remove when fixed)",
     "[climber][!shouldfail]") {
     const std::filesystem::path dir = std::filesystem::path(PLANT_SOURCE_DIR) / "grammars" / "climbers";
     for (const auto& entry : std::filesystem::directory_iterator(dir)) {
-        if (entry.path().extension() != ".plant") continue;
+        if (entry.path().extension() != ".plant" || sets_plant_contacts(entry.path())) continue;
         auto r = derive("", entry.path());
         const std::string name = entry.path().stem().string();
         INFO(name << ": deepest overlap of two plants' links " << r->plant_overlap * 1000 << " mm, step "

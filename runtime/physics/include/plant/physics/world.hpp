@@ -339,7 +339,8 @@ class World {
     // pairs' capsules pushed apart, the four ends by their barycentric weights and inverse masses
     void build_plants();
     void find_link_pairs();
-    void separate_links();
+    // with find false, the pairs found by the last call are pushed again (a later round of a step)
+    void separate_links(bool find = true);
     void integrate();           // Eq. 17-18 with damping, and contacts with obstacles
     void break_overstretched(); // connections stretched past the break threshold let go
 
