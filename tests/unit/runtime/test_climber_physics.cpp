@@ -396,6 +396,19 @@ bool sets_plant_contacts(const std::filesystem::path& grammar) {
     return text.str().find("plant_contacts: 1") != std::string::npos;
 }
 
+// the deepest overlap of two plants' links over a climber grammar's steps within kCapsuleTolerance
+// (PLANT_OVERLAP_REPORT=1 prints it)
+void check_plant_overlap(const std::filesystem::path& grammar) {
+    auto r = derive("", grammar);
+    const std::string name = grammar.stem().string();
+    INFO(name << ": deepest overlap of two plants' links " << r->plant_overlap * 1000 << " mm, step "
+              << r->plant_overlap_step);
+    if (std::getenv("PLANT_OVERLAP_REPORT"))
+        fmt::print("{}: deepest overlap of two plants' links {:.3f} mm, step {}\n", name,
+                   r->plant_overlap * 1000, r->plant_overlap_step);
+    CHECK(r->plant_overlap < kCapsuleTolerance);
+}
+
 } // namespace
 
 // Issue 18 item 2: links of different plants collided as capsules (`plant_contacts: 1`), in
@@ -408,14 +421,7 @@ TEST_CASE("climber: the grammars with plant_contacts keep the links of different
     std::size_t grammars = 0;
     for (const auto& entry : std::filesystem::directory_iterator(dir)) {
         if (entry.path().extension() != ".plant" || !sets_plant_contacts(entry.path())) continue;
-        auto r = derive("", entry.path());
-        const std::string name = entry.path().stem().string();
-        INFO(name << ": deepest overlap of two plants' links " << r->plant_overlap * 1000 << " mm, step "
-                  << r->plant_overlap_step);
-        if (std::getenv("PLANT_OVERLAP_REPORT"))
-            fmt::print("{}: deepest overlap of two plants' links {:.3f} mm, step {}\n", name,
-                       r->plant_overlap * 1000, r->plant_overlap_step);
-        CHECK(r->plant_overlap < kCapsuleTolerance);
+        check_plant_overlap(entry.path());
         ++grammars;
     }
     CHECK(grammars >= 5);
@@ -433,14 +439,7 @@ TEST_CASE(
     const std::filesystem::path dir = std::filesystem::path(PLANT_SOURCE_DIR) / "grammars" / "climbers";
     for (const auto& entry : std::filesystem::directory_iterator(dir)) {
         if (entry.path().extension() != ".plant" || sets_plant_contacts(entry.path())) continue;
-        auto r = derive("", entry.path());
-        const std::string name = entry.path().stem().string();
-        INFO(name << ": deepest overlap of two plants' links " << r->plant_overlap * 1000 << " mm, step "
-                  << r->plant_overlap_step);
-        if (std::getenv("PLANT_OVERLAP_REPORT"))
-            fmt::print("{}: deepest overlap of two plants' links {:.3f} mm, step {}\n", name,
-                       r->plant_overlap * 1000, r->plant_overlap_step);
-        CHECK(r->plant_overlap < kCapsuleTolerance);
+        check_plant_overlap(entry.path());
     }
 }
 
