@@ -133,8 +133,9 @@ void ManifestWriter::finish() {
     if (!file_) return;
     const bool closed = std::fclose(file_) == 0;
     file_ = nullptr;
-    const int err = failed_ || !closed ? errno : replace_file(temp_.c_str(), path_.c_str());
-    if (failed_ || !closed || err != 0) {
+    const bool written = !failed_ && closed;
+    const int err = written ? replace_file(temp_.c_str(), path_.c_str()) : errno;
+    if (!written || err != 0) {
         ::unlink(temp_.c_str());
         throw ExportError(fmt::format("cannot write the manifest '{}': {}", path_, std::strerror(err)));
     }

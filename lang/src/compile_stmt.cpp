@@ -256,7 +256,6 @@ void Compiler::compile_hooks(const ast::File& f) {
     }
 }
 
-// Each hook's bodies, from every file in load order, become one piece of code.
 // The names assigned anywhere in this program's hooks (the only code that may assign a param or
 // var), nested blocks included; a name assigned as a local counts too, which only keeps a param
 // from being folded (folded_param).
@@ -272,6 +271,7 @@ void Compiler::find_assigned_params() {
         for (const ast::Hook& h : lf.file->hooks) scan(h.body);
 }
 
+// Each hook's bodies, from every file in load order, become one piece of code.
 void Compiler::compile_hook_bodies() {
     for (int k = 0; k < 4; ++k) {
         if (hook_bodies_[k].empty()) continue;

@@ -389,11 +389,15 @@ TEST_CASE("climber: no segment of any climber grammar crosses an obstacle, as a 
 
 namespace {
 
-bool sets_plant_contacts(const std::filesystem::path& grammar) {
-    std::ifstream in(grammar);
+std::string text_of(const std::filesystem::path& file) {
+    std::ifstream in(file);
     std::stringstream text;
     text << in.rdbuf();
-    return text.str().find("plant_contacts: 1") != std::string::npos;
+    return text.str();
+}
+
+bool sets_plant_contacts(const std::filesystem::path& grammar) {
+    return text_of(grammar).find("plant_contacts: 1") != std::string::npos;
 }
 
 // the deepest overlap of two plants' links over a climber grammar's steps within kCapsuleTolerance
@@ -447,11 +451,8 @@ TEST_CASE(
 // plants, whose links overlap by over 10 mm without it, stay within kCapsuleTolerance, with every
 // link check of derive() holding.
 TEST_CASE("climber: plant_contacts: 1 keeps the links of different plants apart", "[climber]") {
-    std::ifstream in(std::filesystem::path(PLANT_SOURCE_DIR) / "grammars" / "climbers" /
-                     "fig08_painted_wall.plant");
-    std::stringstream text;
-    text << in.rdbuf();
-    const std::string on = text.str();
+    const std::string on = text_of(std::filesystem::path(PLANT_SOURCE_DIR) / "grammars" / "climbers" /
+                                   "fig08_painted_wall.plant");
     const std::string arg = "plant_contacts: 1";
     std::string off = on;
     REQUIRE(off.find(arg) != std::string::npos);
@@ -468,12 +469,11 @@ TEST_CASE("climber: plant_contacts: 1 keeps the links of different plants apart"
 TEST_CASE("climber: a box slid sideways drags the plants anchored to it along (Fig. 9)", "[climber]") {
     // grammars/climbers/fig09_boxes.plant slides box 2 (the low one on the right) by 0.25 m from
     // step 24: every particle anchored to it before stays within 2 cm of it
-    std::ifstream in(std::filesystem::path(PLANT_SOURCE_DIR) / "grammars" / "climbers" / "fig09_boxes.plant");
-    std::stringstream text;
-    text << in.rdbuf();
     CompileOptions opts;
     opts.environments = runtime_environments();
-    auto compiled = test::compile(text.str(), opts);
+    auto compiled = test::compile(
+        text_of(std::filesystem::path(PLANT_SOURCE_DIR) / "grammars" / "climbers" / "fig09_boxes.plant"),
+        opts);
     REQUIRE(compiled->program);
     TurtleEnvironmentPhase phase;
     DeriveOptions options;

@@ -340,7 +340,7 @@ class World {
     void build_plants();
     void find_link_pairs();
     // with find false, the pairs found by the last call are pushed again (a later round of a step)
-    void separate_links(bool find = true);
+    void separate_links(bool find);
     void integrate();           // Eq. 17-18 with damping, and contacts with obstacles
     void break_overstretched(); // connections stretched past the break threshold let go
 
