@@ -11,23 +11,6 @@ namespace plant {
 
 namespace {
 
-bool holds(Op op, double x, double y) {
-    switch (op) {
-    case Op::Lt:
-        return x < y;
-    case Op::Le:
-        return x <= y;
-    case Op::Gt:
-        return x > y;
-    case Op::Ge:
-        return x >= y;
-    case Op::Eq:
-        return x == y;
-    default:
-        return x != y; // Ne
-    }
-}
-
 // Records a snapshot of a writer (Worker::snaps). Out of line: the writer's loop stays as tight
 // as without it.
 [[gnu::noinline]] void snapshot(std::vector<std::uint64_t>& snaps, std::size_t written,
@@ -52,22 +35,50 @@ bool holds(Op op, double x, double y) {
     return next;
 }
 
-// Per kind, the outcome of copying a module of it when its symbol has no productions, else
-// kNoCopy: write_direct reads a run of copied modules with one table load a module (the kind's)
-// instead of three for its symbol (the symbol, whether it has productions, its copy's outcome).
-constexpr std::uint32_t kNoCopy = ~std::uint32_t{0};
-const std::uint32_t* copy_outcomes(const RulePlan& plan, const SymbolReader& reader, std::size_t kinds,
-                                   std::vector<std::uint32_t>& out) {
+// Whether a module of table kind k, of symbol s, can be copied with a run and then have its
+// numbers rewritten in place (KindRow::kPatch): s is guarded, and whichever of its productions
+// applies writes one module of kind k, every stored number of which is computed from the
+// module's own (RulePlan::outcome_args). So a rule such as `F(l) : l > 0 -> F(l * 1.1)` does
+// not cut the runs of copied modules around each F.
+bool patchable(const RulePlan& plan, SymbolId s, KindId k) {
+    if (plan.guarded_at[s] < 0) return false;
+    const RulePlan::Guarded& g = plan.guarded[static_cast<std::size_t>(plan.guarded_at[s])];
+    if (!g.uniform || g.picks < 0) return false;
+    for (std::uint32_t j = 0; j < g.count; ++j) {
+        const SuccessorTemplate& t = plan.guards[g.first + j].pr->tmpl;
+        if (t.kinds.size() != 1 || t.kinds[0] != k || t.holes.size() != t.stored.size() ||
+            plan.outcome_args[plan.outcome_at[s] + 1 + j] < 0)
+            return false;
+    }
+    return true;
+}
+
+// The writer's table of kinds (KindRow), in `rows`. A run of copied modules is read with one
+// table load a module (the kind's) instead of three for its symbol (the symbol, whether it has
+// productions, its copy's outcome).
+const KindRow* kind_rows(const RulePlan& plan, const KindTable& kt, std::vector<KindRow>& rows) {
     // (a symbol past the plan's cannot be in the string: the kinds of a string made without a
     // program, 0x8000 plain ones, are left at kNoCopy past the plan's symbols)
-    const std::size_t symbols = plan.has_prod.size();
-    out.assign(kinds, kNoCopy);
-    for (std::size_t k = 0; k < std::min<std::size_t>(reader.plain, symbols); ++k)
-        out[k] = plan.has_prod[k] ? kNoCopy : plan.outcome_at[k];
-    for (std::size_t k = reader.plain; k < kinds; ++k)
-        if (const SymbolId s = reader.table[k - reader.plain]; s < symbols)
-            out[k] = plan.has_prod[s] ? kNoCopy : plan.outcome_at[s];
-    return out.data();
+    const std::size_t symbols = plan.has_prod.size(), kinds = kt.stored.size();
+    rows.assign(kinds, KindRow{});
+    for (std::size_t k = 0; k < kinds; ++k) {
+        const bool plain = k < kt.plain;
+        const SymbolId s = plain ? static_cast<SymbolId>(k) : kt.symbol[k - kt.plain];
+        KindRow& r = rows[k];
+        r.stored = kt.stored[k];
+        r.arity = plain ? 0 : kt.arity[k - kt.plain];
+        r.dense = plain || kt.layout_at[k - kt.plain] == KindTable::kAllStored;
+        if (s >= symbols) continue;
+        r.at = plan.outcome_at[s];
+        if (!plan.has_prod[s]) {
+            r.copy = plan.outcome_at[s];
+            continue;
+        }
+        r.direct = plan.direct[s];
+        if (!r.direct) r.guarded = plan.guarded_at[s];
+        if (!plain && patchable(plan, s, static_cast<KindId>(k))) r.copy = KindRow::kPatch;
+    }
+    return rows.data();
 }
 
 } // namespace
@@ -75,14 +86,36 @@ const std::uint32_t* copy_outcomes(const RulePlan& plan, const SymbolReader& rea
 // The first production whose condition holds applies; when it is weighted, every weighted
 // production from it on whose condition holds is a candidate and one is drawn by weight, with
 // the same arithmetic as Rewriter::choose (general.cpp), so that both routes draw alike.
-const RulePlan::Guard* Rewriter::pick_guarded(std::size_t i, const ModuleArgs& a,
-                                              const RulePlan::Guarded& g) const {
-    if (in.arity(i) != g.width) return nullptr; // no pattern matches
+// (inline: only the writer and count_direct below call it)
+inline const RulePlan::Guard* Rewriter::pick_guarded(std::size_t i, const ModuleArgs& a,
+                                                     const RulePlan::Guarded& g) const {
+    if (a.size() != g.width) return nullptr; // no pattern matches
+    if (g.picks < 0) return pick_unlisted(i, a, g);
+    // which conditions hold, then the table (RulePlan::build_picks)
     const RulePlan::Guard* gs = plan.guards.data() + g.first;
-    auto ok = [&](const RulePlan::Guard& q) {
-        if (q.op == Op::Halt) return true;
-        return q.swapped ? holds(q.op, q.constant, a[q.param]) : holds(q.op, a[q.param], q.constant);
-    };
+    // (a guard without a condition reads parameter 0 and holds whatever it is; a module without
+    // parameters has no conditions)
+    std::uint32_t mask = (1u << g.count) - 1;
+    if (g.width != 0) {
+        mask = 0;
+        for (std::uint32_t k = 0; k < g.count; ++k) mask |= std::uint32_t{gs[k].holds(a[gs[k].param])} << k;
+    }
+    const RulePlan::Pick& pk = plan.picks[static_cast<std::size_t>(g.picks) + mask];
+    if (pk.count == 0) return pk.only == RulePlan::kNone ? nullptr : gs + pk.only;
+    const RulePlan::PickOption* o = plan.pick_options.data() + pk.first;
+    double u = random_unit(random_bits_at(draw_phase, i, stream::kChoiceDraw)) * pk.total;
+    for (std::uint32_t j = 0; j + 1 < pk.count; ++j) {
+        if (u < o[j].weight) return gs + o[j].guard;
+        u -= o[j].weight;
+    }
+    return gs + o[pk.count - 1].guard;
+}
+
+// pick_guarded for a symbol with more guards than the table takes.
+const RulePlan::Guard* Rewriter::pick_unlisted(std::size_t i, const ModuleArgs& a,
+                                               const RulePlan::Guarded& g) const {
+    const RulePlan::Guard* gs = plan.guards.data() + g.first;
+    auto ok = [&](const RulePlan::Guard& q) { return g.width == 0 || q.holds(a[q.param]); };
     std::uint32_t k = 0;
     while (k < g.count && !ok(gs[k])) ++k;
     if (k == g.count) return nullptr;
@@ -149,6 +182,67 @@ Rewriter::Counts Rewriter::count_direct(std::size_t b, std::size_t e) const {
     return c;
 }
 
+// write_direct's copy of the run of modules from i on (before e) that are copied or patched
+// (KindRow::kPatch), module i included, whatever its row; their parameters start at q. Writes
+// them at S, PA and ID, tallies them (module i's outcome excepted) and returns the end of the
+// run, its parameters' count in np.
+template <bool Ids>
+std::size_t Rewriter::copy_run(const KindRow* rows, std::size_t i, std::size_t e, std::size_t q, KindId* S,
+                               double* PA, ModuleId* ID, ModuleId& id_at, std::uint64_t* tally,
+                               std::uint32_t& np) const {
+    const KindId* in_kinds = in.kinds.data();
+    const double* in_params = in.params.data();
+    const ModuleId* in_ids = Ids ? in.ids.data() : nullptr;
+    np = rows[in_kinds[i]].stored;
+    std::size_t j = i + 1;
+    // the patchable modules of the run: where they are in it, and their numbers
+    constexpr std::uint32_t kMaxPatches = 8;
+    std::uint32_t patches = 0, patch_m[kMaxPatches], patch_p[kMaxPatches];
+    for (; j < e; ++j) {
+        const KindRow& rj = rows[in_kinds[j]];
+        if (rj.copy >= KindRow::kPatch) {
+            if (rj.copy == KindRow::kNoCopy || patches == kMaxPatches) break;
+            patch_m[patches] = static_cast<std::uint32_t>(j - i);
+            patch_p[patches++] = np;
+        } else {
+            ++tally[rj.copy];
+        }
+        np += rj.stored;
+    }
+    const std::size_t n = j - i;
+    if (n <= 8 && np <= 8) {
+        // the usual run between two rewritten modules is a few turtle symbols: plain loops beat
+        // three library calls
+        for (std::size_t k = 0; k < n; ++k) {
+            S[k] = in_kinds[i + k];
+            if constexpr (Ids) ID[k] = in_ids[i + k];
+        }
+        for (std::uint32_t k = 0; k < np; ++k) PA[k] = in_params[q + k];
+    } else {
+        std::memcpy(S, in_kinds + i, n * sizeof(KindId));
+        if constexpr (Ids) std::memcpy(ID, in_ids + i, n * sizeof(ModuleId));
+        if (np) std::memcpy(PA, in_params + q, np * sizeof(double));
+    }
+    const RulePlan::Guard* guards = plan.guards.data();
+    for (std::uint32_t k = 0; k < patches; ++k) { // as the top of write_direct's loop would
+        const std::size_t m = i + patch_m[k];
+        const KindRow& rm = rows[in_kinds[m]];
+        const double* at = in_params + q + patch_p[k];
+        const ModuleArgs a = rm.dense ? ModuleArgs(at, rm.arity) : in.args_at(m, at);
+        const RulePlan::Guarded& g = plan.guarded[static_cast<std::size_t>(rm.guarded)];
+        const RulePlan::Guard* gd = pick_guarded(m, a, g);
+        if (!gd) {
+            ++tally[rm.at];
+            continue;
+        }
+        const auto o = rm.at + 1 + static_cast<std::uint32_t>(gd - (guards + g.first));
+        ++tally[o];
+        put_affine<Ids>(o, plan.emits[o], a, Ids ? in_ids[m] : 0, id_at, S + patch_m[k], PA + patch_p[k],
+                        Ids ? ID + patch_m[k] : nullptr);
+    }
+    return j;
+}
+
 // Writes the output of modules [b, e) at module m_at and parameter p_at of `out`, whose
 // arrays are already sized; new identities are numbered from id_at.
 // Identities are written only when `out` keeps them (Ids, a template argument so that the
@@ -156,33 +250,28 @@ Rewriter::Counts Rewriter::count_direct(std::size_t b, std::size_t e) const {
 Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out,
                                         std::size_t m_at, std::size_t p_at, ModuleId id_at,
                                         std::uint64_t* tally) {
-    // Kinds: whether the table has kinds past the symbols' own (plain kinds with numbers, kinds
-    // of constants); otherwise every kind is its symbol, and the loop does without the test
-    const bool kinds = in.kind_table && in.kind_table->size() > 0;
-    if (out.keep_ids)
-        return kinds ? write_direct<true, true>(w, b, e, out, m_at, p_at, id_at, tally)
-                     : write_direct<true, false>(w, b, e, out, m_at, p_at, id_at, tally);
-    return kinds ? write_direct<false, true>(w, b, e, out, m_at, p_at, id_at, tally)
-                 : write_direct<false, false>(w, b, e, out, m_at, p_at, id_at, tally);
+    if (out.keep_ids) return write_direct<true>(w, b, e, out, m_at, p_at, id_at, tally);
+    return write_direct<false>(w, b, e, out, m_at, p_at, id_at, tally);
 }
-template <bool Ids, bool Kinds>
+template <bool Ids>
 Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out,
                                         std::size_t m_at, std::size_t p_at, ModuleId id_at,
                                         std::uint64_t* tally) {
     w.frame.assign(plan.frame_size, 0.0);
-    const SymbolReader reader = in.symbols();
-    auto sym_of = [reader](std::size_t j) -> SymbolId {
-        if constexpr (Kinds)
-            return reader(j);
-        else
-            return reader.kinds[j];
-    };
+    // the tables, read through local copies (members read through `in` or `plan` would be
+    // reloaded after every store)
+    const KindRow* rows = kind_rows(plan, *in.kind_table, w.kind_rows);
+    const KindId* in_kinds = in.kinds.data();
+    const double* in_params = in.params.data();
+    const ModuleId* in_ids = Ids ? in.ids.data() : nullptr;
+    const RulePlan::Guarded* guarded = plan.guarded.data();
+    const RulePlan::Guard* guards = plan.guards.data();
+    const RulePlan::Emit* emits = plan.emits.data();
     KindId* S = out.kinds.data() + m_at;
     ModuleId* ID = Ids ? out.ids.data() + m_at : nullptr;
     const std::uint8_t* stored_of = in.kind_table->stored.data();
     double* PA = out.params.data() + p_at;
     std::size_t q = in.offset(b); // where module i's parameters start
-    const std::uint32_t* at = plan.outcome_at.data();
     const ModuleId id0 = id_at;
     std::size_t p = p_at;
     double values[256];
@@ -190,7 +279,14 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
     std::size_t next_check = b + kSnapEvery;
     const std::size_t outcomes = plan.outcome_tmpl.size();
     w.snaps.clear();
-    const std::uint32_t* copy_of = copy_outcomes(plan, reader, in.kind_table->stored.size(), w.copy_outcome);
+    // module i's numbers, its parameters starting at `at`
+    auto args_of = [&](std::size_t j, const KindRow& r, const double* at) {
+        return r.dense ? ModuleArgs(at, r.arity) : in.args_at(j, at);
+    };
+    // the guard that applies to module j of guarded row r (see pick_guarded), or nullptr
+    auto pick = [&](std::size_t j, const KindRow& r, const ModuleArgs& a) {
+        return pick_guarded(j, a, guarded[static_cast<std::size_t>(r.guarded)]);
+    };
     // the next module that starts a block (ModuleString::block_at), as a position in `out`
     constexpr std::size_t B = ModuleString::kBlock;
     std::size_t next_block = (m_at + B - 1) & ~(B - 1);
@@ -211,38 +307,20 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
             // the snapshot from which the next step sizes its threads' stretches
             snapshot(w.snaps, static_cast<std::size_t>(S - (out.kinds.data() + m_at)), tally, outcomes);
         }
-        const SymbolId s = sym_of(i);
-        const Production* prp = plan.direct[s];
-        std::uint32_t outcome = at[s] + 1;
-        if (!prp && plan.has_prod[s]) {
-            const RulePlan::Guarded& g = plan.guarded[static_cast<std::size_t>(plan.guarded_at[s])];
-            if (const RulePlan::Guard* gd = pick_guarded(i, in.args_at(i, in.params.data() + q), g)) {
+        const KindRow& r = rows[in_kinds[i]];
+        const Production* prp = r.direct;
+        std::uint32_t outcome = r.at + 1;
+        if (r.guarded >= 0) {
+            if (const RulePlan::Guard* gd = pick(i, r, args_of(i, r, in_params + q))) {
                 prp = gd->pr;
-                outcome += static_cast<std::uint32_t>(gd - (plan.guards.data() + g.first));
+                outcome += static_cast<std::uint32_t>(gd - (guards + guarded[r.guarded].first));
             }
         }
         if (!prp) { // a run of modules without productions (or none that applies): copy it
-            ++tally[at[s]];
-            std::uint32_t np = stored_of[reader.kinds[i]];
-            std::size_t j = i + 1;
-            for (std::uint32_t o; j < e && (o = copy_of[reader.kinds[j]]) != kNoCopy; ++j) {
-                ++tally[o];
-                np += stored_of[reader.kinds[j]];
-            }
+            ++tally[r.at];
+            std::uint32_t np = 0;
+            const std::size_t j = copy_run<Ids>(rows, i, e, q, S, PA, ID, id_at, tally, np);
             const std::size_t n = j - i;
-            if (n <= 8 && np <= 8) {
-                // the usual run between two rewritten modules is a few turtle symbols: plain
-                // loops beat three library calls
-                for (std::size_t k = 0; k < n; ++k) {
-                    S[k] = in.kinds[i + k];
-                    if constexpr (Ids) ID[k] = in.ids[i + k];
-                }
-                for (std::uint32_t k = 0; k < np; ++k) PA[k] = in.params[q + k];
-            } else {
-                std::memcpy(S, in.kinds.data() + i, n * sizeof(KindId));
-                if constexpr (Ids) std::memcpy(ID, in.ids.data() + i, n * sizeof(ModuleId));
-                if (np) std::memcpy(PA, in.params.data() + q, np * sizeof(double));
-            }
             marks(S, n, p);
             S += n;
             if constexpr (Ids) ID += n;
@@ -253,14 +331,17 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
             continue;
         }
         ++tally[outcome];
-        const Production& pr = *prp;
-        const SuccessorTemplate& t = pr.tmpl;
-        if (const std::int32_t affine = plan.outcome_args[outcome]; affine >= 0) {
-            put_affine<Ids>(t, plan.args.data() + affine, in.args_at(i, in.params.data() + q),
-                            Ids ? in.ids[i] : 0, id_at, S, PA, ID);
+        const RulePlan::Emit& em = emits[outcome];
+        std::uint32_t m = 0, stored = 0;
+        if (em.kinds) {
+            put_affine<Ids>(outcome, em, args_of(i, r, in_params + q), Ids ? in_ids[i] : 0, id_at, S, PA, ID);
+            m = em.m;
+            stored = em.stored_n;
         } else {
+            const Production& pr = *prp;
+            const SuccessorTemplate& t = pr.tmpl;
             if (!t.holes.empty()) {
-                bind_args(w, i, in.params.data() + q, pr.strict[0]);
+                bind_args(w, i, in_params + q, pr.strict[0]);
                 w.env.position = i;
                 w.env.draw = 0;
                 w.env.id = in.id(i);
@@ -268,15 +349,16 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
                 compute_holes(w, t, values);
                 check_holes(t, values);
             }
-            put_template<Ids>(t, values, Ids ? in.ids[i] : 0, id_at, S, PA, ID);
+            put_template<Ids>(t, values, Ids ? in_ids[i] : 0, id_at, S, PA, ID);
+            m = static_cast<std::uint32_t>(t.syms.size());
+            stored = static_cast<std::uint32_t>(t.stored.size());
         }
-        const std::size_t m = t.syms.size();
         marks(S, m, p);
         if constexpr (Ids) ID += m;
         S += m;
-        PA += t.stored.size();
-        p += t.stored.size();
-        q += stored_of[reader.kinds[i]];
+        PA += stored;
+        p += stored;
+        q += r.stored;
         ++i;
     }
     Counts c;

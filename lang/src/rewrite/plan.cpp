@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <utility>
 
@@ -116,6 +117,22 @@ void RulePlan::build_copy_kernel() {
 
 namespace {
 
+// `c op x` as `x mirrored(op) c`.
+Op mirrored(Op op) {
+    switch (op) {
+    case Op::Lt:
+        return Op::Gt;
+    case Op::Le:
+        return Op::Ge;
+    case Op::Gt:
+        return Op::Lt;
+    case Op::Ge:
+        return Op::Le;
+    default: // Eq, Ne
+        return op;
+    }
+}
+
 // The guard a production's condition and weight make (see RulePlan::Guard), or nothing when
 // they are not of the simple forms.
 std::optional<RulePlan::Guard> guard_of(const Production& pr) {
@@ -129,9 +146,10 @@ std::optional<RulePlan::Guard> guard_of(const Production& pr) {
         if (op != Op::Lt && op != Op::Le && op != Op::Gt && op != Op::Ge && op != Op::Eq && op != Op::Ne)
             return std::nullopt;
         const Instr *load = &c.instrs[0], *k = &c.instrs[1];
+        bool swapped = false; // `constant OP parameter`
         if (load->op == Op::Const) {
             std::swap(load, k);
-            g.swapped = true;
+            swapped = true;
         }
         if (load->op != Op::LoadLocal || load->n != 1 || k->op != Op::Const) return std::nullopt;
         const auto slot = static_cast<std::uint32_t>(load->a);
@@ -146,8 +164,18 @@ std::optional<RulePlan::Guard> guard_of(const Production& pr) {
             at += pa.width;
         }
         if (!found) return std::nullopt;
-        g.op = op;
-        g.constant = c.consts[static_cast<std::size_t>(k->a)];
+        // `x OP c` as an interval of x, the parameter, and whether it is the outside: a strict
+        // bound is the next double inward (nothing is between), NaN where nothing is inward (x
+        // < -inf), so that a NaN parameter or constant compares as IEEE says
+        const double cst = c.consts[static_cast<std::size_t>(k->a)];
+        constexpr double inf = std::numeric_limits<double>::infinity();
+        const double nan = std::numeric_limits<double>::quiet_NaN();
+        auto below = [&](double v) { return v == -inf ? nan : std::nextafter(v, -inf); };
+        auto above = [&](double v) { return v == inf ? nan : std::nextafter(v, inf); };
+        const Op o = swapped ? mirrored(op) : op; // as `x o c`
+        g.negate = o == Op::Ne;
+        g.lo = o == Op::Lt || o == Op::Le ? -inf : o == Op::Gt ? above(cst) : cst;
+        g.hi = o == Op::Gt || o == Op::Ge ? inf : o == Op::Lt ? below(cst) : cst;
     }
     const Code& w = pr.weight;
     if (!w.empty()) {
@@ -193,9 +221,50 @@ bool RulePlan::build_guards(SymbolId sym) {
         entry.uniform = entry.uniform && t.syms.size() == 1 && t.stored.size() == width && t.keep == 0;
     }
     guarded_at[sym] = static_cast<std::int32_t>(guarded.size());
-    guarded.push_back(entry);
     guards.insert(guards.end(), gs.begin(), gs.end());
+    build_picks(entry);
+    guarded.push_back(entry);
     return true;
+}
+
+// The table of what a guarded module becomes for each set of its conditions that hold (see
+// Pick), when it has few enough guards. The same choice as Rewriter::choose makes: the first
+// guard that holds applies; when it is weighted, a draw among it and the weighted guards after
+// it that hold, zero weights left out, with the weights scaled down together when their sum
+// overflows.
+void RulePlan::build_picks(Guarded& g) {
+    if (g.count > kPickBits) return;
+    g.picks = static_cast<std::int32_t>(picks.size());
+    const Guard* gs = guards.data() + g.first;
+    for (std::uint32_t mask = 0; mask < (1u << g.count); ++mask) {
+        Pick pk;
+        std::uint32_t k = 0;
+        while (k < g.count && !(mask >> k & 1)) ++k;
+        if (k < g.count && gs[k].weight < 0) {
+            pk.only = k;
+        } else if (k < g.count) {
+            pk.first = static_cast<std::uint32_t>(pick_options.size());
+            for (std::uint32_t j = k; j < g.count; ++j) {
+                if (gs[j].weight < 0 || !(mask >> j & 1) || gs[j].weight == 0) continue;
+                pick_options.push_back({j, gs[j].weight});
+                pk.total += gs[j].weight;
+            }
+            pk.count = static_cast<std::uint32_t>(pick_options.size()) - pk.first;
+            if (!std::isfinite(pk.total)) {
+                double largest = 0;
+                for (std::uint32_t j = 0; j < pk.count; ++j)
+                    largest = std::max(largest, pick_options[pk.first + j].weight);
+                const double scale = 1 / largest;
+                pk.total = 0;
+                for (std::uint32_t j = 0; j < pk.count; ++j) {
+                    PickOption& o = pick_options[pk.first + j];
+                    o.weight *= scale;
+                    pk.total += o.weight;
+                }
+            }
+        }
+        picks.push_back(pk);
+    }
 }
 
 void RulePlan::build_outcomes() {
@@ -214,6 +283,20 @@ void RulePlan::build_outcomes() {
         }
         const Guarded& g = guarded[static_cast<std::size_t>(guarded_at[s])];
         for (std::uint32_t k = 0; k < g.count; ++k) add(guards[g.first + k].pr, s);
+    }
+    emits.resize(outcome_tmpl.size());
+    for (std::size_t o = 0; o < outcome_tmpl.size(); ++o) {
+        const SuccessorTemplate* t = outcome_tmpl[o];
+        if (!t || outcome_args[o] < 0) continue;
+        Emit& em = emits[o];
+        em.kinds = t->kinds.data();
+        em.m = static_cast<std::uint32_t>(t->syms.size());
+        em.stored_n = static_cast<std::uint32_t>(t->stored.size());
+        em.holes_n = static_cast<std::uint32_t>(t->holes.size());
+        em.stored = em.stored_n != em.holes_n ? t->stored.data() : nullptr;
+        em.holes_at = static_cast<std::uint32_t>(outcome_args[o]);
+        em.fresh = static_cast<std::uint32_t>(t->fresh());
+        em.keep = t->keep;
     }
 }
 
@@ -240,8 +323,8 @@ std::int32_t RulePlan::add_args(const Production& pr) {
         ArgHole hole;
         hole.from = static_cast<std::uint32_t>(from);
         hole.to = t.stored_holes[h];
-        hole.add = a.kind == SuccessorTemplate::Affine::Add;
-        hole.constant = a.kind == SuccessorTemplate::Affine::Copy ? 1.0 : a.constant;
+        if (a.kind == SuccessorTemplate::Affine::Add) hole.add = a.constant;
+        if (a.kind == SuccessorTemplate::Affine::Mul) hole.mul = a.constant;
         args.push_back(hole);
     }
     return first;

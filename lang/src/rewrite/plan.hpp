@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace plant {
@@ -75,20 +76,42 @@ struct RulePlan {
     // the module is copied) is then decided without the stack machine, on the direct path.
     struct Guard {
         const Production* pr = nullptr;
-        std::uint32_t param = 0; // the module's parameter the condition compares
-        Op op = Op::Halt;        // Halt: no condition
-        bool swapped = false;    // `constant OP parameter`
-        double constant = 0;
-        double weight = -1; // below 0: not weighted
+        std::uint32_t param = 0; // the module's parameter the condition compares (if any)
+        double weight = -1;      // below 0: not weighted
+        // The condition as an interval: it holds where (lo <= x && x <= hi) != negate, for x
+        // the parameter (see guard_of); without a condition, lo is NaN and negate set: always
+        double lo = std::numeric_limits<double>::quiet_NaN(), hi = 0;
+        bool negate = true;
+        bool holds(double x) const { return ((x >= lo) & (x <= hi)) != negate; }
     };
     struct Guarded {
         std::uint32_t first = 0, count = 0; // its guards, in the order apply() tries them
         std::uint32_t width = 0;            // the parameters every pattern of the symbol takes
         bool uniform = false;               // every outcome (a production or the copy) writes as much
+        // Up to kPickBits guards: the entry in `picks` of the first of its 2^count outcomes of
+        // the conditions, indexed by which hold (bit k: guard k's); -1 for more guards.
+        std::int32_t picks = -1;
     };
     std::vector<std::int32_t> guarded_at; // per symbol: its entry in `guarded`, or -1
     std::vector<Guarded> guarded;
     std::vector<Guard> guards;
+    // What a guarded module becomes when a given set of its conditions holds (see
+    // Rewriter::pick_guarded): the one guard that applies (`only`, among the symbol's), none
+    // (kNone, no options), or a draw among the options from `first` on in `pick_options`, by
+    // the weights there (each already scaled, and `total` their sum, as Rewriter::choose
+    // computes them).
+    static constexpr std::uint32_t kPickBits = 6, kNone = ~std::uint32_t{0};
+    struct Pick {
+        std::uint32_t only = kNone;
+        std::uint32_t first = 0, count = 0;
+        double total = 0;
+    };
+    struct PickOption {
+        std::uint32_t guard = 0; // among the symbol's
+        double weight = 0;
+    };
+    std::vector<Pick> picks;
+    std::vector<PickOption> pick_options;
     // The outcomes a module can have on the direct path, which the writer tallies so that the
     // next step knows its output's size without a counting pass (see Engine::StringCounts):
     // outcome_at[s] is the copy of a module of symbol s, outcome_at[s] + 1 + k its direct
@@ -100,14 +123,26 @@ struct RulePlan {
     // frame (Rewriter::put_args): when every computed number is one of the module's own, times
     // or plus a constant (SuccessorTemplate::affine), each number's source among the module's
     // numbers, its place among the stored ones and its constant, from args_first on in `args`.
+    // The number is x * mul + add for x the source, one expression for the three forms, each
+    // exact: x * c + (-0.0) is x * c (a zero keeps its sign), x * 1 + c is x + c, x * 1 + (-0.0)
+    // is x (docs/design.md, "The direct path").
     struct ArgHole {
         std::uint32_t from = 0; // the predecessor's number it reads
         std::uint32_t to = 0;   // its place among the template's stored numbers
-        double constant = 1;    // the factor (a plain copy is a factor of 1), or the addend
-        bool add = false;
+        double mul = 1, add = -0.0;
     };
     std::vector<std::int32_t> outcome_args; // its first entry in `args`; -1: run the frame
     std::vector<ArgHole> args;
+    // Per outcome whose numbers are affine, what Rewriter::put_affine writes, read from one
+    // place: the template's kinds and stored numbers (nullptr when every one is computed), its
+    // holes from holes_at on in `args`, and the modules that get new identities.
+    struct Emit {
+        const KindId* kinds = nullptr;
+        const double* stored = nullptr;
+        std::uint32_t m = 0, stored_n = 0, holes_at = 0, holes_n = 0, fresh = 0;
+        std::int32_t keep = -1;
+    };
+    std::vector<Emit> emits;
     // Whether a step must rewrite on one thread, left to right (or right to left for `>>`).
     bool sequential() const { return multi || left_new || right_new; }
     std::size_t max_modules_out = 1; // the longest template's modules (at least 1: a copy)
@@ -117,6 +152,7 @@ struct RulePlan {
     void build_symbol_kernel();
     void build_copy_kernel();
     bool build_guards(SymbolId sym);
+    void build_picks(Guarded& g);
     void build_outcomes();
     std::int32_t add_args(const Production& pr);
     void build_context_table();

@@ -25,6 +25,22 @@ namespace plant {
 
 constexpr std::int64_t kUnknown = -2;
 
+// What write_direct needs of a module of a given kind, read with one load: its symbol's direct
+// template, else its entry in RulePlan::guarded (-1: none, or a direct template); `copy`, the
+// outcome of copying it when its symbol has no productions, else kPatch or kNoCopy (see
+// write_direct); its symbol's first outcome (RulePlan::outcome_at); its numbers and how many of
+// them are stored, and whether all of them are (its ModuleArgs are then one array).
+struct KindRow {
+    static constexpr std::uint32_t kNoCopy = ~std::uint32_t{0}, kPatch = kNoCopy - 1;
+    const Production* direct = nullptr;
+    std::int32_t guarded = -1;
+    std::uint32_t copy = kNoCopy;
+    std::uint32_t at = 0;
+    std::uint16_t arity = 0;
+    std::uint8_t stored = 0;
+    bool dense = true;
+};
+
 // Everything one thread needs to rewrite a stretch of the string.
 struct Worker {
     Worker() = default;
@@ -41,8 +57,8 @@ struct Worker {
     // write_direct's snapshots, one every kSnapEvery modules read: where the output stood
     // (modules written so far), then the tally of every outcome so far (Engine::counts).
     std::vector<std::uint64_t> snaps;
-    // write_direct's outcome of copying each kind (kNoCopy where its symbol has productions)
-    std::vector<std::uint32_t> copy_outcome;
+    // write_direct's table of the kinds (see KindRow)
+    std::vector<KindRow> kind_rows;
 };
 
 class Rewriter {
@@ -109,6 +125,8 @@ class Rewriter {
     // apply() and choose() would decide it; nullptr: none applies, the module is copied.
     // a: module i's parameters
     const RulePlan::Guard* pick_guarded(std::size_t i, const ModuleArgs& a, const RulePlan::Guarded& g) const;
+    [[gnu::noinline]] const RulePlan::Guard* pick_unlisted(std::size_t i, const ModuleArgs& a,
+                                                           const RulePlan::Guarded& g) const;
     // The seed and phase of the step's random draws (weighted choice on the direct path).
     void set_draws(std::uint64_t seed, std::uint64_t phase) { draw_phase = random_phase(seed, phase); }
 
@@ -117,7 +135,11 @@ class Rewriter {
     ModuleString assemble_backward(const ModuleString& pieces) const;
 
   private:
-    template <bool Ids, bool Kinds>
+    template <bool Ids>
+    std::size_t copy_run(const KindRow* rows, std::size_t i, std::size_t e, std::size_t q, KindId* S,
+                         double* PA, ModuleId* ID, ModuleId& id_at, std::uint64_t* tally,
+                         std::uint32_t& np) const;
+    template <bool Ids>
     Counts write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at,
                         std::size_t p_at, ModuleId id_at, std::uint64_t* tally);
     template <bool Ids> void run_templates(Worker& w, std::size_t b, std::size_t e);
@@ -154,32 +176,64 @@ class Rewriter {
         }
     }
 
+    // Copies m kinds without a library call for the short lengths templates have: two
+    // overlapping fixed-size copies cover any length between a size and its double.
+    static void copy_kinds(KindId* to, const KindId* from, std::size_t m) {
+        auto two = [&](auto block) {
+            constexpr std::size_t w = sizeof(block) / sizeof(KindId);
+            std::memcpy(&block, from, sizeof block);
+            std::memcpy(to, &block, sizeof block);
+            std::memcpy(&block, from + m - w, sizeof block);
+            std::memcpy(to + m - w, &block, sizeof block);
+        };
+        struct Sixteen {
+            std::uint64_t a, b;
+        };
+        if (m > 16)
+            std::memcpy(to, from, m * sizeof(KindId));
+        else if (m >= 8)
+            two(Sixteen{});
+        else if (m >= 4)
+            two(std::uint64_t{});
+        else if (m >= 2)
+            two(std::uint32_t{});
+        else if (m == 1)
+            to[0] = from[0];
+    }
+
     // put_template for a template whose numbers are affine functions of the predecessor's own
-    // (RulePlan::outcome_args): each computed from `a` (the module's numbers) and written in its
-    // place, without the frame. Numbers that are not finite are an error, as with check_holes;
-    // the test is folded into the loop (check_holes reads back values just stored one by one,
-    // which the processor cannot forward to its paired loads).
+    // (RulePlan::outcome_args), outcome o with RulePlan::Emit em: each computed from `a` (the
+    // module's numbers) and written in its place, without the frame. Numbers that are not
+    // finite are an error, as with check_holes; the test is folded into the loop (check_holes
+    // reads back values just stored one by one, which the processor cannot forward to its
+    // paired loads).
     template <bool Ids>
-    void put_affine(const SuccessorTemplate& t, const RulePlan::ArgHole* hs, const ModuleArgs& a,
-                    ModuleId kept, ModuleId& next_new, KindId* S, double* PA, ModuleId* ID) const {
-        const std::size_t m = t.syms.size();
-        if (m != 0) std::memcpy(S, t.kinds.data(), m * sizeof(KindId));
-        const std::size_t holes = t.holes.size();
-        if (t.stored.size() != holes) std::memcpy(PA, t.stored.data(), t.stored.size() * sizeof(double));
+    void put_affine(std::uint32_t o, const RulePlan::Emit& em, const ModuleArgs& a, ModuleId kept,
+                    ModuleId& next_new, KindId* S, double* PA, ModuleId* ID) const {
+        copy_kinds(S, em.kinds, em.m);
+        if (em.stored) std::memcpy(PA, em.stored, em.stored_n * sizeof(double));
+        const RulePlan::ArgHole* hs = plan.args.data() + em.holes_at;
+        const std::uint32_t holes = em.holes_n;
         double sum = 0;
-        for (std::size_t h = 0; h < holes; ++h) {
-            const double x = a[hs[h].from];
-            const double v = hs[h].add ? x + hs[h].constant : x * hs[h].constant;
-            sum += v * 0.0;
-            PA[hs[h].to] = v;
-        }
+        auto put = [&](const auto& x) {
+            for (std::uint32_t h = 0; h < holes; ++h) {
+                const double v = x[hs[h].from] * hs[h].mul + hs[h].add;
+                sum += v * 0.0;
+                PA[hs[h].to] = v;
+            }
+        };
+        if (const double* dense = a.dense())
+            put(dense);
+        else
+            put(a);
         if (sum != sum) [[unlikely]]
-            for (std::size_t h = 0; h < holes; ++h)
-                if (!std::isfinite(PA[hs[h].to])) hole_error(t, h, PA[hs[h].to]);
+            for (std::uint32_t h = 0; h < holes; ++h)
+                if (!std::isfinite(PA[hs[h].to])) hole_error(*plan.outcome_tmpl[o], h, PA[hs[h].to]);
         if constexpr (Ids) {
-            for (std::size_t j = 0; j < m; ++j) ID[j] = static_cast<int>(j) == t.keep ? kept : next_new++;
+            for (std::uint32_t j = 0; j < em.m; ++j)
+                ID[j] = static_cast<int>(j) == em.keep ? kept : next_new++;
         } else {
-            next_new += t.fresh();
+            next_new += em.fresh;
         }
     }
 

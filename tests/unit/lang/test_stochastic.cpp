@@ -2,6 +2,7 @@
 #include "plant/random.hpp"
 
 #include <catch2/catch.hpp>
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
@@ -149,6 +150,29 @@ TEST_CASE("guarded symbols on the direct path draw as the general path does", "[
         const std::string a = run_with(guarded, 3, threads), b = run_with(general.c_str(), 3, threads);
         CHECK(a.size() > 100000);
         CHECK(a == b);
+    }
+    // past RulePlan::kPickBits guards, pick_unlisted decides without the table: four more
+    // productions of A, after the others, that never apply
+    std::string more = guarded;
+    more.insert(more.find("F(l, w) : l > 0.3"), "A(l, w) : l > 100 -> X : 1; A(l, w) : l > 100 -> X : 2; "
+                                                "A(l, w) : l > 100 -> X; A(l, w) : l < -100 -> X : 1;\n");
+    CHECK(run_with(more.c_str(), 3, 2) == run_with(general.c_str(), 3, 2));
+}
+
+TEST_CASE("a guard's condition holds on the direct path exactly where the comparison does", "[stochastic]") {
+    // The direct path tests `x OP c` as an interval of x (RulePlan::Guard::holds), strict bounds
+    // moved to the next double; `|| 0` keeps the same comparison on the general path. Values on,
+    // just below and just above each constant, and both zeros, with every operator both ways.
+    const std::string axiom = "axiom: A(0.5) A(0.49999999999999994) A(0.5000000000000001) A(-0) A(0) "
+                              "A(-5e-324) A(5e-324) A(-1) A(1);";
+    for (const char* op : {"<", "<=", ">", ">=", "==", "!="}) {
+        auto grammar = [&](const char* tail) {
+            return fmt::format("derive 1; {} rules {{ A(x) : x {} 0.5{} -> B(x); A(x) : 0 {} x{} -> C(x); }}",
+                               axiom, op, tail, op, tail);
+        };
+        const std::string direct = run_with(grammar("").c_str(), 1, 1);
+        CAPTURE(op, direct);
+        CHECK(direct == run_with(grammar(" || 0").c_str(), 1, 1));
     }
 }
 
