@@ -113,7 +113,7 @@ struct Engine {
                    std::size_t& modules, std::size_t& params, std::size_t& new_ids) const;
     // slices.cpp: where each of T threads writes the output of its stretch of `in`, a string
     // `counts` describes, from the snapshots: exact or bounds as size_from_counts. False when
-    // the counts have no snapshots or cannot size the output.
+    // the counts cannot size the output.
     bool size_slices(const RulePlan& plan, const ModuleString& in, std::size_t T,
                      std::vector<std::size_t>& m_at, std::vector<std::size_t>& p_at,
                      std::vector<ModuleId>& id_at);

@@ -61,8 +61,10 @@ bool Engine::size_from(const RulePlan& plan, const std::vector<std::uint64_t>& p
 bool Engine::size_slices(const RulePlan& plan, const ModuleString& in, std::size_t T,
                          std::vector<std::size_t>& m_at, std::vector<std::size_t>& p_at,
                          std::vector<ModuleId>& id_at) {
+    // (no snapshots: every stretch of the last write was shorter than Rewriter::kSnapEvery; the
+    // symbols before each start are then counted from the string's start)
     const RulePlan* sp = counts.snap_plan;
-    if (!sp || counts.snap_pos.empty()) return false;
+    if (!sp) return false;
     const std::size_t n = in.size(), S = plan.has_prod.size(), O = sp->outcome_tmpl.size();
     const SymbolReader sym_of = in.symbols();
     std::vector<std::uint64_t> per_symbol(S);
