@@ -6,6 +6,7 @@
 #include "plant/streams.hpp"
 
 #include <algorithm>
+#include <type_traits>
 
 namespace plant {
 
@@ -87,10 +88,16 @@ const KindRow* kind_rows(const RulePlan& plan, const KindTable& kt, std::vector<
 // production from it on whose condition holds is a candidate and one is drawn by weight, with
 // the same arithmetic as Rewriter::choose (general.cpp), so that both routes draw alike.
 // (inline: only the writer and count_direct below call it)
-inline const RulePlan::Guard* Rewriter::pick_guarded(std::size_t i, const ModuleArgs& a,
-                                                     const RulePlan::Guarded& g) const {
-    if (a.size() != g.width) return nullptr; // no pattern matches
-    if (g.picks < 0) return pick_unlisted(i, a, g);
+template <typename Numbers>
+inline std::int32_t Rewriter::pick_guarded(std::size_t i, const Numbers& x, std::uint32_t arity,
+                                           const RulePlan::Guarded& g) const {
+    if (arity != g.width) return -1; // no pattern matches
+    if (g.picks < 0) {
+        if constexpr (std::is_same_v<Numbers, ModuleArgs>)
+            return pick_unlisted(i, x, g);
+        else
+            return pick_unlisted(i, ModuleArgs(x, arity), g);
+    }
     // which conditions hold, then the table (RulePlan::build_picks)
     const RulePlan::Guard* gs = plan.guards.data() + g.first;
     // (a guard without a condition reads parameter 0 and holds whatever it is; a module without
@@ -98,28 +105,27 @@ inline const RulePlan::Guard* Rewriter::pick_guarded(std::size_t i, const Module
     std::uint32_t mask = (1u << g.count) - 1;
     if (g.width != 0) {
         mask = 0;
-        for (std::uint32_t k = 0; k < g.count; ++k) mask |= std::uint32_t{gs[k].holds(a[gs[k].param])} << k;
+        for (std::uint32_t k = 0; k < g.count; ++k) mask |= std::uint32_t{gs[k].holds(x[gs[k].param])} << k;
     }
     const RulePlan::Pick& pk = plan.picks[static_cast<std::size_t>(g.picks) + mask];
-    if (pk.count == 0) return pk.only == RulePlan::kNone ? nullptr : gs + pk.only;
+    if (pk.count == 0) return pk.only == RulePlan::kNone ? -1 : static_cast<std::int32_t>(pk.only);
     const RulePlan::PickOption* o = plan.pick_options.data() + pk.first;
     double u = random_unit(random_bits_at(draw_phase, i, stream::kChoiceDraw)) * pk.total;
     for (std::uint32_t j = 0; j + 1 < pk.count; ++j) {
-        if (u < o[j].weight) return gs + o[j].guard;
+        if (u < o[j].weight) return static_cast<std::int32_t>(o[j].guard);
         u -= o[j].weight;
     }
-    return gs + o[pk.count - 1].guard;
+    return static_cast<std::int32_t>(o[pk.count - 1].guard);
 }
 
 // pick_guarded for a symbol with more guards than the table takes.
-const RulePlan::Guard* Rewriter::pick_unlisted(std::size_t i, const ModuleArgs& a,
-                                               const RulePlan::Guarded& g) const {
+std::int32_t Rewriter::pick_unlisted(std::size_t i, const ModuleArgs& a, const RulePlan::Guarded& g) const {
     const RulePlan::Guard* gs = plan.guards.data() + g.first;
     auto ok = [&](const RulePlan::Guard& q) { return g.width == 0 || q.holds(a[q.param]); };
     std::uint32_t k = 0;
     while (k < g.count && !ok(gs[k])) ++k;
-    if (k == g.count) return nullptr;
-    if (gs[k].weight < 0) return &gs[k];
+    if (k == g.count) return -1;
+    if (gs[k].weight < 0) return static_cast<std::int32_t>(k);
     const RulePlan::Guard* options[64];
     std::size_t count = 0;
     double total = 0;
@@ -128,7 +134,7 @@ const RulePlan::Guard* Rewriter::pick_unlisted(std::size_t i, const ModuleArgs& 
         options[count++] = &gs[j];
         total += gs[j].weight;
     }
-    if (count == 0) return nullptr;
+    if (count == 0) return -1;
     double scale = 1;
     if (!std::isfinite(total)) {
         double largest = 0;
@@ -147,7 +153,7 @@ const RulePlan::Guard* Rewriter::pick_unlisted(std::size_t i, const ModuleArgs& 
         }
         u -= weight;
     }
-    return options[pick];
+    return static_cast<std::int32_t>(options[pick] - gs);
 }
 
 Rewriter::Counts Rewriter::count_direct(std::size_t b, std::size_t e) const {
@@ -165,7 +171,8 @@ Rewriter::Counts Rewriter::count_direct(std::size_t b, std::size_t e) const {
         if (!pr) {
             const RulePlan::Guarded& g = plan.guarded[static_cast<std::size_t>(plan.guarded_at[s])];
             if (!g.uniform)
-                if (const RulePlan::Guard* q = pick_guarded(i, in.args_at(i, a), g)) pr = q->pr;
+                if (const std::int32_t k = pick_guarded(i, in.args_at(i, a), in.arity(i), g); k >= 0)
+                    pr = plan.guards[g.first + static_cast<std::uint32_t>(k)].pr;
             if (!pr) { // copied, or as large as a copy
                 ++c.modules;
                 c.params += in.stored(i);
@@ -228,14 +235,26 @@ std::size_t Rewriter::copy_run(const KindRow* rows, std::size_t i, std::size_t e
         const std::size_t m = i + patch_m[k];
         const KindRow& rm = rows[in_kinds[m]];
         const double* at = in_params + q + patch_p[k];
-        const ModuleArgs a = rm.dense ? ModuleArgs(at, rm.arity) : in.args_at(m, at);
         const RulePlan::Guarded& g = plan.guarded[static_cast<std::size_t>(rm.guarded)];
-        const RulePlan::Guard* gd = pick_guarded(m, a, g);
-        if (!gd) {
+        if (g.count == 1 && guards[g.first].weight < 0 && rm.dense) {
+            // one production, no draw (`F(l) : l > 0 -> F(l * 1.1)`): its condition, then the
+            // module's numbers in place (its kind and identity stay as copied)
+            const RulePlan::Guard& q1 = guards[g.first];
+            if (rm.arity == g.width && (g.width == 0 || q1.holds(at[q1.param]))) {
+                ++tally[rm.at + 1];
+                put_numbers(rm.at + 1, plan.emits[rm.at + 1], at, PA + patch_p[k]);
+            } else {
+                ++tally[rm.at];
+            }
+            continue;
+        }
+        const ModuleArgs a = rm.dense ? ModuleArgs(at, rm.arity) : in.args_at(m, at);
+        const std::int32_t gd = pick_guarded(m, a, rm.arity, g);
+        if (gd < 0) {
             ++tally[rm.at];
             continue;
         }
-        const auto o = rm.at + 1 + static_cast<std::uint32_t>(gd - (guards + g.first));
+        const auto o = rm.at + 1 + static_cast<std::uint32_t>(gd);
         ++tally[o];
         put_affine<Ids>(o, plan.emits[o], a, Ids ? in_ids[m] : 0, id_at, S + patch_m[k], PA + patch_p[k],
                         Ids ? ID + patch_m[k] : nullptr);
@@ -279,14 +298,6 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
     std::size_t next_check = b + kSnapEvery;
     const std::size_t outcomes = plan.outcome_tmpl.size();
     w.snaps.clear();
-    // module i's numbers, its parameters starting at `at`
-    auto args_of = [&](std::size_t j, const KindRow& r, const double* at) {
-        return r.dense ? ModuleArgs(at, r.arity) : in.args_at(j, at);
-    };
-    // the guard that applies to module j of guarded row r (see pick_guarded), or nullptr
-    auto pick = [&](std::size_t j, const KindRow& r, const ModuleArgs& a) {
-        return pick_guarded(j, a, guarded[static_cast<std::size_t>(r.guarded)]);
-    };
     // the next module that starts a block (ModuleString::block_at), as a position in `out`
     constexpr std::size_t B = ModuleString::kBlock;
     std::size_t next_block = (m_at + B - 1) & ~(B - 1);
@@ -310,10 +321,13 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
         const KindRow& r = rows[in_kinds[i]];
         const Production* prp = r.direct;
         std::uint32_t outcome = r.at + 1;
-        if (r.guarded >= 0) {
-            if (const RulePlan::Guard* gd = pick(i, r, args_of(i, r, in_params + q))) {
-                prp = gd->pr;
-                outcome += static_cast<std::uint32_t>(gd - (guards + guarded[r.guarded].first));
+        if (r.guarded >= 0) { // the guard that applies (see pick_guarded), if one does
+            const RulePlan::Guarded& g = guarded[static_cast<std::size_t>(r.guarded)];
+            const std::int32_t k = r.dense ? pick_guarded(i, in_params + q, r.arity, g)
+                                           : pick_guarded(i, in.args_at(i, in_params + q), r.arity, g);
+            if (k >= 0) {
+                prp = guards[g.first + static_cast<std::uint32_t>(k)].pr;
+                outcome += static_cast<std::uint32_t>(k);
             }
         }
         if (!prp) { // a run of modules without productions (or none that applies): copy it
@@ -334,7 +348,11 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
         const RulePlan::Emit& em = emits[outcome];
         std::uint32_t m = 0, stored = 0;
         if (em.kinds) {
-            put_affine<Ids>(outcome, em, args_of(i, r, in_params + q), Ids ? in_ids[i] : 0, id_at, S, PA, ID);
+            if (r.dense)
+                put_affine<Ids>(outcome, em, in_params + q, Ids ? in_ids[i] : 0, id_at, S, PA, ID);
+            else
+                put_affine<Ids>(outcome, em, in.args_at(i, in_params + q), Ids ? in_ids[i] : 0, id_at, S, PA,
+                                ID);
             m = em.m;
             stored = em.stored_n;
         } else {

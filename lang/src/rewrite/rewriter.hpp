@@ -122,11 +122,14 @@ class Rewriter {
                         std::size_t p_at, ModuleId id_at, std::uint64_t* tally);
 
     // The production a guarded symbol's module i gets (see RulePlan::Guarded), decided as
-    // apply() and choose() would decide it; nullptr: none applies, the module is copied.
-    // a: module i's parameters
-    const RulePlan::Guard* pick_guarded(std::size_t i, const ModuleArgs& a, const RulePlan::Guarded& g) const;
-    [[gnu::noinline]] const RulePlan::Guard* pick_unlisted(std::size_t i, const ModuleArgs& a,
-                                                           const RulePlan::Guarded& g) const;
+    // apply() and choose() would decide it: its guard's index among the symbol's, or -1 when
+    // none applies and the module is copied. x: module i's numbers (an array when all are
+    // stored, else its ModuleArgs), `arity` of them.
+    template <typename Numbers>
+    std::int32_t pick_guarded(std::size_t i, const Numbers& x, std::uint32_t arity,
+                              const RulePlan::Guarded& g) const;
+    [[gnu::noinline]] std::int32_t pick_unlisted(std::size_t i, const ModuleArgs& a,
+                                                 const RulePlan::Guarded& g) const;
     // The seed and phase of the step's random draws (weighted choice on the direct path).
     void set_draws(std::uint64_t seed, std::uint64_t phase) { draw_phase = random_phase(seed, phase); }
 
@@ -202,39 +205,39 @@ class Rewriter {
     }
 
     // put_template for a template whose numbers are affine functions of the predecessor's own
-    // (RulePlan::outcome_args), outcome o with RulePlan::Emit em: each computed from `a` (the
+    // (RulePlan::outcome_args), outcome o with RulePlan::Emit em: each computed from `x` (the
     // module's numbers) and written in its place, without the frame. Numbers that are not
     // finite are an error, as with check_holes; the test is folded into the loop (check_holes
     // reads back values just stored one by one, which the processor cannot forward to its
     // paired loads).
-    template <bool Ids>
-    void put_affine(std::uint32_t o, const RulePlan::Emit& em, const ModuleArgs& a, ModuleId kept,
+    template <bool Ids, typename Numbers>
+    void put_affine(std::uint32_t o, const RulePlan::Emit& em, const Numbers& x, ModuleId kept,
                     ModuleId& next_new, KindId* S, double* PA, ModuleId* ID) const {
         copy_kinds(S, em.kinds, em.m);
         if (em.stored) std::memcpy(PA, em.stored, em.stored_n * sizeof(double));
-        const RulePlan::ArgHole* hs = plan.args.data() + em.holes_at;
-        const std::uint32_t holes = em.holes_n;
-        double sum = 0;
-        auto put = [&](const auto& x) {
-            for (std::uint32_t h = 0; h < holes; ++h) {
-                const double v = x[hs[h].from] * hs[h].mul + hs[h].add;
-                sum += v * 0.0;
-                PA[hs[h].to] = v;
-            }
-        };
-        if (const double* dense = a.dense())
-            put(dense);
-        else
-            put(a);
-        if (sum != sum) [[unlikely]]
-            for (std::uint32_t h = 0; h < holes; ++h)
-                if (!std::isfinite(PA[hs[h].to])) hole_error(*plan.outcome_tmpl[o], h, PA[hs[h].to]);
+        put_numbers(o, em, x, PA);
         if constexpr (Ids) {
             for (std::uint32_t j = 0; j < em.m; ++j)
                 ID[j] = static_cast<int>(j) == em.keep ? kept : next_new++;
         } else {
             next_new += em.fresh;
         }
+    }
+    // put_affine's computed numbers alone, from x (the module's numbers: an array, or its
+    // ModuleArgs), into PA.
+    template <typename Numbers>
+    void put_numbers(std::uint32_t o, const RulePlan::Emit& em, const Numbers& x, double* PA) const {
+        const RulePlan::ArgHole* hs = plan.args.data() + em.holes_at;
+        const std::uint32_t holes = em.holes_n;
+        double sum = 0;
+        for (std::uint32_t h = 0; h < holes; ++h) {
+            const double v = x[hs[h].from] * hs[h].mul + hs[h].add;
+            sum += v * 0.0;
+            PA[hs[h].to] = v;
+        }
+        if (sum != sum) [[unlikely]]
+            for (std::uint32_t h = 0; h < holes; ++h)
+                if (!std::isfinite(PA[hs[h].to])) hole_error(*plan.outcome_tmpl[o], h, PA[hs[h].to]);
     }
 
     // Binds the numbers of module i, whose stored ones start at `at`, to the names of pattern

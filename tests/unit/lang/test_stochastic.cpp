@@ -176,6 +176,35 @@ TEST_CASE("a guard's condition holds on the direct path exactly where the compar
     }
 }
 
+TEST_CASE("modules rewritten in place inside copied runs match the general path", "[stochastic][threads]") {
+    // G, H and K rewrite a module into one of its own kind, so the direct path copies them with
+    // the runs around them and then writes their numbers in place (Rewriter::copy_run): H and K
+    // with one production and no draw, G drawn between two. `x - c < 0` keeps the same
+    // conditions on the general path.
+    const char* direct = R"(
+        derive 11;
+        seed 4;
+        axiom: A(1) G(1, 2) H(1);
+        rules {
+          A(x) -> [ G(x, x) ] H(x) A(x * 1.1) [ K(x) ] K(x);
+          G(x, y) : x < 3 -> G(x * 1.5, y + 1) : 1;
+          G(x, y) : x < 3 -> G(x * 0.5, y) : 2;
+          H(x) : x < 2 -> H(x + 0.25);
+          K(x) : x < 1.5 -> K(x * 1.1);
+        })";
+    std::string general = direct;
+    for (auto [from, to] :
+         {std::pair{"x < 3", "x - 3 < 0"}, {"x < 2", "x - 2 < 0"}, {"x < 1.5", "x - 1.5 < 0"}}) {
+        for (std::size_t at = general.find(from); at != std::string::npos; at = general.find(from, at))
+            general.replace(at, std::string(from).size(), to);
+    }
+    for (int threads : {1, 2}) {
+        const std::string a = run_with(direct, 4, threads);
+        CHECK(a.size() > 1000);
+        CHECK(a == run_with(general.c_str(), 4, threads));
+    }
+}
+
 TEST_CASE("output sized from the last step's tallies matches the general path", "[stochastic]") {
     // On one thread the direct path sizes a step's output from what the step before tallied
     // (Engine::counts) rather than counting: here with modules of A that carry no parameter
