@@ -121,8 +121,6 @@ class ModuleArgs {
     }
     std::uint32_t size() const { return n_; }
     bool empty() const { return n_ == 0; }
-    // The numbers as one array, when every one is stored (nullptr for a kind with constants).
-    const double* dense() const { return slot_ ? nullptr : p_; }
     // Copies the numbers to out[0 .. size()).
     void copy_to(double* out) const {
         for (std::uint32_t k = 0; k < n_; ++k) out[k] = (*this)[k];

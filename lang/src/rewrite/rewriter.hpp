@@ -182,6 +182,7 @@ class Rewriter {
     // Copies m kinds without a library call for the short lengths templates have: two
     // overlapping fixed-size copies cover any length between a size and its double.
     static void copy_kinds(KindId* to, const KindId* from, std::size_t m) {
+        static_assert(sizeof(KindId) == 2, "the size classes below assume 2-byte kinds");
         auto two = [&](auto block) {
             constexpr std::size_t w = sizeof(block) / sizeof(KindId);
             std::memcpy(&block, from, sizeof block);
