@@ -39,8 +39,9 @@ namespace {
 // Whether a module of table kind k, of symbol s, can be copied with a run and then have its
 // numbers rewritten in place (KindRow::kPatch): s is guarded, and whichever of its productions
 // applies writes one module of kind k, every stored number of which is computed from the
-// module's own (RulePlan::outcome_args). So a rule such as `F(l) : l > 0 -> F(l * 1.1)` does
-// not cut the runs of copied modules around each F.
+// module's own (RulePlan::outcome_args), so that its kind and identity stay as copied. So a
+// rule such as `F(l) : l > 0 -> F(l * 1.1)` does not cut the runs of copied modules around each
+// F. (kind_rows asks it only of kinds that store all their numbers.)
 bool patchable(const RulePlan& plan, SymbolId s, KindId k) {
     if (plan.guarded_at[s] < 0) return false;
     const RulePlan::Guarded& g = plan.guarded[static_cast<std::size_t>(plan.guarded_at[s])];
@@ -77,7 +78,7 @@ const KindRow* kind_rows(const RulePlan& plan, const KindTable& kt, std::vector<
         }
         r.direct = plan.direct[s];
         if (!r.direct) r.guarded = plan.guarded_at[s];
-        if (!plain && patchable(plan, s, static_cast<KindId>(k))) r.copy = KindRow::kPatch;
+        if (!plain && r.dense && patchable(plan, s, static_cast<KindId>(k))) r.copy = KindRow::kPatch;
     }
     return rows.data();
 }
@@ -195,8 +196,7 @@ Rewriter::Counts Rewriter::count_direct(std::size_t b, std::size_t e) const {
 // run, its parameters' count in np.
 template <bool Ids>
 std::size_t Rewriter::copy_run(const KindRow* rows, std::size_t i, std::size_t e, std::size_t q, KindId* S,
-                               double* PA, ModuleId* ID, ModuleId& id_at, std::uint64_t* tally,
-                               std::uint32_t& np) const {
+                               double* PA, ModuleId* ID, std::uint64_t* tally, std::uint32_t& np) const {
     const KindId* in_kinds = in.kinds.data();
     const double* in_params = in.params.data();
     const ModuleId* in_ids = Ids ? in.ids.data() : nullptr;
@@ -230,34 +230,15 @@ std::size_t Rewriter::copy_run(const KindRow* rows, std::size_t i, std::size_t e
         if constexpr (Ids) std::memcpy(ID, in_ids + i, n * sizeof(ModuleId));
         if (np) std::memcpy(PA, in_params + q, np * sizeof(double));
     }
-    const RulePlan::Guard* guards = plan.guards.data();
     for (std::uint32_t k = 0; k < patches; ++k) { // as the top of write_direct's loop would
         const std::size_t m = i + patch_m[k];
         const KindRow& rm = rows[in_kinds[m]];
-        const double* at = in_params + q + patch_p[k];
+        const double* at = in_params + q + patch_p[k]; // all its numbers (the row is dense)
         const RulePlan::Guarded& g = plan.guarded[static_cast<std::size_t>(rm.guarded)];
-        if (g.count == 1 && guards[g.first].weight < 0 && rm.dense) {
-            // one production, no draw (`F(l) : l > 0 -> F(l * 1.1)`): its condition, then the
-            // module's numbers in place (its kind and identity stay as copied)
-            const RulePlan::Guard& q1 = guards[g.first];
-            if (rm.arity == g.width && (g.width == 0 || q1.holds(at[q1.param]))) {
-                ++tally[rm.at + 1];
-                put_numbers(rm.at + 1, plan.emits[rm.at + 1], at, PA + patch_p[k]);
-            } else {
-                ++tally[rm.at];
-            }
-            continue;
-        }
-        const ModuleArgs a = rm.dense ? ModuleArgs(at, rm.arity) : in.args_at(m, at);
-        const std::int32_t gd = pick_guarded(m, a, rm.arity, g);
-        if (gd < 0) {
-            ++tally[rm.at];
-            continue;
-        }
-        const auto o = rm.at + 1 + static_cast<std::uint32_t>(gd);
+        const std::int32_t gd = pick_guarded(m, at, rm.arity, g);
+        const std::uint32_t o = gd < 0 ? rm.at : rm.at + 1 + static_cast<std::uint32_t>(gd);
         ++tally[o];
-        put_affine<Ids>(o, plan.emits[o], a, Ids ? in_ids[m] : 0, id_at, S + patch_m[k], PA + patch_p[k],
-                        Ids ? ID + patch_m[k] : nullptr);
+        if (gd >= 0) put_numbers(o, plan.emits[o], at, PA + patch_p[k]);
     }
     return j;
 }
@@ -333,7 +314,7 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
         if (!prp) { // a run of modules without productions (or none that applies): copy it
             ++tally[r.at];
             std::uint32_t np = 0;
-            const std::size_t j = copy_run<Ids>(rows, i, e, q, S, PA, ID, id_at, tally, np);
+            const std::size_t j = copy_run<Ids>(rows, i, e, q, S, PA, ID, tally, np);
             const std::size_t n = j - i;
             marks(S, n, p);
             S += n;

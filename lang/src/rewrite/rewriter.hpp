@@ -140,8 +140,7 @@ class Rewriter {
   private:
     template <bool Ids>
     std::size_t copy_run(const KindRow* rows, std::size_t i, std::size_t e, std::size_t q, KindId* S,
-                         double* PA, ModuleId* ID, ModuleId& id_at, std::uint64_t* tally,
-                         std::uint32_t& np) const;
+                         double* PA, ModuleId* ID, std::uint64_t* tally, std::uint32_t& np) const;
     template <bool Ids>
     Counts write_direct(Worker& w, std::size_t b, std::size_t e, ModuleString& out, std::size_t m_at,
                         std::size_t p_at, ModuleId id_at, std::uint64_t* tally);
