@@ -58,11 +58,14 @@ bool patchable(const RulePlan& plan, SymbolId s, KindId k) {
 // The writer's table of kinds (KindRow), in `rows`. A run of copied modules is read with one
 // table load a module (the kind's) instead of three for its symbol (the symbol, whether it has
 // productions, its copy's outcome).
-const KindRow* kind_rows(const RulePlan& plan, const KindTable& kt, std::vector<KindRow>& rows) {
+const KindRow* kind_rows(const RulePlan& plan, const KindTable& kt, std::vector<KindRow>& rows,
+                         std::vector<PatchOne>& ones) {
     // (a symbol past the plan's cannot be in the string: the kinds of a string made without a
     // program, 0x8000 plain ones, are left at kNoCopy past the plan's symbols)
     const std::size_t symbols = plan.has_prod.size(), kinds = kt.stored.size();
     rows.assign(kinds, KindRow{});
+    ones.clear();
+    std::vector<std::size_t> one_of; // the kinds that get ones[k], in order
     for (std::size_t k = 0; k < kinds; ++k) {
         const bool plain = k < kt.plain;
         const SymbolId s = plain ? static_cast<SymbolId>(k) : kt.symbol[k - kt.plain];
@@ -78,8 +81,19 @@ const KindRow* kind_rows(const RulePlan& plan, const KindTable& kt, std::vector<
         }
         r.direct = plan.direct[s];
         if (!r.direct) r.guarded = plan.guarded_at[s];
-        if (!plain && r.dense && patchable(plan, s, static_cast<KindId>(k))) r.copy = KindRow::kPatch;
+        if (plain || !r.dense || !patchable(plan, s, static_cast<KindId>(k))) continue;
+        r.copy = KindRow::kPatch;
+        // one guard, and no draw: its pick table holds no guard for none and it for all
+        const RulePlan::Guarded& g = plan.guarded[static_cast<std::size_t>(r.guarded)];
+        const RulePlan::Pick* pk = plan.picks.data() + g.picks;
+        if (g.count == 1 && g.tests_n == 1 && g.width == r.arity && pk[0].count == 0 &&
+            pk[0].only == RulePlan::kNone && pk[1].count == 0 && pk[1].only == 0) {
+            const RulePlan::Emit& em = plan.emits[r.at + 1];
+            ones.push_back({plan.guards[g.first], plan.moved.data() + em.moved_at, em.moved_n, r.at});
+            one_of.push_back(k);
+        }
     }
+    for (std::size_t j = 0; j < ones.size(); ++j) rows[one_of[j]].one = &ones[j]; // (ones is complete)
     return rows.data();
 }
 
@@ -99,16 +113,12 @@ inline std::int32_t Rewriter::pick_guarded(std::size_t i, const Numbers& x, std:
         else
             return pick_unlisted(i, ModuleArgs(x, arity), g);
     }
-    // which conditions hold, then the table (RulePlan::build_picks)
-    const RulePlan::Guard* gs = plan.guards.data() + g.first;
-    // (a guard without a condition reads parameter 0 and holds whatever it is; a module without
-    // parameters has no conditions)
-    std::uint32_t mask = (1u << g.count) - 1;
-    if (g.width != 0) {
-        mask = 0;
-        for (std::uint32_t k = 0; k < g.count; ++k) mask |= std::uint32_t{gs[k].holds(x[gs[k].param])} << k;
-    }
-    const RulePlan::Pick& pk = plan.picks[static_cast<std::size_t>(g.picks) + mask];
+    // which of the symbol's intervals hold their parameters, then the table (RulePlan::build_picks;
+    // a module without parameters has no conditions, so no tests)
+    const RulePlan::Test* ts = plan.tests.data() + g.tests_first;
+    std::uint32_t inside = 0;
+    for (std::uint32_t k = 0; k < g.tests_n; ++k) inside |= std::uint32_t{ts[k].inside(x[ts[k].param])} << k;
+    const RulePlan::Pick& pk = plan.picks[static_cast<std::size_t>(g.picks) + inside];
     if (pk.count == 0) return pk.only == RulePlan::kNone ? -1 : static_cast<std::int32_t>(pk.only);
     const RulePlan::PickOption* o = plan.pick_options.data() + pk.first;
     double u = random_unit(random_bits_at(draw_phase, i, stream::kChoiceDraw)) * pk.total;
@@ -205,10 +215,12 @@ std::size_t Rewriter::copy_run(const KindRow* rows, std::size_t i, std::size_t e
     // the patchable modules of the run: where they are in it, and their numbers
     constexpr std::uint32_t kMaxPatches = 8;
     std::uint32_t patches = 0, patch_m[kMaxPatches], patch_p[kMaxPatches];
+    const KindRow* patch_r[kMaxPatches];
     for (; j < e; ++j) {
         const KindRow& rj = rows[in_kinds[j]];
         if (rj.copy >= KindRow::kPatch) {
             if (rj.copy == KindRow::kNoCopy || patches == kMaxPatches) break;
+            patch_r[patches] = &rj;
             patch_m[patches] = static_cast<std::uint32_t>(j - i);
             patch_p[patches++] = np;
         } else {
@@ -230,15 +242,22 @@ std::size_t Rewriter::copy_run(const KindRow* rows, std::size_t i, std::size_t e
         if constexpr (Ids) std::memcpy(ID, in_ids + i, n * sizeof(ModuleId));
         if (np) std::memcpy(PA, in_params + q, np * sizeof(double));
     }
+    const RulePlan::Emit* emits = plan.emits.data();
     for (std::uint32_t k = 0; k < patches; ++k) { // as the top of write_direct's loop would
-        const std::size_t m = i + patch_m[k];
-        const KindRow& rm = rows[in_kinds[m]];
+        const KindRow& rm = *patch_r[k];
         const double* at = in_params + q + patch_p[k]; // all its numbers (the row is dense)
+        if (const PatchOne* one = rm.one) {
+            const bool holds = one->guard.holds(at[one->guard.param]);
+            ++tally[one->at + holds];
+            if (holds) put_moved(*one, at, PA + patch_p[k]);
+            continue;
+        }
+        const std::size_t m = i + patch_m[k];
         const RulePlan::Guarded& g = plan.guarded[static_cast<std::size_t>(rm.guarded)];
         const std::int32_t gd = pick_guarded(m, at, rm.arity, g);
         const std::uint32_t o = gd < 0 ? rm.at : rm.at + 1 + static_cast<std::uint32_t>(gd);
         ++tally[o];
-        if (gd >= 0) put_numbers(o, plan.emits[o], at, PA + patch_p[k]);
+        if (gd >= 0) put_numbers(o, emits[o], at, PA + patch_p[k]);
     }
     return j;
 }
@@ -260,7 +279,7 @@ Rewriter::Counts Rewriter::write_direct(Worker& w, std::size_t b, std::size_t e,
     w.frame.assign(plan.frame_size, 0.0);
     // the tables, read through local copies (members read through `in` or `plan` would be
     // reloaded after every store)
-    const KindRow* rows = kind_rows(plan, *in.kind_table, w.kind_rows);
+    const KindRow* rows = kind_rows(plan, *in.kind_table, w.kind_rows, w.patch_ones);
     const KindId* in_kinds = in.kinds.data();
     const double* in_params = in.params.data();
     const ModuleId* in_ids = Ids ? in.ids.data() : nullptr;

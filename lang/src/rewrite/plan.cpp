@@ -3,6 +3,7 @@
 #include "plan.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -233,10 +234,37 @@ bool RulePlan::build_guards(SymbolId sym) {
 // it that hold, zero weights left out, with the weights scaled down together when their sum
 // overflows.
 void RulePlan::build_picks(Guarded& g) {
-    if (g.count > kPickBits) return;
+    // the distinct intervals (bit for bit); a guard without a condition (an interval that holds
+    // nothing, negated: lo is NaN) needs none
+    Guard* gs = guards.data() + g.first;
+    std::vector<Test> ts;
+    for (std::uint32_t k = 0; k < g.count; ++k) {
+        Guard& q = gs[k];
+        if (std::isnan(q.lo) && q.negate) {
+            q.test = kNone;
+            continue;
+        }
+        const Test t{q.param, q.lo, q.hi};
+        std::uint32_t j = 0;
+        while (j < ts.size() &&
+               !(ts[j].param == t.param &&
+                 std::bit_cast<std::uint64_t>(ts[j].lo) == std::bit_cast<std::uint64_t>(t.lo) &&
+                 std::bit_cast<std::uint64_t>(ts[j].hi) == std::bit_cast<std::uint64_t>(t.hi)))
+            ++j;
+        if (j == ts.size()) ts.push_back(t);
+        q.test = j;
+    }
+    if (ts.size() > kPickBits) return;
+    g.tests_first = static_cast<std::uint32_t>(tests.size());
+    g.tests_n = static_cast<std::uint32_t>(ts.size());
+    tests.insert(tests.end(), ts.begin(), ts.end());
     g.picks = static_cast<std::int32_t>(picks.size());
-    const Guard* gs = guards.data() + g.first;
-    for (std::uint32_t mask = 0; mask < (1u << g.count); ++mask) {
+    for (std::uint32_t inside = 0; inside < (1u << g.tests_n); ++inside) {
+        // which guards hold (bit k: guard k's) when the intervals in `inside` hold their parameters
+        std::uint64_t mask = 0;
+        for (std::uint32_t k = 0; k < g.count; ++k)
+            if (gs[k].test == kNone || (inside >> gs[k].test & 1) != gs[k].negate)
+                mask |= std::uint64_t{1} << k;
         Pick pk;
         std::uint32_t k = 0;
         while (k < g.count && !(mask >> k & 1)) ++k;
@@ -297,6 +325,13 @@ void RulePlan::build_outcomes() {
         em.holes_at = static_cast<std::uint32_t>(outcome_args[o]);
         em.fresh = static_cast<std::uint32_t>(t->fresh());
         em.keep = t->keep;
+        em.moved_at = static_cast<std::uint32_t>(moved.size());
+        if (em.m != 1 || em.stored || outcome_sym[o] != t->syms[0]) continue;
+        for (std::uint32_t h = 0; h < em.holes_n; ++h) {
+            const ArgHole& a = args[em.holes_at + h];
+            if (a.from != a.to || a.mul != 1 || a.add != 0 || !std::signbit(a.add)) moved.push_back(a);
+        }
+        em.moved_n = static_cast<std::uint32_t>(moved.size()) - em.moved_at;
     }
 }
 

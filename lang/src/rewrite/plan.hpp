@@ -17,6 +17,7 @@ namespace plant {
 bool reads_queries(const Program& p, const RuleSet& rs);
 
 struct RulePlan {
+    static constexpr std::uint32_t kNone = ~std::uint32_t{0};
     RulePlan(const Program& p, std::vector<const RuleSet*> rule_sets);
 
     // The symbol kernel's tables (see Rewriter::run_symbols). Every symbol has a row, and a
@@ -83,24 +84,36 @@ struct RulePlan {
         double lo = std::numeric_limits<double>::quiet_NaN(), hi = 0;
         bool negate = true;
         bool holds(double x) const { return ((x >= lo) & (x <= hi)) != negate; }
+        std::uint32_t test = 0; // its interval among its symbol's tests (kNone: it always holds)
+    };
+    // The distinct intervals of a symbol's guards (see build_picks): several conditions often
+    // share one (`l >= 0.5` in two productions, `l < 0.5` in a third), and the table of
+    // outcomes is indexed by which of these hold, each tested once.
+    struct Test {
+        std::uint32_t param = 0;
+        double lo = 0, hi = 0;
+        bool inside(double x) const { return (x >= lo) & (x <= hi); }
     };
     struct Guarded {
         std::uint32_t first = 0, count = 0; // its guards, in the order apply() tries them
         std::uint32_t width = 0;            // the parameters every pattern of the symbol takes
         bool uniform = false;               // every outcome (a production or the copy) writes as much
-        // Up to kPickBits guards: the entry in `picks` of the first of its 2^count outcomes of
-        // the conditions, indexed by which hold (bit k: guard k's); -1 for more guards.
+        // Up to kPickBits distinct intervals (`tests` from tests_first on): the entry in
+        // `picks` of the first of its 2^tests_n outcomes, indexed by which intervals hold the
+        // parameter they test (bit k: test k's); -1 for more.
         std::int32_t picks = -1;
+        std::uint32_t tests_first = 0, tests_n = 0;
     };
     std::vector<std::int32_t> guarded_at; // per symbol: its entry in `guarded`, or -1
     std::vector<Guarded> guarded;
     std::vector<Guard> guards;
+    std::vector<Test> tests;
     // What a guarded module becomes when a given set of its conditions holds (see
     // Rewriter::pick_guarded): the one guard that applies (`only`, among the symbol's), none
     // (kNone, no options), or a draw among the options from `first` on in `pick_options`, by
     // the weights there (each already scaled, and `total` their sum, as Rewriter::choose
     // computes them).
-    static constexpr std::uint32_t kPickBits = 6, kNone = ~std::uint32_t{0};
+    static constexpr std::uint32_t kPickBits = 6;
     struct Pick {
         std::uint32_t only = kNone;
         std::uint32_t first = 0, count = 0;
@@ -136,13 +149,19 @@ struct RulePlan {
     // Per outcome whose numbers are affine, what Rewriter::put_affine writes, read from one
     // place: the template's kinds and stored numbers (nullptr when every one is computed), its
     // holes from holes_at on in `args`, and the modules that get new identities.
+    // For an outcome that writes one module of its predecessor's symbol with every stored
+    // number a hole, the holes that change a number when that module is rewritten in place (a
+    // patched module, Rewriter::copy_run): from moved_at on in `moved`, moved_n of them. A hole
+    // that takes the number at its own place unchanged (x * 1 + (-0.0)) keeps it as copied.
     struct Emit {
         const KindId* kinds = nullptr;
         const double* stored = nullptr;
         std::uint32_t m = 0, stored_n = 0, holes_at = 0, holes_n = 0, fresh = 0;
         std::int32_t keep = -1;
+        std::uint32_t moved_at = 0, moved_n = 0;
     };
     std::vector<Emit> emits;
+    std::vector<ArgHole> moved;
     // Whether a step must rewrite on one thread, left to right (or right to left for `>>`).
     bool sequential() const { return multi || left_new || right_new; }
     std::size_t max_modules_out = 1; // the longest template's modules (at least 1: a copy)

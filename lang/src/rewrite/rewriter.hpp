@@ -29,10 +29,19 @@ constexpr std::int64_t kUnknown = -2;
 // template, else its entry in RulePlan::guarded (-1: none, or a direct template); `copy`, the
 // outcome of copying it when its symbol has no productions, else kPatch or kNoCopy (see
 // write_direct); its symbol's first outcome (RulePlan::outcome_at); its numbers and how many of
-// them are stored, and whether all of them are (its ModuleArgs are then one array).
+// them are stored, and whether all of them are (its ModuleArgs are then one array). For a
+// patched kind whose symbol has one guard and no draw, `one` is all that a copied run needs of
+// it (Rewriter::copy_run).
+struct PatchOne {
+    RulePlan::Guard guard;                    // the module is rewritten where it holds,
+    const RulePlan::ArgHole* moved = nullptr; // these numbers changed (RulePlan::Emit::moved)
+    std::uint32_t moved_n = 0;
+    std::uint32_t at = 0; // the outcome of its copy (its rewrite's is the next)
+};
 struct KindRow {
     static constexpr std::uint32_t kNoCopy = ~std::uint32_t{0}, kPatch = kNoCopy - 1;
     const Production* direct = nullptr;
+    const PatchOne* one = nullptr;
     std::int32_t guarded = -1;
     std::uint32_t copy = kNoCopy;
     std::uint32_t at = 0;
@@ -57,8 +66,9 @@ struct Worker {
     // write_direct's snapshots, one every kSnapEvery modules read: where the output stood
     // (modules written so far), then the tally of every outcome so far (Engine::counts).
     std::vector<std::uint64_t> snaps;
-    // write_direct's table of the kinds (see KindRow)
+    // write_direct's table of the kinds (see KindRow), and its kinds' PatchOne
     std::vector<KindRow> kind_rows;
+    std::vector<PatchOne> patch_ones;
 };
 
 class Rewriter {
@@ -223,6 +233,21 @@ class Rewriter {
             next_new += em.fresh;
         }
     }
+    // put_numbers for a module rewritten in place (RulePlan::Emit::moved): only the numbers
+    // that change. A number that is not finite is reported by put_numbers, as it would be.
+    void put_moved(const PatchOne& one, const double* x, double* PA) const {
+        const RulePlan::ArgHole* hs = one.moved;
+        double sum = 0;
+        for (std::uint32_t h = 0; h < one.moved_n; ++h) {
+            const double v = x[hs[h].from] * hs[h].mul + hs[h].add;
+            sum += v;
+            PA[hs[h].to] = v;
+        }
+        if (sum - sum != 0) [[unlikely]] { // (see put_numbers)
+            const std::uint32_t o = one.at + 1;
+            put_numbers(o, plan.emits[o], x, PA);
+        }
+    }
     // put_affine's computed numbers alone, from x (the module's numbers: an array, or its
     // ModuleArgs), into PA.
     template <typename Numbers>
@@ -232,10 +257,12 @@ class Rewriter {
         double sum = 0;
         for (std::uint32_t h = 0; h < holes; ++h) {
             const double v = x[hs[h].from] * hs[h].mul + hs[h].add;
-            sum += v * 0.0;
+            sum += v;
             PA[hs[h].to] = v;
         }
-        if (sum != sum) [[unlikely]]
+        // the sum is not finite when a number is not (inf - inf and NaN are NaN), or, rarely,
+        // when finite numbers overflow it; then the numbers themselves are looked at
+        if (sum - sum != 0) [[unlikely]]
             for (std::uint32_t h = 0; h < holes; ++h)
                 if (!std::isfinite(PA[hs[h].to])) hole_error(*plan.outcome_tmpl[o], h, PA[hs[h].to]);
     }

@@ -151,11 +151,13 @@ TEST_CASE("guarded symbols on the direct path draw as the general path does", "[
         CHECK(a.size() > 100000);
         CHECK(a == b);
     }
-    // past RulePlan::kPickBits guards, pick_unlisted decides without the table: four more
-    // productions of A, after the others, that never apply
+    // past RulePlan::kPickBits distinct intervals, pick_unlisted decides without the table: five
+    // more productions of A, after the others, that never apply (the first four's three
+    // conditions are two intervals, tested once each: 7 in all)
     std::string more = guarded;
-    more.insert(more.find("F(l, w) : l > 0.3"), "A(l, w) : l > 100 -> X : 1; A(l, w) : l > 100 -> X : 2; "
-                                                "A(l, w) : l > 100 -> X; A(l, w) : l < -100 -> X : 1;\n");
+    more.insert(more.find("F(l, w) : l > 0.3"), "A(l, w) : l > 100 -> X : 1; A(l, w) : l > 101 -> X : 2; "
+                                                "A(l, w) : l > 102 -> X; A(l, w) : l > 103 -> X; "
+                                                "A(l, w) : l < -100 -> X : 1;\n");
     CHECK(run_with(more.c_str(), 3, 2) == run_with(general.c_str(), 3, 2));
 }
 
