@@ -286,4 +286,23 @@ TEST_CASE("a number that overflows on the direct path is named as on the general
         CHECK_THROWS_WITH(d1.run(), "step 2: parameter 1 of 'A' is infinite");
         CHECK_THROWS_WITH(d2.run(), "step 3: parameter 2 of 'A' is infinite");
     }
+    // a module rewritten in place inside a copied run (one guard, no draw: Rewriter::put_moved),
+    // and on the general path (`x - 0 > 0`)
+    for (const char* cond : {"x > 0", "x - 0 > 0"}) {
+        auto c = test::compile(std::string("axiom: X G(1e300, 1) X; derive 3; rules { G(x, y) : ") + cond +
+                               " -> G(x * 1e5, y); }");
+        REQUIRE(c->program);
+        Derivation d(*c->program, {});
+        CHECK_THROWS_WITH(d.run(), "step 2: parameter 1 of 'G' is infinite");
+    }
+    // two finite numbers whose sum overflows: the test of the sum is only a first look, and no
+    // number is reported
+    for (const char* cond : {"x > 0", "x - 0 > 0"}) {
+        auto c = test::compile(std::string("axiom: X G(1.7e308, 1.7e308) X; derive 2; rules { G(x, y) : ") +
+                               cond + " -> G(x + 0.5, y + 0.5); }");
+        REQUIRE(c->program);
+        Derivation d(*c->program, {});
+        CHECK_NOTHROW(d.run());
+        CHECK(d.string().size() == 3);
+    }
 }
