@@ -65,7 +65,7 @@ const KindRow* kind_rows(const RulePlan& plan, const KindTable& kt, std::vector<
     const std::size_t symbols = plan.has_prod.size(), kinds = kt.stored.size();
     rows.assign(kinds, KindRow{});
     ones.clear();
-    std::vector<std::size_t> one_of; // the kinds that get ones[k], in order
+    ones.reserve(kinds); // (so the rows' pointers into it stay valid)
     for (std::size_t k = 0; k < kinds; ++k) {
         const bool plain = k < kt.plain;
         const SymbolId s = plain ? static_cast<SymbolId>(k) : kt.symbol[k - kt.plain];
@@ -89,11 +89,10 @@ const KindRow* kind_rows(const RulePlan& plan, const KindTable& kt, std::vector<
         if (g.count == 1 && g.tests_n == 1 && g.width == r.arity && pk[0].count == 0 &&
             pk[0].only == RulePlan::kNone && pk[1].count == 0 && pk[1].only == 0) {
             const RulePlan::Emit& em = plan.emits[r.at + 1];
-            ones.push_back({plan.guards[g.first], plan.moved.data() + em.moved_at, em.moved_n, r.at});
-            one_of.push_back(k);
+            r.one = &ones.emplace_back(
+                PatchOne{plan.guards[g.first], plan.moved.data() + em.moved_at, em.moved_n, r.at});
         }
     }
-    for (std::size_t j = 0; j < ones.size(); ++j) rows[one_of[j]].one = &ones[j]; // (ones is complete)
     return rows.data();
 }
 

@@ -233,37 +233,35 @@ class Rewriter {
             next_new += em.fresh;
         }
     }
-    // put_numbers for a module rewritten in place (RulePlan::Emit::moved): only the numbers
-    // that change. A number that is not finite is reported by put_numbers, as it would be.
-    void put_moved(const PatchOne& one, const double* x, double* PA) const {
-        const RulePlan::ArgHole* hs = one.moved;
+    // Writes x[from] * mul + add for each of the n holes at hs into PA; returns whether all are
+    // certainly finite: their sum is not finite when a number is not (inf - inf and NaN are
+    // NaN), or, rarely, when finite numbers overflow it.
+    template <typename Numbers>
+    static bool put_holes(const RulePlan::ArgHole* hs, std::uint32_t n, const Numbers& x, double* PA) {
         double sum = 0;
-        for (std::uint32_t h = 0; h < one.moved_n; ++h) {
+        for (std::uint32_t h = 0; h < n; ++h) {
             const double v = x[hs[h].from] * hs[h].mul + hs[h].add;
             sum += v;
             PA[hs[h].to] = v;
         }
-        if (sum - sum != 0) [[unlikely]] { // (see put_numbers)
+        return sum - sum == 0;
+    }
+    // put_numbers for a module rewritten in place (RulePlan::Emit::moved): only the numbers
+    // that change. A number that is not finite is reported by put_numbers, as it would be.
+    void put_moved(const PatchOne& one, const double* x, double* PA) const {
+        if (!put_holes(one.moved, one.moved_n, x, PA)) [[unlikely]] {
             const std::uint32_t o = one.at + 1;
             put_numbers(o, plan.emits[o], x, PA);
         }
     }
     // put_affine's computed numbers alone, from x (the module's numbers: an array, or its
-    // ModuleArgs), into PA.
+    // ModuleArgs), into PA; when put_holes cannot vouch for them, the numbers themselves are
+    // looked at and the first that is not finite reported.
     template <typename Numbers>
     void put_numbers(std::uint32_t o, const RulePlan::Emit& em, const Numbers& x, double* PA) const {
         const RulePlan::ArgHole* hs = plan.args.data() + em.holes_at;
-        const std::uint32_t holes = em.holes_n;
-        double sum = 0;
-        for (std::uint32_t h = 0; h < holes; ++h) {
-            const double v = x[hs[h].from] * hs[h].mul + hs[h].add;
-            sum += v;
-            PA[hs[h].to] = v;
-        }
-        // the sum is not finite when a number is not (inf - inf and NaN are NaN), or, rarely,
-        // when finite numbers overflow it; then the numbers themselves are looked at
-        if (sum - sum != 0) [[unlikely]]
-            for (std::uint32_t h = 0; h < holes; ++h)
+        if (!put_holes(hs, em.holes_n, x, PA)) [[unlikely]]
+            for (std::uint32_t h = 0; h < em.holes_n; ++h)
                 if (!std::isfinite(PA[hs[h].to])) hole_error(*plan.outcome_tmpl[o], h, PA[hs[h].to]);
     }
 
