@@ -555,7 +555,7 @@ bool ClimberArgs::read(const EnvArg& a, std::string& error) {
         "elasticity",     "attractor_radius", "attractor_strength", "threads",         "light_cell",
         "opacity",        "air_spacing",      "air_density",        "air_viscosity",   "air_stiffness",
         "air_coupling",   "mesh_cell",        "attractor_reach",    "emitter_radius",  "strand",
-        "obstacle_shade", "grab_speed",       "plant_contacts"};
+        "obstacle_shade", "grab_speed",       "plant_contacts",     "energy_budget"};
     static const char* vectors[] = {"gravity", "light",   "wind",    "attractor",
                                     "air_min", "air_max", "emitter", "emitter_velocity"};
     if (a.key == "mesh") {
@@ -673,6 +673,8 @@ void ClimberArgs::set(const std::string& key, double x, const glm::dvec3& v) {
         c.obstacle_shade = x != 0;
     else if (key == "plant_contacts")
         s.link_collisions = x != 0; // links of different plants collided as capsules (off: see docs)
+    else if (key == "energy_budget")
+        s.energy_budget = x != 0; // no particle gains energy gravity and forcing did not give it
 }
 
 bool ClimberArgs::check(std::string& error) {

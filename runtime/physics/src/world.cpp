@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 namespace plant::physics {
@@ -128,6 +129,12 @@ void World::step() {
     using clock = std::chrono::steady_clock;
     using ms = std::chrono::duration<double, std::milli>;
     const auto t_start = clock::now();
+    // where each particle starts the step counts toward its highest point (unexplained_speed):
+    // growth and the climber place particles between steps
+    highest_.resize(x_.size(), -std::numeric_limits<double>::infinity());
+    for (std::size_t i = 0; i < x_.size(); ++i)
+        if (alive_[i]) highest_[i] = std::max(highest_[i], -glm::dot(settings_.gravity, x_[i]));
+    if (settings_.energy_budget) open_energy_budget();
     predict();
     pull_to_anchors();
     refresh_groups();
@@ -150,10 +157,17 @@ void World::step() {
     double collision_ms = ms(clock::now() - t0).count();
     t0 = clock::now();
     integrate();
+    if (settings_.energy_budget) close_energy_budget();
     collision_ms += ms(clock::now() - t0).count();
     double fastest = 0; // squared
-    for (std::size_t i = 0; i < x_.size(); ++i)
-        if (alive_[i]) fastest = std::max(fastest, glm::dot(v_[i], v_[i]));
+    for (std::size_t i = 0; i < x_.size(); ++i) {
+        if (!alive_[i]) continue;
+        const double speed2 = glm::dot(v_[i], v_[i]), phi = -glm::dot(settings_.gravity, x_[i]);
+        fastest = std::max(fastest, speed2);
+        highest_[i] = std::max(highest_[i], phi);
+        unexplained_speed_ =
+            std::max(unexplained_speed_, std::sqrt(speed2) - std::sqrt(2 * (highest_[i] - phi)));
+    }
     peak_speed_ = std::max(peak_speed_, std::sqrt(fastest));
     if (break_threshold_ > 0) break_overstretched();
     pulls_.clear();

@@ -69,6 +69,9 @@ struct Settings {
     // Off by default for now: on, a push can carry a link through a thin rail
     // (docs/physics.md, "Plant-plant collision").
     bool link_collisions = false;
+    // No step gives a particle mechanical energy that gravity, the wind and the air did not give
+    // it (energy.cpp; docs/physics.md, "The energy budget"). Off: the solver as it was before.
+    bool energy_budget = true;
 };
 
 // Growth directions (Hädrich et al., section 4.2). Each returns the apex's forward vector turned
@@ -231,9 +234,14 @@ class World {
     };
     const StepTimes& last_step_times() const { return times_; }
     // The fastest particle's speed at the end of any step since clear_peak_speed() (m/s): a
-    // growing shoot should not move at metres a second (docs/physics.md, "Whipping").
+    // growing shoot should not move at metres a second (docs/whipping.md).
     double peak_speed() const { return peak_speed_; }
-    void clear_peak_speed() { peak_speed_ = 0; }
+    // The most, at the end of any step since clear_peak_speed(), that a particle moved faster than
+    // a fall from the highest point it has been at (at a step's start or end) gives: |v| - sqrt(2 (phi_max -
+    // phi)), phi = -g.x (m/s; 0 when every particle is within it). Only gravity gives a passive
+    // plant speed, so more is motion the solver made up (docs/physics.md, "The energy budget").
+    double unexplained_speed() const { return unexplained_speed_; }
+    void clear_peak_speed() { peak_speed_ = 0, unexplained_speed_ = 0; }
 
     // A hash of the whole state, for determinism tests.
     std::uint64_t state_hash() const;
@@ -341,7 +349,12 @@ class World {
     void find_link_pairs();
     // with find false, the pairs found by the last call are pushed again (a later round of a step)
     void separate_links(bool find);
-    void integrate();           // Eq. 17-18 with damping, and contacts with obstacles
+    void integrate(); // Eq. 17-18 with damping, and contacts with obstacles
+    // energy.cpp: each particle's mechanical energy before the step and the forcing on it (open,
+    // before predict); after integrate, a particle that ends the step with more than that energy
+    // plus the forcing's work, damped, has its velocity scaled down to it (close)
+    void open_energy_budget();
+    void close_energy_budget();
     void break_overstretched(); // connections stretched past the break threshold let go
 
     Settings settings_;
@@ -365,7 +378,8 @@ class World {
         return a.obstacle < obstacles_.size() ? a.point + (obstacles_[a.obstacle].a - a.origin) : a.point;
     }
     std::vector<Anchor> anchors_;
-    double peak_speed_ = 0;
+    double peak_speed_ = 0, unexplained_speed_ = 0;
+    std::vector<double> highest_; // each particle's highest potential per unit mass at a step's ends
     std::vector<Obstacle> obstacles_;
     std::vector<std::pair<std::uint32_t, glm::dvec3>> pulls_;
     double break_threshold_ = 0;
@@ -414,6 +428,11 @@ class World {
         std::vector<LinkCell> link_table;
         std::vector<std::pair<std::uint32_t, std::uint32_t>> link_pairs;
         std::vector<std::uint32_t> link_big; // link contacts: boxes too large for the grid
+        // the energy budget (energy.cpp): the forcing on each particle this step, its energy
+        // per unit mass before the step, and whether the hand holds it
+        std::vector<glm::dvec3> forcing;
+        std::vector<double> energy_before;
+        std::vector<std::uint8_t> held;
 
         static double thin_of(std::uint32_t i, const std::vector<glm::dvec3>& radii) {
             return std::min({radii[i].x, radii[i].y, radii[i].z});
