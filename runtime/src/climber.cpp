@@ -409,7 +409,7 @@ void Climber::thicken() {
         // thick as the room around its root and along it allows (0.5 mm kept free), never thinner
         // than at birth. The root counts: a capsule leaning from a root in the ground enters the
         // ground by r (1 - sin of its lean) just beyond one radius from the root, and the lean
-        // changes after the radius is set (docs/physics.md, "Secondary growth in the figures")
+        // changes after the radius is set (docs/climber-growth.md, "Secondary growth in the figures")
         const std::uint32_t parent = world_.parent(h);
         if (parent < world_.size() && world_.parent(world_.handle(parent)) == ~0u) {
             const glm::dvec3 a = world_.position(world_.handle(parent)), b = world_.position(h);
@@ -434,7 +434,7 @@ double Climber::occlusion(const glm::dvec3& p) const {
     // Eq. 7's O: an obstacle between p and the light is opaque, a full shade (the paper's shadow
     // maps include the scene); else the particles in the cells between p and the light
     return physics::scene_occlusion(light_, world_.obstacles(), config_.obstacle_shade, p,
-                                    glm::normalize(config_.light), config_.opacity);
+                                    glm::normalize(config_.light), config_.opacity, config_.diffuse);
 }
 
 glm::dvec3 Climber::grow_dir(const glm::dvec3& p, const glm::dvec3& h) const {
@@ -555,7 +555,7 @@ bool ClimberArgs::read(const EnvArg& a, std::string& error) {
         "elasticity",     "attractor_radius", "attractor_strength", "threads",         "light_cell",
         "opacity",        "air_spacing",      "air_density",        "air_viscosity",   "air_stiffness",
         "air_coupling",   "mesh_cell",        "attractor_reach",    "emitter_radius",  "strand",
-        "obstacle_shade", "grab_speed",       "plant_contacts",     "energy_budget"};
+        "obstacle_shade", "grab_speed",       "plant_contacts",     "energy_budget",   "diffuse"};
     static const char* vectors[] = {"gravity", "light",   "wind",    "attractor",
                                     "air_min", "air_max", "emitter", "emitter_velocity"};
     if (a.key == "mesh") {
@@ -671,6 +671,8 @@ void ClimberArgs::set(const std::string& key, double x, const glm::dvec3& v) {
         c.grab_speed = std::clamp(x, 0.0, 1e3); // a hand faster than 1 km/s is no hand
     else if (key == "obstacle_shade")
         c.obstacle_shade = x != 0;
+    else if (key == "diffuse")
+        c.diffuse = std::clamp(x, 0.0, 1.0);
     else if (key == "plant_contacts")
         s.link_collisions = x != 0; // links of different plants collided as capsules (off: see docs)
     else if (key == "energy_budget")

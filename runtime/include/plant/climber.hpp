@@ -93,6 +93,7 @@ class Climber : public Environment {
         double light_cell = 0.1;    // occupancy grid for occlusion
         double opacity = 0.15;      // occlusion 1 - exp(-opacity * particles between p and the light)
         bool obstacle_shade = true; // an obstacle between p and the light: occlusion 1 (full shade)
+        double diffuse = 0;         // the share of the light from the open sky (scene_occlusion)
         std::vector<Attractor> attractors;
         double attractor_reach = 0.1; // a painted sample a particle comes this near is used up
         double strand = 0;            // secondary growth: a pipe's radius per segment beyond (0: none)
@@ -148,7 +149,7 @@ class Climber : public Environment {
     glm::dvec3 grow_dir(const glm::dvec3& p, const glm::dvec3& h) const;
     glm::dvec3 clear_dir(const glm::dvec3& p, const glm::dvec3& v, double r) const;
     void rebuild_occupancy();
-    // Secondary growth (docs/physics.md, "Growth rate and secondary growth"): with a `strand`,
+    // Secondary growth (docs/climber-growth.md, "Growth rate and secondary growth"): with a `strand`,
     // thicken() counts the segments beyond every particle before each step's physics and widens
     // each segment from the radius it was born with.
     void place_pending(); // the new bound modules become particles

@@ -89,7 +89,8 @@ void World::grow() {
             shade.build(points, g.light_cell);
             shade_counted = true;
         }
-        return scene_occlusion(shade, obstacles_, g.obstacle_shade, p, glm::normalize(g.to_light), g.opacity);
+        return scene_occlusion(shade, obstacles_, g.obstacle_shade, p, glm::normalize(g.to_light), g.opacity,
+                               g.diffuse);
     };
     for (std::uint32_t i = 0; i < n && x_.size() < g.max_particles; ++i) {
         if (!alive_[i] || !children_[i].empty()) continue;

@@ -1,6 +1,6 @@
 // The scene's shade: a ray from a point toward the light, tested against each obstacle
 // (light.hpp). Hädrich et al. 2017 light their scenes with shadow maps (section 4.2), so the
-// obstacles shade the plant as well as its own leaves; docs/physics.md, "Growth rate".
+// obstacles shade the plant as well as its own leaves; docs/climber-growth.md, "Growth rate".
 #include "plant/physics/light.hpp"
 
 #include "obstacle_field.hpp"
@@ -9,6 +9,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
+#include <vector>
 
 namespace plant::physics {
 
@@ -83,10 +85,33 @@ bool in_shadow(const std::vector<Obstacle>& obstacles, const glm::dvec3& p, cons
                        [&](const Obstacle& o) { return blocks_light(o, p, to_light); });
 }
 
+double sky_visible(const std::vector<Obstacle>& obstacles, const glm::dvec3& p) {
+    // a Fibonacci spiral over the upper half of the sphere, equal solid angles: direction k at
+    // height y = (k + 0.5) / n, turned by the golden angle from the one before
+    static const std::vector<glm::dvec3> sky = [] {
+        std::vector<glm::dvec3> d;
+        const double golden = std::numbers::pi * (3 - std::sqrt(5.0));
+        for (int k = 0; k < kSkyDirections; ++k) {
+            const double y = (k + 0.5) / kSkyDirections, r = std::sqrt(1 - y * y);
+            d.emplace_back(r * std::cos(golden * k), y, r * std::sin(golden * k));
+        }
+        return d;
+    }();
+    int open = 0;
+    for (const glm::dvec3& d : sky) open += in_shadow(obstacles, p, d) ? 0 : 1;
+    return static_cast<double>(open) / kSkyDirections;
+}
+
 double scene_occlusion(const LightGrid& grid, const std::vector<Obstacle>& obstacles, bool obstacles_shade,
-                       const glm::dvec3& p, const glm::dvec3& to_light, double opacity) {
-    if (obstacles_shade && in_shadow(obstacles, p, to_light)) return 1.0; // an obstacle is opaque
-    return grid.occlusion(p, to_light, opacity);
+                       const glm::dvec3& p, const glm::dvec3& to_light, double opacity, double diffuse) {
+    if (diffuse <= 0) {
+        if (obstacles_shade && in_shadow(obstacles, p, to_light)) return 1.0; // an obstacle is opaque
+        return grid.occlusion(p, to_light, opacity);
+    }
+    const double through_plant = 1 - grid.occlusion(p, to_light, opacity);
+    const double direct = obstacles_shade && in_shadow(obstacles, p, to_light) ? 0.0 : 1.0;
+    const double sky = obstacles_shade ? sky_visible(obstacles, p) : 1.0;
+    return 1 - through_plant * ((1 - diffuse) * direct + diffuse * sky);
 }
 
 } // namespace plant::physics

@@ -1,4 +1,4 @@
-// The scene's shade (runtime/physics/src/shadow.cpp; docs/physics.md, "Growth rate and secondary
+// The scene's shade (runtime/physics/src/shadow.cpp; docs/climber-growth.md, "Growth rate and secondary
 // growth"): a ray from a point toward the light, against each kind of obstacle.
 #include "plant/physics/light.hpp"
 
@@ -76,4 +76,29 @@ TEST_CASE("shadow: spheres, planes and sampled grids shade the points behind the
     moved.a = glm::dvec3(2, 0, 0);
     CHECK(!blocks_light(moved, {0.1, -0.8, 0}, up));
     CHECK(blocks_light(moved, {2.1, -0.8, 0}, up));
+}
+
+TEST_CASE("diffuse light: the open sky lights a point in an obstacle's shadow", "[physics]") {
+    // the share of the sky no obstacle hides: all of it in the open, about half beside a tall
+    // wide wall, none under a roof
+    const std::vector<Obstacle> none;
+    CHECK(sky_visible(none, {0, 0.5, 0}) == 1.0);
+    const std::vector<Obstacle> wall = {box({0.0, 0.0, -50}, {0.1, 100, 50})};
+    const double beside = sky_visible(wall, {-0.05, 0.5, 0});
+    INFO("sky beside a tall wall " << beside);
+    CHECK(beside > 0.4);
+    CHECK(beside < 0.6);
+    const std::vector<Obstacle> roof = {box({-50, 1, -50}, {50, 1.1, 50})};
+    CHECK(sky_visible(roof, {0, 0.5, 0}) == 0.0);
+    // Eq. 7's O with a share d of the light from the sky: behind the wall from a level light, the
+    // light is d times the sky it sees; in the open, all of it; with d = 0, as without the sky
+    LightGrid empty;
+    const glm::dvec3 from_right(1, 0, 0);
+    const glm::dvec3 behind(-0.05, 0.5, 0), open(0.5, 0.5, 0);
+    CHECK(scene_occlusion(empty, wall, true, behind, from_right, 0.15) == 1.0);
+    CHECK(scene_occlusion(empty, wall, true, behind, from_right, 0.15, 0.3) == Approx(1 - 0.3 * beside));
+    CHECK(scene_occlusion(empty, wall, true, open, from_right, 0.15, 0.3) ==
+          Approx(1 - (0.7 + 0.3 * sky_visible(wall, open))));
+    CHECK(scene_occlusion(empty, wall, false, behind, from_right, 0.15, 0.3) == 0.0);
+    CHECK(scene_occlusion(empty, roof, true, {0, 0.5, 0}, glm::dvec3(0, 1, 0), 0.15, 0.3) == 1.0);
 }

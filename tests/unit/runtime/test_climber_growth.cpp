@@ -1,4 +1,4 @@
-// Growth by the paper's rules (issue 18 item 4; docs/physics.md, "Growth rate and secondary
+// Growth by the paper's rules (issue 18 item 4; docs/climber-growth.md, "Growth rate and secondary
 // growth"): an apex grows by the light it receives, and stems thicken with age by the pipe model.
 #include "helpers.hpp"
 #include "plant/climber.hpp"
@@ -124,6 +124,17 @@ seed 1;
     REQUIRE(unshaded.size() == 2);
     CHECK(unshaded[0].size() == 20);
     CHECK(unshaded[1].size() == 20);
+    // diffuse: 0.3, a share of the light from the open sky: the shoot behind the wall grows on
+    // the sky it sees, slowly; the one in the open a little slower than in full sun, since the
+    // wall hides part of its sky too (docs/climber-growth.md, "Diffuse light")
+    const auto sky = main_shoots(*grown("1, diffuse: 0.3"));
+    REQUIRE(sky.size() == 2);
+    INFO("with diffuse light, segments: behind the wall " << sky[0].size() << ", in the open "
+                                                          << sky[1].size());
+    CHECK(sky[0].size() > 1);
+    CHECK(sky[0].size() * 3 < sky[1].size());
+    CHECK(sky[1].size() < 20);
+    CHECK(sky[1].size() >= 15);
 }
 
 TEST_CASE("climber growth: stems thicken with age by the pipe model, base thicker than tip", "[climber]") {

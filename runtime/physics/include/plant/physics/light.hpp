@@ -40,10 +40,19 @@ bool blocks_light(const Obstacle& o, const glm::dvec3& p, const glm::dvec3& to_l
 // Whether any of the obstacles blocks the light at p.
 bool in_shadow(const std::vector<Obstacle>& obstacles, const glm::dvec3& p, const glm::dvec3& to_light);
 
-// Eq. 7's O at p in a scene: 1 where an obstacle blocks the light (with `obstacles_shade`), else
-// the plant's particles counted in `grid` (LightGrid::occlusion). World::grow and the climber's
-// occlusion() both use it.
+// The share of the sky (the half of the directions with y > 0, sampled by kSkyDirections fixed
+// directions spread evenly over it) that no obstacle hides from p.
+constexpr int kSkyDirections = 32;
+double sky_visible(const std::vector<Obstacle>& obstacles, const glm::dvec3& p);
+
+// Eq. 7's O at p in a scene, 1 less the light p receives. With diffuse = 0: 1 where an obstacle
+// blocks the light (with `obstacles_shade`), else the plant's particles counted in `grid`
+// (LightGrid::occlusion). With diffuse d > 0, d of the light comes from the open sky and 1 - d from
+// the light's direction: the light is (1 - O_plant) ((1 - d) direct + d sky), direct 0 or 1 as an
+// obstacle blocks it and sky the share of the sky no obstacle hides (sky_visible), so a point in
+// an obstacle's shadow still has the sky's light (docs/climber-growth.md, "Diffuse light"). World::grow
+// and the climber's occlusion() both use it.
 double scene_occlusion(const LightGrid& grid, const std::vector<Obstacle>& obstacles, bool obstacles_shade,
-                       const glm::dvec3& p, const glm::dvec3& to_light, double opacity);
+                       const glm::dvec3& p, const glm::dvec3& to_light, double opacity, double diffuse = 0);
 
 } // namespace plant::physics

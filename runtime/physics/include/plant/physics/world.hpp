@@ -42,6 +42,7 @@ struct Growth {
     double opacity = 0.15;       // Eq. 7's O = 1 - exp(-opacity * particles between the apex and the light)
     double light_cell = 0.1;     // the cells those particles are counted in
     bool obstacle_shade = true;  // an obstacle between the apex and the light: O = 1 (shadow.cpp)
+    double diffuse = 0;          // the share of the light from the open sky (scene_occlusion)
     std::uint64_t seed = 1;
 };
 
