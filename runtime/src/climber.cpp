@@ -35,7 +35,8 @@ constexpr EnvMethod kClimberMethods[] = {
     env_method(M::GrowDir, "grow_dir", {V, V}, V, Pure, false,
                "heading h at p turned by surface adaption (Eq. 6), attractors and phototropism (Eq. 7)"),
     env_method(M::Occlusion, "occlusion", {V}, N, Pure, true,
-               "light occlusion at p, 0 to 1: 1 behind an obstacle, else by the plant's particles"),
+               "light occlusion at p, 0 to 1: 1 behind an obstacle (1 - diffuse * sky seen, with `diffuse`), "
+               "else by the plant's particles"),
     env_method(M::Anchored, "anchored", {N}, N, Pure, false,
                "1 when module id's particle is anchored to a surface"),
     env_method(M::Particles, "particles", {}, N, Pure, false, "particles in the world"),
