@@ -273,7 +273,7 @@ double whip_bound(const std::string& grammar, std::size_t k) {
     return 1.0;
 }
 
-// Issue 18, whipping (docs/physics.md, "Whipping free shoots" and "The energy budget"): in every
+// Issue 18, whipping (docs/whipping.md; docs/physics.md, "The energy budget"): in every
 // derivation step, no particle faster than a fall from its highest point gives, by more than
 // whip_bound. Before the energy budget, free shoots circled at up to 29 m/s at a steady height.
 // PLANT_WHIP_REPORT=1 prints each grammar's fastest particle and worst excess (=steps: per step).
@@ -444,8 +444,8 @@ TEST_CASE(
 
 // `plant_contacts: 1` switches the capsule contacts on from a grammar: fig05_branching's plants,
 // whose links overlap by 15.6 mm without it, stay within kCapsuleTolerance (0.03 mm), with every
-// link check of derive() holding. (fig08_painted_wall's, 10 mm apart without it before the energy
-// budget, no longer touch either way.)
+// link check of derive() holding. (fig08_painted_wall's, 10 mm into each other without it before
+// the energy budget, no longer touch either way.)
 TEST_CASE("climber: plant_contacts: 1 keeps the links of different plants apart", "[climber]") {
     const std::string on =
         text_of(std::filesystem::path(PLANT_SOURCE_DIR) / "grammars" / "climbers" / "fig05_branching.plant");
