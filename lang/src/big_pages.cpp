@@ -12,7 +12,7 @@
 // until one is the size asked for. Without that, each small string of a derivation's early steps
 // took a page of its own, and the first touch of a 2 MiB page costs the kernel clearing all of
 // it: ABOP's Fig. 1.24d at n = 10 faulted in two pages for strings of 84 KB and 254 KB, about
-// 0.3 ms each on a VM, most of its derivation time (docs/architecture.md).
+// 0.3 ms each on a VM, most of its derivation time (docs/rewriting.md).
 #include "plant/big_allocator.hpp"
 
 #include <algorithm>

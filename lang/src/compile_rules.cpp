@@ -110,7 +110,7 @@ void Compiler::finish_rule_set(RuleSet& set) {
     set.index(P_.symbols.size());
 }
 
-// The kinds of the successor templates' modules (docs/architecture.md, memory): a module with
+// The kinds of the successor templates' modules (docs/rewriting.md, memory): a module with
 // constant numbers gets a kind of its own, shared by every module with the same symbol, the
 // same constants and its holes in the same places, and the string stores only its holes. Plain
 // (every number stored, the kind's id the symbol's): a module without constants, and every

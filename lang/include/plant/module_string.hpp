@@ -6,7 +6,7 @@
 // Readers go through symbol(i) and args(i) (or args_at for one that walks the string in order,
 // keeping its own position in `params`, advanced by stored(i)), never through `kinds` and
 // `params` directly: that leaves room for kinds whose constant numbers are kept in a table
-// rather than in `params` (docs/architecture.md, memory).
+// rather than in `params` (docs/rewriting.md, memory).
 //
 // A string may go without identities (keep_ids false, ids empty): a derivation whose identities
 // nobody can observe (`plant derive` without --ids, a program that never calls id() and has no
@@ -35,7 +35,7 @@ using ModuleId = std::uint64_t;
 // What the string stores per module in place of its symbol. A *plain* kind's id is its symbol's
 // and the string stores all of its numbers. The compiler adds a kind for each module of a
 // successor template that has constant numbers (`&(30)`, `A(1, w)`): the string stores only
-// its computed numbers, the table the rest (docs/architecture.md, memory).
+// its computed numbers, the table the rest (docs/rewriting.md, memory).
 using KindId = std::uint16_t;
 
 struct KindTable {

@@ -71,7 +71,7 @@ void Engine::check_limits(const Derivation& d, std::size_t modules, std::size_t 
         throw limit(fmt::format("the string grew past the limit of {} modules (raise it with --max-modules)",
                                 d.opt_.max_modules));
     // a module holds its symbol and a byte of arity (the block offsets add 4 bytes per 64
-    // modules, docs/architecture.md), its identity when kept, and its parameters
+    // modules, docs/rewriting.md), its identity when kept, and its parameters
     std::size_t estimate = modules * (sizeof(SymbolId) + 1 + (d.current_.keep_ids ? sizeof(ModuleId) : 0)) +
                            modules / 16 + params * sizeof(double);
     if (estimate > d.opt_.max_bytes)

@@ -138,7 +138,7 @@ struct RulePlan {
     // numbers, its place among the stored ones and its constant, from args_first on in `args`.
     // The number is x * mul + add for x the source, one expression for the three forms, each
     // exact: x * c + (-0.0) is x * c (a zero keeps its sign), x * 1 + c is x + c, x * 1 + (-0.0)
-    // is x (docs/architecture.md, "The direct path").
+    // is x (docs/rewriting.md, "The direct path").
     struct ArgHole {
         std::uint32_t from = 0; // the predecessor's number it reads
         std::uint32_t to = 0;   // its place among the template's stored numbers

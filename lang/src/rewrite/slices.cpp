@@ -1,7 +1,7 @@
 // Sizing the direct path's output from what the last step's writers counted (Engine::counts),
 // instead of reading the string once more: the whole output (one thread), and where each of
 // several threads writes its stretch (from the writers' snapshots, Worker::snaps). See
-// docs/architecture.md, "The direct path".
+// docs/rewriting.md, "The direct path".
 #include "engine.hpp"
 #include "rewriter.hpp"
 

@@ -28,7 +28,7 @@ template <typename Vector> [[gnu::noinline]] void resize(Vector& v, std::size_t 
 // - the right keys come from one right-to-left pass that does the same mirrored, so there is no
 //   bracket table. The kernel runs on one thread over the whole string (Engine::rewrite): split
 //   over two threads it needed the bracket table, a search for each right neighbour and a join,
-//   and ran 1.4x slower on 1.31a at n = 50 (docs/architecture.md).
+//   and ran 1.4x slower on 1.31a at n = 50 (docs/rewriting.md).
 void Rewriter::run_symbols(Worker& w) {
     using Plan = RulePlan;
     ModuleString& out = w.out;

@@ -1,4 +1,4 @@
-// Module kinds (docs/architecture.md, memory): a successor template's module with constant
+// Module kinds (docs/rewriting.md, memory): a successor template's module with constant
 // numbers gets a kind whose constants live in the program's kind table, and the string stores
 // only its computed numbers. The strings read back the same on every rewriting route.
 #include "helpers.hpp"

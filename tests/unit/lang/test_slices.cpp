@@ -1,5 +1,5 @@
 // The direct path on several threads sizes each thread's stretch from the snapshots the last
-// step's writers took (Engine::size_slices, docs/architecture.md "The direct path") instead of
+// step's writers took (Engine::size_slices, docs/rewriting.md "The direct path") instead of
 // counting the whole string: the strings, identities and block offsets are those of one thread,
 // and the string is read to count only once (the first step past 20,000 modules) and then only
 // the few modules after each snapshot.
