@@ -470,10 +470,14 @@ glm::dvec3 Climber::grow_dir(const glm::dvec3& p, const glm::dvec3& h) const {
     }
     if (glm::length(pull) > 0) f = glm::normalize(f + pull * time);
     // Eq. 7: toward the light, less where the plant shades itself. On a support the shoot follows
-    // the light along it: the turn does not lift it off the surface.
+    // the light along it: the turn does not lift it off the surface. The turn is toward the
+    // light's direction, so it is weighed by the direct light alone: a shoot in an obstacle's
+    // shadow, lit by the open sky (`diffuse`), does not turn toward the sun behind the obstacle.
     if (config_.phototropism > 0) {
-        glm::dvec3 g =
-            physics::phototropism(f, glm::normalize(config_.light), occlusion(p), config_.phototropism, time);
+        const glm::dvec3 to_light = glm::normalize(config_.light);
+        const double direct = physics::scene_occlusion(light_, world_.obstacles(), config_.obstacle_shade, p,
+                                                       to_light, config_.opacity, 0.0);
+        glm::dvec3 g = physics::phototropism(f, to_light, direct, config_.phototropism, time);
         if (nearest) {
             glm::dvec3 kept = g + normal * (glm::dot(f, normal) - glm::dot(g, normal));
             if (glm::length(kept) > 1e-9) g = glm::normalize(kept);

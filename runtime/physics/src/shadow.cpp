@@ -104,9 +104,11 @@ double sky_visible(const std::vector<Obstacle>& obstacles, const glm::dvec3& p) 
 
 double scene_occlusion(const LightGrid& grid, const std::vector<Obstacle>& obstacles, bool obstacles_shade,
                        const glm::dvec3& p, const glm::dvec3& to_light, double opacity, double diffuse) {
-    const bool shaded = obstacles_shade && in_shadow(obstacles, p, to_light); // an obstacle is opaque
-    if (diffuse <= 0) return shaded ? 1.0 : grid.occlusion(p, to_light, opacity);
+    const bool shaded = obstacles_shade && in_shadow(obstacles, p, to_light);       // an obstacle is opaque
+    if (!(diffuse > 0)) return shaded ? 1.0 : grid.occlusion(p, to_light, opacity); // (NaN: none)
+    diffuse = std::min(diffuse, 1.0);
     const double through_plant = 1 - grid.occlusion(p, to_light, opacity);
+    if (through_plant <= 0) return 1.0; // the plants let nothing through: no sky to look for
     const double sky = obstacles_shade ? sky_visible(obstacles, p) : 1.0;
     return 1 - through_plant * ((1 - diffuse) * (shaded ? 0.0 : 1.0) + diffuse * sky);
 }

@@ -4,6 +4,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <limits>
 #include <memory>
 
 using namespace plant::physics;
@@ -101,4 +102,10 @@ TEST_CASE("diffuse light: the open sky lights a point in an obstacle's shadow", 
           Approx(1 - (0.7 + 0.3 * sky_visible(wall, open))));
     CHECK(scene_occlusion(empty, wall, false, behind, from_right, 0.15, 0.3) == 0.0);
     CHECK(scene_occlusion(empty, roof, true, {0, 0.5, 0}, glm::dvec3(0, 1, 0), 0.15, 0.3) == 1.0);
+    // a share out of [0, 1] from a caller of the library (the climber clamps its argument): NaN or
+    // below 0 is no sky, above 1 all sky; O stays within [0, 1]
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    CHECK(scene_occlusion(empty, wall, true, behind, from_right, 0.15, nan) == 1.0);
+    CHECK(scene_occlusion(empty, wall, true, behind, from_right, 0.15, -2) == 1.0);
+    CHECK(scene_occlusion(empty, wall, true, behind, from_right, 0.15, 7) == Approx(1 - beside));
 }

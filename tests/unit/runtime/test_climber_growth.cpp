@@ -137,6 +137,38 @@ seed 1;
     CHECK(sky[1].size() >= 15);
 }
 
+// Eq. 7 turns a shoot toward the light's direction, so only the direct light weighs the turn: a
+// shoot in an obstacle's shadow that grows on the open sky's light (`diffuse`) does not turn toward
+// the sun behind the obstacle (docs/climber-growth.md, "Diffuse light").
+TEST_CASE("climber growth: in an obstacle's shadow, diffuse light does not turn a shoot toward the sun",
+          "[climber]") {
+    const std::string scene = R"(
+import climber with { N = 1, BP = 0, Ph = 0, steps = 1, leaf_size = 0 };
+env ivy = climber(gravity: vec3(0, 0, 0), light: vec3(1, 0.05, 0), phototropism: 2, adaption: 0,
+                  stiffness: 1, opacity: 0, diffuse: DIFFUSE,
+                  box_min: vec3(-0.1, 0, -0.3), box_max: vec3(0.1, 3, 0.3));
+seed 1;
+)";
+    auto turn = [&](const char* diffuse, glm::dvec3 p) {
+        std::string text = scene;
+        text.replace(text.find("DIFFUSE"), 7, diffuse);
+        auto g = start(text);
+        const Climber& c = climber_of(*g->d);
+        const double args[6] = {p.x, p.y, p.z, 0, 1, 0}; // heading straight up
+        double r[3] = {0, 0, 0};
+        c.query(static_cast<std::size_t>(ClimberMethod::GrowDir), args, r);
+        return glm::dvec3(r[0], r[1], r[2]);
+    };
+    const glm::dvec3 behind(-0.3, 0.5, 0.015), open(0.3, 0.5, 0.015);
+    const glm::dvec3 lit = turn("0.5", open), shaded = turn("0.5", behind), dark = turn("0", behind);
+    INFO("toward the light (+x): in the open " << lit.x << ", behind the wall " << shaded.x
+                                               << " with the sky's "
+                                               << "light, " << dark.x << " without");
+    CHECK(lit.x > 0.01);       // in the open it turns toward the light
+    CHECK(dark.x == 0.0);      // behind the wall, without the sky, it does not (O = 1)
+    CHECK(shaded.x == dark.x); // and with the sky's light it still does not
+}
+
 TEST_CASE("climber growth: stems thicken with age by the pipe model, base thicker than tip", "[climber]") {
     auto g = start(R"(
 import climber with { N = 1, BP = 0.3, V = 0.5, Ph = 0, steps = 24, leaf_size = 0 };
