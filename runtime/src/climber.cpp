@@ -431,11 +431,12 @@ void Climber::rebuild_occupancy() {
     light_.build(points, config_.light_cell);
 }
 
-double Climber::occlusion(const glm::dvec3& p) const {
+double Climber::occlusion(const glm::dvec3& p, bool sky) const {
     // Eq. 7's O: an obstacle between p and the light is opaque, a full shade (the paper's shadow
     // maps include the scene); else the particles in the cells between p and the light
     return physics::scene_occlusion(light_, world_.obstacles(), config_.obstacle_shade, p,
-                                    glm::normalize(config_.light), config_.opacity, config_.diffuse);
+                                    glm::normalize(config_.light), config_.opacity,
+                                    sky ? config_.diffuse : 0.0);
 }
 
 glm::dvec3 Climber::grow_dir(const glm::dvec3& p, const glm::dvec3& h) const {
@@ -474,10 +475,8 @@ glm::dvec3 Climber::grow_dir(const glm::dvec3& p, const glm::dvec3& h) const {
     // light's direction, so it is weighed by the direct light alone: a shoot in an obstacle's
     // shadow, lit by the open sky (`diffuse`), does not turn toward the sun behind the obstacle.
     if (config_.phototropism > 0) {
-        const glm::dvec3 to_light = glm::normalize(config_.light);
-        const double direct = physics::scene_occlusion(light_, world_.obstacles(), config_.obstacle_shade, p,
-                                                       to_light, config_.opacity, 0.0);
-        glm::dvec3 g = physics::phototropism(f, to_light, direct, config_.phototropism, time);
+        glm::dvec3 g = physics::phototropism(f, glm::normalize(config_.light), occlusion(p, false),
+                                             config_.phototropism, time);
         if (nearest) {
             glm::dvec3 kept = g + normal * (glm::dot(f, normal) - glm::dot(g, normal));
             if (glm::length(kept) > 1e-9) g = glm::normalize(kept);

@@ -143,7 +143,8 @@ class Climber : public Environment {
     static constexpr std::size_t kBytesPerParticle = 1024, kBytesPerAirParticle = 512;
 
   private:
-    double occlusion(const glm::dvec3& p) const;
+    // Eq. 7's O at p; with `sky` false, of the direct light alone (the share `diffuse` left out)
+    double occlusion(const glm::dvec3& p, bool sky = true) const;
     // The obstacle nearest to p if one is nearer than `within`, and its distance.
     const physics::Obstacle* nearest_obstacle(const glm::dvec3& p, double within, double& distance) const;
     glm::dvec3 grow_dir(const glm::dvec3& p, const glm::dvec3& h) const;

@@ -162,8 +162,7 @@ seed 1;
     const glm::dvec3 behind(-0.3, 0.5, 0.015), open(0.3, 0.5, 0.015);
     const glm::dvec3 lit = turn("0.5", open), shaded = turn("0.5", behind), dark = turn("0", behind);
     INFO("toward the light (+x): in the open " << lit.x << ", behind the wall " << shaded.x
-                                               << " with the sky's "
-                                               << "light, " << dark.x << " without");
+                                               << " with the sky's light, " << dark.x << " without");
     CHECK(lit.x > 0.01);       // in the open it turns toward the light
     CHECK(dark.x == 0.0);      // behind the wall, without the sky, it does not (O = 1)
     CHECK(shaded.x == dark.x); // and with the sky's light it still does not
