@@ -121,6 +121,14 @@ inline std::int32_t Rewriter::pick_guarded(std::size_t i, const Numbers& x, std:
     if (pk.count == 0) return pk.only == RulePlan::kNone ? -1 : static_cast<std::int32_t>(pk.only);
     const RulePlan::PickOption* o = plan.pick_options.data() + pk.first;
     double u = random_unit(random_bits_at(draw_phase, i, stream::kChoiceDraw)) * pk.total;
+    if (pk.count <= 2) {
+        // one option or two: the second when there is one and the draw is not below the first's
+        // weight (the loop below, without a branch on a random draw that the processor would
+        // mispredict about as often as the smaller weight's share)
+        const std::uint32_t second =
+            static_cast<std::uint32_t>(pk.count == 2) & static_cast<std::uint32_t>(!(u < o[0].weight));
+        return static_cast<std::int32_t>(o[second].guard);
+    }
     for (std::uint32_t j = 0; j + 1 < pk.count; ++j) {
         if (u < o[j].weight) return static_cast<std::int32_t>(o[j].guard);
         u -= o[j].weight;
