@@ -8,7 +8,7 @@
 // copying or clearing. Only the rest of the block is faulted in fresh. The pages a run touches
 // are then about its peak footprint instead of the sum of all its strings.
 //
-// Blocks of 64 KiB to 1 MiB (map_shared) are parts of 2 MiB pages, split in halves as buddies
+// Blocks of 4 KiB to 1 MiB (map_shared) are parts of 2 MiB pages, split in halves as buddies
 // until one is the size asked for. Without that, each small string of a derivation's early steps
 // took a page of its own, and the first touch of a 2 MiB page costs the kernel clearing all of
 // it: ABOP's Fig. 1.24d at n = 10 faulted in two pages for strings of 84 KB and 254 KB, about
@@ -36,7 +36,7 @@ std::vector<Block> kept; // guarded by lock
 std::size_t kept_total = 0;
 
 // The free parts of shared pages by size, kShareFrom << k for k = 0..kClasses-1 (guarded by lock).
-constexpr int kClasses = 5;
+constexpr int kClasses = 9;
 static_assert((kShareFrom << (kClasses - 1)) == kShareTo);
 std::vector<char*> free_parts[kClasses];
 std::size_t free_parts_total = 0;

@@ -1,11 +1,12 @@
 // Allocator for the module string's arrays. Three things a derivation step pays for otherwise:
 // - value-initialisation: resize() would zero memory that is overwritten right after, so
 //   construct() without arguments default-initialises (leaves numbers as they are);
-// - page faults: a step writes its whole output into fresh memory, so blocks of 64 KiB and more
-//   are whole 2 MiB pages, aligned and marked for transparent huge pages: one fault per 2 MiB
+// - page faults: a step writes its whole output into fresh memory, so blocks of 4 KiB and more
+//   live in 2 MiB pages, aligned and marked for transparent huge pages: one fault per 2 MiB
 //   instead of one per 4 KiB. Measured on the parametric tree (n = 16): 15 ms -> 6 ms. Blocks
-//   of 64 KiB to 1 MiB share 2 MiB pages (a power of two each, split and merged as buddies),
-//   so a derivation's small strings fault in one page between them instead of one each;
+//   of 4 KiB to 1 MiB share 2 MiB pages (a power of two each, split and merged as buddies),
+//   so a derivation's small strings fault in one page between them instead of one each, the
+//   page its large strings take later (docs/rewriting.md, "Shared pages from 4 KiB");
 // - zeroing: the kernel clears every page it hands out, and a growing derivation frees a string
 //   every step. Freed blocks are kept (see big_pages) and their pages moved into the next blocks,
 //   so a page is cleared once per run, not once per step.
@@ -41,7 +42,7 @@ std::size_t kept_bytes();
 // Blocks of kShareFrom to kShareTo bytes share 2 MiB pages: each is a power of two at an offset
 // that is a multiple of its size, split from a larger free one and merged with its free buddy
 // when freed; a page whose parts are all free again goes back to the kept blocks.
-constexpr std::size_t kShareFrom = std::size_t{64} << 10;
+constexpr std::size_t kShareFrom = std::size_t{4} << 10;
 constexpr std::size_t kShareTo = kHuge / 2;
 // The bytes a block asked for takes: a power of two from kShareFrom up to kShareTo, whole 2 MiB
 // pages beyond. Only for bytes >= kShareFrom.
@@ -58,7 +59,7 @@ std::size_t shared_free_bytes();               // free parts of pages that are p
 
 template <typename T> struct BigAllocator {
     using value_type = T;
-    static constexpr std::size_t kMapped = std::size_t{64} << 10;
+    static constexpr std::size_t kMapped = std::size_t{4} << 10;
 
     BigAllocator() noexcept = default;
     template <typename U> BigAllocator(const BigAllocator<U>&) noexcept {}

@@ -39,10 +39,14 @@ TEST_CASE("freed string blocks lend their pages to later ones, which read and wr
     CHECK(big_pages::kept_bytes() == 0);
 }
 
-TEST_CASE("blocks of 64 KiB to 1 MiB share 2 MiB pages as buddies and give the page back whole", "[derive]") {
+TEST_CASE("blocks of 4 KiB to 1 MiB share 2 MiB pages as buddies and give the page back whole", "[derive]") {
     big_pages::trim();
     const std::size_t kib = std::size_t{1} << 10, page = big_pages::kHuge;
     REQUIRE(big_pages::shared_free_bytes() == 0);
+    CHECK(big_pages::block_bytes(4 * kib) == 4 * kib);
+    CHECK(big_pages::block_bytes(5 * kib) == 8 * kib);
+    CHECK(BigAllocator<std::uint16_t>::charged_bytes(2047) == 4094); // under 4 KiB: malloc's
+    CHECK(BigAllocator<std::uint16_t>::charged_bytes(2048) == 4 * kib);
     CHECK(big_pages::block_bytes(64 * kib) == 64 * kib);
     CHECK(big_pages::block_bytes(65 * kib) == 128 * kib);
     CHECK(big_pages::block_bytes(1024 * kib) == 1024 * kib);
@@ -97,4 +101,24 @@ TEST_CASE("blocks of 64 KiB to 1 MiB share 2 MiB pages as buddies and give the p
     CHECK(big_pages::kept_bytes() == 2 * page);
     big_pages::trim();
     CHECK(big_pages::kept_bytes() == 0);
+}
+
+TEST_CASE("a derivation's strings of a few KB take parts of the page its large ones use", "[derive]") {
+    big_pages::trim();
+    const std::size_t kib = std::size_t{1} << 10, page = big_pages::kHuge;
+    auto page_of = [&](const void* p) { return reinterpret_cast<std::uintptr_t>(p) / page; };
+    {
+        // 1.24d's strings at steps 5 to 10 (kinds, 2 bytes a module): 6 KB to 764 KB, one page
+        BigVector<std::uint16_t> s5(6 * kib / 2), s6(18 * kib / 2), s7(56 * kib / 2);
+        BigVector<std::uint16_t> s8(84 * kib / 2), s9(254 * kib / 2), s10(764 * kib / 2);
+        for (const auto* v : {&s6, &s7, &s8, &s9, &s10}) CHECK(page_of(v->data()) == page_of(s5.data()));
+        CHECK(reinterpret_cast<std::uintptr_t>(s5.data()) % (8 * kib) == 0);
+        CHECK(big_pages::shared_free_bytes() == page - (8 + 32 + 64 + 128 + 256 + 1024) * kib);
+        // under 4 KiB: malloc's, no part taken
+        BigVector<std::uint16_t> tiny(2047);
+        CHECK(big_pages::shared_free_bytes() == page - (8 + 32 + 64 + 128 + 256 + 1024) * kib);
+    }
+    CHECK(big_pages::shared_free_bytes() == 0);
+    CHECK(big_pages::kept_bytes() == page);
+    big_pages::trim();
 }
