@@ -46,6 +46,7 @@ fuzz: | deps
 # and 2 jobs), bench/run-peers (against cpfg and lpfg; skipped when they cannot be built) and
 # bench/run-glb (plant run against a hand-written GLB writer); fails when one misses a target.
 bench: build
+	@bash scripts/install-deps --bench
 	status=0; bash bench/run || status=1; bash bench/run-batch || status=1; \
 	bash bench/run-peers || status=1; bash bench/run-glb || status=1; exit $$status
 
