@@ -198,11 +198,27 @@ void unmap_locked(void* p, std::size_t bytes) {
 
 } // namespace
 
-void trim() {
+void trim(std::size_t keep) {
     std::lock_guard<std::mutex> guard(lock);
-    for (const Block& b : kept) ::munmap(b.at, b.bytes);
-    kept.clear();
+    std::size_t keep_left = keep / kHuge * kHuge;
+    std::vector<Block> still;
+    if (keep_left > 0) {
+        try {
+            still.reserve(kept.size());
+        } catch (...) {
+            keep_left = 0; // (called from destructors: give everything back rather than throw)
+        }
+    }
+    // the blocks freed last are kept first; a block is split at a 2 MiB boundary if need be
+    for (auto b = kept.rbegin(); b != kept.rend(); ++b) {
+        const std::size_t stay = std::min(keep_left, b->bytes);
+        if (stay < b->bytes) ::munmap(b->at + stay, b->bytes - stay);
+        if (stay > 0) still.push_back(Block{b->at, stay});
+        keep_left -= stay;
+    }
+    kept = std::move(still);
     kept_total = 0;
+    for (const Block& b : kept) kept_total += b.bytes;
 }
 
 std::size_t kept_bytes() {

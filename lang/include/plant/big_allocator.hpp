@@ -36,7 +36,10 @@ inline std::size_t rounded(std::size_t bytes) {
 }
 void* map(std::size_t bytes);           // bytes: a multiple of kHuge; nullptr when out of memory
 void unmap(void* p, std::size_t bytes); // a block from map(), whole
-void trim();                            // gives every kept page back to the system
+// Gives kept pages back to the system, all but `keep` bytes of them (rounded down to whole 2 MiB
+// pages): a process that derives again soon (a batch of variants, the REPL, the view server)
+// then reuses a warm page instead of clearing a fresh one.
+void trim(std::size_t keep = 0);
 std::size_t kept_bytes();
 
 // Blocks of kShareFrom to kShareTo bytes share 2 MiB pages: each is a power of two at an offset

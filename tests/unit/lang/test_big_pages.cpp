@@ -122,3 +122,25 @@ TEST_CASE("a derivation's strings of a few KB take parts of the page its large o
     CHECK(big_pages::kept_bytes() == page);
     big_pages::trim();
 }
+
+TEST_CASE("trim gives kept pages back but for the whole pages it is told to keep", "[derive]") {
+    big_pages::trim();
+    const std::size_t page = big_pages::kHuge;
+    {
+        BigVector<std::uint8_t> a(3 * page - 5), b(page); // three pages and one
+        a[0] = b[0] = 1;
+    }
+    REQUIRE(big_pages::kept_bytes() == 4 * page);
+    big_pages::trim(2 * page + page / 2); // rounded down to two pages
+    CHECK(big_pages::kept_bytes() == 2 * page);
+    {
+        BigVector<std::uint8_t> c(2 * page); // the kept pages serve a block of their size
+        c[2 * page - 1] = 7;
+        CHECK(c[2 * page - 1] == 7);
+        CHECK(big_pages::kept_bytes() == 0);
+    }
+    big_pages::trim(page);
+    CHECK(big_pages::kept_bytes() == page);
+    big_pages::trim();
+    CHECK(big_pages::kept_bytes() == 0);
+}
