@@ -60,12 +60,14 @@ void unmap_shared(void* p, std::size_t bytes); // a block from map_shared(), who
 std::size_t shared_free_bytes();               // free parts of pages that are partly in use
 } // namespace big_pages
 
-// Built with AddressSanitizer (make test-sanitize), every block comes from malloc, which ASan
-// guards; it cannot see past the end of a part of a mapped page. Sizes and charges are the same.
+// Built with AddressSanitizer (make test-sanitize), blocks under 64 KiB come from malloc, which
+// ASan guards (it cannot see past the end of a part of a mapped page), as they did before parts
+// started at 4 KiB; sizes and charges are the same. Larger ones stay mapped: ASan keeps freed
+// malloc blocks resident in its quarantine, and the resident-memory backstop would count them.
 #if defined(__SANITIZE_ADDRESS__)
-inline constexpr bool kBlocksFromMalloc = true;
+inline constexpr std::size_t kMallocBelow = std::size_t{64} << 10;
 #else
-inline constexpr bool kBlocksFromMalloc = false;
+inline constexpr std::size_t kMallocBelow = big_pages::kShareFrom;
 #endif
 
 template <typename T> struct BigAllocator {
@@ -87,9 +89,9 @@ template <typename T> struct BigAllocator {
         if (n > std::size_t(-1) / sizeof(T) / 2) throw std::bad_alloc();
         const std::size_t bytes = n * sizeof(T), block = charged_bytes(n);
         memory::charge(block);
-        void* p = bytes < kMapped || kBlocksFromMalloc ? std::malloc(bytes ? bytes : 1)
-                  : block <= big_pages::kShareTo       ? big_pages::map_shared(block)
-                                                       : big_pages::map(block);
+        void* p = bytes < kMallocBelow           ? std::malloc(bytes ? bytes : 1)
+                  : block <= big_pages::kShareTo ? big_pages::map_shared(block)
+                                                 : big_pages::map(block);
         if (!p) {
             memory::release(block);
             throw std::bad_alloc();
@@ -99,7 +101,7 @@ template <typename T> struct BigAllocator {
     void deallocate(T* p, std::size_t n) noexcept {
         const std::size_t block = charged_bytes(n);
         memory::release(block);
-        if (n * sizeof(T) < kMapped || kBlocksFromMalloc)
+        if (n * sizeof(T) < kMallocBelow)
             std::free(p);
         else if (block <= big_pages::kShareTo)
             big_pages::unmap_shared(p, block);
