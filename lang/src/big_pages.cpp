@@ -16,6 +16,7 @@
 #include "plant/big_allocator.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <mutex>
 #include <sys/mman.h>
 
@@ -36,7 +37,7 @@ std::vector<Block> kept; // guarded by lock
 std::size_t kept_total = 0;
 
 // The free parts of shared pages by size, kShareFrom << k for k = 0..kClasses-1 (guarded by lock).
-constexpr int kClasses = 9;
+constexpr int kClasses = std::countr_zero(kShareTo / kShareFrom) + 1;
 static_assert((kShareFrom << (kClasses - 1)) == kShareTo);
 std::vector<char*> free_parts[kClasses];
 std::size_t free_parts_total = 0;

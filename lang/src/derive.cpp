@@ -283,7 +283,7 @@ void Derivation::run() {
     while (step()) {
     }
     finish();
-    big_pages::trim(kKeepAfterRun); // the pages freed strings kept for later steps go back to the system
+    big_pages::trim(kKeepAfterRun); // what freed strings kept for later steps, but two pages, goes back
 }
 
 } // namespace plant

@@ -72,12 +72,10 @@ inline constexpr std::size_t kMallocBelow = big_pages::kShareFrom;
 
 template <typename T> struct BigAllocator {
     using value_type = T;
-    static constexpr std::size_t kMapped = std::size_t{4} << 10;
+    static constexpr std::size_t kMapped = big_pages::kShareFrom;
 
     BigAllocator() noexcept = default;
     template <typename U> BigAllocator(const BigAllocator<U>&) noexcept {}
-
-    static_assert(kMapped == big_pages::kShareFrom);
 
     // The bytes a block of n takes, as charged.
     static std::size_t charged_bytes(std::size_t n) {
