@@ -15,6 +15,7 @@
 // given back when it is freed.
 #pragma once
 
+#include "plant/big_pages.hpp"
 #include "plant/memory_budget.hpp"
 
 #include <cstddef>
@@ -25,50 +26,6 @@
 #include <vector>
 
 namespace plant {
-
-// Blocks of whole 2 MiB pages, 2 MiB aligned, for BigAllocator. A freed block is not returned to
-// the system at once: its pages are kept (up to a cap) and moved by mremap into the blocks asked
-// for later, which then need no fresh, kernel-cleared pages for that part. Thread-safe.
-namespace big_pages {
-constexpr std::size_t kHuge = std::size_t{2} << 20;
-inline std::size_t rounded(std::size_t bytes) {
-    return (bytes + kHuge - 1) / kHuge * kHuge;
-}
-void* map(std::size_t bytes);           // bytes: a multiple of kHuge; nullptr when out of memory
-void unmap(void* p, std::size_t bytes); // a block from map(), whole
-// Gives kept pages back to the system, all but `keep` bytes of them (rounded down to whole 2 MiB
-// pages): a process that derives again soon (a batch of variants, the REPL, the view server)
-// then reuses a warm page instead of clearing a fresh one.
-void trim(std::size_t keep = 0);
-std::size_t kept_bytes();
-
-// Blocks of kShareFrom to kShareTo bytes share 2 MiB pages: each is a power of two at an offset
-// that is a multiple of its size, split from a larger free one and merged with its free buddy
-// when freed; a page whose parts are all free again goes back to the kept blocks.
-constexpr std::size_t kShareFrom = std::size_t{4} << 10;
-constexpr std::size_t kShareTo = kHuge / 2;
-// The bytes a block asked for takes: a power of two from kShareFrom up to kShareTo, whole 2 MiB
-// pages beyond. Only for bytes >= kShareFrom.
-inline std::size_t block_bytes(std::size_t bytes) {
-    if (bytes > kShareTo) return rounded(bytes);
-    std::size_t b = kShareFrom;
-    while (b < bytes) b *= 2;
-    return b;
-}
-void* map_shared(std::size_t bytes);           // bytes: block_bytes of at most kShareTo
-void unmap_shared(void* p, std::size_t bytes); // a block from map_shared(), whole
-std::size_t shared_free_bytes();               // free parts of pages that are partly in use
-} // namespace big_pages
-
-// Built with AddressSanitizer (make test-sanitize), blocks under 64 KiB come from malloc, which
-// ASan guards (it cannot see past the end of a part of a mapped page), as they did before parts
-// started at 4 KiB; sizes and charges are the same. Larger ones stay mapped: ASan keeps freed
-// malloc blocks resident in its quarantine, and the resident-memory backstop would count them.
-#if defined(__SANITIZE_ADDRESS__)
-inline constexpr std::size_t kMallocBelow = std::size_t{64} << 10;
-#else
-inline constexpr std::size_t kMallocBelow = big_pages::kShareFrom;
-#endif
 
 template <typename T> struct BigAllocator {
     using value_type = T;

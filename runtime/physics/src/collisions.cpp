@@ -45,7 +45,7 @@ void World::integrate() {
     // bouncing by the elasticity) and some of the tangential part (friction)
     const double dt = settings_.dt;
     const std::size_t n = x_.size();
-    const std::vector<glm::dvec3>& old = scratch_.old;
+    const Array<glm::dvec3>& old = scratch_.old;
     parallel_ranges(n, settings_.threads, 2048, [&](std::size_t b, std::size_t e) {
         for (std::size_t i = b; i < e; ++i) {
             if (!alive_[i]) continue;

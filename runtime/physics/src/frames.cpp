@@ -97,8 +97,8 @@ void World::group_frame(std::uint32_t i, glm::dquat warm, const glm::dmat3& mome
     out.valid = true;
 }
 
-void World::frame_pair(const std::uint32_t (&group)[2], const std::vector<glm::dmat3>& moments,
-                       const Groups& g, std::vector<Frame>& frames) const {
+void World::frame_pair(const std::uint32_t (&group)[2], const Array<glm::dmat3>& moments, const Groups& g,
+                       Array<Frame>& frames) const {
     // group_frame with one rotation iteration from the last pass's frame, for two groups with
     // the same number of members at once (equal counts: no lane needs padding)
     const Groups::Member* from[2] = {g.member.data() + g.start[group[0]],
@@ -188,7 +188,7 @@ void World::frame_pair(const std::uint32_t (&group)[2], const std::vector<glm::d
     }
 }
 
-void World::match_shapes(std::vector<Frame>& frames, const std::vector<glm::dmat3>& moments, int iterations,
+void World::match_shapes(Array<Frame>& frames, const Array<glm::dmat3>& moments, int iterations,
                          const Groups& g) const {
     const std::size_t n = x_.size();
     frames.resize(n);

@@ -83,7 +83,7 @@ void World::grow() {
     bool shade_counted = false;
     auto occlusion = [&](const glm::dvec3& p) {
         if (!shade_counted) {
-            std::vector<glm::dvec3> points;
+            Array<glm::dvec3> points;
             for (std::size_t k = 0; k < n; ++k)
                 if (alive_[k]) points.push_back(x_[k]);
             shade.build(points, g.light_cell);

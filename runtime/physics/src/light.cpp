@@ -11,7 +11,7 @@ void LightGrid::clear() {
     n_ = glm::ivec3(0);
 }
 
-void LightGrid::build(const std::vector<glm::dvec3>& points, double cell) {
+void LightGrid::build(std::span<const glm::dvec3> points, double cell) {
     clear();
     glm::dvec3 lo(1e300), hi(-1e300);
     for (const auto& p : points) {

@@ -62,10 +62,10 @@ constexpr int kSweeps = 16;
 
 // Lists each oversized link (find_link_pairs) with every other link of another plant whose bounds
 // it meets.
-void pair_oversized(const std::vector<std::uint32_t>& big, const std::vector<std::uint32_t>& links,
-                    const std::vector<glm::dvec3>& lo, const std::vector<glm::dvec3>& hi,
-                    const std::vector<std::uint32_t>& plant,
-                    std::vector<std::pair<std::uint32_t, std::uint32_t>>& pairs) {
+void pair_oversized(const Array<std::uint32_t>& big, const Array<std::uint32_t>& links,
+                    const Array<glm::dvec3>& lo, const Array<glm::dvec3>& hi,
+                    const Array<std::uint32_t>& plant,
+                    Array<std::pair<std::uint32_t, std::uint32_t>>& pairs) {
     for (std::size_t u = 0; u < big.size(); ++u) {
         const std::uint32_t a = big[u];
         auto consider = [&](std::uint32_t b) {

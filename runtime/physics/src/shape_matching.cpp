@@ -39,8 +39,7 @@ glm::dmat3 World::ellipsoid_moment(std::uint32_t j) const {
     return glm::mat3_cast(q_[j]) * rest_moment(j);
 }
 
-void World::group_moments(const Groups& g, std::vector<glm::dmat3>& each,
-                          std::vector<glm::dmat3>& sums) const {
+void World::group_moments(const Groups& g, Array<glm::dmat3>& each, Array<glm::dmat3>& sums) const {
     const std::size_t n = x_.size();
     each.resize(n);
     sums.resize(n);
@@ -130,7 +129,7 @@ void World::build_groups(Groups& g) const {
     g.source_start[n] = static_cast<std::uint32_t>(g.source.size());
 }
 
-glm::dvec3 World::goal_of(std::uint32_t j, const std::vector<Frame>& frames, const Groups& g) const {
+glm::dvec3 World::goal_of(std::uint32_t j, const Array<Frame>& frames, const Groups& g) const {
     // Eq. 3: the target of particle j in group i is R_i (x̄_j - c̄_i) + c_i; Eq. 4: j's goal is
     // their mass-weighted mean over the groups j belongs to (its own, its parent's, its
     // children's), its parent's group counting twice as much as its own and its children's half.
@@ -153,8 +152,8 @@ glm::dvec3 World::goal_of(std::uint32_t j, const std::vector<Frame>& frames, con
 }
 
 std::vector<glm::dvec3> World::goals() const {
-    std::vector<Frame> frames;
-    std::vector<glm::dmat3> each, moments;
+    Array<Frame> frames;
+    Array<glm::dmat3> each, moments;
     Groups groups;
     build_groups(groups);
     group_moments(groups, each, moments);

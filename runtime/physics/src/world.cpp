@@ -178,7 +178,7 @@ void World::step() {
 void World::predict() {
     const double dt = settings_.dt;
     const std::size_t n = x_.size();
-    std::vector<glm::dvec3>& old = scratch_.old;
+    Array<glm::dvec3>& old = scratch_.old;
     old.resize(n);
     // Eq. 1: predicted positions; a_e is the steady wind plus what the fluid pushed (Fluid::step)
     if (external_.size() < n) external_.resize(n, glm::dvec3(0.0));

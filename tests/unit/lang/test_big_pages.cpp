@@ -1,5 +1,6 @@
 // The module string's allocator: freed blocks keep their pages for the next blocks.
 #include "plant/big_allocator.hpp"
+#include "plant/big_pages.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -160,5 +161,27 @@ TEST_CASE("trim gives kept pages back but for the whole pages it is told to keep
     CHECK(big_pages::kept_bytes() == page);
     big_pages::trim();
     CHECK(big_pages::kept_bytes() == 0);
+}
+TEST_CASE("the physics library's arrays take the same pages, zeroed, and charge nothing", "[physics]") {
+    big_pages::trim();
+    const std::size_t page = big_pages::kHuge;
+    const auto charged = memory::charged();
+    {
+        // 25,000 positions of 24 bytes: a 1 MiB part of a shared page; 25,000 3x3 matrices:
+        // a whole page of its own, 2 MiB aligned
+        PagedVector<double> x(3 * 25000), m(9 * 25000, 1.0);
+        CHECK(reinterpret_cast<std::uintptr_t>(m.data()) % page == 0);
+        CHECK(big_pages::shared_free_bytes() == page / 2);
+        CHECK(memory::charged() == charged);
+        for (double d : x) REQUIRE(d == 0.0); // resize and the size constructor zero, as std::vector
+        x.resize(4 * 25000);
+        CHECK(x.back() == 0.0);
+        CHECK(m[9 * 25000 - 1] == 1.0);
+    }
+    CHECK(big_pages::shared_free_bytes() == 0);
+    CHECK(big_pages::kept_bytes() >= 2 * page); // the matrices' page and the shared one, kept
+    PagedVector<int> small(100); // under 4 KiB: malloc's
+    CHECK(small[99] == 0);
+    big_pages::trim();
 }
 #endif

@@ -9,6 +9,7 @@
 #include <glm/glm.hpp>
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace plant::physics {
@@ -17,7 +18,7 @@ class LightGrid {
   public:
     // Counts `points` in cells of `cell` (doubled until the grid has at most 4 million cells);
     // points that are not finite are left out.
-    void build(const std::vector<glm::dvec3>& points, double cell);
+    void build(std::span<const glm::dvec3> points, double cell);
     void clear();
     // Particles in the cells a ray from p toward `to_light` (unit) passes, p's own cell left out.
     double count_toward(const glm::dvec3& p, const glm::dvec3& to_light) const;
@@ -28,7 +29,7 @@ class LightGrid {
     glm::dvec3 lo_{0.0};
     double cell_ = 0.1;
     glm::ivec3 n_{0};
-    std::vector<std::uint32_t> count_;
+    Array<std::uint32_t> count_; // a grid of millions of cells: in 2 MiB pages (world.hpp)
 };
 
 // Whether the ray from p toward `to_light` (unit) enters obstacle o: the paper's light includes

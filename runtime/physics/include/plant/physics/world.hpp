@@ -10,6 +10,8 @@
 // a {index, generation} handle (Box2D's), and a parent's index is always below its children's.
 #pragma once
 
+#include "plant/big_pages.hpp"
+
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 
@@ -19,6 +21,11 @@
 #include <vector>
 
 namespace plant::physics {
+
+// The per-particle arrays and the solver's scratch live in 2 MiB pages (plant/big_pages.hpp): a
+// step over 25,000 particles touches about 20 MB, which faulted in 4 KiB at a time took the
+// first step 108 ms on a VM where a fault costs 10 us (docs/physics.md, "Memory").
+template <typename T> using Array = PagedVector<T>;
 
 struct Handle {
     std::uint32_t index = ~0u;
@@ -289,16 +296,15 @@ class World {
             double weight;     // Eq. 4's weight over the sum of j's weights
             glm::dvec3 offset; // x̄_j - c̄_i
         };
-        std::vector<std::uint32_t> start; // group i: member[start[i] .. start[i + 1])
-        std::vector<Member> member;
-        std::vector<std::uint32_t> source_start; // particle j: source[source_start[j] .. source_start[j + 1])
-        std::vector<Source> source;
-        std::vector<glm::dvec3> rest_center; // per group: c̄, while building
+        Array<std::uint32_t> start; // group i: member[start[i] .. start[i + 1])
+        Array<Member> member;
+        Array<std::uint32_t> source_start; // particle j: source[source_start[j] .. source_start[j + 1])
+        Array<Source> source;
+        Array<glm::dvec3> rest_center; // per group: c̄, while building
     };
     void build_groups(Groups& g) const;
     // Eq. 15's ellipsoid moments of every particle (`each`) and their sums over each group.
-    void group_moments(const Groups& groups, std::vector<glm::dmat3>& each,
-                       std::vector<glm::dmat3>& sums) const;
+    void group_moments(const Groups& groups, Array<glm::dmat3>& each, Array<glm::dmat3>& sums) const;
     // Group i's frame, given the sum of its members' ellipsoid moments, with at most
     // `iterations` rotation-extraction iterations warm-started from `warm`; with `warm_matrix`,
     // out.M is warm's rotation matrix already.
@@ -306,15 +312,15 @@ class World {
                      const Groups& groups, Frame& out, bool warm_matrix = false) const;
     // group_frame for two groups with the same number of members, each warm-started from its
     // frame with one iteration: the same results, computed two lanes at a time.
-    void frame_pair(const std::uint32_t (&group)[2], const std::vector<glm::dmat3>& moments,
-                    const Groups& groups, std::vector<Frame>& frames) const;
+    void frame_pair(const std::uint32_t (&group)[2], const Array<glm::dmat3>& moments, const Groups& groups,
+                    Array<Frame>& frames) const;
     // One shape-matching pass: every group's frame (Eq. 14-15, warm-started from `frames`),
     // with at most `iterations` rotation-extraction iterations per group; `moments` holds each
     // group's moment sum (group_moments).
-    void match_shapes(std::vector<Frame>& frames, const std::vector<glm::dmat3>& moments, int iterations,
+    void match_shapes(Array<Frame>& frames, const Array<glm::dmat3>& moments, int iterations,
                       const Groups& groups) const;
     // Particle j's goal from the groups' frames (Eq. 3-4).
-    glm::dvec3 goal_of(std::uint32_t j, const std::vector<Frame>& frames, const Groups& groups) const;
+    glm::dvec3 goal_of(std::uint32_t j, const Array<Frame>& frames, const Groups& groups) const;
     double stiffness(std::uint32_t i) const;
 
     // The phases of step(), in order (world.cpp, shape_matching.cpp, collisions.cpp).
@@ -359,13 +365,13 @@ class World {
     void break_overstretched(); // connections stretched past the break threshold let go
 
     Settings settings_;
-    std::vector<glm::dvec3> x_, v_, rest_x_, radii_;
-    std::vector<glm::dquat> q_, rest_q_;
-    std::vector<double> m_, age_, length_;
-    std::vector<std::uint32_t> laterals_;
-    std::vector<std::uint32_t> parent_, generation_;
-    std::vector<std::vector<std::uint32_t>> children_;
-    std::vector<std::uint8_t> fixed_, alive_;
+    Array<glm::dvec3> x_, v_, rest_x_, radii_;
+    Array<glm::dquat> q_, rest_q_;
+    Array<double> m_, age_, length_;
+    Array<std::uint32_t> laterals_;
+    Array<std::uint32_t> parent_, generation_;
+    Array<Array<std::uint32_t>> children_;
+    Array<std::uint8_t> fixed_, alive_;
     struct Anchor {
         std::uint32_t particle;
         glm::dvec3 point; // where it was made
@@ -380,13 +386,13 @@ class World {
     }
     std::vector<Anchor> anchors_;
     double peak_speed_ = 0, unexplained_speed_ = 0;
-    std::vector<double> highest_; // each particle's highest potential per unit mass at a step's ends
+    Array<double> highest_; // each particle's highest potential per unit mass at a step's ends
     std::vector<Obstacle> obstacles_;
     std::vector<std::pair<std::uint32_t, glm::dvec3>> pulls_;
     double break_threshold_ = 0;
     glm::dvec3 wind_{0.0};
     StepTimes times_;
-    std::vector<glm::dvec3> external_; // per particle, cleared after each step
+    Array<glm::dvec3> external_; // per particle, cleared after each step
     // A cell of the collision pass's hash table: its key and its particles' run in `members`.
     struct Cell {
         std::uint64_t key = 0;
@@ -401,41 +407,41 @@ class World {
     // the rest moments were built: growth, cuts and breaks do, a step without them does not.
     bool groups_stale_ = true;
     struct Scratch {
-        std::vector<Frame> frames;
-        std::vector<glm::dmat3> moments, group_moment; // per particle, and summed per group
-        std::vector<glm::dvec3> old;
-        std::vector<Cell> table;                     // the collision pass's cells
-        std::vector<std::uint32_t> slot_of, members; // particles grouped by table slot
-        std::vector<glm::i64vec3> cell_of;           // each particle's collision cell
-        std::vector<double> thin;                    // each particle's thinnest radius
-        std::vector<std::uint32_t> oversized;        // contacts: particles too wide for the grid
-        std::vector<glm::dmat3> rest_moment;         // 0.2 m D R̄ᵀ, while the groups are current
-        std::vector<glm::dvec3> push;
-        std::vector<std::uint8_t> near;           // links near an obstacle (resolve_segments)
-        std::vector<std::uint32_t> contact_links; // the same, as a list in index order
-        std::vector<double> stiffness;            // each particle's s, during a step
+        Array<Frame> frames;
+        Array<glm::dmat3> moments, group_moment; // per particle, and summed per group
+        Array<glm::dvec3> old;
+        Array<Cell> table;                     // the collision pass's cells
+        Array<std::uint32_t> slot_of, members; // particles grouped by table slot
+        Array<glm::i64vec3> cell_of;           // each particle's collision cell
+        Array<double> thin;                    // each particle's thinnest radius
+        Array<std::uint32_t> oversized;        // contacts: particles too wide for the grid
+        Array<glm::dmat3> rest_moment;         // 0.2 m D R̄ᵀ, while the groups are current
+        Array<glm::dvec3> push;
+        Array<std::uint8_t> near;           // links near an obstacle (resolve_segments)
+        Array<std::uint32_t> contact_links; // the same, as a list in index order
+        Array<double> stiffness;            // each particle's s, during a step
         Groups groups;
         // the length and bending sweep (length.cpp): each link's rest offset from the parent,
         // its rest length and unit direction (kept with the groups), and its direction now
-        std::vector<glm::dvec3> rest_link, rest_dir, dir;
-        std::vector<double> rest_length;
+        Array<glm::dvec3> rest_link, rest_dir, dir;
+        Array<double> rest_length;
         // links of different plants (link_contacts.cpp): each particle's plant (root index) and
         // how many plants have a link, kept with the groups; each link's capsule bounds, the
         // link grid and the candidate pairs, per step
-        std::vector<std::uint32_t> plant;
+        Array<std::uint32_t> plant;
         std::size_t plants = 0;
-        std::vector<glm::dvec3> box_lo, box_hi;
-        std::vector<std::uint32_t> link_list, link_members;
-        std::vector<LinkCell> link_table;
-        std::vector<std::pair<std::uint32_t, std::uint32_t>> link_pairs;
-        std::vector<std::uint32_t> link_big; // link contacts: boxes too large for the grid
+        Array<glm::dvec3> box_lo, box_hi;
+        Array<std::uint32_t> link_list, link_members;
+        Array<LinkCell> link_table;
+        Array<std::pair<std::uint32_t, std::uint32_t>> link_pairs;
+        Array<std::uint32_t> link_big; // link contacts: boxes too large for the grid
         // the energy budget (energy.cpp): the forcing on each particle this step, its energy
         // per unit mass before the step, and whether the hand holds it
-        std::vector<glm::dvec3> forcing;
-        std::vector<double> energy_before;
-        std::vector<std::uint8_t> held;
+        Array<glm::dvec3> forcing;
+        Array<double> energy_before;
+        Array<std::uint8_t> held;
 
-        static double thin_of(std::uint32_t i, const std::vector<glm::dvec3>& radii) {
+        static double thin_of(std::uint32_t i, const Array<glm::dvec3>& radii) {
             return std::min({radii[i].x, radii[i].y, radii[i].z});
         }
     } scratch_;

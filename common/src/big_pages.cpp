@@ -1,4 +1,4 @@
-// Page recycling for BigAllocator (see big_allocator.hpp).
+// Page recycling for BigAllocator and PagedAllocator (see plant/big_pages.hpp).
 //
 // A derivation that doubles its string every step frees, each step, the string before last. With
 // plain mmap/munmap every output is fresh memory the kernel must clear first, and on the
@@ -13,7 +13,7 @@
 // took a page of its own, and the first touch of a 2 MiB page costs the kernel clearing all of
 // it: ABOP's Fig. 1.24d at n = 10 faulted in two pages for strings of 84 KB and 254 KB, about
 // 0.3 ms each on a VM, most of its derivation time (docs/rewriting.md).
-#include "plant/big_allocator.hpp"
+#include "plant/big_pages.hpp"
 
 #include <algorithm>
 #include <bit>
