@@ -183,6 +183,9 @@ void World::separate_particles() {
             // the block's eight keys, z slowest (the order the pushes are summed in)
             std::uint64_t keys[8];
             for (int q = 0; q < 8; ++q) keys[q] = hx[q & 1] ^ hy[(q >> 1) & 1] ^ hz[q >> 2];
+            // the eight slots are scattered over a table of megabytes: asked for all at once,
+            // their cache misses overlap instead of following one another
+            for (const std::uint64_t k : keys) __builtin_prefetch(&table[k & (size - 1)]);
             for (const std::uint64_t k : keys) {
                 std::size_t slot = k & (size - 1);
                 while (table[slot].end != table[slot].begin && table[slot].key != k)

@@ -30,18 +30,6 @@ inline glm::dvec3 turn_between(const glm::dvec3& a, const glm::dvec3& b, const g
     return v * c + glm::cross(k, v) + k * (glm::dot(k, v) / (1 + c));
 }
 
-// the shortest rotation taking unit a to unit b, as a quaternion
-glm::dquat rotation_between(const glm::dvec3& a, const glm::dvec3& b) {
-    const double c = glm::dot(a, b);
-    if (c < -1 + 1e-9) {
-        const glm::dvec3 k =
-            glm::normalize(glm::cross(a, std::fabs(a.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0)));
-        return glm::dquat(0, k.x, k.y, k.z);
-    }
-    const glm::dvec3 k = glm::cross(a, b);
-    return glm::normalize(glm::dquat(1 + c, k.x, k.y, k.z));
-}
-
 } // namespace
 
 glm::dvec3 World::carried(std::uint32_t p, const glm::dvec3& v, bool back) const {
@@ -67,6 +55,46 @@ void World::build_links() {
         sc.rest_link[i] = rest_x_[i] - rest_x_[p];
         sc.rest_length[i] = glm::length(sc.rest_link[i]);
         if (sc.rest_length[i] > 1e-12) sc.rest_dir[i] = sc.rest_link[i] / sc.rest_length[i];
+    }
+    build_sweep_order();
+}
+
+void World::build_sweep_order() {
+    // A particle's place in the sweep depends only on its parent's, which index order puts first.
+    // In index order most particles follow their parent directly (a stem's chain), so each waits
+    // for the square root and divisions of the one before. Two chains handed out in index order
+    // and visited in turn give the processor two independent particles at a time; every particle
+    // still sees its parent placed, so the result is the same bit for bit. A chain's first
+    // particle may wait for its parent in the other chain, which then goes on alone.
+    const auto n = static_cast<std::uint32_t>(x_.size());
+    auto& order = scratch_.sweep;
+    order.clear();
+    order.reserve(n);
+    Array<std::uint8_t> placed(n, 0);
+    auto chain_end = [&](std::uint32_t s) {
+        std::uint32_t e = s + 1;
+        while (e < n && parent_[e] == e - 1) ++e;
+        return e;
+    };
+    std::uint32_t at[2] = {0, 0}, end[2] = {0, 0}, next = 0;
+    for (;;) {
+        bool moved = false;
+        for (int l = 0; l < 2; ++l) {
+            if (at[l] == end[l] && next < n) at[l] = next, end[l] = next = chain_end(next);
+            if (at[l] == end[l]) continue;
+            const std::uint32_t i = at[l], p = parent_[i];
+            if (p != kNone && (p >= n || !placed[p])) continue; // its parent first
+            order.push_back(i);
+            placed[i] = 1;
+            ++at[l];
+            moved = true;
+        }
+        if (moved) continue;
+        // both lanes empty and nothing left, or (were a parent ever after its child) stuck: the
+        // rest in index order
+        for (std::uint32_t i = 0; i < n; ++i)
+            if (!placed[i]) order.push_back(i);
+        break;
     }
 }
 
@@ -98,10 +126,10 @@ bool World::outside_obstacles(glm::dvec3& x, double r, const glm::dvec3* parent)
 void World::keep_shape(bool orient, bool bend) {
     // parents come before their children in index order, so one pass in that order sees every
     // parent already placed; it runs on one thread, so the result does not depend on the count
-    const std::size_t n = x_.size();
     auto& sc = scratch_;
     const auto& stiff = sc.stiffness;
-    for (std::uint32_t i = 0; i < n; ++i) {
+    sc.oriented.clear(); // the particles whose orientation follows their link, after the sweep
+    for (const std::uint32_t i : sc.sweep) { // (build_sweep_order)
         const std::uint32_t p = parent_[i];
         if (!alive_[i] || p == kNone) continue;
         const glm::dvec3& rest = sc.rest_link[i];
@@ -147,12 +175,9 @@ void World::keep_shape(bool orient, bool bend) {
                 }
         }
         sc.dir[i] = d;
-        if (!orient) continue;
-        // the orientation follows its segment (keeping its twist about it), so the heading a
-        // grammar reads and grows along is the stem's direction
-        const glm::dvec3 axis = glm::normalize(rotation_from_rest(i) * sc.rest_dir[i]);
-        q_[i] = glm::normalize(rotation_between(axis, d) * q_[i]);
+        if (orient) sc.oriented.push_back(i);
     }
+    if (orient) orient_along_links(); // (orient.cpp)
 }
 
 } // namespace plant::physics

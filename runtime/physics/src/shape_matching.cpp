@@ -84,8 +84,14 @@ void World::group_moments(const Groups& g, Array<glm::dmat3>& each, Array<glm::d
 
 void World::build_groups(Groups& g) const {
     const std::size_t n = x_.size();
+    // a group is its particle, its parent and its children, and so are a particle's goal sources:
+    // counted first, so that the lists are not grown (and copied) a doubling at a time
+    std::size_t total = 0;
+    for (std::uint32_t i = 0; i < n; ++i)
+        if (alive_[i]) total += 1 + (parent_[i] != kNone) + children_[i].size();
     g.start.assign(n + 1, 0);
     g.member.clear();
+    if (g.member.capacity() < total) g.member.reserve(total + total / 4); // room for some growth
     g.rest_center.assign(n, glm::dvec3(0.0));
     for (std::uint32_t i = 0; i < n; ++i) {
         g.start[i] = static_cast<std::uint32_t>(g.member.size());
@@ -110,6 +116,7 @@ void World::build_groups(Groups& g) const {
     // goal sources: its own group, its parent's (twice the weight), its children's (half)
     g.source_start.assign(n + 1, 0);
     g.source.clear();
+    if (g.source.capacity() < total) g.source.reserve(total + total / 4);
     for (std::uint32_t j = 0; j < n; ++j) {
         const auto first = static_cast<std::uint32_t>(g.source.size());
         g.source_start[j] = first;

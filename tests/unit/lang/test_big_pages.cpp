@@ -180,7 +180,7 @@ TEST_CASE("the physics library's arrays take the same pages, zeroed, and charge 
     }
     CHECK(big_pages::shared_free_bytes() == 0);
     CHECK(big_pages::kept_bytes() >= 2 * page); // the matrices' page and the shared one, kept
-    PagedVector<int> small(100); // under 4 KiB: malloc's
+    PagedVector<int> small(100);                // under 4 KiB: malloc's
     CHECK(small[99] == 0);
     big_pages::trim();
 }

@@ -331,7 +331,13 @@ class World {
     // root to tip: bending toward the rest shape (with `bend`), then each rest length; with
     // `orient`, the orientations follow their segments too
     void keep_shape(bool orient, bool bend = true);
-    void build_links(); // the sweep's rest links, with the groups
+    // after the last sweep (orient.cpp): each particle in scratch_.oriented turned so that its
+    // rest direction lies along its link (scratch_.dir), keeping its twist about it
+    void orient_along_links();
+    void orient_one(std::uint32_t i);
+    void orient_pair(std::uint32_t i, std::uint32_t j);
+    void build_links();       // the sweep's rest links, with the groups
+    void build_sweep_order(); // (with the links) the sweep's order, two chains at a time
     // pushes x out of every obstacle it is in, r off the surface (across the face its parent
     // lies on, when given and against the same obstacle); whether any pushed
     bool outside_obstacles(glm::dvec3& x, double r, const glm::dvec3* parent = nullptr) const;
@@ -425,6 +431,10 @@ class World {
         // its rest length and unit direction (kept with the groups), and its direction now
         Array<glm::dvec3> rest_link, rest_dir, dir;
         Array<double> rest_length;
+        // the order the sweep visits the particles in: two chains at a time, interleaved, every
+        // parent before its children (build_links)
+        Array<std::uint32_t> sweep;
+        Array<std::uint32_t> oriented; // (keep_shape) the particles to orient after the sweep
         // links of different plants (link_contacts.cpp): each particle's plant (root index) and
         // how many plants have a link, kept with the groups; each link's capsule bounds, the
         // link grid and the candidate pairs, per step
