@@ -1,10 +1,16 @@
-// The orientations after the last length and bending sweep (docs/physics.md, "Length and
+// The orientations after the last shape-matching pass and after the last length and bending
+// sweep. After the pass (blend_orientations), each free particle's orientation goes as far
+// toward its group's rotation of its rest orientation as `passes` blends by its stiffness s would
+// take it: a normalized linear blend on the short arc, by 1 - (1 - s)^passes. The steps are small,
+// where it and slerp agree to second order, and it needs no trigonometry. After the sweep
+// (orient_along_links) (docs/physics.md, "Length and
 // bending"): each particle turned by the shortest rotation that lays its rest direction, as its
 // rotation from rest carries it, along its link now, so the heading a grammar reads and grows
 // along is the stem's direction and the twist about it is kept. A particle's turn reads only its
 // own orientation and link, so this runs after the sweep instead of inside its serial chain, on
 // any number of threads, and two particles at a time lane by lane (lanes.hpp) with exactly the
-// scalar code's operations: the results are the same bit for bit as one particle at a time.
+// scalar code's operations: the results are the same bit for bit as one particle at a time. The
+// blend, too, reads only the particle's own state and its group's frame, and runs the same way.
 #include "plant/physics/world.hpp"
 
 #include "lanes.hpp"
@@ -78,7 +84,8 @@ void World::orient_pair(std::uint32_t i, std::uint32_t j) {
     const v2 ux = Qy * vz - vy * Qz, uy = Qz * vx - vz * Qx, uz = Qx * vy - vx * Qy;
     const v2 uux = Qy * uz - uy * Qz, uuy = Qz * ux - uz * Qx, uuz = Qx * uy - ux * Qy;
     const v2 two = both(2.0);
-    const v2 cx = vx + ((ux * Qw) + uux) * two, cy = vy + ((uy * Qw) + uuy) * two, cz = vz + ((uz * Qw) + uuz) * two;
+    const v2 cx = vx + ((ux * Qw) + uux) * two, cy = vy + ((uy * Qw) + uuy) * two,
+             cz = vz + ((uz * Qw) + uuz) * two;
     const v2 c2 = (cx * cx + cy * cy) + cz * cz;
     const v2 inv_len = both(1.0) / v2{std::sqrt(c2[0]), std::sqrt(c2[1])};
     const v2 ax = cx * inv_len, ay = cy * inv_len, az = cz * inv_len;
@@ -107,6 +114,63 @@ void World::orient_along_links() {
         std::size_t k = b;
         for (; k + 1 < e; k += 2) orient_pair(list[k], list[k + 1]);
         if (k < e) orient_one(list[k]);
+    });
+}
+
+void World::blend_one(std::uint32_t i) {
+    const int passes = settings_.iterations;
+    const double st = scratch_.stiffness[i];
+    double rest = 1.0; // (1 - s)^passes, by multiplying: pow() costs more than the rest of the blend
+    for (int k = 0; k < passes; ++k) rest *= 1.0 - st;
+    const double so = 1.0 - rest;
+    glm::dquat target = glm::normalize(scratch_.frames[i].R * rest_q_[i]);
+    if (glm::dot(q_[i], target) < 0) target = -target;
+    q_[i] = glm::normalize(q_[i] * (1.0 - so) + target * so);
+}
+
+void World::blend_pair(std::uint32_t i, std::uint32_t j) {
+    // blend_one for i and j, lane by lane
+    const int passes = settings_.iterations;
+    const v2 st{scratch_.stiffness[i], scratch_.stiffness[j]};
+    v2 rest = both(1.0);
+    for (int k = 0; k < passes; ++k) rest *= both(1.0) - st;
+    const v2 so = both(1.0) - rest, keep = both(1.0) - so;
+    bool degenerate = false;
+    Quat2 target = normalize4(
+        mul(load(scratch_.frames[i].R, scratch_.frames[j].R), load(rest_q_[i], rest_q_[j])), degenerate);
+    const Quat2 q = load(q_[i], q_[j]);
+    const v2 along = dot4(q, target);
+    for (int l = 0; l < 2; ++l)
+        if (along[l] < 0) { // -target, lane by lane (negated, as glm does, not multiplied by -1)
+            target.w[l] = -target.w[l], target.x[l] = -target.x[l];
+            target.y[l] = -target.y[l], target.z[l] = -target.z[l];
+        }
+    const Quat2 mix{q.w * keep + target.w * so, q.x * keep + target.x * so, q.y * keep + target.y * so,
+                    q.z * keep + target.z * so};
+    const Quat2 out = normalize4(mix, degenerate);
+    if (degenerate) { // a zero quaternion, which glm normalizes to the identity: one at a time
+        blend_one(i), blend_one(j);
+        return;
+    }
+    q_[i] = glm::dquat(out.w[0], out.x[0], out.y[0], out.z[0]);
+    q_[j] = glm::dquat(out.w[1], out.x[1], out.y[1], out.z[1]);
+}
+
+void World::blend_orientations() {
+    const std::size_t n = x_.size();
+    parallel_ranges(n, settings_.threads, 2048, [&](std::size_t b, std::size_t e) {
+        std::uint32_t waiting = kNone; // the first of a pair
+        for (std::size_t k = b; k < e; ++k) {
+            const auto i = static_cast<std::uint32_t>(k);
+            if (!alive_[i] || fixed_[i]) continue;
+            if (waiting == kNone) {
+                waiting = i;
+                continue;
+            }
+            blend_pair(waiting, i);
+            waiting = kNone;
+        }
+        if (waiting != kNone) blend_one(waiting);
     });
 }
 

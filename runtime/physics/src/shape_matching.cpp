@@ -224,20 +224,9 @@ void World::match_shapes_passes() {
                 const double st = stiff[i];
                 const glm::dvec3 goal = goal_of(static_cast<std::uint32_t>(i), frames, scratch_.groups);
                 x_[i] = x_[i] + st * (goal - x_[i]);
-                if (it + 1 < passes) continue;
-                // after the last pass, the orientation goes as far toward its goal as `passes`
-                // blends by s would take it: a normalized linear blend on the short arc. The
-                // steps are small, where it and slerp agree to second order, and it needs no
-                // trigonometry.
-                double rest =
-                    1.0; // (1 - s)^passes, by multiplying: pow() costs more than the rest of the blend
-                for (int k = 0; k < passes; ++k) rest *= 1.0 - st;
-                const double so = 1.0 - rest;
-                glm::dquat target = glm::normalize(frames[i].R * rest_q_[i]);
-                if (glm::dot(q_[i], target) < 0) target = -target;
-                q_[i] = glm::normalize(q_[i] * (1.0 - so) + target * so);
             }
         });
+        if (it + 1 == passes) blend_orientations();            // (orient.cpp)
         for (const auto& [i, target] : pulls_) x_[i] = target; // a dragged particle goes where it is dragged
         keep_shape(it + 1 == passes); // root to tip: bending and rest lengths (length.cpp)
     }

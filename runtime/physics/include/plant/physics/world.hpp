@@ -334,6 +334,11 @@ class World {
     // after the last sweep (orient.cpp): each particle in scratch_.oriented turned so that its
     // rest direction lies along its link (scratch_.dir), keeping its twist about it
     void orient_along_links();
+    // after the last shape-matching pass (orient.cpp): each free particle's orientation blended
+    // toward its group's rotation of its rest orientation, by its stiffness over the passes
+    void blend_orientations();
+    void blend_one(std::uint32_t i);
+    void blend_pair(std::uint32_t i, std::uint32_t j);
     void orient_one(std::uint32_t i);
     void orient_pair(std::uint32_t i, std::uint32_t j);
     void build_links();       // the sweep's rest links, with the groups
