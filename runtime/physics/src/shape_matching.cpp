@@ -193,6 +193,43 @@ void World::refresh_groups() {
     groups_stale_ = false;
 }
 
+void World::move_one(std::uint32_t i) {
+    // x'_g = x_p + s (x_g - x_p) (section 4.3)
+    const double st = scratch_.stiffness[i];
+    const glm::dvec3 goal = goal_of(i, scratch_.frames, scratch_.groups);
+    x_[i] = x_[i] + st * (goal - x_[i]);
+}
+
+void World::move_pair(std::uint32_t i, std::uint32_t j) {
+    // move_one for two particles with the same number of goal sources, lane by lane (goal_of's
+    // operations in its order)
+    const Groups& g = scratch_.groups;
+    const Groups::Source* a = g.source.data() + g.source_start[i];
+    const Groups::Source* b = g.source.data() + g.source_start[j];
+    const std::uint32_t count = g.source_start[i + 1] - g.source_start[i];
+    const auto& frames = scratch_.frames;
+    v2 sx = both(0), sy = both(0), sz = both(0);
+    for (std::uint32_t k = 0; k < count; ++k) {
+        const Frame &fa = frames[a[k].group], &fb = frames[b[k].group];
+        const v2 ox{a[k].offset.x, b[k].offset.x}, oy{a[k].offset.y, b[k].offset.y},
+            oz{a[k].offset.z, b[k].offset.z};
+        auto row = [&](int r) {
+            return v2{fa.M[0][r], fb.M[0][r]} * ox + v2{fa.M[1][r], fb.M[1][r]} * oy +
+                   v2{fa.M[2][r], fb.M[2][r]} * oz + v2{fa.c[r], fb.c[r]};
+        };
+        const v2 w{a[k].weight, b[k].weight};
+        sx += w * row(0);
+        sy += w * row(1);
+        sz += w * row(2);
+    }
+    const v2 st{scratch_.stiffness[i], scratch_.stiffness[j]};
+    glm::dvec3 &xa = x_[i], &xb = x_[j];
+    const v2 px{xa.x, xb.x}, py{xa.y, xb.y}, pz{xa.z, xb.z};
+    const v2 nx = px + st * (sx - px), ny = py + st * (sy - py), nz = pz + st * (sz - pz);
+    xa = glm::dvec3(nx[0], ny[0], nz[0]);
+    xb = glm::dvec3(nx[1], ny[1], nz[1]);
+}
+
 void World::match_shapes_passes() {
     // Shape matching on the predictions. Small overlapping groups pass a correction on by one
     // particle per pass, so a chain needs several passes to hold its shape; the positions move
@@ -213,18 +250,33 @@ void World::match_shapes_passes() {
         match_shapes(frames, scratch_.group_moment, settings_.rotation_iterations, scratch_.groups);
         // each particle's goal, and the move toward it: the goals read only the frames, so a
         // particle can move as soon as its own goal is known
+        // particle can move as soon as its own goal is known. Particles with as many sources
+        // go two at a time (move_pair), each exactly as alone; the order does not matter, since
+        // a move reads only the particle's own position and the frames.
         parallel_ranges(n, settings_.threads, 2048, [&](std::size_t b, std::size_t e) {
-            for (std::size_t i = b; i < e; ++i) {
+            constexpr std::uint32_t kMaxPaired = 8;
+            std::uint32_t waiting[kMaxPaired + 1];
+            std::fill(std::begin(waiting), std::end(waiting), kNone);
+            const auto& start = scratch_.groups.source_start;
+            for (std::size_t k = b; k < e; ++k) {
+                const auto i = static_cast<std::uint32_t>(k);
                 if (!alive_[i]) continue;
                 if (fixed_[i]) {
                     x_[i] = rest_x_[i];
                     continue;
                 }
-                // x'_g = x_p + s (x_g - x_p) (section 4.3)
-                const double st = stiff[i];
-                const glm::dvec3 goal = goal_of(static_cast<std::uint32_t>(i), frames, scratch_.groups);
-                x_[i] = x_[i] + st * (goal - x_[i]);
+                const std::uint32_t count = start[i + 1] - start[i];
+                if (count > kMaxPaired) {
+                    move_one(i);
+                } else if (waiting[count] == kNone) {
+                    waiting[count] = i;
+                } else {
+                    move_pair(waiting[count], i);
+                    waiting[count] = kNone;
+                }
             }
+            for (const std::uint32_t i : waiting)
+                if (i != kNone) move_one(i);
         });
         if (it + 1 == passes) blend_orientations();            // (orient.cpp)
         for (const auto& [i, target] : pulls_) x_[i] = target; // a dragged particle goes where it is dragged

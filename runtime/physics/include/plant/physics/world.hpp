@@ -321,6 +321,10 @@ class World {
                       const Groups& groups) const;
     // Particle j's goal from the groups' frames (Eq. 3-4).
     glm::dvec3 goal_of(std::uint32_t j, const Array<Frame>& frames, const Groups& groups) const;
+    // x'_g = x_p + s (x_g - x_p) toward the goal of the last frames, for one particle or for two
+    // with as many goal sources at once (lane by lane, the same results)
+    void move_one(std::uint32_t i);
+    void move_pair(std::uint32_t i, std::uint32_t j);
     double stiffness(std::uint32_t i) const;
 
     // The phases of step(), in order (world.cpp, shape_matching.cpp, collisions.cpp).
