@@ -68,10 +68,10 @@ if(PLANT_PYTHON_BUILT)
                  "${pybind11_VERSION}; installed into PREFIX/${PLANT_PYTHON_INSTALL_DIR}")
   # The static libraries end up in a shared object: position-independent code. Without semantic
   # interposition GCC still inlines and calls them directly, as in a program (docs/api.md).
-  set_target_properties(plant_lang plant_physics plant_runtime plant_outputs PROPERTIES
+  set_target_properties(plant_common plant_lang plant_physics plant_runtime plant_outputs PROPERTIES
                         POSITION_INDEPENDENT_CODE ON)
   if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
-    foreach(lib plant_lang plant_physics plant_runtime plant_outputs)
+    foreach(lib plant_common plant_lang plant_physics plant_runtime plant_outputs)
       target_compile_options(${lib} PRIVATE -fno-semantic-interposition)
     endforeach()
   endif()

@@ -59,20 +59,28 @@ inline constexpr std::size_t kMallocBelow = std::size_t{64} << 10;
 inline constexpr std::size_t kMallocBelow = big_pages::kShareFrom;
 #endif
 
-// Blocks of kMallocBelow bytes and more come from big_pages, smaller ones from malloc. Unlike
-// BigAllocator, elements are constructed as std::allocator constructs them (resize() zeroes
-// numbers) and nothing is charged to the memory budget.
+// Blocks of kMallocBelow bytes and more come from big_pages, smaller ones from malloc; built with
+// AddressSanitizer, every block comes from malloc, so that ASan guards the physics arrays (they
+// are kept from step to step, not freed and taken again as strings are, so its quarantine holds
+// little of them). Unlike BigAllocator, elements are constructed as std::allocator constructs
+// them (resize() zeroes numbers) and nothing is charged to the memory budget.
 template <typename T> struct PagedAllocator {
     using value_type = T;
 
     PagedAllocator() noexcept = default;
     template <typename U> PagedAllocator(const PagedAllocator<U>&) noexcept {}
 
+#if defined(__SANITIZE_ADDRESS__)
+    static constexpr std::size_t kFromMallocBelow = std::size_t(-1); // every block
+#else
+    static constexpr std::size_t kFromMallocBelow = kMallocBelow;
+#endif
+
     T* allocate(std::size_t n) {
         if (n > std::size_t(-1) / sizeof(T) / 2) throw std::bad_alloc();
         const std::size_t bytes = n * sizeof(T);
         void* p = nullptr;
-        if (bytes < kMallocBelow)
+        if (bytes < kFromMallocBelow)
             p = std::malloc(bytes ? bytes : 1);
         else if (const std::size_t block = big_pages::block_bytes(bytes); block <= big_pages::kShareTo)
             p = big_pages::map_shared(block);
@@ -83,7 +91,7 @@ template <typename T> struct PagedAllocator {
     }
     void deallocate(T* p, std::size_t n) noexcept {
         const std::size_t bytes = n * sizeof(T);
-        if (bytes < kMallocBelow)
+        if (bytes < kFromMallocBelow)
             std::free(p);
         else if (const std::size_t block = big_pages::block_bytes(bytes); block <= big_pages::kShareTo)
             big_pages::unmap_shared(p, block);
@@ -91,7 +99,9 @@ template <typename T> struct PagedAllocator {
             big_pages::unmap(p, block);
     }
 
-    template <typename U> bool operator==(const PagedAllocator<U>&) const noexcept { return true; }
+    template <typename U> bool operator==(const PagedAllocator<U>&) const noexcept {
+        return true;
+    }
 };
 
 template <typename T> using PagedVector = std::vector<T, PagedAllocator<T>>;

@@ -55,7 +55,7 @@ void World::integrate() {
             const double r = std::min({radii_[i].x, radii_[i].y, radii_[i].z});
             for (std::size_t k = 0; k < obstacles_.size(); ++k) {
                 const Obstacle& o = obstacles_[k];
-                if (signed_distance(o, x_[i]) - r >= 0) continue;
+                if (distance_to(k, x_[i]) - r >= 0) continue;
                 // out by the shortest way that does not end in another obstacle (exit_point)
                 glm::dvec3 nrm;
                 x_[i] = exit_point(x_[i], r, k, &nrm);
@@ -123,13 +123,21 @@ void World::separate_particles() {
     slot_of.assign(n, ~0u);
     auto& cell_of = scratch_.cell_of;
     cell_of.resize(n);
+    // consecutive particles of a stem often share a cell: the last one's slot is taken again
+    // without probing (the same slot the probe would find)
+    std::uint64_t last_key = 0;
+    std::size_t last_slot = size; // none yet
     for (std::uint32_t i = 0; i < n; ++i) {
         if (!alive_[i] || thin[i] > limit) continue;
         const glm::dvec3 u = x_[i] / cell;
         cell_of[i] = glm::i64vec3(far_floor(u.x), far_floor(u.y), far_floor(u.z));
         const std::uint64_t k = cell_hash(cell_of[i]);
         std::size_t slot = k & (size - 1);
-        while (table[slot].end != 0 && table[slot].key != k) slot = (slot + 1) & (size - 1);
+        if (last_slot < size && k == last_key)
+            slot = last_slot;
+        else
+            while (table[slot].end != 0 && table[slot].key != k) slot = (slot + 1) & (size - 1);
+        last_key = k, last_slot = slot;
         table[slot].key = k;
         ++table[slot].end; // counts, for now
         slot_of[i] = static_cast<std::uint32_t>(slot);

@@ -106,15 +106,15 @@ bool World::outside_obstacles(glm::dvec3& x, double r, const glm::dvec3* parent)
     bool moved = false;
     for (std::size_t k = 0; k < obstacles_.size(); ++k) {
         const Obstacle& o = obstacles_[k];
-        double d = signed_distance(o, x) - r;
+        double d = distance_to(k, x) - r;
         if (d >= 0) continue;
         moved = true;
-        if (parent && signed_distance(o, *parent) < 2 * r) {
+        if (parent && distance_to(k, *parent) < 2 * r) {
             const glm::dvec3 n = surface_normal(o, *parent);
             // inside a box the distance is to the nearest face
             for (int round = 0; round < 8 && d < 0; ++round) {
                 x -= n * d;
-                d = signed_distance(o, x) - r;
+                d = distance_to(k, x) - r;
             }
             if (d >= 0) continue;
         }
@@ -124,8 +124,9 @@ bool World::outside_obstacles(glm::dvec3& x, double r, const glm::dvec3* parent)
 }
 
 void World::keep_shape(bool orient, bool bend) {
-    // parents come before their children in index order, so one pass in that order sees every
-    // parent already placed; it runs on one thread, so the result does not depend on the count
+    // every parent comes before its children in the sweep's order (build_sweep_order), so one
+    // pass sees every parent already placed; it runs on one thread, so the result does not
+    // depend on the count
     auto& sc = scratch_;
     const auto& stiff = sc.stiffness;
     sc.oriented.clear(); // the particles whose orientation follows their link, after the sweep

@@ -30,6 +30,13 @@ namespace plant::physics {
     return 1e300;
 }
 
+// World::distance_to: signed_distance with a plane's unit normal normalized once (the same value)
+[[gnu::always_inline]] inline double World::distance_to(std::size_t k, const glm::dvec3& p) const {
+    const Obstacle& o = obstacles_[k];
+    if (o.kind == Obstacle::Plane) return glm::dot(p - o.a, unit_[k]);
+    return signed_distance(o, p);
+}
+
 inline glm::dvec3 surface_normal(const Obstacle& o, const glm::dvec3& p) {
     if (o.kind == Obstacle::Plane) return glm::normalize(o.b);
     // central differences of the distance (over half a cell for a sampled grid)

@@ -211,8 +211,8 @@ void World::resolve_segments() {
             if (!alive_[i] || p == kNone) continue;
             const glm::dvec3 mid = (x_[i] + x_[p]) * 0.5;
             const double reach = 0.5 * glm::length(x_[i] - x_[p]) + sc.thin_of(i, radii_) + 0.002;
-            for (const auto& o : obstacles_)
-                if (signed_distance(o, mid) < reach) {
+            for (std::size_t k = 0; k < obstacles_.size(); ++k)
+                if (distance_to(k, mid) < reach) {
                     near[i] = 1;
                     break;
                 }

@@ -249,7 +249,6 @@ void World::match_shapes_passes() {
     for (int it = 0; it < passes; ++it) {
         match_shapes(frames, scratch_.group_moment, settings_.rotation_iterations, scratch_.groups);
         // each particle's goal, and the move toward it: the goals read only the frames, so a
-        // particle can move as soon as its own goal is known
         // particle can move as soon as its own goal is known. Particles with as many sources
         // go two at a time (move_pair), each exactly as alone; the order does not matter, since
         // a move reads only the particle's own position and the frames.

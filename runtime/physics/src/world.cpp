@@ -107,6 +107,7 @@ bool World::anchored_to(Handle h, std::size_t k) const {
 void World::remove_obstacle(std::size_t k) {
     if (k >= obstacles_.size()) return;
     obstacles_.erase(obstacles_.begin() + static_cast<std::ptrdiff_t>(k));
+    unit_.erase(unit_.begin() + static_cast<std::ptrdiff_t>(k));
     std::erase_if(anchors_, [&](const Anchor& a) { return a.obstacle == k; });
     for (Anchor& a : anchors_)
         if (a.obstacle != ~std::size_t{0} && a.obstacle > k) --a.obstacle;

@@ -184,7 +184,10 @@ class World {
     bool anchored(Handle h) const;
     // Whether h is anchored to obstacle k.
     bool anchored_to(Handle h, std::size_t k) const;
-    void add_obstacle(const Obstacle& o) { obstacles_.push_back(o); }
+    void add_obstacle(const Obstacle& o) {
+        obstacles_.push_back(o);
+        unit_.push_back(o.kind == Obstacle::Plane ? glm::normalize(o.b) : glm::dvec3(0.0));
+    }
     // `to` moved as little as it takes for the segment from `from`, a capsule of radius r, to lie
     // outside every obstacle, at the segment's length from `from` (a new segment's end, before it
     // is drawn: segment_contacts.cpp). Where `from` itself is too near an obstacle, as far as it can.
@@ -403,6 +406,11 @@ class World {
     double peak_speed_ = 0, unexplained_speed_ = 0;
     Array<double> highest_; // each particle's highest potential per unit mass at a step's ends
     std::vector<Obstacle> obstacles_;
+    // each plane's unit normal, normalized once when it is added (the distance of every particle to
+    // a plane normalized it at every call: about 2 % of a step); zero for other kinds
+    std::vector<glm::dvec3> unit_;
+    // obstacle k's signed distance at p, as signed_distance (obstacle_field.hpp) computes it
+    double distance_to(std::size_t k, const glm::dvec3& p) const;
     std::vector<std::pair<std::uint32_t, glm::dvec3>> pulls_;
     double break_threshold_ = 0;
     glm::dvec3 wind_{0.0};
