@@ -67,6 +67,53 @@ void World::integrate() {
     });
 }
 
+std::size_t World::fill_contact_grid(double cell, double limit) {
+    const std::size_t n = x_.size();
+    const auto& thin = scratch_.thin;
+    // (cell keys and coordinates: cell_hash, far_floor in cells.hpp)
+    // an open-addressing table from a cell's key to its run of particles in `members` (in index
+    // order), built by counting: no sort. A slot holds the key and the run's bounds together, so
+    // a lookup touches one cache line.
+    std::size_t size = 16;
+    while (size < 4 * n) size *= 2; // a quarter full at most: short probes
+    auto& table = scratch_.table;   // begin == end: an empty slot
+    table.assign(size, Cell{});
+    auto& slot_of = scratch_.slot_of;
+    slot_of.assign(n, ~0u);
+    auto& cell_of = scratch_.cell_of;
+    cell_of.resize(n);
+    // consecutive particles of a stem often share a cell: the last one's slot is taken again
+    // without probing (the same slot the probe would find)
+    std::uint64_t last_key = 0;
+    std::size_t last_slot = size; // none yet
+    for (std::uint32_t i = 0; i < n; ++i) {
+        if (!alive_[i] || thin[i] > limit) continue;
+        const glm::dvec3 u = x_[i] / cell;
+        cell_of[i] = glm::i64vec3(far_floor(u.x), far_floor(u.y), far_floor(u.z));
+        const std::uint64_t k = cell_hash(cell_of[i]);
+        std::size_t slot = k & (size - 1);
+        if (last_slot < size && k == last_key)
+            slot = last_slot;
+        else
+            while (table[slot].end != 0 && table[slot].key != k) slot = (slot + 1) & (size - 1);
+        last_key = k, last_slot = slot;
+        table[slot].key = k;
+        ++table[slot].end; // counts, for now
+        slot_of[i] = static_cast<std::uint32_t>(slot);
+    }
+    std::uint32_t running = 0;
+    for (Cell& c : table) { // counts to runs; `end` is the fill cursor below
+        const std::uint32_t count = c.end;
+        c.begin = c.end = running;
+        running += count;
+    }
+    auto& members = scratch_.members;
+    members.resize(running);
+    for (std::uint32_t i = 0; i < n; ++i)
+        if (slot_of[i] != ~0u) members[table[slot_of[i]].end++] = i;
+    return size;
+}
+
 // Section 5.2: plants collide with each other and with themselves. Particles are spheres of
 // their thinnest radius; two that overlap and are not joined (parent and child, or children of
 // one parent) move apart along the line between them, half each (all of it when the other is a
@@ -111,47 +158,10 @@ void World::separate_particles() {
     if (reach <= 0 && oversized.empty()) return;
     reach = std::max(reach, 1e-9); // (every radius is at least 1e-4 m; this is for the cell's sake)
     const double cell = 2 * reach; // twice the widest contact: a 2 x 2 x 2 block of cells holds every partner
-    // (cell keys and coordinates: cell_hash, far_floor in cells.hpp)
-    // an open-addressing table from a cell's key to its run of particles in `members` (in index
-    // order), built by counting: no sort. A slot holds the key and the run's bounds together, so
-    // a lookup touches one cache line.
-    std::size_t size = 16;
-    while (size < 4 * n) size *= 2; // a quarter full at most: short probes
-    auto& table = scratch_.table;   // begin == end: an empty slot
-    table.assign(size, Cell{});
-    auto& slot_of = scratch_.slot_of;
-    slot_of.assign(n, ~0u);
-    auto& cell_of = scratch_.cell_of;
-    cell_of.resize(n);
-    // consecutive particles of a stem often share a cell: the last one's slot is taken again
-    // without probing (the same slot the probe would find)
-    std::uint64_t last_key = 0;
-    std::size_t last_slot = size; // none yet
-    for (std::uint32_t i = 0; i < n; ++i) {
-        if (!alive_[i] || thin[i] > limit) continue;
-        const glm::dvec3 u = x_[i] / cell;
-        cell_of[i] = glm::i64vec3(far_floor(u.x), far_floor(u.y), far_floor(u.z));
-        const std::uint64_t k = cell_hash(cell_of[i]);
-        std::size_t slot = k & (size - 1);
-        if (last_slot < size && k == last_key)
-            slot = last_slot;
-        else
-            while (table[slot].end != 0 && table[slot].key != k) slot = (slot + 1) & (size - 1);
-        last_key = k, last_slot = slot;
-        table[slot].key = k;
-        ++table[slot].end; // counts, for now
-        slot_of[i] = static_cast<std::uint32_t>(slot);
-    }
-    std::uint32_t running = 0;
-    for (Cell& c : table) { // counts to runs; `end` is the fill cursor below
-        const std::uint32_t count = c.end;
-        c.begin = c.end = running;
-        running += count;
-    }
+    const std::size_t size = fill_contact_grid(cell, limit);
+    auto& table = scratch_.table;
     auto& members = scratch_.members;
-    members.resize(running);
-    for (std::uint32_t i = 0; i < n; ++i)
-        if (slot_of[i] != ~0u) members[table[slot_of[i]].end++] = i;
+    auto& cell_of = scratch_.cell_of;
     auto& push = scratch_.push;
     push.assign(n, glm::dvec3(0.0));
     // the push on particle i from particle j, when they overlap and are not joined (parent and

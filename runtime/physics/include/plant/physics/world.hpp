@@ -367,6 +367,10 @@ class World {
     // the contacts of the link into i with the obstacles, ends weighted wp and wi; whether any
     bool link_contacts(std::uint32_t i, double wp, double wi);
     void separate_particles(); // contacts between particles (section 5.2)
+    // the contact grid of separate_particles: scratch_.table from each cell's key to its run of
+    // particles in scratch_.members, and each particle's cell in scratch_.cell_of, for cells of
+    // `cell` and the particles no thicker than `limit`; returns the table's size (a power of 2)
+    std::size_t fill_contact_grid(double cell, double limit);
     // link_contacts.cpp: each particle's plant (its root), kept with the groups; the pairs of
     // links of different plants whose capsules' bounds overlap (scratch_.link_pairs); and those
     // pairs' capsules pushed apart, the four ends by their barycentric weights and inverse masses
