@@ -127,8 +127,7 @@ void World::frame_pair(const std::uint32_t (&group)[2], const Array<glm::dmat3>&
     }
     // rotation_of, one iteration, warm-started from the frames' rotations and their matrices
     Frame* f[2] = {&frames[group[0]], &frames[group[1]]};
-    Quat2 q{v2{f[0]->R.w, f[1]->R.w}, v2{f[0]->R.x, f[1]->R.x}, v2{f[0]->R.y, f[1]->R.y},
-            v2{f[0]->R.z, f[1]->R.z}};
+    const Quat2 q = load2(f[0]->R, f[1]->R);
     Mat2 M;
     for (int c = 0; c < 3; ++c)
         for (int r = 0; r < 3; ++r) M.m[c][r] = v2{f[0]->M[c][r], f[1]->M[c][r]};
@@ -164,9 +163,8 @@ void World::frame_pair(const std::uint32_t (&group)[2], const Array<glm::dmat3>&
             }
         const Quat2 p{cw, omega[0] * sw, omega[1] * sw, omega[2] * sw};
         // p * q as glm multiplies quaternions, then glm::normalize
-        n = {p.w * q.w - p.x * q.x - p.y * q.y - p.z * q.z, p.w * q.x + p.x * q.w + p.y * q.z - p.z * q.y,
-             p.w * q.y + p.y * q.w + p.z * q.x - p.x * q.z, p.w * q.z + p.z * q.w + p.x * q.y - p.y * q.x};
-        const v2 len2 = (n.w * n.w + n.x * n.x) + (n.y * n.y + n.z * n.z);
+        n = mul2(p, q);
+        const v2 len2 = dot2(n, n);
         len = v2{std::sqrt(len2[0]), std::sqrt(len2[1])};
         const v2 one_over = both(1.0) / len;
         n = {n.w * one_over, n.x * one_over, n.y * one_over, n.z * one_over};

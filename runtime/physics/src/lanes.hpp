@@ -3,6 +3,7 @@
 #pragma once
 
 #include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
 
 namespace plant::physics {
 
@@ -23,6 +24,22 @@ struct Quat2 {
 struct Mat2 {
     v2 m[3][3]; // column-major, as glm: m[column][row]
 };
+
+// two quaternions, one a lane
+inline Quat2 load2(const glm::dquat& a, const glm::dquat& b) {
+    return {v2{a.w, b.w}, v2{a.x, b.x}, v2{a.y, b.y}, v2{a.z, b.z}};
+}
+
+// glm's quaternion product p * q, lane by lane
+inline Quat2 mul2(const Quat2& p, const Quat2& q) {
+    return {p.w * q.w - p.x * q.x - p.y * q.y - p.z * q.z, p.w * q.x + p.x * q.w + p.y * q.z - p.z * q.y,
+            p.w * q.y + p.y * q.w + p.z * q.x - p.x * q.z, p.w * q.z + p.z * q.w + p.x * q.y - p.y * q.x};
+}
+
+// glm::dot of two quaternions, lane by lane
+inline v2 dot2(const Quat2& a, const Quat2& b) {
+    return (a.w * b.w + a.x * b.x) + (a.y * b.y + a.z * b.z);
+}
 
 // glm::mat3_cast, lane by lane
 inline Mat2 mat3_cast2(const Quat2& q) {

@@ -1,16 +1,16 @@
 // The orientations after the last shape-matching pass and after the last length and bending
 // sweep. After the pass (blend_orientations), each free particle's orientation goes as far
 // toward its group's rotation of its rest orientation as `passes` blends by its stiffness s would
-// take it: a normalized linear blend on the short arc, by 1 - (1 - s)^passes. The steps are small,
-// where it and slerp agree to second order, and it needs no trigonometry. After the sweep
-// (orient_along_links) (docs/physics.md, "Length and
-// bending"): each particle turned by the shortest rotation that lays its rest direction, as its
-// rotation from rest carries it, along its link now, so the heading a grammar reads and grows
-// along is the stem's direction and the twist about it is kept. A particle's turn reads only its
-// own orientation and link, so this runs after the sweep instead of inside its serial chain, on
-// any number of threads, and two particles at a time lane by lane (lanes.hpp) with exactly the
-// scalar code's operations: the results are the same bit for bit as one particle at a time. The
-// blend, too, reads only the particle's own state and its group's frame, and runs the same way.
+// take it: a normalized linear blend on the short arc, by 1 - (1 - s)^passes. The steps are
+// small, where it and slerp agree to second order, and it needs no trigonometry. After the sweep
+// (orient_along_links; docs/physics.md, "Length and bending"), each particle is turned by the
+// shortest rotation that lays its rest direction, as its rotation from rest carries it, along its
+// link now, so the heading a grammar reads and grows along is the stem's direction and the twist
+// about it is kept. A particle's turn reads only its own orientation and link, so this runs after
+// the sweep instead of inside its serial chain, on any number of threads, and two particles at a
+// time lane by lane (lanes.hpp) with exactly the scalar code's operations: the results are the
+// same bit for bit as one particle at a time. The blend, too, reads only the particle's own state
+// and its group's frame, and runs the same way.
 #include "plant/physics/world.hpp"
 
 #include "lanes.hpp"
@@ -36,29 +36,14 @@ glm::dquat rotation_between(const glm::dvec3& a, const glm::dvec3& b) {
 
 constexpr double kOpposite = -1 + 1e-9; // rotation_between's half turn, left to the scalar code
 
-// glm's quaternion product p * q, lane by lane
-Quat2 mul(const Quat2& p, const Quat2& q) {
-    return {p.w * q.w - p.x * q.x - p.y * q.y - p.z * q.z, p.w * q.x + p.x * q.w + p.y * q.z - p.z * q.y,
-            p.w * q.y + p.y * q.w + p.z * q.x - p.x * q.z, p.w * q.z + p.z * q.w + p.x * q.y - p.y * q.x};
-}
-
-// glm::dot of two quaternions
-v2 dot4(const Quat2& a, const Quat2& b) {
-    return (a.w * b.w + a.x * b.x) + (a.y * b.y + a.z * b.z);
-}
-
 // glm::normalize of a quaternion, but for a zero length (glm's answer is the identity there):
 // `degenerate` says whether a lane had one, for the caller to redo it alone
-Quat2 normalize4(const Quat2& q, bool& degenerate) {
-    const v2 len2 = dot4(q, q);
+Quat2 normalize2(const Quat2& q, bool& degenerate) {
+    const v2 len2 = dot2(q, q);
     const v2 len{std::sqrt(len2[0]), std::sqrt(len2[1])};
     if (!(len[0] > 0) || !(len[1] > 0)) degenerate = true;
     const v2 over = both(1.0) / len;
     return {q.w * over, q.x * over, q.y * over, q.z * over};
-}
-
-Quat2 load(const glm::dquat& a, const glm::dquat& b) {
-    return {v2{a.w, b.w}, v2{a.x, b.x}, v2{a.y, b.y}, v2{a.z, b.z}};
 }
 
 } // namespace
@@ -70,13 +55,13 @@ void World::orient_one(std::uint32_t i) {
 
 void World::orient_pair(std::uint32_t i, std::uint32_t j) {
     // orient_one for i and j, lane by lane
-    const Quat2 q = load(q_[i], q_[j]);
-    const Quat2 r = load(rest_q_[i], rest_q_[j]);
+    const Quat2 q = load2(q_[i], q_[j]);
+    const Quat2 r = load2(rest_q_[i], rest_q_[j]);
     // rotation_from_rest: normalize(q * inverse(rest)), inverse being conjugate / dot
-    const v2 rr = dot4(r, r);
+    const v2 rr = dot2(r, r);
     const Quat2 inv{r.w / rr, (-r.x) / rr, (-r.y) / rr, (-r.z) / rr};
     bool degenerate = false;
-    const Quat2 from_rest = normalize4(mul(q, inv), degenerate);
+    const Quat2 from_rest = normalize2(mul2(q, inv), degenerate);
     // the rest direction carried by it (glm's quaternion times vector), normalized
     const glm::dvec3 &ra = scratch_.rest_dir[i], &rb = scratch_.rest_dir[j];
     const v2 vx{ra.x, rb.x}, vy{ra.y, rb.y}, vz{ra.z, rb.z};
@@ -98,8 +83,8 @@ void World::orient_pair(std::uint32_t i, std::uint32_t j) {
         return;
     }
     const Quat2 turn{both(1.0) + c, ay * dz - dy * az, az * dx - dz * ax, ax * dy - dx * ay};
-    const Quat2 unit_turn = normalize4(turn, degenerate);
-    const Quat2 out = normalize4(mul(unit_turn, q), degenerate);
+    const Quat2 unit_turn = normalize2(turn, degenerate);
+    const Quat2 out = normalize2(mul2(unit_turn, q), degenerate);
     if (degenerate) {
         orient_one(i), orient_one(j);
         return;
@@ -136,10 +121,10 @@ void World::blend_pair(std::uint32_t i, std::uint32_t j) {
     for (int k = 0; k < passes; ++k) rest *= both(1.0) - st;
     const v2 so = both(1.0) - rest, keep = both(1.0) - so;
     bool degenerate = false;
-    Quat2 target = normalize4(
-        mul(load(scratch_.frames[i].R, scratch_.frames[j].R), load(rest_q_[i], rest_q_[j])), degenerate);
-    const Quat2 q = load(q_[i], q_[j]);
-    const v2 along = dot4(q, target);
+    Quat2 target = normalize2(
+        mul2(load2(scratch_.frames[i].R, scratch_.frames[j].R), load2(rest_q_[i], rest_q_[j])), degenerate);
+    const Quat2 q = load2(q_[i], q_[j]);
+    const v2 along = dot2(q, target);
     for (int l = 0; l < 2; ++l)
         if (along[l] < 0) { // -target, lane by lane (negated, as glm does, not multiplied by -1)
             target.w[l] = -target.w[l], target.x[l] = -target.x[l];
@@ -147,7 +132,7 @@ void World::blend_pair(std::uint32_t i, std::uint32_t j) {
         }
     const Quat2 mix{q.w * keep + target.w * so, q.x * keep + target.x * so, q.y * keep + target.y * so,
                     q.z * keep + target.z * so};
-    const Quat2 out = normalize4(mix, degenerate);
+    const Quat2 out = normalize2(mix, degenerate);
     if (degenerate) { // a zero quaternion, which glm normalizes to the identity: one at a time
         blend_one(i), blend_one(j);
         return;

@@ -60,7 +60,7 @@ void World::group_moments(const Groups& g, Array<glm::dmat3>& each, Array<glm::d
                     continue;
                 }
                 const glm::dquat &qa = q_[j], &qb = q_[j + 1];
-                const Mat2 R = mat3_cast2({v2{qa.w, qb.w}, v2{qa.x, qb.x}, v2{qa.y, qb.y}, v2{qa.z, qb.z}});
+                const Mat2 R = mat3_cast2(load2(qa, qb));
                 const glm::dmat3 &ra = scratch_.rest_moment[j], &rb = scratch_.rest_moment[j + 1];
                 for (int c = 0; c < 3; ++c) {
                     const v2 b0{ra[c][0], rb[c][0]}, b1{ra[c][1], rb[c][1]}, b2{ra[c][2], rb[c][2]};
