@@ -52,7 +52,7 @@ struct Engine {
     std::vector<std::shared_ptr<const RulePlan>> plans;
     std::vector<const RulePlan*> step_plans; // per group + 1 (index 0: no group), from plans
     std::vector<std::uint32_t> brackets;     // the bracket table, kept from step to step
-    BigVector<std::uint16_t> kernel_scratch; // the symbol kernel's right keys (Rewriter::run_symbols)
+    BigVector<ContextKey> kernel_scratch;    // the symbol kernel's right keys (Rewriter::run_symbols)
     // The string a step replaced, when small, kept for the next step to write its output into:
     // small strings would otherwise pay a round of allocations a step.
     ModuleString spare;

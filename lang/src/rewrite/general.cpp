@@ -13,7 +13,7 @@
 namespace plant {
 
 Rewriter::Rewriter(const RulePlan& rule_plan, const ModuleString& in, std::vector<std::uint32_t>* brackets,
-                   BigVector<std::uint16_t>* scratch, bool whole)
+                   BigVector<ContextKey>* scratch, bool whole)
     : plan(rule_plan), P(rule_plan.P), in(in), n(in.size()), whole(whole),
       kernel_scratch(whole ? scratch : nullptr) {
     table_kinds = whole && plan.symbol_kernel && in.params.empty() && in.has_table_kinds();

@@ -16,6 +16,11 @@ namespace plant {
 // context: then the turtle pass runs before each step to fill them.
 bool reads_queries(const Program& p, const RuleSet& rs);
 
+// A context key of the symbol kernel (Rewriter::run_symbols; RulePlan::ctx_key). An enum rather
+// than a char type: the compiler must assume a store through a char may change anything, and the
+// kernel's loops would reload their pointers after each one.
+enum class ContextKey : std::uint8_t {};
+
 struct RulePlan {
     static constexpr std::uint32_t kNone = ~std::uint32_t{0};
     RulePlan(const Program& p, std::vector<const RuleSet*> rule_sets);

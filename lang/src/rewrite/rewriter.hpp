@@ -61,8 +61,7 @@ struct Worker {
     // context neighbours of the module at ctx_at, found once for all its productions
     std::size_t ctx_at = ~std::size_t{0};
     std::int64_t ctx_left = kUnknown, ctx_right = kUnknown;
-    BigVector<std::uint16_t>
-        scratch; // Rewriter::run_symbols's keys, when the rewriter has no buffer for them
+    BigVector<ContextKey> scratch; // Rewriter::run_symbols's keys, when the rewriter has no buffer for them
     // write_direct's snapshots, one every kSnapEvery modules read: where the output stood
     // (modules written so far), then the tally of every outcome so far (Engine::counts).
     std::vector<std::uint64_t> snaps;
@@ -79,7 +78,7 @@ class Rewriter {
     // does the symbol kernel apply (it needs no bracket table, and keeps its right keys in
     // `scratch`).
     Rewriter(const RulePlan& rule_plan, const ModuleString& in,
-             std::vector<std::uint32_t>* brackets = nullptr, BigVector<std::uint16_t>* scratch = nullptr,
+             std::vector<std::uint32_t>* brackets = nullptr, BigVector<ContextKey>* scratch = nullptr,
              bool whole = false);
 
     // The production the context table gives for module i, which has a table and no parameters.
@@ -425,8 +424,8 @@ class Rewriter {
     const std::size_t n;
     const bool whole; // see the constructor
     std::vector<std::uint32_t> own_match;
-    BigVector<std::uint16_t>* kernel_scratch = nullptr; // run_symbols's right keys, kept from step to step
-    const std::uint32_t* match = nullptr;               // the bracket table (see bracket_table)
+    BigVector<ContextKey>* kernel_scratch = nullptr; // run_symbols's right keys, kept from step to step
+    const std::uint32_t* match = nullptr;            // the bracket table (see bracket_table)
     std::vector<std::size_t> piece_starts; // run_backward: where each piece of the new string starts
 };
 

@@ -16,6 +16,14 @@ template <typename Vector> [[gnu::noinline]] void resize(Vector& v, std::size_t 
     v.resize(size);
 }
 
+// A push onto a full stack of saved keys: twice the room (out of the loops' common case).
+// (The stack's pointer is returned, not written through a reference: a local whose address
+// escapes must be reloaded after every store of the loop that might reach it.)
+[[gnu::noinline]] ContextKey* grow_stack(std::vector<ContextKey>& saved) {
+    saved.resize(2 * saved.size());
+    return saved.data();
+}
+
 } // namespace
 
 // run_range for strings without parameters or identities under a plan with a symbol kernel
@@ -43,27 +51,39 @@ void Rewriter::run_symbols(Worker& w) {
     // The right-to-left pass: the key of the last module context sees, saved at each ']'
     // and taken back at its '[' (going leftwards, a branch is entered at its ']'). A bracket
     // without a partner has none.
-    // Both passes keep their saved keys on `stack`, which is as deep as the stretch is long.
-    BigVector<std::uint16_t>& scratch = kernel_scratch ? *kernel_scratch : w.scratch;
-    size_whole(scratch, 2 * n + 1);
-    std::uint16_t* const rkey = scratch.data();
-    std::uint16_t* const stack = rkey + n;
+    // The keys are bytes (RulePlan::build_context_table keeps them under 255), one a module. Both
+    // passes keep their saved keys on `stack`: the first grows it when full; the second pushes
+    // only at '[' and is given room for every '[' the first counted, so its loop has no check
+    // (one more live value there made the loop spill and run 10 % slower). Sized for the worst
+    // case instead, the stretch's length, the stack was as large as the keys again and made
+    // 1.31a's largest block (docs/rewriting.md, "Stalls").
+    BigVector<ContextKey>& scratch = kernel_scratch ? *kernel_scratch : w.scratch;
+    size_whole(scratch, n + 1);
+    ContextKey* const rkey = scratch.data();
+    std::vector<ContextKey> saved(256);
+    std::size_t opens = 0;
     {
-        std::uint16_t right = 0;
+        ContextKey* stack = saved.data();
+        std::size_t room = saved.size();
+        ContextKey right{};
         std::size_t depth = 0;
         for (std::size_t j = n; j-- > 0;) {
             const Plan::SymbolRow r = rows[in_sym[j]];
             rkey[j] = right;
             if (r.shape == 0) {
-                right = r.key;
+                right = ContextKey{r.key};
             } else if (r.shape == Plan::kClose) {
+                if (depth == room) stack = grow_stack(saved), room = saved.size();
                 stack[depth++] = right;
-                right = 0;
+                right = ContextKey{};
             } else if (r.shape == Plan::kOpen) {
-                right = depth ? stack[--depth] : 0;
+                right = depth ? stack[--depth] : ContextKey{};
+                ++opens;
             }
         }
     }
+    if (saved.size() < opens) saved.resize(opens);
+    ContextKey* const stack = saved.data();
 
     const std::size_t p_end = out.params.size(); // every module written here has none
     std::size_t m = out.size();
@@ -92,16 +112,19 @@ void Rewriter::run_symbols(Worker& w) {
         KindId* S = out.kinds.data();
         for (; i < stop; ++i) {
             const Plan::SymbolRow row = rows[in_sym[i]];
-            const Plan::SymbolSucc& su = succs[row.block + (left & row.lmask) * K + (rkey[i] & row.rmask)];
+            const Plan::SymbolSucc& su =
+                succs[row.block + (left & row.lmask) * K + (static_cast<std::size_t>(rkey[i]) & row.rmask)];
             std::memcpy(S + m, su.syms, sizeof su.syms);
             m += su.len;
             fresh += su.fresh;
             if (row.shape == 0) {
                 left = row.key;
             } else if (row.shape == Plan::kOpen) {
-                stack[depth++] = static_cast<std::uint16_t>(left);
+                stack[depth++] = ContextKey{static_cast<std::uint8_t>(left)};
             } else if (row.shape == Plan::kClose) {
-                left = depth == 0 ? 0 : stack[--depth]; // a ']' without its '[': no left key
+                left = depth == 0
+                           ? 0
+                           : static_cast<std::size_t>(stack[--depth]); // a ']' without its '[': no left key
             }
         }
     }

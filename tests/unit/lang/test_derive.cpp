@@ -381,14 +381,19 @@ TEST_CASE("the symbol kernel writes what the general route writes", "[derive][id
         // a left context only, a right context only, ignored symbols that are rewritten
         "ignore: x; axiom: a x b x a; derive 12; rules { a < b -> b x a; b > a -> a; x -> y; y -> x x; }",
     };
-    // deep nesting, 80 levels of saved left keys: a [ b [ b ... b ] b ] b ..., where
-    // each b after a ']' has for left neighbour the b before that branch's '['
-    std::string deep = "axiom: a";
-    for (int k = 0; k < 80; ++k) deep += " [ b";
-    for (int k = 0; k < 80; ++k) deep += " ] b";
-    deep += "; derive 5; rules { a < b -> b a; b < b -> c; c < b -> b [ c ]; c -> b; }";
+    // deep nesting, 300 levels of saved left keys: a [ b [ b ... b ] b ] b ..., where
+    // each b after a ']' has for left neighbour the b before that branch's '['. The kernel's
+    // stack of saved keys starts with room for 256 and grows; then the same opened 300 times and
+    // never closed, and closed 300 times without an opening
+    auto nested = [](int opens, int closes) {
+        std::string g = "axiom: a";
+        for (int k = 0; k < opens; ++k) g += " [ b";
+        for (int k = 0; k < closes; ++k) g += " ] b";
+        return g + "; derive 5; rules { a < b -> b a; b < b -> c; c < b -> b [ c ]; c -> b; b > c -> a; }";
+    };
     std::vector<std::string> all(std::begin(grammars), std::end(grammars));
-    all.push_back(deep);
+    for (auto [opens, closes] : {std::pair{300, 300}, std::pair{300, 0}, std::pair{0, 300}})
+        all.push_back(nested(opens, closes));
     for (const std::string& g : all) {
         INFO(g);
         auto c = test::compile(g);
