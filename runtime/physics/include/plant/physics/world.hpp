@@ -445,6 +445,7 @@ class World {
         Array<glm::dmat3> rest_moment;         // 0.2 m D R̄ᵀ, while the groups are current
         Array<glm::dvec3> push;
         Array<std::uint8_t> near;           // links near an obstacle (resolve_segments)
+        Array<std::uint8_t> ring_flag;      // (resolve_segments) particles whose links join a near one
         Array<std::uint32_t> contact_links; // the same, as a list in index order
         Array<double> stiffness;            // each particle's s, during a step
         Groups groups;
@@ -464,6 +465,7 @@ class World {
         Array<glm::dvec3> box_lo, box_hi;
         Array<std::uint32_t> link_list, link_members;
         Array<LinkCell> link_table;
+        Array<std::uint32_t> link_used; // the slots of link_table the last call filled
         Array<std::pair<std::uint32_t, std::uint32_t>> link_pairs;
         Array<std::uint32_t> link_big; // link contacts: boxes too large for the grid
         // the energy budget (energy.cpp): the forcing on each particle this step, its energy
