@@ -150,7 +150,10 @@ void TurtleEnvironmentPhase::run(const Derivation& d, RunState& state, ModuleStr
     ModuleString interpreted = d.interpreted(string);
     QuerySink sink(p, interpreted);
     std::optional<SkeletonBuilder> skeleton;
-    if (!state.empty()) skeleton.emplace(p, interpreted);
+    bool seen = false;
+    for (std::size_t e = 0; e < state.size() && !seen; ++e)
+        if (const Environment* env = state.environment(e)) seen = env->sees_plant();
+    if (seen) skeleton.emplace(p, interpreted);
     BothSinks both(sink, skeleton ? &*skeleton : nullptr);
     interpret(p, interpreted, turtle_options(d), both);
     if (skeleton) {

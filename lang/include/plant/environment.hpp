@@ -169,6 +169,10 @@ class Environment : public BoundPoses {
     virtual void advance(std::set<ModuleId>& /*left*/) {}
     // 2. Every environment sees the plant as the turtle draws it now.
     virtual void see(const Skeleton&) {}
+    // Whether see() looks at the skeleton: when no environment of a run does, the phase does not
+    // build one (a climber, which holds its own segments, does not; building the skeleton of Fig.
+    // 14 right's 25,000 segments and their leaves every step was about a tenth of its run).
+    virtual bool sees_plant() const { return true; }
     // Bound modules' poses, for every turtle pass (kinds that hold segments).
     bool pose(ModuleId, glm::dvec3&, glm::dmat3&) const override { return false; }
 };

@@ -132,6 +132,7 @@ class Climber : public Environment {
     void begin_segments() override;
     void segment(const BoundSegment& s) override;
     void advance(std::set<ModuleId>& left) override;
+    bool sees_plant() const override { return false; } // its particles are its plant
 
     physics::World& world() { return world_; }
     const physics::World& world() const { return world_; }

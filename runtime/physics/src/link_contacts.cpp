@@ -180,32 +180,58 @@ void World::find_link_pairs() {
         std::sort(sc.link_pairs.begin(), sc.link_pairs.end());
         return;
     }
-    const double cell = std::max({total / static_cast<double>(links.size()) + 2 * widest, largest / 4, 1e-6});
+    grid_link_pairs(std::max({total / static_cast<double>(links.size()) + 2 * widest, largest / 4, 1e-6}));
+    std::sort(sc.link_pairs.begin(), sc.link_pairs.end()); // index order, whatever the table's
+}
+
+// find_link_pairs' grid, of cells `cell` wide: the candidate pairs of the links in
+// scratch_.link_list (none oversized), appended to scratch_.link_pairs.
+void World::grid_link_pairs(double cell) {
+    auto& sc = scratch_;
+    auto& links = sc.link_list;
+    const auto& lo = sc.box_lo;
+    const auto& hi = sc.box_hi;
+    const auto& plant = sc.plant;
     auto range = [&](std::uint32_t i, glm::i64vec3& a, glm::i64vec3& b) {
         for (int k = 0; k < 3; ++k) a[k] = far_floor(lo[i][k] / cell), b[k] = far_floor(hi[i][k] / cell);
     };
-    // an open-addressing table from a cell to its run of links, filled by counting (no sort)
+    // each cell's run grouped by plant: the links taken in plant order, then index order
+    std::sort(links.begin(), links.end(), [&](std::uint32_t a, std::uint32_t b) {
+        return plant[a] != plant[b] ? plant[a] < plant[b] : a < b;
+    });
+    // the cells a link's box touches, one entry each
     std::size_t entries = 0;
     for (const std::uint32_t i : links) {
         glm::i64vec3 a, b;
         range(i, a, b);
         entries += static_cast<std::size_t>((b.x - a.x + 1) * (b.y - a.y + 1) * (b.z - a.z + 1));
     }
+    // The cells that hold an entry, each with its run of links in `members` (filled by counting,
+    // no sort), and an open-addressing table from a cell to its index there (+1; 0: none). A
+    // link spans several cells and a cell holds about fifteen, so the cells are few (Fig. 14
+    // right: about 2,800 a call for 41,000 entries): the table is of 4-byte indices, at most half
+    // full in entries, and only the slots the last call filled are emptied. (The cells and their
+    // runs in the table's slots, 40 bytes each and four slots an entry, was a 10 MB table filled
+    // and scanned whole each call, most of this function's time.)
     std::size_t size = 16;
-    while (size < 4 * entries) size *= 2; // a quarter full at most
-    // Only the slots the last call used are emptied and only they are scanned: a quarter full in
-    // entries is about 1 % in cells, as a link spans several cells and a cell holds about fifteen
-    // (Fig. 14 right: 2,800 cells a call, 262,144 slots of 40 bytes, once most of this time).
+    while (size < 2 * entries) size *= 2;
     auto& table = sc.link_table;
-    auto& used = sc.link_used;
+    auto& cells = sc.link_cells;
+    auto& used = sc.link_used; // the slot of each cell
     for (const std::uint32_t slot : used)
-        if (slot < table.size()) table[slot] = LinkCell{};
+        if (slot < table.size()) table[slot] = 0;
     used.clear();
-    if (table.size() != size) table.assign(size, LinkCell{});
-    auto slot_of = [&](const glm::i64vec3& c) {
+    cells.clear();
+    if (table.size() != size) table.assign(size, 0);
+    auto cell_at = [&](const glm::i64vec3& c) { // c's index in `cells`, added if new
         std::size_t slot = cell_hash(c) & (size - 1);
-        while (table[slot].count != 0 && table[slot].cell != c) slot = (slot + 1) & (size - 1);
-        return slot;
+        while (table[slot] != 0 && cells[table[slot] - 1].cell != c) slot = (slot + 1) & (size - 1);
+        if (table[slot] == 0) {
+            used.push_back(static_cast<std::uint32_t>(slot)); // first: the next call empties it
+            cells.push_back(LinkCell{c, 0, 0, 0});
+            table[slot] = static_cast<std::uint32_t>(cells.size());
+        }
+        return table[slot] - 1;
     };
     auto each_cell = [&](std::uint32_t i, auto&& f) {
         glm::i64vec3 a, b;
@@ -214,33 +240,27 @@ void World::find_link_pairs() {
             for (std::int64_t y = a.y; y <= b.y; ++y)
                 for (std::int64_t x = a.x; x <= b.x; ++x) f(glm::i64vec3(x, y, z));
     };
+    auto& entry_cell = sc.link_entry_cell; // each entry's cell, in the order of the two passes
+    entry_cell.resize(entries);
+    std::size_t e = 0;
     for (const std::uint32_t i : links)
         each_cell(i, [&](const glm::i64vec3& c) {
-            const std::size_t slot = slot_of(c);
-            LinkCell& s = table[slot];
-            if (s.count == 0) used.push_back(static_cast<std::uint32_t>(slot));
-            s.cell = c;
-            ++s.count;
+            const std::uint32_t k = cell_at(c);
+            ++cells[k].count;
+            entry_cell[e++] = k;
         });
     std::uint32_t running = 0;
-    for (const std::uint32_t slot : used) {
-        LinkCell& s = table[slot];
+    for (LinkCell& s : cells) {
         s.begin = s.fill = running;
         running += s.count;
     }
-    // each cell's run grouped by plant: the links filled in plant order, then index order
-    std::sort(links.begin(), links.end(), [&](std::uint32_t a, std::uint32_t b) {
-        return plant[a] != plant[b] ? plant[a] < plant[b] : a < b;
-    });
     auto& members = sc.link_members;
     members.resize(running);
+    e = 0;
     for (const std::uint32_t i : links)
-        each_cell(i, [&](const glm::i64vec3& c) { members[table[slot_of(c)].fill++] = i; });
-    for (const std::uint32_t slot : used) {
-        const LinkCell& s = table[slot];
+        each_cell(i, [&](const glm::i64vec3&) { members[cells[entry_cell[e++]].fill++] = i; });
+    for (const LinkCell& s : cells)
         pairs_in_cell(members, s.begin, s.begin + s.count, s.cell, cell, lo, hi, plant, sc.link_pairs);
-    }
-    std::sort(sc.link_pairs.begin(), sc.link_pairs.end()); // index order, whatever the table's
 }
 
 void World::separate_links(bool find) {

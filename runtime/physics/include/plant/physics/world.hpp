@@ -376,6 +376,7 @@ class World {
     // pairs' capsules pushed apart, the four ends by their barycentric weights and inverse masses
     void build_plants();
     void find_link_pairs();
+    void grid_link_pairs(double cell); // (find_link_pairs)
     // with find false, the pairs found by the last call are pushed again (a later round of a step)
     void separate_links(bool find);
     void integrate(); // Eq. 17-18 with damping, and contacts with obstacles
@@ -464,8 +465,8 @@ class World {
         std::size_t plants = 0;
         Array<glm::dvec3> box_lo, box_hi;
         Array<std::uint32_t> link_list, link_members;
-        Array<LinkCell> link_table;
-        Array<std::uint32_t> link_used; // the slots of link_table the last call filled
+        Array<std::uint32_t> link_table, link_used, link_entry_cell; // (find_link_pairs)
+        Array<LinkCell> link_cells;
         Array<std::pair<std::uint32_t, std::uint32_t>> link_pairs;
         Array<std::uint32_t> link_big; // link contacts: boxes too large for the grid
         // the energy budget (energy.cpp): the forcing on each particle this step, its energy
