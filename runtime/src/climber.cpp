@@ -72,9 +72,15 @@ const EnvironmentKind& climber_kind() {
     return kind;
 }
 
+const Climber::Bound* Climber::bound(ModuleId id) const {
+    auto it = std::lower_bound(particle_of_.begin(), particle_of_.end(), id,
+                               [](const Bound& b, ModuleId v) { return b.id < v; });
+    return it == particle_of_.end() || it->id != id ? nullptr : &*it;
+}
+
 physics::Handle Climber::particle(ModuleId id) const {
-    auto it = particle_of_.find(id);
-    return it == particle_of_.end() ? physics::Handle{} : it->second;
+    const Bound* b = bound(id);
+    return b ? b->particle : physics::Handle{};
 }
 
 namespace {
@@ -85,6 +91,15 @@ ModuleId id_of(double v) {
 }
 bool finite(const glm::dvec3& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+// Drops the elements `drop` says to, visiting them front to back (its side effects happen in
+// that order), the others kept in order.
+template <class T, class Drop> void drop_in_order(std::vector<T>& v, Drop&& drop) {
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < v.size(); ++i)
+        if (!drop(v[i])) v[kept++] = v[i];
+    v.resize(kept);
 }
 
 } // namespace
@@ -205,19 +220,19 @@ void Climber::geometry(std::vector<glm::dvec3>& triangles, const glm::dvec3& lo,
 }
 
 void Climber::begin_segments() {
-    seen_.clear();
+    for (Bound& b : particle_of_) b.seen = false;
     pending_.clear();
     rethickened_.clear();
 }
 
 void Climber::segment(const BoundSegment& s) {
-    if (auto it = particle_of_.find(s.id); it != particle_of_.end()) {
-        seen_.insert(s.id);
+    if (Bound* b = bound(s.id)) {
+        b->seen = true;
         // a segment the grammar thickened (secondary growth) thickens its particle too, so
         // collisions and its mass (Eq. 2) follow the stem drawn
-        if (world_.alive(it->second) && std::isfinite(s.radius) && s.radius > 0 &&
-            std::abs(std::clamp(s.radius, 1e-4, 1e6) - world_.radii(it->second).x) > 1e-12)
-            rethickened_.emplace_back(it->second, s);
+        if (world_.alive(b->particle) && std::isfinite(s.radius) && s.radius > 0 &&
+            std::abs(std::clamp(s.radius, 1e-4, 1e6) - world_.radii(b->particle).x) > 1e-12)
+            rethickened_.emplace_back(b->particle, s);
         return;
     }
     pending_.push_back(s);
@@ -248,7 +263,13 @@ void Climber::place_pending() {
             roots_.push_back(parent);
         }
         physics::Handle h = world_.add_grown(parent, p.to, q, radii);
-        particle_of_[p.id] = h;
+        // new modules' identities are above the old ones', so this nearly always appends
+        auto at = std::lower_bound(particle_of_.begin(), particle_of_.end(), p.id,
+                                   [](const Bound& b, ModuleId v) { return b.id < v; });
+        if (at != particle_of_.end() && at->id == p.id)
+            at->particle = h;
+        else
+            particle_of_.insert(at, Bound{p.id, h});
         if (born_radius_.size() <= h.index) born_radius_.resize(h.index + 1, 0.0);
         born_radius_[h.index] = r;
         // Eq. 5: a particle born near a surface holds on to it
@@ -266,14 +287,11 @@ void Climber::place_pending() {
 void Climber::advance(std::set<ModuleId>& left) {
     charge_particles(fluid_.size());
     // particles whose modules the grammar removed go too
-    for (auto it = particle_of_.begin(); it != particle_of_.end();) {
-        if (seen_.count(it->first)) {
-            ++it;
-            continue;
-        }
-        world_.remove(it->second);
-        it = particle_of_.erase(it);
-    }
+    drop_in_order(particle_of_, [&](const Bound& b) {
+        if (b.seen) return false;
+        world_.remove(b.particle);
+        return true;
+    });
     place_pending();
     // painted samples a new particle reached are used up, so shoots move on across the region
     // instead of circling a sample (as a space-colonization attractor is removed once reached)
@@ -342,28 +360,25 @@ void Climber::advance(std::set<ModuleId>& left) {
     grabs_.clear();
     // a wind, pull or segment far beyond any scene can push particles out of finite space; the
     // plant cannot be drawn from there, so the derivation ends (the caller names the climber)
-    for (const auto& [id, h] : particle_of_)
-        if (!finite(world_.position(h)))
+    for (const Bound& b : particle_of_)
+        if (!finite(world_.position(b.particle)))
             throw RuntimeError(RuntimeErrorKind::Physics, Span{},
                                fmt::format("the segment of module #{} left finite space (its position is "
                                            "infinite or not a number): lower the wind, pulls, segment "
                                            "lengths or box sizes that drove it there",
-                                           id));
+                                           b.id));
     for (const glm::dvec3& x : fluid_.positions())
         if (!finite(x))
             throw RuntimeError(RuntimeErrorKind::Physics, Span{},
                                "the air left finite space (a particle's position is infinite or not a "
                                "number): lower the wind or the emitters' velocities");
     // broken-off and cut parts leave the string (and the world)
-    for (auto it = particle_of_.begin(); it != particle_of_.end();) {
-        if (world_.attached(it->second)) {
-            ++it;
-            continue;
-        }
-        left.insert(it->first);
-        world_.remove(it->second); // a broken-off part is no longer drawn, so no longer simulated
-        it = particle_of_.erase(it);
-    }
+    drop_in_order(particle_of_, [&](const Bound& b) {
+        if (world_.attached(b.particle)) return false;
+        left.insert(b.id);
+        world_.remove(b.particle); // a broken-off part is no longer drawn, so no longer simulated
+        return true;
+    });
     // a fixed root whose plant is gone would only be in the way of the next one planted there
     for (auto it = roots_.begin(); it != roots_.end();) {
         if (world_.has_children(*it)) {
@@ -427,7 +442,7 @@ void Climber::thicken() {
 void Climber::rebuild_occupancy() {
     std::vector<glm::dvec3> points;
     points.reserve(particle_of_.size());
-    for (const auto& [id, h] : particle_of_) points.push_back(world_.position(h));
+    for (const Bound& b : particle_of_) points.push_back(world_.position(b.particle));
     light_.build(points, config_.light_cell);
 }
 

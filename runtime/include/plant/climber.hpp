@@ -48,6 +48,7 @@
 #include <set>
 #include <string>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 namespace plant {
@@ -163,10 +164,21 @@ class Climber : public Environment {
     physics::World world_;
     physics::Fluid fluid_;
     Config config_;
-    std::map<ModuleId, physics::Handle> particle_of_; // ordered: removals happen in id order
-    std::vector<physics::Handle> roots_;              // the fixed roots made for plants' first segments
+    // Module identity to particle, in identity order (removals happen in that order), with
+    // whether the last turtle pass drew the module: a sorted array searched by halving. (A
+    // std::map's node per segment made each of the turtle's lookups, one per bound module and
+    // pass, a chain of cache misses, and a std::set of the drawn modules allocated a node each
+    // per step: together about a tenth of Table 1's scene, Fig. 14 right.)
+    struct Bound {
+        ModuleId id;
+        physics::Handle particle;
+        bool seen = false;
+    };
+    std::vector<Bound> particle_of_;
+    const Bound* bound(ModuleId id) const;
+    Bound* bound(ModuleId id) { return const_cast<Bound*>(std::as_const(*this).bound(id)); }
+    std::vector<physics::Handle> roots_; // the fixed roots made for plants' first segments
     std::vector<std::pair<std::size_t, std::vector<glm::dvec3>>> meshes_; // obstacle index, its triangles
-    std::set<ModuleId> seen_;
     std::vector<BoundSegment> pending_; // bound modules without a particle yet
     // edits asked for by hooks since the last advance
     std::vector<std::pair<ModuleId, glm::dvec3>> pulls_, grabs_;
