@@ -39,23 +39,37 @@ bool beyond_one_face(const Obstacle& o, const glm::dvec3& a, const glm::dvec3& b
     return false;
 }
 
-// Whether a box's capsule test would find the capsule clear without searching along it: both
-// ends beyond one face by r or more (beyond_one_face), or both in the region over one face (the
-// point nearest to each is on that face, the same face for both), where the signed distance is
-// linear along the segment and the ends are its least, both at least r. The margin of 1e-12
-// under deepest_on_segment's bound covers the rounding of its distances, so this says clear only
-// where deepest_on_segment would (and then link_contacts does not push).
+// Whether a box's capsule test (deepest_on_segment) would find the capsule clear, told without
+// its search where that can be done exactly:
+// - both ends beyond one face by r or more (beyond_one_face, its first test);
+// - both ends in the same zone along each axis (below the box, across it, above it) and outside
+//   the box. Each zone is an interval, so the whole segment stays in them; the signed distance
+//   there is the length of a vector whose components along the axes the segment is beyond are
+//   linear along it and the others zero, and its least is a point's distance to a segment.
+// The margin of 1e-12 under deepest_on_segment's bound covers the rounding of its distances, so
+// this says clear only where deepest_on_segment would (and then link_contacts does not push).
 bool box_clear(const Obstacle& o, const glm::dvec3& a, const glm::dvec3& b, double r) {
-    if (beyond_one_face(o, a, b, r)) return true;
     const glm::dvec3 c = (o.a + o.b) * 0.5, h = (o.b - o.a) * 0.5;
-    const glm::dvec3 qa = glm::abs(a - c) - h, qb = glm::abs(b - c) - h; // as signed_distance has them
+    const glm::dvec3 pa = a - c, pb = b - c;
+    for (int j = 0; j < 3; ++j)
+        if ((pa[j] - h[j] >= r && pb[j] - h[j] >= r) || (-pa[j] - h[j] >= r && -pb[j] - h[j] >= r))
+            return true;
+    glm::dvec3 u(0.0), v(0.0); // the outside parts at a and at b (signed_distance's q, cut at 0)
+    bool outside = false;
     for (int j = 0; j < 3; ++j) {
-        const int k = (j + 1) % 3, l = (j + 2) % 3;
-        if (qa[j] > 0 && qb[j] > 0 && (a[j] > c[j]) == (b[j] > c[j]) && qa[k] <= 0 && qa[l] <= 0 &&
-            qb[k] <= 0 && qb[l] <= 0)
-            return std::min(qa[j], qb[j]) >= r - 1e-9 + 1e-12;
+        const int za = pa[j] > h[j] ? 1 : pa[j] < -h[j] ? -1 : 0;
+        const int zb = pb[j] > h[j] ? 1 : pb[j] < -h[j] ? -1 : 0;
+        if (za != zb) return false;
+        if (za == 0) continue;
+        u[j] = za * pa[j] - h[j];
+        v[j] = za * pb[j] - h[j];
+        outside = true;
     }
-    return false;
+    if (!outside) return false; // inside the box
+    const glm::dvec3 d = v - u;
+    const double dd = glm::dot(d, d);
+    const double s = dd > 0 ? std::clamp(-glm::dot(u, d) / dd, 0.0, 1.0) : 0.0;
+    return glm::length(u + d * s) >= r - 1e-9 + 1e-12;
 }
 
 // the least of f over [lo, hi] for f convex there: golden-section search
