@@ -268,21 +268,32 @@ void World::separate_links(bool find) {
     if (find) find_link_pairs();
     const auto& pairs = scratch_.link_pairs;
     if (pairs.empty()) return;
+    // a particle's inverse mass, 0 when it does not move (fixed, or dragged: a dragged particle
+    // stays where it is dragged)
+    auto mobility = [&](std::uint32_t j) {
+        if (fixed_[j]) return 0.0;
+        for (const auto& pull : pulls_)
+            if (pull.first == j) return 0.0;
+        return 1.0 / std::max(m_[j], 1e-12);
+    };
+    // and for a push along `dir`: 0 too for a particle lying on a support (within a millimetre)
+    // that the push would move into it; the other link gives way (two stems crossing on a wall:
+    // the one on top lifts)
     auto weight = [&](std::uint32_t j, const glm::dvec3& dir) {
         if (fixed_[j]) return 0.0;
         for (const auto& pull : pulls_)
-            if (pull.first == j) return 0.0; // a dragged particle stays where it is dragged
-        // a particle lying on a support (within a millimetre) is not pushed into it: the other
-        // link gives way (two stems crossing on a wall: the one on top lifts)
+            if (pull.first == j) return 0.0;
         const double r = scratch_.thin_of(j, radii_) + 0.001;
         for (const Obstacle& o : obstacles_)
             if (signed_distance(o, x_[j]) < r && glm::dot(dir, surface_normal(o, x_[j])) < 0) return 0.0;
         return 1.0 / std::max(m_[j], 1e-12);
     };
+    // (the length and obstacle fixes below move along no one direction: mobility, the weight of
+    // a push along none, without the supports' normals, six distances each for a box)
     auto keep_length = [&](std::uint32_t j) {
         const std::uint32_t p = parent_[j];
         if (p == kNone) return;
-        const double wp = weight(p, glm::dvec3(0.0)), wj = weight(j, glm::dvec3(0.0));
+        const double wp = mobility(p), wj = mobility(j);
         const glm::dvec3 e = x_[j] - x_[p];
         const double len = glm::length(e), rest = scratch_.rest_length[j];
         if (wp + wj <= 0 || len < 1e-12 || rest < 1e-12) return;
@@ -295,7 +306,7 @@ void World::separate_links(bool find) {
     auto out_of_obstacles = [&](std::uint32_t j) {
         const std::uint32_t p = parent_[j];
         if (p == kNone) return;
-        const double wp = weight(p, glm::dvec3(0.0)), wj = weight(j, glm::dvec3(0.0));
+        const double wp = mobility(p), wj = mobility(j);
         if (wp + wj > 0) link_contacts(j, wp, wj);
     };
     // Gauss-Seidel over the pairs in index order, on one thread (the same result on any thread
