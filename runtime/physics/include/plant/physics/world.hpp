@@ -439,6 +439,7 @@ class World {
         Array<glm::dmat3> moments, group_moment; // per particle, and summed per group
         Array<glm::dvec3> old;
         Array<Cell> table;                     // the collision pass's cells
+        Array<std::uint32_t> used_cells;       // the slots of `table` the last step filled
         Array<std::uint32_t> slot_of, members; // particles grouped by table slot
         Array<glm::i64vec3> cell_of;           // each particle's collision cell
         Array<double> thin;                    // each particle's thinnest radius
