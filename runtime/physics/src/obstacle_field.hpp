@@ -55,4 +55,10 @@ inline glm::dvec3 surface_normal(const Obstacle& o, const glm::dvec3& p) {
 // apart refined by a search for a sampled grid (segment_contacts.cpp).
 double deepest_on_segment(const Obstacle& o, const glm::dvec3& a, const glm::dvec3& b, double r, double& t);
 
+// Whether deepest_on_segment would find the capsule of radius r from a to b clear of box o (its
+// least at least r - 1e-9), told without its search: exactly, from the pieces of the segment
+// between the planes of the box's faces, with a margin of 1e-12 for rounding
+// (segment_contacts.cpp). False also where it cannot tell so closely.
+bool box_clear(const Obstacle& o, const glm::dvec3& a, const glm::dvec3& b, double r);
+
 } // namespace plant::physics

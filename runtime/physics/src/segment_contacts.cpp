@@ -39,39 +39,6 @@ bool beyond_one_face(const Obstacle& o, const glm::dvec3& a, const glm::dvec3& b
     return false;
 }
 
-// Whether a box's capsule test (deepest_on_segment) would find the capsule clear, told without
-// its search where that can be done exactly:
-// - both ends beyond one face by r or more (beyond_one_face, its first test);
-// - both ends in the same zone along each axis (below the box, across it, above it) and outside
-//   the box. Each zone is an interval, so the whole segment stays in them; the signed distance
-//   there is the length of a vector whose components along the axes the segment is beyond are
-//   linear along it and the others zero, and its least is a point's distance to a segment.
-// The margin of 1e-12 under deepest_on_segment's bound covers the rounding of its distances, so
-// this says clear only where deepest_on_segment would (and then link_contacts does not push).
-bool box_clear(const Obstacle& o, const glm::dvec3& a, const glm::dvec3& b, double r) {
-    const glm::dvec3 c = (o.a + o.b) * 0.5, h = (o.b - o.a) * 0.5;
-    const glm::dvec3 pa = a - c, pb = b - c;
-    for (int j = 0; j < 3; ++j)
-        if ((pa[j] - h[j] >= r && pb[j] - h[j] >= r) || (-pa[j] - h[j] >= r && -pb[j] - h[j] >= r))
-            return true;
-    glm::dvec3 u(0.0), v(0.0); // the outside parts at a and at b (signed_distance's q, cut at 0)
-    bool outside = false;
-    for (int j = 0; j < 3; ++j) {
-        const int za = pa[j] > h[j] ? 1 : pa[j] < -h[j] ? -1 : 0;
-        const int zb = pb[j] > h[j] ? 1 : pb[j] < -h[j] ? -1 : 0;
-        if (za != zb) return false;
-        if (za == 0) continue;
-        u[j] = za * pa[j] - h[j];
-        v[j] = za * pb[j] - h[j];
-        outside = true;
-    }
-    if (!outside) return false; // inside the box
-    const glm::dvec3 d = v - u;
-    const double dd = glm::dot(d, d);
-    const double s = dd > 0 ? std::clamp(-glm::dot(u, d) / dd, 0.0, 1.0) : 0.0;
-    return glm::length(u + d * s) >= r - 1e-9 + 1e-12;
-}
-
 // the least of f over [lo, hi] for f convex there: golden-section search
 template <class F> double golden_min(F&& f, double lo, double hi, double& at) {
     constexpr double g = 0.6180339887498949;
@@ -90,7 +57,67 @@ template <class F> double golden_min(F&& f, double lo, double hi, double& at) {
     return std::min(f1, f2);
 }
 
+// The least distance outside the box (half-extents h, centre at the origin) over the piece
+// [s0, s1] of the segment from pa to pb, all of which lies in the zones of its midpoint along
+// each axis (below the box, across it, above it): there the distance is the length of a vector
+// whose components along the axes the piece is beyond are linear and the others zero, and its
+// least is a point's distance to a segment. Negative when the piece is inside the box.
+double least_outside(const glm::dvec3& pa, const glm::dvec3& pb, const glm::dvec3& h, double s0, double s1) {
+    const glm::dvec3 m = pa + (pb - pa) * ((s0 + s1) / 2);
+    glm::dvec3 u(0.0), v(0.0); // the outside parts at s0 and s1 (signed_distance's q, cut at 0)
+    bool outside = false;
+    for (int j = 0; j < 3; ++j) {
+        const double z = m[j] > h[j] ? 1 : m[j] < -h[j] ? -1 : 0;
+        if (z == 0) continue;
+        u[j] = z * (pa[j] + (pb[j] - pa[j]) * s0) - h[j];
+        v[j] = z * (pa[j] + (pb[j] - pa[j]) * s1) - h[j];
+        outside = true;
+    }
+    if (!outside) return -1; // inside the box
+    const glm::dvec3 d = v - u;
+    const double dd = glm::dot(d, d);
+    const double s = dd > 0 ? std::clamp(-glm::dot(u, d) / dd, 0.0, 1.0) : 0.0;
+    return glm::length(u + d * s);
+}
+
 } // namespace
+
+// Whether a box's capsule test (deepest_on_segment) would find the capsule clear, told without
+// its search: both ends beyond one face by r or more (beyond_one_face, its first test), or else
+// the segment cut where it crosses the planes of the box's faces into pieces that each lie in
+// one zone along every axis, and the least of each piece's distance (least_outside) at least r.
+// That is the exact least of the distance along the segment; the margin of 1e-12 under
+// deepest_on_segment's bound covers the rounding of its distances and of the cuts, so this says
+// clear only where deepest_on_segment would (and then link_contacts does not push).
+bool box_clear(const Obstacle& o, const glm::dvec3& a, const glm::dvec3& b, double r) {
+    const glm::dvec3 c = (o.a + o.b) * 0.5, h = (o.b - o.a) * 0.5;
+    const glm::dvec3 pa = a - c, pb = b - c;
+    for (int j = 0; j < 3; ++j)
+        if ((pa[j] - h[j] >= r && pb[j] - h[j] >= r) || (-pa[j] - h[j] >= r && -pb[j] - h[j] >= r))
+            return true;
+    // most links lie in one zone along every axis (along a face, beyond an edge): one piece
+    auto zone = [&](const glm::dvec3& p, int j) { return p[j] > h[j] ? 1 : p[j] < -h[j] ? -1 : 0; };
+    bool one_piece = true;
+    for (int j = 0; j < 3; ++j) one_piece = one_piece && zone(pa, j) == zone(pb, j);
+    if (one_piece) return least_outside(pa, pb, h, 0, 1) >= r - 1e-9 + 1e-12;
+    double cut[8];
+    int cuts = 0;
+    cut[cuts++] = 0;
+    for (int j = 0; j < 3; ++j) {
+        const double step = pb[j] - pa[j];
+        if (step == 0 || zone(pa, j) == zone(pb, j)) continue; // no face plane crossed
+        for (const double face : {-h[j], h[j]}) {
+            const double s = (face - pa[j]) / step;
+            if (s > 0 && s < 1) cut[cuts++] = s;
+        }
+    }
+    for (int k = 2; k < cuts; ++k) // in order (at most six: by insertion)
+        for (int l = k; l > 1 && cut[l] < cut[l - 1]; --l) std::swap(cut[l], cut[l - 1]);
+    cut[cuts++] = 1;
+    for (int k = 0; k + 1 < cuts; ++k)
+        if (least_outside(pa, pb, h, cut[k], cut[k + 1]) < r - 1e-9 + 1e-12) return false;
+    return true;
+}
 
 double deepest_on_segment(const Obstacle& o, const glm::dvec3& a, const glm::dvec3& b, double r, double& t) {
     const glm::dvec3 d = b - a;
