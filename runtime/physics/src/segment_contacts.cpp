@@ -30,7 +30,7 @@ namespace {
 constexpr double kPinched = 1.2;
 
 // a box's capsule test that needs no search: both ends beyond the same face by r or more
-bool beyond_one_face(const Obstacle& o, const glm::dvec3& a, const glm::dvec3& b, double r) {
+inline bool beyond_one_face(const Obstacle& o, const glm::dvec3& a, const glm::dvec3& b, double r) {
     const glm::dvec3 c = (o.a + o.b) * 0.5, h = (o.b - o.a) * 0.5;
     const glm::dvec3 qa = a - c, qb = b - c;
     for (int j = 0; j < 3; ++j)
@@ -90,11 +90,9 @@ double least_outside(const glm::dvec3& pa, const glm::dvec3& pb, const glm::dvec
 // deepest_on_segment's bound covers the rounding of its distances and of the cuts, so this says
 // clear only where deepest_on_segment would (and then link_contacts does not push).
 bool box_clear(const Obstacle& o, const glm::dvec3& a, const glm::dvec3& b, double r) {
+    if (beyond_one_face(o, a, b, r)) return true;
     const glm::dvec3 c = (o.a + o.b) * 0.5, h = (o.b - o.a) * 0.5;
     const glm::dvec3 pa = a - c, pb = b - c;
-    for (int j = 0; j < 3; ++j)
-        if ((pa[j] - h[j] >= r && pb[j] - h[j] >= r) || (-pa[j] - h[j] >= r && -pb[j] - h[j] >= r))
-            return true;
     // most links lie in one zone along every axis (along a face, beyond an edge): one piece
     auto zone = [&](const glm::dvec3& p, int j) { return p[j] > h[j] ? 1 : p[j] < -h[j] ? -1 : 0; };
     bool one_piece = true;
