@@ -72,9 +72,17 @@ const EnvironmentKind& climber_kind() {
     return kind;
 }
 
+namespace {
+
+// The first entry of a list sorted by identity (Climber::particle_of_) at or after `id`.
+template <class List> auto first_at(List& list, ModuleId id) {
+    return std::lower_bound(list.begin(), list.end(), id, [](const auto& b, ModuleId v) { return b.id < v; });
+}
+
+} // namespace
+
 const Climber::Bound* Climber::bound(ModuleId id) const {
-    auto it = std::lower_bound(particle_of_.begin(), particle_of_.end(), id,
-                               [](const Bound& b, ModuleId v) { return b.id < v; });
+    auto it = first_at(particle_of_, id);
     return it == particle_of_.end() || it->id != id ? nullptr : &*it;
 }
 
@@ -264,8 +272,7 @@ void Climber::place_pending() {
         }
         physics::Handle h = world_.add_grown(parent, p.to, q, radii);
         // new modules' identities are above the old ones', so this nearly always appends
-        auto at = std::lower_bound(particle_of_.begin(), particle_of_.end(), p.id,
-                                   [](const Bound& b, ModuleId v) { return b.id < v; });
+        auto at = first_at(particle_of_, p.id);
         if (at != particle_of_.end() && at->id == p.id)
             at->particle = h;
         else

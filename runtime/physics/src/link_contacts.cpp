@@ -280,13 +280,12 @@ void World::separate_links(bool find) {
     // that the push would move into it; the other link gives way (two stems crossing on a wall:
     // the one on top lifts)
     auto weight = [&](std::uint32_t j, const glm::dvec3& dir) {
-        if (fixed_[j]) return 0.0;
-        for (const auto& pull : pulls_)
-            if (pull.first == j) return 0.0;
+        const double w = mobility(j);
+        if (w == 0) return 0.0;
         const double r = scratch_.thin_of(j, radii_) + 0.001;
         for (const Obstacle& o : obstacles_)
             if (signed_distance(o, x_[j]) < r && glm::dot(dir, surface_normal(o, x_[j])) < 0) return 0.0;
-        return 1.0 / std::max(m_[j], 1e-12);
+        return w;
     };
     // (the length and obstacle fixes below move along no one direction: mobility, the weight of
     // a push along none, without the supports' normals, six distances each for a box)

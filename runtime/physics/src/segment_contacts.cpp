@@ -57,6 +57,12 @@ template <class F> double golden_min(F&& f, double lo, double hi, double& at) {
     return std::min(f1, f2);
 }
 
+// Where p lies along axis j of a box of half-extents h about the origin: below it (-1), across
+// it (0) or above it (1).
+int zone(const glm::dvec3& p, const glm::dvec3& h, int j) {
+    return p[j] > h[j] ? 1 : p[j] < -h[j] ? -1 : 0;
+}
+
 // The least distance outside the box (half-extents h, centre at the origin) over the piece
 // [s0, s1] of the segment from pa to pb, all of which lies in the zones of its midpoint along
 // each axis (below the box, across it, above it): there the distance is the length of a vector
@@ -67,7 +73,7 @@ double least_outside(const glm::dvec3& pa, const glm::dvec3& pb, const glm::dvec
     glm::dvec3 u(0.0), v(0.0); // the outside parts at s0 and s1 (signed_distance's q, cut at 0)
     bool outside = false;
     for (int j = 0; j < 3; ++j) {
-        const double z = m[j] > h[j] ? 1 : m[j] < -h[j] ? -1 : 0;
+        const double z = zone(m, h, j);
         if (z == 0) continue;
         u[j] = z * (pa[j] + (pb[j] - pa[j]) * s0) - h[j];
         v[j] = z * (pa[j] + (pb[j] - pa[j]) * s1) - h[j];
@@ -94,16 +100,15 @@ bool box_clear(const Obstacle& o, const glm::dvec3& a, const glm::dvec3& b, doub
     const glm::dvec3 c = (o.a + o.b) * 0.5, h = (o.b - o.a) * 0.5;
     const glm::dvec3 pa = a - c, pb = b - c;
     // most links lie in one zone along every axis (along a face, beyond an edge): one piece
-    auto zone = [&](const glm::dvec3& p, int j) { return p[j] > h[j] ? 1 : p[j] < -h[j] ? -1 : 0; };
     bool one_piece = true;
-    for (int j = 0; j < 3; ++j) one_piece = one_piece && zone(pa, j) == zone(pb, j);
+    for (int j = 0; j < 3; ++j) one_piece = one_piece && zone(pa, h, j) == zone(pb, h, j);
     if (one_piece) return least_outside(pa, pb, h, 0, 1) >= r - 1e-9 + 1e-12;
     double cut[8];
     int cuts = 0;
     cut[cuts++] = 0;
     for (int j = 0; j < 3; ++j) {
         const double step = pb[j] - pa[j];
-        if (step == 0 || zone(pa, j) == zone(pb, j)) continue; // no face plane crossed
+        if (step == 0 || zone(pa, h, j) == zone(pb, h, j)) continue; // no face plane crossed
         for (const double face : {-h[j], h[j]}) {
             const double s = (face - pa[j]) / step;
             if (s > 0 && s < 1) cut[cuts++] = s;
@@ -353,7 +358,7 @@ bool World::link_contacts(std::uint32_t i, double wp, double wi) {
         // most links are clear, and most of those can be told without deepest_on_segment: a
         // plane's distance at the ends with its kept unit normal (the same values), a box's
         // faces (box_clear). Fig. 14 right: the broad phase keeps most links (they lie on the
-        // ground or the wall), and about one in 500 of these tests finds a contact
+        // ground or the wall), and about one in 250 of these tests finds a contact
         const Obstacle& o = obstacles_[k];
         if (o.kind == Obstacle::Plane) {
             if (std::min(distance_to(k, x_[p]), distance_to(k, x_[i])) >= r - 1e-9) continue;
