@@ -259,10 +259,21 @@ glm::dvec3 World::clear_segment_end(const glm::dvec3& from, const glm::dvec3& to
     return from + dir * length;
 }
 
-void World::resolve_segments() {
+void World::resolve_segments(bool fresh) {
     const std::size_t n = x_.size();
     if (obstacles_.empty() || n < 2) return;
     auto& sc = scratch_;
+    // the links a contact sweep of this step found clear, with their ends where they were then.
+    // At the same positions a contact sweep does nothing to such a link: its length was brought
+    // within the bounds of the contact sweeps just before (so the clamp below leaves it), and
+    // the obstacles, the masses and the held particles do not change within a step. So the later
+    // calls of a step (after each round of links of different plants, World::step) test only the
+    // links some push has moved since; the result is the same bit for bit (Fig. 14 right: three
+    // calls in four ended after their first sweep, which went over every link on the wall)
+    auto& found_clear = sc.found_clear;
+    auto& ends = sc.clear_ends;
+    if (fresh || found_clear.size() != n) found_clear.assign(n, 0);
+    ends.resize(2 * n);
     // broad phase: a link whose midpoint is farther than half its length and its radius (and a
     // margin of 2 mm for this pass's pushes) from an obstacle cannot reach it (a signed distance
     // changes no faster than the distance)
@@ -325,6 +336,7 @@ void World::resolve_segments() {
         bool any = false;
         for (const std::uint32_t i : links) {
             const std::uint32_t p = parent_[i];
+            if (!lengths && found_clear[i] && x_[i] == ends[2 * i + 1] && x_[p] == ends[2 * i]) continue;
             const double wp = weight(p), wi = weight(i);
             if (wp + wi <= 0) continue;
             const glm::dvec3 d = x_[i] - x_[p];
@@ -341,7 +353,14 @@ void World::resolve_segments() {
                     x_[i] -= fix * wi;
                 }
             }
-            if (near[i] < 3) any = link_contacts(i, wp, wi) || any;
+            if (near[i] >= 3) continue;
+            if (link_contacts(i, wp, wi)) {
+                any = true;
+                found_clear[i] = 0;
+            } else {
+                found_clear[i] = 1;
+                ends[2 * i] = x_[p], ends[2 * i + 1] = x_[i];
+            }
         }
         if (!any) break;
     }

@@ -145,7 +145,7 @@ void World::step() {
     // contacts and obstacles push particles: the links get their lengths back (length.cpp)
     keep_shape(false, false);
     // and the links between particles, as capsules, out of the obstacles (segment_contacts.cpp)
-    resolve_segments();
+    resolve_segments(true);
     // and the links of different plants, as capsules, apart (link_contacts.cpp), alternating with
     // the obstacles (the pairs' own pushes keep only the pushed links out of them): a stem pressed
     // between another plant's stem and a thin rail is parted from both within a few rounds, the
@@ -153,7 +153,7 @@ void World::step() {
     if (settings_.collisions && settings_.link_collisions)
         for (int round = 0; round < kLinkRounds; ++round) {
             separate_links(round == 0); // the candidate pairs are found once a step
-            resolve_segments();
+            resolve_segments(false);
         }
     double collision_ms = ms(clock::now() - t0).count();
     t0 = clock::now();

@@ -362,8 +362,10 @@ class World {
     // `normal`, the direction it went
     glm::dvec3 exit_point(const glm::dvec3& x, double r, std::size_t k, glm::dvec3* normal = nullptr) const;
     // every link (particle and parent) as a capsule of the particle's thinnest radius out of the
-    // obstacles, both ends moved by their barycentric weights and inverse masses
-    void resolve_segments();
+    // obstacles, both ends moved by their barycentric weights and inverse masses; `fresh` at a
+    // step's first call (the links found clear by the calls before it in the step are not
+    // tested again while their ends stay where they were)
+    void resolve_segments(bool fresh);
     // the contacts of the link into i with the obstacles, ends weighted wp and wi; whether any
     bool link_contacts(std::uint32_t i, double wp, double wi);
     void separate_particles(); // contacts between particles (section 5.2)
@@ -449,7 +451,11 @@ class World {
         Array<std::uint8_t> near;           // links near an obstacle (resolve_segments)
         Array<std::uint8_t> ring_flag;      // (resolve_segments) particles whose links join a near one
         Array<std::uint32_t> contact_links; // the same, as a list in index order
-        Array<double> stiffness;            // each particle's s, during a step
+        // (resolve_segments) the links its contact sweeps found clear this step, and where their
+        // ends were then: a parent's at 2 i, the particle's at 2 i + 1
+        Array<std::uint8_t> found_clear;
+        Array<glm::dvec3> clear_ends;
+        Array<double> stiffness; // each particle's s, during a step
         Groups groups;
         // the length and bending sweep (length.cpp): each link's rest offset from the parent,
         // its rest length and unit direction (kept with the groups), and its direction now
