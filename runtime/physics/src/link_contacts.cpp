@@ -195,10 +195,28 @@ void World::grid_link_pairs(double cell) {
     auto range = [&](std::uint32_t i, glm::i64vec3& a, glm::i64vec3& b) {
         for (int k = 0; k < 3; ++k) a[k] = far_floor(lo[i][k] / cell), b[k] = far_floor(hi[i][k] / cell);
     };
-    // each cell's run grouped by plant: the links taken in plant order, then index order
-    std::sort(links.begin(), links.end(), [&](std::uint32_t a, std::uint32_t b) {
-        return plant[a] != plant[b] ? plant[a] < plant[b] : a < b;
-    });
+    // each cell's run grouped by plant: the links taken in plant order, then index order. They
+    // come in index order, and the plants (their roots' indices) are few: counted into place by
+    // plant, each plant's links keep their order (a comparison sort was 1.4 % of Fig. 14 right)
+    {
+        auto& start = sc.plant_start; // by root: its count of links, then where the next goes
+        auto& roots = sc.plant_roots;
+        start.assign(x_.size(), 0);
+        roots.clear();
+        for (const std::uint32_t i : links)
+            if (start[plant[i]]++ == 0) roots.push_back(plant[i]);
+        std::sort(roots.begin(), roots.end());
+        std::uint32_t running = 0;
+        for (const std::uint32_t root : roots) {
+            const std::uint32_t count = start[root];
+            start[root] = running;
+            running += count;
+        }
+        auto& sorted = sc.link_sorted;
+        sorted.resize(links.size());
+        for (const std::uint32_t i : links) sorted[start[plant[i]]++] = i;
+        links.swap(sorted);
+    }
     // the cells a link's box touches, one entry each
     std::size_t entries = 0;
     for (const std::uint32_t i : links) {

@@ -321,12 +321,13 @@ void World::resolve_segments(bool fresh) {
     for (std::uint32_t i = 0; i < n; ++i)
         if (near[i]) links.push_back(i);
     if (links.empty()) return;
-    auto weight = [&](std::uint32_t j) {
-        if (fixed_[j]) return 0.0;
-        for (const auto& pull : pulls_)
-            if (pull.first == j) return 0.0; // a dragged particle stays where it is dragged
-        return 1.0 / std::max(m_[j], 1e-12);
-    };
+    // each particle's inverse mass, 0 where it does not move: fixed, or dragged (a dragged
+    // particle stays where it is dragged); worked out once a call, not twice a visit
+    auto& inverse = sc.inverse_mass;
+    inverse.resize(n);
+    for (std::size_t j = 0; j < n; ++j) inverse[j] = fixed_[j] ? 0.0 : 1.0 / std::max(m_[j], 1e-12);
+    for (const auto& pull : pulls_)
+        if (pull.first < n) inverse[pull.first] = 0.0;
     // Gauss-Seidel over those links, in index order (one thread: the same result on any thread
     // count). A first sweep of contacts alone: when no capsule is in an obstacle, nothing more.
     // Else sweeps of each link's rest length (a distance constraint, both ends by inverse mass)
@@ -338,7 +339,7 @@ void World::resolve_segments(bool fresh) {
         for (const std::uint32_t i : links) {
             const std::uint32_t p = parent_[i];
             if (!lengths && found_clear[i] && x_[i] == ends[2 * i + 1] && x_[p] == ends[2 * i]) continue;
-            const double wp = weight(p), wi = weight(i);
+            const double wp = inverse[p], wi = inverse[i];
             if (wp + wi <= 0) continue;
             const glm::dvec3 d = x_[i] - x_[p];
             const double len = glm::length(d), want = sc.rest_length[i];

@@ -454,6 +454,7 @@ class World {
         // (resolve_segments) the links its contact sweeps found clear this step, and where their
         // ends were then: a parent's at 2 i, the particle's at 2 i + 1
         Array<std::uint8_t> found_clear;
+        Array<double> inverse_mass; // (resolve_segments) 0 for a particle that does not move
         Array<glm::dvec3> clear_ends;
         Array<double> stiffness; // each particle's s, during a step
         Groups groups;
@@ -472,6 +473,7 @@ class World {
         std::size_t plants = 0;
         Array<glm::dvec3> box_lo, box_hi;
         Array<std::uint32_t> link_list, link_members;
+        Array<std::uint32_t> link_sorted, plant_start, plant_roots;  // (grid_link_pairs) by plant
         Array<std::uint32_t> link_table, link_used, link_entry_cell; // (find_link_pairs)
         Array<LinkCell> link_cells;
         Array<std::pair<std::uint32_t, std::uint32_t>> link_pairs;
