@@ -13,7 +13,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
+#include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -80,8 +83,10 @@ struct Figure {
     }
 };
 
-// Compiles grammars/climbers/`name` with `defines` and derives it `steps` steps (all: -1).
-std::unique_ptr<Figure> grow(const std::string& name, const Defines& defines = {}, int steps = -1) {
+// Compiles grammars/climbers/`name` with `defines` and derives it `steps` steps (all: -1), with
+// the grammar's own seed or `seed`.
+std::unique_ptr<Figure> grow(const std::string& name, const Defines& defines = {}, int steps = -1,
+                             std::optional<std::uint64_t> seed = std::nullopt) {
     auto f = std::make_unique<Figure>();
     CompileOptions opts;
     opts.environments = runtime_environments();
@@ -90,6 +95,7 @@ std::unique_ptr<Figure> grow(const std::string& name, const Defines& defines = {
     INFO(render_all(f->diags, f->sources));
     REQUIRE(f->program);
     f->options.environment_phase = &f->phase;
+    f->options.seed = seed;
     f->d = std::make_unique<Derivation>(*f->program, f->options);
     f->d->start();
     // step() returns false for the last step it has just run: that state is measured too
@@ -270,11 +276,22 @@ TEST_CASE("climber figures: Fig. 14 left's shoots past the water tank bend down 
         }
         return l;
     };
-    auto heavy = grow("fig14_left.plant");
-    auto weightless = grow("fig14_left.plant", {{"gravity_y", "0"}});
-    const double down = hanging(*heavy), floating = hanging(*weightless);
-    INFO("hanging stem: " << down << " m under gravity, " << floating << " m weightless");
-    CHECK(down > 0.5);
+    // Three seeds, the grammar's own (14) and two more: how much stem a seed hangs past the tank
+    // varies several times over (2.0, 8.4 and 3.2 m here; 1.3 to 8.5 m over seeds 14 to 19),
+    // and a change of the solver that moves positions by under a nanometre moves seed 14 alone
+    // from 2.0 to 0.35 m (docs/climber-growth.md, Table 1's largest scene). Each seed hangs
+    // more under gravity than weightless, and the three together over four times as much.
+    double down = 0, floating = 0;
+    for (const std::uint64_t seed : {14, 15, 16}) {
+        auto heavy = grow("fig14_left.plant", {}, -1, seed);
+        auto weightless = grow("fig14_left.plant", {{"gravity_y", "0"}}, -1, seed);
+        const double d = hanging(*heavy), f = hanging(*weightless);
+        INFO("seed " << seed << ", hanging stem: " << d << " m under gravity, " << f << " m weightless");
+        CHECK(d > f);
+        down += d, floating += f;
+    }
+    INFO("three seeds, hanging stem: " << down << " m under gravity, " << floating << " m weightless");
+    CHECK(down > 1.5);
     CHECK(floating < 0.25 * down);
 }
 
