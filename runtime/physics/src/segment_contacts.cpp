@@ -20,6 +20,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 namespace plant::physics {
 
@@ -28,6 +29,11 @@ namespace {
 // how far a link pinched across an obstacle may stretch (or squash) in the contact pass: its ends
 // on two sides of a rail thicker than it is long cannot both be clear at its rest length
 constexpr double kPinched = 1.2;
+
+// the least move of a link's end that has the contact pass's later sweeps visit the links at that
+// particle, and the least gap between a link's length and its rest length that has them visit it
+// (World::segment_sweeps): a nanometre, far below any contact's depth
+constexpr double kFollow = 1e-9;
 
 // a box's capsule test that needs no search: both ends beyond the same face by r or more
 inline bool beyond_one_face(const Obstacle& o, const glm::dvec3& a, const glm::dvec3& b, double r) {
@@ -321,6 +327,15 @@ void World::resolve_segments(bool fresh) {
     for (std::uint32_t i = 0; i < n; ++i)
         if (near[i]) links.push_back(i);
     if (links.empty()) return;
+    segment_sweeps(links);
+}
+
+void World::segment_sweeps(const Array<std::uint32_t>& links) {
+    const std::size_t n = x_.size();
+    auto& sc = scratch_;
+    const auto& near = sc.near;
+    auto& found_clear = sc.found_clear;
+    auto& ends = sc.clear_ends;
     // each particle's inverse mass, 0 where it does not move: fixed, or dragged (a dragged
     // particle stays where it is dragged); worked out once a call, not twice a visit
     auto& inverse = sc.inverse_mass;
@@ -328,46 +343,93 @@ void World::resolve_segments(bool fresh) {
     for (std::size_t j = 0; j < n; ++j) inverse[j] = fixed_[j] ? 0.0 : 1.0 / std::max(m_[j], 1e-12);
     for (const auto& pull : pulls_)
         if (pull.first < n) inverse[pull.first] = 0.0;
-    // Gauss-Seidel over those links, in index order (one thread: the same result on any thread
-    // count). A first sweep of contacts alone: when no capsule is in an obstacle, nothing more.
-    // Else sweeps of each link's rest length (a distance constraint, both ends by inverse mass)
-    // and then its contacts, until no capsule is in any obstacle or after four, and up to three
-    // last sweeps of contacts alone, so the obstacles have the last word.
-    for (int sweep = 0; sweep < 8; ++sweep) {
-        const bool lengths = sweep > 0 && sweep < 5;
-        bool any = false;
-        for (const std::uint32_t i : links) {
-            const std::uint32_t p = parent_[i];
-            if (!lengths && found_clear[i] && x_[i] == ends[2 * i + 1] && x_[p] == ends[2 * i]) continue;
-            const double wp = inverse[p], wi = inverse[i];
-            if (wp + wi <= 0) continue;
-            const glm::dvec3 d = x_[i] - x_[p];
-            const double len = glm::length(d), want = sc.rest_length[i];
-            if (len > 1e-12 && want > 1e-12) {
-                // the length sweeps put the link back to its rest length; the last sweeps, of
-                // contacts, keep it within kPinched of it: a contact on a neighbouring link (its
-                // parent's or a child's) moves one of its ends and can stretch it further than a
-                // contact on the link itself does (link_contacts bounds that one)
-                const double to = lengths ? want : std::clamp(len, want / kPinched, want * kPinched);
-                if (to != len) {
-                    const glm::dvec3 fix = d * ((len - to) / (len * (wp + wi)));
-                    x_[p] += fix * wp;
-                    x_[i] -= fix * wi;
-                }
-            }
-            if (near[i] >= 3) continue;
-            // the same in a length sweep, where the fix above left both ends as they were (a link
-            // at its rest length to the last bit)
-            if (found_clear[i] && x_[i] == ends[2 * i + 1] && x_[p] == ends[2 * i]) continue;
-            if (link_contacts(i, wp, wi)) {
-                any = true;
-                found_clear[i] = 0;
-            } else {
-                found_clear[i] = 1;
-                ends[2 * i] = x_[p], ends[2 * i + 1] = x_[i];
+    // Gauss-Seidel in index order (one thread: the same result on any thread count). A first
+    // sweep of contacts alone over every near link: when no capsule is in an obstacle, nothing
+    // more. Else sweeps of each link's rest length (a distance constraint, both ends by inverse
+    // mass) and then its contacts, until no capsule is in any obstacle or after four, and up to
+    // three last sweeps of contacts alone, so the obstacles have the last word.
+    // These later sweeps follow the pushes instead of going over every near link: a sweep visits,
+    // in index order, the links an end of which moved by more than kFollow since their last
+    // visit (those after the link that moved them in the same sweep, the others in the next, as
+    // a sweep over all of them would reach them) and the links the first sweep found off their
+    // rest length by more than that. A link no push reached is where the length sweep of the
+    // step left it (keep_shape), and going over it again only rounded it anew; but one contact
+    // anywhere had every link on a wall swept seven more times (Fig. 14 right: a quarter of the
+    // calls, most of this pass's time).
+    auto& later = sc.woken_links; // for the next sweep
+    auto& heap = sc.sweep_links;  // this sweep's, smallest first
+    auto& woken = sc.woken;       // 1: in `later`, 2: in `heap`, 3: both
+    woken.assign(n, 0);
+    later.clear();
+    heap.clear();
+    const auto after = std::greater<std::uint32_t>{};
+    std::uint32_t at = 0; // the link being visited
+    bool first = true;    // the first sweep goes over every near link anyway
+    auto add = [&](std::uint32_t j, bool now) {
+        if (!near[j]) return;
+        if (now && j > at) {
+            if (!(woken[j] & 2))
+                woken[j] |= 2, heap.push_back(j), std::push_heap(heap.begin(), heap.end(), after);
+        } else if (!(woken[j] & 1)) {
+            woken[j] |= 1, later.push_back(j);
+        }
+    };
+    auto wake = [&](std::uint32_t q, const glm::dvec3& before) { // the links at q, when it moved
+        const glm::dvec3 by = x_[q] - before;
+        if (glm::dot(by, by) <= kFollow * kFollow) return;
+        if (parent_[q] != kNone) add(q, !first);
+        for (const std::uint32_t c : children_[q]) add(c, !first);
+    };
+    auto visit = [&](std::uint32_t i, bool lengths) { // whether it found a contact
+        at = i;
+        const std::uint32_t p = parent_[i];
+        const double wp = inverse[p], wi = inverse[i];
+        if (wp + wi <= 0) return false;
+        const glm::dvec3 was_p = x_[p], was_i = x_[i], d = x_[i] - x_[p];
+        const double len = glm::length(d), want = sc.rest_length[i];
+        if (first && len > 1e-12 && want > 1e-12 && std::fabs(len - want) > kFollow) add(i, false);
+        if (!lengths && found_clear[i] && x_[i] == ends[2 * i + 1] && x_[p] == ends[2 * i]) return false;
+        if (len > 1e-12 && want > 1e-12) {
+            // the length sweeps put the link back to its rest length; the last sweeps, of
+            // contacts, keep it within kPinched of it: a contact on a neighbouring link (its
+            // parent's or a child's) moves one of its ends and can stretch it further than a
+            // contact on the link itself does (link_contacts bounds that one)
+            const double to = lengths ? want : std::clamp(len, want / kPinched, want * kPinched);
+            if (to != len) {
+                const glm::dvec3 fix = d * ((len - to) / (len * (wp + wi)));
+                x_[p] += fix * wp;
+                x_[i] -= fix * wi;
             }
         }
-        if (!any) break;
+        bool hit = false;
+        // the same in a length sweep, where the fix above left both ends as they were (a link
+        // at its rest length to the last bit)
+        if (near[i] < 3 && !(found_clear[i] && x_[i] == ends[2 * i + 1] && x_[p] == ends[2 * i])) {
+            hit = link_contacts(i, wp, wi);
+            found_clear[i] = !hit;
+            if (!hit) ends[2 * i] = x_[p], ends[2 * i + 1] = x_[i];
+        }
+        wake(p, was_p);
+        wake(i, was_i);
+        return hit;
+    };
+    bool any = false;
+    for (const std::uint32_t i : links) any = visit(i, false) || any;
+    first = false;
+    for (int sweep = 1; sweep < 8 && any && !later.empty(); ++sweep) {
+        const bool lengths = sweep < 5;
+        for (const std::uint32_t i : later) woken[i] = 2;
+        heap.swap(later);
+        later.clear();
+        std::make_heap(heap.begin(), heap.end(), after);
+        any = false;
+        while (!heap.empty()) {
+            std::pop_heap(heap.begin(), heap.end(), after);
+            const std::uint32_t i = heap.back();
+            heap.pop_back();
+            woken[i] &= 1;
+            any = visit(i, lengths) || any;
+        }
     }
 }
 

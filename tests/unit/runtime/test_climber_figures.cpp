@@ -10,6 +10,7 @@
 #include "plant/turtle.hpp"
 
 #include <catch2/catch.hpp>
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
@@ -276,20 +277,21 @@ TEST_CASE("climber figures: Fig. 14 left's shoots past the water tank bend down 
         }
         return l;
     };
-    // Three seeds, the grammar's own (14) and two more: how much stem a seed hangs past the tank
-    // varies several times over (2.0, 8.4 and 3.2 m here; 1.3 to 8.5 m over seeds 14 to 19),
-    // and a change of the solver that moves positions by under a nanometre moves seed 14 alone
-    // from 2.0 to 0.35 m (docs/climber-growth.md, Table 1's largest scene). Each seed hangs
-    // more under gravity than weightless, and the three together over four times as much.
+    // Three seeds, the grammar's own (14) and two more, together: how much stem one seed hangs
+    // past the tank varies from next to nothing (when no shoot has got past it in 100 steps) to
+    // several metres, and a change of the solver that moves positions by under a nanometre moved
+    // seed 14 alone from 2.0 to 0.35 m and seed 15 from 8.4 to 0.1 m (docs/climber-figures.md).
+    // The three together hang over four times as much under gravity as weightless.
     double down = 0, floating = 0;
+    std::string each;
     for (const std::uint64_t seed : {14, 15, 16}) {
         auto heavy = grow("fig14_left.plant", {}, -1, seed);
         auto weightless = grow("fig14_left.plant", {{"gravity_y", "0"}}, -1, seed);
         const double d = hanging(*heavy), f = hanging(*weightless);
-        INFO("seed " << seed << ", hanging stem: " << d << " m under gravity, " << f << " m weightless");
-        CHECK(d > f);
+        each += fmt::format(" seed {}: {:.2f} and {:.2f} m;", seed, d, f);
         down += d, floating += f;
     }
+    INFO("hanging stem under gravity and weightless:" << each);
     INFO("three seeds, hanging stem: " << down << " m under gravity, " << floating << " m weightless");
     CHECK(down > 1.5);
     CHECK(floating < 0.25 * down);

@@ -366,6 +366,7 @@ class World {
     // step's first call (the links found clear by the calls before it in the step are not
     // tested again while their ends stay where they were)
     void resolve_segments(bool fresh);
+    void segment_sweeps(const Array<std::uint32_t>& links); // (resolve_segments) its sweeps
     // the contacts of the link into i with the obstacles, ends weighted wp and wi; whether any
     bool link_contacts(std::uint32_t i, double wp, double wi);
     void separate_particles(); // contacts between particles (section 5.2)
@@ -455,6 +456,10 @@ class World {
         // ends were then: a parent's at 2 i, the particle's at 2 i + 1
         Array<std::uint8_t> found_clear;
         Array<double> inverse_mass; // (resolve_segments) 0 for a particle that does not move
+        // (segment_sweeps) the links a sweep's pushes reached: flags, the list for the next
+        // sweep, and the heap the present sweep takes them from in index order
+        Array<std::uint8_t> woken;
+        Array<std::uint32_t> woken_links, sweep_links;
         Array<glm::dvec3> clear_ends;
         Array<double> stiffness; // each particle's s, during a step
         Groups groups;
