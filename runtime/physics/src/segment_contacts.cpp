@@ -20,7 +20,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 
 namespace plant::physics {
 
@@ -356,22 +355,23 @@ void World::segment_sweeps(const Array<std::uint32_t>& links) {
     // step left it (keep_shape), and going over it again only rounded it anew; but one contact
     // anywhere had every link on a wall swept seven more times (Fig. 14 right: a quarter of the
     // calls, most of this pass's time).
-    auto& later = sc.woken_links; // for the next sweep
-    auto& heap = sc.sweep_links;  // this sweep's, smallest first
-    auto& woken = sc.woken;       // 1: in `later`, 2: in `heap`, 3: both
-    woken.assign(n, 0);
-    later.clear();
-    heap.clear();
-    const auto after = std::greater<std::uint32_t>{};
+    // Flags by link index for this sweep and the next, each with the range it has flags in: a
+    // sweep scans its range in index order (a byte a link), so a link flagged ahead of the one
+    // being visited is visited in the same sweep
+    auto& now = sc.woken_now;
+    auto& next = sc.woken_next;
+    now.assign(n, 0);
+    next.assign(n, 0);
+    std::size_t next_lo = n, next_hi = 0, now_hi = 0;
     std::uint32_t at = 0; // the link being visited
     bool first = true;    // the first sweep goes over every near link anyway
-    auto add = [&](std::uint32_t j, bool now) {
+    auto add = [&](std::uint32_t j, bool in_this) {
         if (!near[j]) return;
-        if (now && j > at) {
-            if (!(woken[j] & 2))
-                woken[j] |= 2, heap.push_back(j), std::push_heap(heap.begin(), heap.end(), after);
-        } else if (!(woken[j] & 1)) {
-            woken[j] |= 1, later.push_back(j);
+        if (in_this && j > at) {
+            now[j] = 1, now_hi = std::max<std::size_t>(now_hi, j);
+        } else if (!next[j]) {
+            next[j] = 1, next_lo = std::min<std::size_t>(next_lo, j),
+            next_hi = std::max<std::size_t>(next_hi, j);
         }
     };
     auto wake = [&](std::uint32_t q, const glm::dvec3& before) { // the links at q, when it moved
@@ -416,20 +416,17 @@ void World::segment_sweeps(const Array<std::uint32_t>& links) {
     bool any = false;
     for (const std::uint32_t i : links) any = visit(i, false) || any;
     first = false;
-    for (int sweep = 1; sweep < 8 && any && !later.empty(); ++sweep) {
+    for (int sweep = 1; sweep < 8 && any && next_lo < n; ++sweep) {
         const bool lengths = sweep < 5;
-        for (const std::uint32_t i : later) woken[i] = 2;
-        heap.swap(later);
-        later.clear();
-        std::make_heap(heap.begin(), heap.end(), after);
+        now.swap(next);
+        const std::size_t lo = next_lo;
+        now_hi = next_hi, next_lo = n, next_hi = 0;
         any = false;
-        while (!heap.empty()) {
-            std::pop_heap(heap.begin(), heap.end(), after);
-            const std::uint32_t i = heap.back();
-            heap.pop_back();
-            woken[i] &= 1;
-            any = visit(i, lengths) || any;
-        }
+        for (std::size_t j = lo; j <= now_hi; ++j) // (now_hi grows as links ahead are flagged)
+            if (now[j]) {
+                now[j] = 0;
+                any = visit(static_cast<std::uint32_t>(j), lengths) || any;
+            }
     }
 }
 

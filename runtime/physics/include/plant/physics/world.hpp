@@ -456,10 +456,8 @@ class World {
         // ends were then: a parent's at 2 i, the particle's at 2 i + 1
         Array<std::uint8_t> found_clear;
         Array<double> inverse_mass; // (resolve_segments) 0 for a particle that does not move
-        // (segment_sweeps) the links a sweep's pushes reached: flags, the list for the next
-        // sweep, and the heap the present sweep takes them from in index order
-        Array<std::uint8_t> woken;
-        Array<std::uint32_t> woken_links, sweep_links;
+        // (segment_sweeps) the links a sweep's pushes reached: flags for this sweep and the next
+        Array<std::uint8_t> woken_now, woken_next;
         Array<glm::dvec3> clear_ends;
         Array<double> stiffness; // each particle's s, during a step
         Groups groups;
