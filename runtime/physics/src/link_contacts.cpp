@@ -286,19 +286,13 @@ void World::separate_links(bool find) {
     if (find) find_link_pairs();
     const auto& pairs = scratch_.link_pairs;
     if (pairs.empty()) return;
-    // a particle's inverse mass, 0 when it does not move (fixed, or dragged: a dragged particle
-    // stays where it is dragged)
-    auto mobility = [&](std::uint32_t j) {
-        if (fixed_[j]) return 0.0;
-        for (const auto& pull : pulls_)
-            if (pull.first == j) return 0.0;
-        return 1.0 / std::max(m_[j], 1e-12);
-    };
+    // a particle's inverse mass, 0 when it does not move (weigh_particles, once a step)
+    const auto& mobility = scratch_.inverse_mass;
     // and for a push along `dir`: 0 too for a particle lying on a support (within a millimetre)
     // that the push would move into it; the other link gives way (two stems crossing on a wall:
     // the one on top lifts)
     auto weight = [&](std::uint32_t j, const glm::dvec3& dir) {
-        const double w = mobility(j);
+        const double w = mobility[j];
         if (w == 0) return 0.0;
         const double r = scratch_.thin_of(j, radii_) + 0.001;
         for (const Obstacle& o : obstacles_)
@@ -310,7 +304,7 @@ void World::separate_links(bool find) {
     auto keep_length = [&](std::uint32_t j) {
         const std::uint32_t p = parent_[j];
         if (p == kNone) return;
-        const double wp = mobility(p), wj = mobility(j);
+        const double wp = mobility[p], wj = mobility[j];
         const glm::dvec3 e = x_[j] - x_[p];
         const double len = glm::length(e), rest = scratch_.rest_length[j];
         if (wp + wj <= 0 || len < 1e-12 || rest < 1e-12) return;
@@ -323,7 +317,7 @@ void World::separate_links(bool find) {
     auto out_of_obstacles = [&](std::uint32_t j) {
         const std::uint32_t p = parent_[j];
         if (p == kNone) return;
-        const double wp = mobility(p), wj = mobility(j);
+        const double wp = mobility[p], wj = mobility[j];
         if (wp + wj > 0) link_contacts(j, wp, wj);
     };
     // Gauss-Seidel over the pairs in index order, on one thread (the same result on any thread

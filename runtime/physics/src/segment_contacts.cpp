@@ -264,6 +264,19 @@ glm::dvec3 World::clear_segment_end(const glm::dvec3& from, const glm::dvec3& to
     return from + dir * length;
 }
 
+void World::weigh_particles() {
+    // each particle's inverse mass, 0 where it does not move: fixed, or dragged (a dragged
+    // particle stays where it is dragged). Neither changes within a step, so the contact passes
+    // of the links (segment_sweeps, separate_links) read it from here, not working it out at
+    // every visit of a link
+    const std::size_t n = x_.size();
+    auto& inverse = scratch_.inverse_mass;
+    inverse.resize(n);
+    for (std::size_t j = 0; j < n; ++j) inverse[j] = fixed_[j] ? 0.0 : 1.0 / std::max(m_[j], 1e-12);
+    for (const auto& pull : pulls_)
+        if (pull.first < n) inverse[pull.first] = 0.0;
+}
+
 void World::resolve_segments(bool fresh) {
     const std::size_t n = x_.size();
     if (obstacles_.empty() || n < 2) return;
@@ -335,13 +348,7 @@ void World::segment_sweeps(const Array<std::uint32_t>& links) {
     const auto& near = sc.near;
     auto& found_clear = sc.found_clear;
     auto& ends = sc.clear_ends;
-    // each particle's inverse mass, 0 where it does not move: fixed, or dragged (a dragged
-    // particle stays where it is dragged); worked out once a call, not twice a visit
-    auto& inverse = sc.inverse_mass;
-    inverse.resize(n);
-    for (std::size_t j = 0; j < n; ++j) inverse[j] = fixed_[j] ? 0.0 : 1.0 / std::max(m_[j], 1e-12);
-    for (const auto& pull : pulls_)
-        if (pull.first < n) inverse[pull.first] = 0.0;
+    const auto& inverse = sc.inverse_mass; // (weigh_particles, once a step)
     // Gauss-Seidel in index order (one thread: the same result on any thread count). A first
     // sweep of contacts alone over every near link: when no capsule is in an obstacle, nothing
     // more. Else sweeps of each link's rest length (a distance constraint, both ends by inverse
@@ -380,6 +387,10 @@ void World::segment_sweeps(const Array<std::uint32_t>& links) {
         if (parent_[q] != kNone) add(q, !first);
         for (const std::uint32_t c : children_[q]) add(c, !first);
     };
+    // found clear, and neither end has moved since (then its contact test would find it clear)
+    auto still_clear = [&](std::uint32_t i, std::uint32_t p) {
+        return found_clear[i] && x_[i] == ends[2 * i + 1] && x_[p] == ends[2 * i];
+    };
     auto visit = [&](std::uint32_t i, bool lengths) { // whether it found a contact
         at = i;
         const std::uint32_t p = parent_[i];
@@ -388,7 +399,7 @@ void World::segment_sweeps(const Array<std::uint32_t>& links) {
         const glm::dvec3 was_p = x_[p], was_i = x_[i], d = x_[i] - x_[p];
         const double len = glm::length(d), want = sc.rest_length[i];
         if (first && len > 1e-12 && want > 1e-12 && std::fabs(len - want) > kFollow) add(i, false);
-        if (!lengths && found_clear[i] && x_[i] == ends[2 * i + 1] && x_[p] == ends[2 * i]) return false;
+        if (!lengths && still_clear(i, p)) return false;
         if (len > 1e-12 && want > 1e-12) {
             // the length sweeps put the link back to its rest length; the last sweeps, of
             // contacts, keep it within kPinched of it: a contact on a neighbouring link (its
@@ -404,7 +415,7 @@ void World::segment_sweeps(const Array<std::uint32_t>& links) {
         bool hit = false;
         // the same in a length sweep, where the fix above left both ends as they were (a link
         // at its rest length to the last bit)
-        if (near[i] < 3 && !(found_clear[i] && x_[i] == ends[2 * i + 1] && x_[p] == ends[2 * i])) {
+        if (near[i] < 3 && !still_clear(i, p)) {
             hit = link_contacts(i, wp, wi);
             found_clear[i] = !hit;
             if (!hit) ends[2 * i] = x_[p], ends[2 * i + 1] = x_[i];

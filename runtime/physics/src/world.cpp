@@ -145,6 +145,7 @@ void World::step() {
     // contacts and obstacles push particles: the links get their lengths back (length.cpp)
     keep_shape(false, false);
     // and the links between particles, as capsules, out of the obstacles (segment_contacts.cpp)
+    weigh_particles();
     resolve_segments(true);
     // and the links of different plants, as capsules, apart (link_contacts.cpp), alternating with
     // the obstacles (the pairs' own pushes keep only the pushed links out of them): a stem pressed

@@ -366,6 +366,7 @@ class World {
     // step's first call (the links found clear by the calls before it in the step are not
     // tested again while their ends stay where they were)
     void resolve_segments(bool fresh);
+    void weigh_particles(); // scratch_.inverse_mass, for this step's contact passes of links
     void segment_sweeps(const Array<std::uint32_t>& links); // (resolve_segments) its sweeps
     // the contacts of the link into i with the obstacles, ends weighted wp and wi; whether any
     bool link_contacts(std::uint32_t i, double wp, double wi);
@@ -455,11 +456,11 @@ class World {
         // (resolve_segments) the links its contact sweeps found clear this step, and where their
         // ends were then: a parent's at 2 i, the particle's at 2 i + 1
         Array<std::uint8_t> found_clear;
-        Array<double> inverse_mass; // (resolve_segments) 0 for a particle that does not move
+        Array<glm::dvec3> clear_ends;
         // (segment_sweeps) the links a sweep's pushes reached: flags for this sweep and the next
         Array<std::uint8_t> woken_now, woken_next;
-        Array<glm::dvec3> clear_ends;
-        Array<double> stiffness; // each particle's s, during a step
+        Array<double> inverse_mass; // (weigh_particles) 0 for a particle that does not move
+        Array<double> stiffness;    // each particle's s, during a step
         Groups groups;
         // the length and bending sweep (length.cpp): each link's rest offset from the parent,
         // its rest length and unit direction (kept with the groups), and its direction now
