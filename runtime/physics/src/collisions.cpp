@@ -68,46 +68,59 @@ void World::integrate() {
 }
 
 std::size_t World::fill_contact_grid(double cell, double limit) {
+    constexpr std::size_t kTableFactor = 4;
     const std::size_t n = x_.size();
     const auto& thin = scratch_.thin;
     // (cell keys and coordinates: cell_hash, far_floor in cells.hpp)
     // an open-addressing table from a cell's key to its run of particles in `members` (in index
     // order), built by counting: no sort. A slot holds the key and the run's bounds together, so
     // a lookup touches one cache line.
-    std::size_t size = 16;
-    while (size < 4 * n) size *= 2; // a quarter full at most: short probes
-    auto& table = scratch_.table;   // begin == end: an empty slot
-    // only the slots the last step filled are emptied, and only this step's are turned into runs
-    // (a 25,000-particle plant fills about a tenth of its 131,072 slots: clearing and scanning the
-    // whole 2 MiB table each step cost more than that)
+    auto& table = scratch_.table; // begin == end: an empty slot
     auto& used = scratch_.used_cells;
-    for (const std::uint32_t slot : used)
-        if (slot < table.size()) table[slot] = Cell{};
-    used.clear();
-    if (table.size() != size) table.assign(size, Cell{});
+    // Sized for short probes: four slots for each cell the last step filled (a plant fills
+    // cells with a few particles each, and a smaller table leaves more of the core's cache to the
+    // contact pass's lookups); a fill that reaches half the table starts again with four slots
+    // for each particle. Where a cell's slot lies does not change any result.
+    std::size_t most = 16;
+    while (most < 4 * n) most *= 2;
+    std::size_t size = 16;
+    while (size < kTableFactor * std::max<std::size_t>(used.size(), 16)) size *= 2;
+    size = std::min(size, most);
     auto& slot_of = scratch_.slot_of;
-    slot_of.assign(n, ~0u);
     auto& cell_of = scratch_.cell_of;
     cell_of.resize(n);
-    // consecutive particles of a stem often share a cell: the last one's slot is taken again
-    // without probing (the same slot the probe would find)
-    std::uint64_t last_key = 0;
-    std::size_t last_slot = size; // none yet
-    for (std::uint32_t i = 0; i < n; ++i) {
-        if (!alive_[i] || thin[i] > limit) continue;
-        const glm::dvec3 u = x_[i] / cell;
-        cell_of[i] = glm::i64vec3(far_floor(u.x), far_floor(u.y), far_floor(u.z));
-        const std::uint64_t k = cell_hash(cell_of[i]);
-        std::size_t slot = k & (size - 1);
-        if (last_slot < size && k == last_key)
-            slot = last_slot;
-        else
-            while (table[slot].end != 0 && table[slot].key != k) slot = (slot + 1) & (size - 1);
-        last_key = k, last_slot = slot;
-        if (table[slot].end == 0) used.push_back(static_cast<std::uint32_t>(slot)); // (first: see above)
-        table[slot].key = k;
-        ++table[slot].end; // counts, for now
-        slot_of[i] = static_cast<std::uint32_t>(slot);
+    for (;;) {
+        // only the slots the last fill used are emptied, and only this one's are turned into
+        // runs (a 25,000-particle plant fills about 13,000 cells: clearing and scanning a whole
+        // table of 2 MiB each step cost more than that)
+        for (const std::uint32_t slot : used)
+            if (slot < table.size()) table[slot] = Cell{};
+        used.clear();
+        if (table.size() != size) table.assign(size, Cell{});
+        slot_of.assign(n, ~0u);
+        // consecutive particles of a stem often share a cell: the last one's slot is taken
+        // again without probing (the same slot the probe would find)
+        std::uint64_t last_key = 0;
+        std::size_t last_slot = size; // none yet
+        const std::size_t full = size / 2;
+        for (std::uint32_t i = 0; i < n && used.size() < full; ++i) {
+            if (!alive_[i] || thin[i] > limit) continue;
+            const glm::dvec3 u = x_[i] / cell;
+            cell_of[i] = glm::i64vec3(far_floor(u.x), far_floor(u.y), far_floor(u.z));
+            const std::uint64_t k = cell_hash(cell_of[i]);
+            std::size_t slot = k & (size - 1);
+            if (last_slot < size && k == last_key)
+                slot = last_slot;
+            else
+                while (table[slot].end != 0 && table[slot].key != k) slot = (slot + 1) & (size - 1);
+            last_key = k, last_slot = slot;
+            if (table[slot].end == 0) used.push_back(static_cast<std::uint32_t>(slot)); // (first: see above)
+            table[slot].key = k;
+            ++table[slot].end; // counts, for now
+            slot_of[i] = static_cast<std::uint32_t>(slot);
+        }
+        if (used.size() < full || size == most) break;
+        size = most; // more cells than the table was sized for: again, in the largest
     }
     std::uint32_t running = 0;
     for (const std::uint32_t slot : used) { // counts to runs; `end` is the fill cursor below
@@ -116,10 +129,18 @@ std::size_t World::fill_contact_grid(double cell, double limit) {
         c.begin = c.end = running;
         running += count;
     }
+    // each member's position and thinnest radius beside it, so that the contact pass reads a
+    // cell's candidates in one stretch of memory instead of gathering them from the particles
     auto& members = scratch_.members;
+    auto& member_at = scratch_.member_at;
     members.resize(running);
+    member_at.resize(running);
     for (std::uint32_t i = 0; i < n; ++i)
-        if (slot_of[i] != ~0u) members[table[slot_of[i]].end++] = i;
+        if (slot_of[i] != ~0u) {
+            const std::uint32_t at = table[slot_of[i]].end++;
+            members[at] = i;
+            member_at[at] = glm::dvec4(x_[i], thin[i]);
+        }
     return size;
 }
 
@@ -170,22 +191,51 @@ void World::separate_particles() {
     const std::size_t size = fill_contact_grid(cell, limit);
     auto& table = scratch_.table;
     auto& members = scratch_.members;
+    const auto& member_at = scratch_.member_at;
     auto& cell_of = scratch_.cell_of;
     auto& push = scratch_.push;
     push.assign(n, glm::dvec3(0.0));
     // the push on particle i from particle j, when they overlap and are not joined (parent and
     // child, or children of one parent)
-    auto contact = [&](std::uint32_t i, const glm::dvec3& xi, double ri, std::uint32_t j,
-                       glm::dvec3& pushed) {
-        const glm::dvec3 d = xi - x_[j];
-        const double dist2 = glm::dot(d, d), want = ri + thin[j];
+    // (with j's position and thinnest radius, xj and rj)
+    auto contact_at = [&](std::uint32_t i, const glm::dvec3& xi, double ri, std::uint32_t j,
+                          const glm::dvec3& xj, double rj, glm::dvec3& pushed) {
+        const glm::dvec3 d = xi - xj;
+        const double dist2 = glm::dot(d, d), want = ri + rj;
         if (dist2 >= want * want || dist2 < 1e-24) return; // apart, or itself
         const std::uint32_t pi = parent_[i], pj = parent_[j];
         if (pi == j || pj == i || (pi != kNone && pi == pj)) return;
         const double dist = std::sqrt(dist2);
         pushed += d / dist * ((want - dist) * (fixed_[j] ? 1.0 : 0.5));
     };
+    auto contact = [&](std::uint32_t i, const glm::dvec3& xi, double ri, std::uint32_t j,
+                       glm::dvec3& pushed) { contact_at(i, xi, ri, j, x_[j], thin[j], pushed); };
+    // the eight keys of the 2 x 2 x 2 block of cells on the side of each axis particle i is
+    // nearer to (only those can hold a partner), z slowest: the order the pushes are summed in
+    auto block_keys = [&](std::size_t i, std::uint64_t* keys) {
+        const glm::i64vec3 c = cell_of[i];
+        const glm::dvec3 frac = x_[i] / cell - glm::dvec3(c);
+        const glm::i64vec3 side(frac.x < 0.5 ? -1 : 1, frac.y < 0.5 ? -1 : 1, frac.z < 0.5 ? -1 : 1);
+        // the hash's three terms for the two cells along each axis
+        const std::uint64_t hx[2] = {cell_term_x(c.x), cell_term_x(c.x + side.x)};
+        const std::uint64_t hy[2] = {cell_term_y(c.y), cell_term_y(c.y + side.y)};
+        const std::uint64_t hz[2] = {cell_term_z(c.z), cell_term_z(c.z + side.z)};
+        for (int q = 0; q < 8; ++q) keys[q] = hx[q & 1] ^ hy[(q >> 1) & 1] ^ hz[q >> 2];
+    };
+    auto in_grid = [&](std::size_t i) { return alive_[i] && !fixed_[i] && thin[i] <= limit; };
     parallel_ranges(n, settings_.threads, 2048, [&](std::size_t b, std::size_t e) {
+        // the eight slots are scattered over a table of megabytes: the next particle's are asked
+        // for while this one's contacts are summed, so their cache misses overlap the work
+        std::uint64_t keys[8], next[8];
+        std::size_t ahead = b; // the particle `next` holds the keys of, if in the grid
+        auto look_ahead = [&](std::size_t from) {
+            for (ahead = from; ahead < e && !in_grid(ahead); ++ahead) {
+            }
+            if (ahead == e) return;
+            block_keys(ahead, next);
+            for (const std::uint64_t k : next) __builtin_prefetch(&table[k & (size - 1)]);
+        };
+        look_ahead(b);
         for (std::size_t i = b; i < e; ++i) {
             if (!alive_[i] || fixed_[i]) continue;
             const double ri = thin[i];
@@ -198,28 +248,17 @@ void World::separate_particles() {
                 push[i] = pushed;
                 continue;
             }
-            // only the 2 x 2 x 2 block of cells on the side of each axis the particle is nearer
-            // to can hold a partner
-            const glm::i64vec3 c = cell_of[i];
-            const glm::dvec3 frac = xi / cell - glm::dvec3(c);
-            const glm::i64vec3 side(frac.x < 0.5 ? -1 : 1, frac.y < 0.5 ? -1 : 1, frac.z < 0.5 ? -1 : 1);
-            // the hash's three terms for the two cells along each axis
-            const std::uint64_t hx[2] = {cell_term_x(c.x), cell_term_x(c.x + side.x)};
-            const std::uint64_t hy[2] = {cell_term_y(c.y), cell_term_y(c.y + side.y)};
-            const std::uint64_t hz[2] = {cell_term_z(c.z), cell_term_z(c.z + side.z)};
-            // the block's eight keys, z slowest (the order the pushes are summed in)
-            std::uint64_t keys[8];
-            for (int q = 0; q < 8; ++q) keys[q] = hx[q & 1] ^ hy[(q >> 1) & 1] ^ hz[q >> 2];
-            // the eight slots are scattered over a table of megabytes: asked for all at once,
-            // their cache misses overlap instead of following one another
-            for (const std::uint64_t k : keys) __builtin_prefetch(&table[k & (size - 1)]);
+            std::copy(next, next + 8, keys); // (ahead == i: every grid particle is looked ahead at)
+            look_ahead(i + 1);
             for (const std::uint64_t k : keys) {
                 std::size_t slot = k & (size - 1);
                 while (table[slot].end != table[slot].begin && table[slot].key != k)
                     slot = (slot + 1) & (size - 1);
                 const Cell& run = table[slot];
-                for (std::uint32_t at = run.begin; at < run.end; ++at)
-                    contact(self, xi, ri, members[at], pushed);
+                for (std::uint32_t at = run.begin; at < run.end; ++at) {
+                    const glm::dvec4& q = member_at[at];
+                    contact_at(self, xi, ri, members[at], glm::dvec3(q), q.w, pushed);
+                }
             }
             for (const std::uint32_t j : oversized) contact(self, xi, ri, j, pushed);
             push[i] = pushed;
