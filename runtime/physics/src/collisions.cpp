@@ -129,18 +129,10 @@ std::size_t World::fill_contact_grid(double cell, double limit) {
         c.begin = c.end = running;
         running += count;
     }
-    // each member's position and thinnest radius beside it, so that the contact pass reads a
-    // cell's candidates in one stretch of memory instead of gathering them from the particles
     auto& members = scratch_.members;
-    auto& member_at = scratch_.member_at;
     members.resize(running);
-    member_at.resize(running);
     for (std::uint32_t i = 0; i < n; ++i)
-        if (slot_of[i] != ~0u) {
-            const std::uint32_t at = table[slot_of[i]].end++;
-            members[at] = i;
-            member_at[at] = glm::dvec4(x_[i], thin[i]);
-        }
+        if (slot_of[i] != ~0u) members[table[slot_of[i]].end++] = i;
     return size;
 }
 
@@ -191,25 +183,21 @@ void World::separate_particles() {
     const std::size_t size = fill_contact_grid(cell, limit);
     auto& table = scratch_.table;
     auto& members = scratch_.members;
-    const auto& member_at = scratch_.member_at;
     auto& cell_of = scratch_.cell_of;
     auto& push = scratch_.push;
     push.assign(n, glm::dvec3(0.0));
     // the push on particle i from particle j, when they overlap and are not joined (parent and
     // child, or children of one parent)
-    // (with j's position and thinnest radius, xj and rj)
-    auto contact_at = [&](std::uint32_t i, const glm::dvec3& xi, double ri, std::uint32_t j,
-                          const glm::dvec3& xj, double rj, glm::dvec3& pushed) {
-        const glm::dvec3 d = xi - xj;
-        const double dist2 = glm::dot(d, d), want = ri + rj;
+    auto contact = [&](std::uint32_t i, const glm::dvec3& xi, double ri, std::uint32_t j,
+                       glm::dvec3& pushed) {
+        const glm::dvec3 d = xi - x_[j];
+        const double dist2 = glm::dot(d, d), want = ri + thin[j];
         if (dist2 >= want * want || dist2 < 1e-24) return; // apart, or itself
         const std::uint32_t pi = parent_[i], pj = parent_[j];
         if (pi == j || pj == i || (pi != kNone && pi == pj)) return;
         const double dist = std::sqrt(dist2);
         pushed += d / dist * ((want - dist) * (fixed_[j] ? 1.0 : 0.5));
     };
-    auto contact = [&](std::uint32_t i, const glm::dvec3& xi, double ri, std::uint32_t j,
-                       glm::dvec3& pushed) { contact_at(i, xi, ri, j, x_[j], thin[j], pushed); };
     // the eight keys of the 2 x 2 x 2 block of cells on the side of each axis particle i is
     // nearer to (only those can hold a partner), z slowest: the order the pushes are summed in
     auto block_keys = [&](std::size_t i, std::uint64_t* keys) {
@@ -255,10 +243,8 @@ void World::separate_particles() {
                 while (table[slot].end != table[slot].begin && table[slot].key != k)
                     slot = (slot + 1) & (size - 1);
                 const Cell& run = table[slot];
-                for (std::uint32_t at = run.begin; at < run.end; ++at) {
-                    const glm::dvec4& q = member_at[at];
-                    contact_at(self, xi, ri, members[at], glm::dvec3(q), q.w, pushed);
-                }
+                for (std::uint32_t at = run.begin; at < run.end; ++at)
+                    contact(self, xi, ri, members[at], pushed);
             }
             for (const std::uint32_t j : oversized) contact(self, xi, ri, j, pushed);
             push[i] = pushed;

@@ -445,7 +445,6 @@ class World {
         Array<Cell> table;                     // the collision pass's cells
         Array<std::uint32_t> used_cells;       // the slots of `table` the last step filled
         Array<std::uint32_t> slot_of, members; // particles grouped by table slot
-        Array<glm::dvec4> member_at;           // beside `members`: position and thinnest radius
         Array<glm::i64vec3> cell_of;           // each particle's collision cell
         Array<double> thin;                    // each particle's thinnest radius
         Array<std::uint32_t> oversized;        // contacts: particles too wide for the grid
