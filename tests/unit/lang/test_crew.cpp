@@ -56,15 +56,16 @@ TEST_CASE("crew: every part runs once, on the kept threads, call after call") {
     CHECK(threads.count(std::this_thread::get_id()) == 1);
     // the same threads, kept: what a part leaves on its thread is there at the next call. Over
     // fifty calls the parts meet a thread new to them only on the caller and the kept threads
-    // (at most one for each part of the widest call so far, four); threads started for each call
-    // would each start from nothing.
+    // (one for each part of the widest call the process has made: four here, more when other
+    // tests ran first in the same process, as with --order rand), where threads started for each
+    // call would each start from nothing, about a hundred times.
     static thread_local int calls_here = 0;
     std::atomic<int> fresh{0};
     for (int call = 0; call < 50; ++call)
         run_on_crew(3, [&](std::size_t) {
             if (calls_here++ == 0) fresh.fetch_add(1);
         });
-    CHECK(fresh.load() <= 4);
+    CHECK(fresh.load() < 16);
 }
 
 TEST_CASE("crew: a call from inside a part, and two callers at once") {
