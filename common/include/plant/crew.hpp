@@ -153,9 +153,10 @@ inline Crew& crew() {
 } // namespace crew_detail
 
 // Runs job(context, k) for k in [0, parts) on the calling thread and the kept threads, each
-// part once, taken by whichever is free first. When those are busy (a call from inside a part, or from two
-// threads at once: the view server's requests, --jobs variants) the parts run on threads started for this
-// call instead. Returns when every part has finished; if parts threw, rethrows what the first to throw threw.
+// part once, taken by whichever is free first. When those are busy (a call from inside a part,
+// or from two threads at once: the view server's requests, --jobs variants) the parts run on
+// threads started for this call instead. Returns when every part has finished; if parts threw,
+// rethrows what the first to throw threw.
 inline void run_on_crew(std::size_t parts, void (*job)(void*, std::size_t), void* context) {
     if (parts <= 1) {
         if (parts == 1) job(context, 0);

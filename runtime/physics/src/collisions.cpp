@@ -215,10 +215,10 @@ void World::separate_particles() {
         // the eight slots are scattered over a table of megabytes: the next particle's are asked
         // for while this one's contacts are summed, so their cache misses overlap the work
         std::uint64_t keys[8], next[8];
-        std::size_t ahead = b; // the particle `next` holds the keys of, if in the grid
+        // `next`: the keys of the first grid particle from `from` on, its slots asked for
         auto look_ahead = [&](std::size_t from) {
-            for (ahead = from; ahead < e && !in_grid(ahead); ++ahead) {
-            }
+            std::size_t ahead = from;
+            while (ahead < e && !in_grid(ahead)) ++ahead;
             if (ahead == e) return;
             block_keys(ahead, next);
             for (const std::uint64_t k : next) __builtin_prefetch(&table[k & (size - 1)]);
@@ -236,7 +236,7 @@ void World::separate_particles() {
                 push[i] = pushed;
                 continue;
             }
-            std::copy(next, next + 8, keys); // (ahead == i: every grid particle is looked ahead at)
+            std::copy(next, next + 8, keys); // (i's own: every grid particle is looked ahead at)
             look_ahead(i + 1);
             for (const std::uint64_t k : keys) {
                 std::size_t slot = k & (size - 1);

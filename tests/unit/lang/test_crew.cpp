@@ -1,7 +1,7 @@
 // The kept threads (common/include/plant/crew.hpp, shared by the derivation and the physics):
 // every part of a call runs exactly once, taken by whichever thread is free, call after call on
-// the same kept threads, from inside a part (which falls back to threads of its own) and from two callers at
-// once; what a part throws reaches the caller.
+// the same kept threads, from inside a part (which falls back to threads of its own) and from two
+// callers at once; what a part throws reaches the caller.
 #include <plant/crew.hpp>
 
 #include <catch2/catch.hpp>
@@ -28,11 +28,10 @@ bool each_once(std::size_t parts) {
     return true;
 }
 
-} // namespace
-
 // Runs `parts` parts that each wait (up to ten seconds) until all of them have started, so that
-// each must be on a thread of its own; true when they all met. Returns the threads they ran on.
-static bool all_at_once(std::size_t parts, std::set<std::thread::id>& threads) {
+// each must be on a thread of its own; true when they all met. Adds the threads they ran on to
+// `threads`.
+bool all_at_once(std::size_t parts, std::set<std::thread::id>& threads) {
     std::mutex m;
     std::condition_variable cv;
     std::size_t started = 0;
@@ -46,6 +45,8 @@ static bool all_at_once(std::size_t parts, std::set<std::thread::id>& threads) {
     });
     return met;
 }
+
+} // namespace
 
 TEST_CASE("crew: every part runs once, on the kept threads, call after call") {
     for (int call = 0; call < 200; ++call) CHECK(each_once(1 + static_cast<std::size_t>(call) % 4));
