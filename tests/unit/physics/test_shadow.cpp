@@ -4,8 +4,11 @@
 
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <limits>
 #include <memory>
+#include <numbers>
+#include <random>
 
 using namespace plant::physics;
 
@@ -108,4 +111,47 @@ TEST_CASE("diffuse light: the open sky lights a point in an obstacle's shadow", 
     CHECK(scene_occlusion(empty, wall, true, behind, from_right, 0.15, nan) == 1.0);
     CHECK(scene_occlusion(empty, wall, true, behind, from_right, 0.15, -2) == 1.0);
     CHECK(scene_occlusion(empty, wall, true, behind, from_right, 0.15, 7) == Approx(1 - beside));
+}
+
+TEST_CASE("diffuse light: sky_visible counts exactly the directions in_shadow finds open", "[physics]") {
+    // sky_visible works out what its tests need of the point once and leaves out the boxes that
+    // cannot hide any direction of the sky (the point inside, the box wholly below it); its count
+    // is checked here against in_shadow itself over the same directions (light.hpp's spiral), for
+    // points all around scenes of boxes (corners given either way round), a sphere and planes
+    const std::vector<glm::dvec3>& sky = sky_directions();
+    REQUIRE(sky.size() == static_cast<std::size_t>(kSkyDirections));
+    Obstacle ball;
+    ball.kind = Obstacle::Sphere;
+    ball.a = glm::dvec3(1.0, 2.0, 0.5);
+    ball.b = glm::dvec3(0.4, 0, 0);
+    Obstacle ground;
+    ground.kind = Obstacle::Plane;
+    ground.a = glm::dvec3(0.0);
+    ground.b = glm::dvec3(0, 1, 0);
+    Obstacle slope; // a plane leaning over: it hides part of the sky of the points above it
+    slope.kind = Obstacle::Plane;
+    slope.a = glm::dvec3(0, 1, 0);
+    slope.b = glm::dvec3(1, -0.4, 0.2);
+    const std::vector<std::vector<Obstacle>> scenes = {
+        {box({-2.5, 0, -1.5}, {2.5, 3.5, 0}), ground},
+        {box({0.5, 1, 0.5}, {-0.5, 0, -0.5}), box({1, 0, 1}, {1.2, 2, 1.2}), ball},
+        {ground, box({-1, 2, -1}, {1, 2.1, 1}), box({-0.1, 0, -0.1}, {0.1, 2, 0.1})},
+        {slope, box({-1, 0, -1}, {-0.5, 1.5, 2}), ground},
+    };
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> at(-3.0, 3.0);
+    std::size_t points = 0, partly = 0;
+    for (const auto& scene : scenes)
+        for (int k = 0; k < 400; ++k) {
+            const glm::dvec3 p(at(rng), at(rng) + 2.0, at(rng));
+            int open = 0;
+            for (const glm::dvec3& d : sky) open += in_shadow(scene, p, d) ? 0 : 1;
+            INFO("point " << p.x << ", " << p.y << ", " << p.z);
+            CHECK(sky_visible(scene, p) == static_cast<double>(open) / kSkyDirections);
+            ++points;
+            if (open > 0 && open < kSkyDirections) ++partly;
+        }
+    // (the points were not all in the open or all under cover)
+    CHECK(points == 1600);
+    CHECK(partly > 400);
 }

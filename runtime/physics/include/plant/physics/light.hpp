@@ -45,6 +45,9 @@ bool in_shadow(const std::vector<Obstacle>& obstacles, const glm::dvec3& p, cons
 // directions spread evenly over it) that no obstacle hides from p.
 constexpr int kSkyDirections = 32;
 double sky_visible(const std::vector<Obstacle>& obstacles, const glm::dvec3& p);
+// Those directions: a Fibonacci spiral over the upper half of the sphere, direction k at height
+// y = (k + 0.5) / kSkyDirections, turned by the golden angle from the one before.
+const std::vector<glm::dvec3>& sky_directions();
 
 // Eq. 7's O at p in a scene, 1 less the light p receives. With diffuse = 0: 1 where an obstacle
 // blocks the light (with `obstacles_shade`), else the plant's particles counted in `grid`
