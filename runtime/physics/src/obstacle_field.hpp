@@ -20,7 +20,16 @@ namespace plant::physics {
         return glm::length(p - a) - b.x;
     case Obstacle::Box: {
         glm::dvec3 c = (a + b) * 0.5, h = (b - a) * 0.5, q = glm::abs(p - c) - h;
-        return glm::length(glm::max(q, glm::dvec3(0.0))) + std::min(std::max(q.x, std::max(q.y, q.z)), 0.0);
+        const double most = std::max(q.x, std::max(q.y, q.z));
+        // Inside (no axis outside) or beside a face (one), the length below is 0 or that axis's
+        // q, found without its square root: sqrt(x * x) rounds to x for any x whose square
+        // neither overflows nor underflows (binary floating point, rounding to nearest), and the
+        // zeros add nothing to x * x. The same value, bit for bit (test_segment_box.cpp), and the
+        // square root off the chain of the length sweep, which waits on each particle's distance.
+        const int outside = (q.x > 0) + (q.y > 0) + (q.z > 0);
+        if (outside == 0) return std::min(most, 0.0);
+        if (outside == 1 && most > 1e-150 && most < 1e150) return most;
+        return glm::length(glm::max(q, glm::dvec3(0.0))) + std::min(most, 0.0);
     }
     case Obstacle::Plane:
         return glm::dot(p - a, glm::normalize(b));

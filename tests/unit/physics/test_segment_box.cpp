@@ -8,6 +8,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cstring>
 #include <random>
 
 using namespace plant::physics;
@@ -68,4 +69,41 @@ TEST_CASE("a box tells a clear link exactly, and never one in contact", "[physic
     // the random links include both kinds, many of each
     CHECK(clear > 5000);
     CHECK(contact > 2000);
+}
+
+TEST_CASE("a box's signed distance beside a face or inside is the full formula's, bit for bit",
+          "[physics][segments]") {
+    // signed_distance skips the square root where at most one axis is outside the box; the value
+    // must be the one the full formula gives (the climber goldens and the bench's state hash rest
+    // on it): points all round boxes (corners either way round), on the faces and the edges,
+    // far off and inside, compared as bits
+    auto full = [](const Obstacle& o, const glm::dvec3& p) {
+        const glm::dvec3 c = (o.a + o.b) * 0.5, h = (o.b - o.a) * 0.5, q = glm::abs(p - c) - h;
+        return glm::length(glm::max(q, glm::dvec3(0.0))) + std::min(std::max(q.x, std::max(q.y, q.z)), 0.0);
+    };
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> around(-2.0, 2.0), unit(0.0, 1.0);
+    std::uniform_int_distribution<int> pick(0, 5);
+    const double scales[] = {1e-3, 1.0, 1e3, 1e140};
+    std::size_t beside = 0, inside = 0, compared = 0;
+    for (const double s : scales)
+        for (int n = 0; n < 20000; ++n) {
+            Obstacle o;
+            o.kind = Obstacle::Box;
+            o.a = glm::dvec3(around(rng), around(rng), around(rng)) * s;
+            o.b = o.a + glm::dvec3(unit(rng), unit(rng), unit(rng)) * (n % 7 == 0 ? -s : s);
+            glm::dvec3 p = glm::dvec3(around(rng), around(rng), around(rng)) * s;
+            // some points exactly on a face's plane or an edge of the box
+            const int on = pick(rng);
+            if (on < 3) p[on] = unit(rng) < 0.5 ? o.a[on] : o.b[on];
+            if (on == 0) p[1] = o.b[1];
+            const double got = signed_distance(o, p), want = full(o, p);
+            CHECK(std::memcmp(&got, &want, sizeof got) == 0);
+            const glm::dvec3 q = glm::abs(p - (o.a + o.b) * 0.5) - glm::abs(o.b - o.a) * 0.5;
+            const int outside = (q.x > 0) + (q.y > 0) + (q.z > 0);
+            beside += outside == 1, inside += outside == 0, ++compared;
+        }
+    CHECK(compared == 80000);
+    CHECK(beside > 10000); // (the shortcut's cases were met)
+    CHECK(inside > 1000);
 }
