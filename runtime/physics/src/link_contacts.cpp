@@ -83,9 +83,9 @@ void pair_oversized(const Array<std::uint32_t>& big, const Array<std::uint32_t>&
 // 100 steps, 96 % of the pairs the runs held were of one plant, 210 of 218 million over the run,
 // each looked at only to be skipped; the pairs found are the same, and the caller sorts them). A
 // pair is listed here when the cell `at` holds the lower corner of the two boxes' overlap, so
-// it is listed once.
+// it is listed once. `per`: cells per unit of length, as grid_link_pairs maps a box to cells.
 void pairs_in_cell(const Array<std::uint32_t>& members, std::uint32_t begin, std::uint32_t end,
-                   const glm::i64vec3& at, double cell, const Array<glm::dvec3>& lo,
+                   const glm::i64vec3& at, double per, const Array<glm::dvec3>& lo,
                    const Array<glm::dvec3>& hi, const Array<std::uint32_t>& plant,
                    Array<std::pair<std::uint32_t, std::uint32_t>>& pairs) {
     for (std::uint32_t group = begin; group < end;) {
@@ -96,8 +96,8 @@ void pairs_in_cell(const Array<std::uint32_t>& members, std::uint32_t begin, std
                 const std::uint32_t a = members[u], b = members[v];
                 const glm::dvec3 low = glm::max(lo[a], lo[b]), high = glm::min(hi[a], hi[b]);
                 if (low.x > high.x || low.y > high.y || low.z > high.z) continue;
-                const glm::i64vec3 owner(far_floor(low.x / cell), far_floor(low.y / cell),
-                                         far_floor(low.z / cell));
+                const glm::i64vec3 owner(far_floor(low.x * per), far_floor(low.y * per),
+                                         far_floor(low.z * per));
                 if (owner != at) continue; // found in the cell that owns it
                 pairs.push_back({std::min(a, b), std::max(a, b)});
             }
@@ -192,9 +192,13 @@ void World::grid_link_pairs(double cell) {
     const auto& lo = sc.box_lo;
     const auto& hi = sc.box_hi;
     const auto& plant = sc.plant;
-    auto range = [&](std::uint32_t i, glm::i64vec3& a, glm::i64vec3& b) {
-        for (int k = 0; k < 3; ++k) a[k] = far_floor(lo[i][k] / cell), b[k] = far_floor(hi[i][k] / cell);
-    };
+    // A box goes into the cells from floor(lo * per) to floor(hi * per) on each axis, and a pair
+    // is listed by the cell of floor(low * per), low the lower corner of their overlap. Any
+    // mapping that keeps the order of points along an axis (multiplying by a positive number
+    // does) puts that cell among both boxes' cells, so every overlapping pair is listed exactly
+    // once whatever the cells' bounds are: the reciprocal's rounding moves no pair. (Divisions,
+    // six a link in each of three passes, were a third of this function's time.)
+    const double per = 1.0 / cell;
     // each cell's run grouped by plant: the links taken in plant order, then index order. They
     // come in index order, and the plants (their roots' indices) are few: counted into place by
     // plant, each plant's links keep their order (a comparison sort was 1.4 % of Fig. 14 right)
@@ -217,11 +221,18 @@ void World::grid_link_pairs(double cell) {
         for (const std::uint32_t i : links) sorted[start[plant[i]]++] = i;
         links.swap(sorted);
     }
-    // the cells a link's box touches, one entry each
+    // the cells a link's box touches (its range of cells, worked out once), one entry each
+    auto& range_lo = sc.link_range_lo;
+    auto& range_hi = sc.link_range_hi;
+    range_lo.resize(links.size());
+    range_hi.resize(links.size());
     std::size_t entries = 0;
-    for (const std::uint32_t i : links) {
-        glm::i64vec3 a, b;
-        range(i, a, b);
+    for (std::size_t k = 0; k < links.size(); ++k) {
+        const std::uint32_t i = links[k];
+        glm::i64vec3& a = range_lo[k];
+        glm::i64vec3& b = range_hi[k];
+        for (int axis = 0; axis < 3; ++axis)
+            a[axis] = far_floor(lo[i][axis] * per), b[axis] = far_floor(hi[i][axis] * per);
         entries += static_cast<std::size_t>((b.x - a.x + 1) * (b.y - a.y + 1) * (b.z - a.z + 1));
     }
     // The cells that hold an entry, each with its run of links in `members` (filled by counting,
@@ -251,22 +262,22 @@ void World::grid_link_pairs(double cell) {
         }
         return table[slot] - 1;
     };
-    auto each_cell = [&](std::uint32_t i, auto&& f) {
-        glm::i64vec3 a, b;
-        range(i, a, b);
+    auto& entry_cell = sc.link_entry_cell; // each entry's cell and link, in link order
+    auto& entry_link = sc.link_entry_link;
+    entry_cell.resize(entries);
+    entry_link.resize(entries);
+    std::size_t e = 0;
+    for (std::size_t k = 0; k < links.size(); ++k) {
+        const glm::i64vec3 a = range_lo[k], b = range_hi[k];
         for (std::int64_t z = a.z; z <= b.z; ++z)
             for (std::int64_t y = a.y; y <= b.y; ++y)
-                for (std::int64_t x = a.x; x <= b.x; ++x) f(glm::i64vec3(x, y, z));
-    };
-    auto& entry_cell = sc.link_entry_cell; // each entry's cell, in the order of the two passes
-    entry_cell.resize(entries);
-    std::size_t e = 0;
-    for (const std::uint32_t i : links)
-        each_cell(i, [&](const glm::i64vec3& c) {
-            const std::uint32_t k = cell_at(c);
-            ++cells[k].count;
-            entry_cell[e++] = k;
-        });
+                for (std::int64_t x = a.x; x <= b.x; ++x) {
+                    const std::uint32_t c = cell_at(glm::i64vec3(x, y, z));
+                    ++cells[c].count;
+                    entry_cell[e] = c;
+                    entry_link[e++] = links[k];
+                }
+    }
     std::uint32_t running = 0;
     for (LinkCell& s : cells) {
         s.begin = s.fill = running;
@@ -274,11 +285,15 @@ void World::grid_link_pairs(double cell) {
     }
     auto& members = sc.link_members;
     members.resize(running);
-    e = 0;
-    for (const std::uint32_t i : links)
-        each_cell(i, [&](const glm::i64vec3&) { members[cells[entry_cell[e++]].fill++] = i; });
+    for (std::size_t k = 0; k < entries; ++k) members[cells[entry_cell[k]].fill++] = entry_link[k];
     for (const LinkCell& s : cells)
-        pairs_in_cell(members, s.begin, s.begin + s.count, s.cell, cell, lo, hi, plant, sc.link_pairs);
+        pairs_in_cell(members, s.begin, s.begin + s.count, s.cell, per, lo, hi, plant, sc.link_pairs);
+}
+
+std::vector<std::pair<std::uint32_t, std::uint32_t>> World::link_candidates() {
+    refresh_groups(); // (the plants of the particles)
+    find_link_pairs();
+    return {scratch_.link_pairs.begin(), scratch_.link_pairs.end()};
 }
 
 void World::separate_links(bool find) {

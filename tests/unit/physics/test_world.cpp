@@ -10,6 +10,9 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <random>
+#include <utility>
+#include <vector>
 
 using namespace plant::physics;
 
@@ -613,4 +616,64 @@ TEST_CASE("collisions: a particle far wider than the rest is tested against each
     for (std::size_t k = 0; k < alone.size(); k += 6)
         spread = std::max(spread, std::fabs(alone[k + 5].x - 0.015 * static_cast<double>(k / 6)));
     CHECK(spread > 1e-4);
+}
+
+TEST_CASE("plant-plant collision: the broad phase lists exactly the pairs of links whose boxes meet",
+          "[physics]") {
+    // find_link_pairs' grid (link_contacts.cpp) against every pair: links of different plants
+    // whose boxes (the capsule's bounds grown by three radii) overlap, each once, in index order.
+    // Random stems of six plants tangled in a box, with radii over a decade, one link wide
+    // enough to stay out of the grid, and the same scene far from the origin, where the cells'
+    // bounds round differently
+    for (const double far : {0.0, 1234.5678, -98765.4321}) {
+        Settings s;
+        World w(s);
+        std::mt19937_64 rng(11);
+        std::uniform_real_distribution<double> unit(0.0, 1.0);
+        auto radius = [&] { return 0.002 * std::pow(10.0, unit(rng)); };
+        const glm::dvec3 origin(far, far * 0.5, -far);
+        std::vector<Handle> roots;
+        for (int plant = 0; plant < 6; ++plant) {
+            glm::dvec3 at = origin + glm::dvec3(unit(rng), unit(rng), unit(rng));
+            Handle h = w.add_root(at, glm::dquat(1, 0, 0, 0), glm::dvec3(radius()));
+            roots.push_back(h);
+            for (int k = 0; k < 150; ++k) {
+                at += (glm::dvec3(unit(rng), unit(rng), unit(rng)) - 0.5) * 0.1;
+                const double r = plant == 0 && k == 75 ? 2.0 : radius(); // (the wide one)
+                h = w.add_particle(h, at, glm::dquat(1, 0, 0, 0), glm::dvec3(r, std::max(r, 0.03), r));
+            }
+        }
+        const auto found = w.link_candidates();
+        std::vector<std::uint32_t> plant(w.size());
+        std::vector<std::pair<std::uint32_t, std::uint32_t>> want;
+        auto box = [&](std::uint32_t i, glm::dvec3& lo, glm::dvec3& hi) {
+            const Handle h = w.handle(i), p = w.handle(w.parent(h));
+            const glm::dvec3 radii = w.radii(h);
+            const double r = 3 * std::min({radii.x, radii.y, radii.z});
+            lo = glm::min(w.position(h), w.position(p)) - r;
+            hi = glm::max(w.position(h), w.position(p)) + r;
+        };
+        for (std::uint32_t i = 0; i < w.size(); ++i) {
+            const std::uint32_t p = w.parent(w.handle(i));
+            plant[i] = p == ~0u ? i : plant[p];
+        }
+        for (std::uint32_t a = 0; a < w.size(); ++a)
+            for (std::uint32_t b = a + 1; b < w.size(); ++b) {
+                if (w.parent(w.handle(a)) == ~0u || w.parent(w.handle(b)) == ~0u || plant[a] == plant[b])
+                    continue;
+                glm::dvec3 la, ha, lb, hb;
+                box(a, la, ha);
+                box(b, lb, hb);
+                const glm::dvec3 low = glm::max(la, lb), high = glm::min(ha, hb);
+                if (!(low.x > high.x || low.y > high.y || low.z > high.z)) want.push_back({a, b});
+            }
+        const auto wide = std::count_if(want.begin(), want.end(), [&](const auto& pair) {
+            return w.radii(w.handle(pair.first)).x > 1 || w.radii(w.handle(pair.second)).x > 1;
+        });
+        INFO("scene at " << far << ": " << want.size() << " pairs, " << wide
+                         << " of them with the wide link");
+        CHECK(wide > 500); // (every link of another plant meets its box)
+        CHECK(want.size() - static_cast<std::size_t>(wide) > 50); // and the grid's own pairs
+        CHECK(found == want);
+    }
 }

@@ -221,6 +221,10 @@ class World {
 
     // Moves a particle (tests); its rest state stays.
     void set_position(Handle h, const glm::dvec3& p) { x_[h.index] = p; }
+    // The candidate pairs of links of different plants (by the particles' indices, in index
+    // order) that the plant-plant contacts would find at the present positions (tests: the broad
+    // phase of link_contacts.cpp against every pair).
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> link_candidates();
     // Holds a particle at `target` through the next step, as a user dragging it would.
     void pull(Handle h, const glm::dvec3& target) { pulls_.push_back({h.index, target}); }
     // A hand grabbing particle h and pulling it toward `target`, by at most `reach` this step
@@ -477,8 +481,9 @@ class World {
         std::size_t plants = 0;
         Array<glm::dvec3> box_lo, box_hi;
         Array<std::uint32_t> link_list, link_members;
-        Array<std::uint32_t> link_sorted, plant_start, plant_roots;  // (grid_link_pairs) by plant
-        Array<std::uint32_t> link_table, link_used, link_entry_cell; // (find_link_pairs)
+        Array<std::uint32_t> link_sorted, plant_start, plant_roots; // (grid_link_pairs) by plant
+        Array<std::uint32_t> link_table, link_used, link_entry_cell, link_entry_link; // (find_link_pairs)
+        Array<glm::i64vec3> link_range_lo, link_range_hi; // (grid_link_pairs) each link's cells
         Array<LinkCell> link_cells;
         Array<std::pair<std::uint32_t, std::uint32_t>> link_pairs;
         Array<std::uint32_t> link_big; // link contacts: boxes too large for the grid
