@@ -71,12 +71,12 @@ TEST_CASE("a box tells a clear link exactly, and never one in contact", "[physic
     CHECK(contact > 2000);
 }
 
-TEST_CASE("a box's signed distance beside a face or inside is the full formula's, bit for bit",
-          "[physics][segments]") {
-    // signed_distance skips the square root where at most one axis is outside the box; the value
-    // must be the one the full formula gives (the climber goldens and the bench's state hash rest
-    // on it): points all round boxes (corners either way round), on the faces and the edges,
-    // far off and inside, compared as bits
+TEST_CASE("a box's signed distance and normal are the full formula's, bit for bit", "[physics][segments]") {
+    // signed_distance skips the square root where at most one axis is outside the box, and
+    // surface_normal works out only the moved axis for each of its six distances; the values
+    // must be the ones the full formulas give (the climber goldens and the bench's state hash
+    // rest on them): points all round boxes (corners either way round), on the faces and the
+    // edges, far off and inside, compared as bits
     auto full = [](const Obstacle& o, const glm::dvec3& p) {
         const glm::dvec3 c = (o.a + o.b) * 0.5, h = (o.b - o.a) * 0.5, q = glm::abs(p - c) - h;
         return glm::length(glm::max(q, glm::dvec3(0.0))) + std::min(std::max(q.x, std::max(q.y, q.z)), 0.0);
@@ -99,6 +99,16 @@ TEST_CASE("a box's signed distance beside a face or inside is the full formula's
             if (on == 0) p[1] = o.b[1];
             const double got = signed_distance(o, p), want = full(o, p);
             CHECK(std::memcmp(&got, &want, sizeof got) == 0);
+            // and the normal, whose six distances share all but one axis of q: as central
+            // differences of the full formula at the six points
+            const double e = 1e-6;
+            auto d = [&](const glm::dvec3& at) { return full(o, at); };
+            const glm::dvec3 g(d(p + glm::dvec3(e, 0, 0)) - d(p - glm::dvec3(e, 0, 0)),
+                               d(p + glm::dvec3(0, e, 0)) - d(p - glm::dvec3(0, e, 0)),
+                               d(p + glm::dvec3(0, 0, e)) - d(p - glm::dvec3(0, 0, e)));
+            const double l = glm::length(g);
+            const glm::dvec3 normal = surface_normal(o, p), n_want = l > 0 ? g / l : glm::dvec3(0, 1, 0);
+            CHECK(std::memcmp(&normal, &n_want, sizeof normal) == 0);
             const glm::dvec3 q = glm::abs(p - (o.a + o.b) * 0.5) - glm::abs(o.b - o.a) * 0.5;
             const int outside = (q.x > 0) + (q.y > 0) + (q.z > 0);
             beside += outside == 1, inside += outside == 0, ++compared;
