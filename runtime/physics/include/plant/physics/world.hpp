@@ -454,7 +454,11 @@ class World {
         Array<std::uint32_t> oversized;        // contacts: particles too wide for the grid
         Array<glm::dmat3> rest_moment;         // 0.2 m D R̄ᵀ, while the groups are current
         Array<glm::dvec3> push;
-        Array<std::uint8_t> near;           // links near an obstacle (resolve_segments)
+        Array<std::uint8_t> near; // links near an obstacle (resolve_segments)
+        // (resolve_segments) the distance test of each link, where each particle was when the
+        // last call looked, and which have moved since
+        Array<std::uint8_t> near_base, near_moved;
+        Array<glm::dvec3> near_seen;
         Array<std::uint8_t> ring_flag;      // (resolve_segments) particles whose links join a near one
         Array<std::uint32_t> contact_links; // the same, as a list in index order
         // (resolve_segments) the links its contact sweeps found clear this step, and where their
