@@ -21,9 +21,13 @@ namespace plant::physics {
 // root off the chain of the length sweep, which waits on each particle's distance.
 [[gnu::always_inline]] inline double box_distance(const glm::dvec3& q) {
     const double most = std::max(q.x, std::max(q.y, q.z));
-    const int outside = (q.x > 0) + (q.y > 0) + (q.z > 0);
-    if (outside == 0) return std::min(most, 0.0);
-    if (outside == 1 && most > 1e-150 && most < 1e150) return most;
+    // (a NaN in q makes the length NaN, which std::max above would pass over: the full formula)
+    if (q.x == q.x && q.y == q.y && q.z == q.z) {
+        const int outside = (q.x > 0) + (q.y > 0) + (q.z > 0);
+        if (outside == 0)
+            return 0.0 + std::min(most, 0.0); // (0.0 +: -0 comes out +0, as the length's 0 + -0)
+        if (outside == 1 && most > 1e-150 && most < 1e150) return most;
+    }
     return glm::length(glm::max(q, glm::dvec3(0.0))) + std::min(most, 0.0);
 }
 

@@ -116,7 +116,10 @@ double sky_visible(const std::vector<Obstacle>& obstacles, const glm::dvec3& p) 
     // out once (a plane's unit normal, whether p is above it), and an obstacle that can hide no
     // direction of the sky is left out: a box p is inside or that lies wholly below p (every
     // direction rises), a plane p is not above. The same tests on the same numbers: the same
-    // answer for every direction (Fig. 14 right: 32 directions for each apex, each step).
+    // answer for every direction (Fig. 14 right: 32 directions for each apex, each step). A box
+    // whose distance is NaN stays in (blocks_light leaves out only those with a distance <= 0),
+    // and a scene with a box whose corners are not finite goes through in_shadow direction by
+    // direction.
     struct Box {
         const Obstacle* o;
         glm::dvec3 lo, hi; // its corners sorted
@@ -133,7 +136,9 @@ double sky_visible(const std::vector<Obstacle>& obstacles, const glm::dvec3& p) 
             above[plane_count++] = n;
         } else if (o.kind != Obstacle::Box) {
             ++other;
-        } else if (signed_distance(o, p) > 0 && std::max(o.a.y, o.b.y) > p.y) {
+        } else if (!finite(o.a) || !finite(o.b)) {
+            return sky_visible_each(obstacles, p); // (the shortcuts below reason on finite corners)
+        } else if (!(signed_distance(o, p) <= 0) && std::max(o.a.y, o.b.y) > p.y) {
             if (box_count == kMostBoxes) return sky_visible_each(obstacles, p);
             boxes[box_count++] = Box{&o, glm::min(o.a, o.b), glm::max(o.a, o.b)};
         }

@@ -9,7 +9,9 @@
 
 #include <algorithm>
 #include <cstring>
+#include <limits>
 #include <random>
+#include <utility>
 
 using namespace plant::physics;
 
@@ -113,6 +115,26 @@ TEST_CASE("a box's signed distance and normal are the full formula's, bit for bi
             const int outside = (q.x > 0) + (q.y > 0) + (q.z > 0);
             beside += outside == 1, inside += outside == 0, ++compared;
         }
+    // points with a NaN coordinate, and a flat box (both corners at 0 on an axis) met at -0 there
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    Obstacle flat;
+    flat.kind = Obstacle::Box;
+    flat.a = glm::dvec3(-1, 0, -1);
+    flat.b = glm::dvec3(1, 0, 1);
+    Obstacle unit_box;
+    unit_box.kind = Obstacle::Box;
+    unit_box.a = glm::dvec3(0.0);
+    unit_box.b = glm::dvec3(1.0);
+    const std::pair<const Obstacle*, glm::dvec3> odd[] = {
+        {&unit_box, {4.5, nan, 0.5}}, {&unit_box, {0.2, 0.3, nan}}, {&unit_box, {nan, 0.5, 0.5}},
+        {&unit_box, {2.0, 0.5, nan}}, {&flat, {0.5, -0.0, 0.25}},   {&flat, {-0.0, -0.0, -0.0}},
+        {&flat, {3.0, -0.0, 0.0}},
+    };
+    for (const auto& [box, p] : odd) {
+        const double got = signed_distance(*box, p), want = full(*box, p);
+        INFO("point " << p.x << ", " << p.y << ", " << p.z << ": " << got << " against " << want);
+        CHECK(std::memcmp(&got, &want, sizeof got) == 0);
+    }
     CHECK(compared == 80000);
     CHECK(beside > 10000); // (the shortcut's cases were met)
     CHECK(inside > 1000);

@@ -137,6 +137,11 @@ TEST_CASE("diffuse light: sky_visible counts exactly the directions in_shadow fi
         {box({0.5, 1, 0.5}, {-0.5, 0, -0.5}), box({1, 0, 1}, {1.2, 2, 1.2}), ball},
         {ground, box({-1, 2, -1}, {1, 2.1, 1}), box({-0.1, 0, -0.1}, {0.1, 2, 0.1})},
         {slope, box({-1, 0, -1}, {-0.5, 1.5, 2}), ground},
+        // corners not finite (a box moved by 1e308, say), or far enough that its distance is NaN
+        {box({0, 2, -1}, {HUGE_VAL, 3, 1}), box({-0.5, 0, -0.5}, {0.5, 1, 0.5})},
+        {box({-HUGE_VAL, 0, 1}, {HUGE_VAL, 10, 2})},
+        {box({-1, 0, -1}, {1, std::numeric_limits<double>::quiet_NaN(), 1}), ground},
+        {box({-1e308, 2, -1}, {1e308, 3, 1})},
     };
     std::mt19937_64 rng(7);
     std::uniform_real_distribution<double> at(-3.0, 3.0);
@@ -152,6 +157,6 @@ TEST_CASE("diffuse light: sky_visible counts exactly the directions in_shadow fi
             if (open > 0 && open < kSkyDirections) ++partly;
         }
     // (the points were not all in the open or all under cover)
-    CHECK(points == 1600);
+    CHECK(points == 3200);
     CHECK(partly > 400);
 }
