@@ -10,9 +10,6 @@
 
 namespace plant::physics {
 
-// declared inline: GCC allows a function declared inline a larger inlining budget, and the
-// loops over the obstacles want it inlined, as it was when the whole step was one file (forced:
-// left to itself, GCC kept it a call in the length sweep)
 // A box's signed distance from q = |p - c| - h (c its centre, h its half sizes), as
 // signed_distance works it out. Inside (no axis outside) or beside a face (one), the length below
 // is 0 or that axis's q, found without its square root: sqrt(x * x) rounds to x for any x whose
@@ -31,6 +28,9 @@ namespace plant::physics {
     return glm::length(glm::max(q, glm::dvec3(0.0))) + std::min(most, 0.0);
 }
 
+// declared inline: GCC allows a function declared inline a larger inlining budget, and the
+// loops over the obstacles want it inlined, as it was when the whole step was one file (forced:
+// left to itself, GCC kept it a call in the length sweep)
 [[gnu::always_inline]] inline double signed_distance(const Obstacle& o, const glm::dvec3& p) {
     const glm::dvec3 &a = o.a, &b = o.b;
     switch (o.kind) {

@@ -124,22 +124,22 @@ double sky_visible(const std::vector<Obstacle>& obstacles, const glm::dvec3& p) 
         const Obstacle* o;
         glm::dvec3 lo, hi; // its corners sorted
     };
-    constexpr std::size_t kMostBoxes = 16;
-    Box boxes[kMostBoxes];
-    glm::dvec3 above[kMostBoxes];                          // the unit normals of the planes p is above
+    constexpr std::size_t kMostEach = 16; // boxes, and planes, worked out ahead (more: in_shadow)
+    Box boxes[kMostEach];
+    glm::dvec3 above[kMostEach];                           // the unit normals of the planes p is above
     std::size_t box_count = 0, plane_count = 0, other = 0; // other: spheres and grids (blocks_light)
     for (const Obstacle& o : obstacles) {
         if (o.kind == Obstacle::Plane) {
             const glm::dvec3 n = glm::normalize(o.b);
             if (!(glm::dot(p - o.a, n) > 0)) continue; // (the light below its horizon: p is not above it)
-            if (plane_count == kMostBoxes) return sky_visible_each(obstacles, p);
+            if (plane_count == kMostEach) return sky_visible_each(obstacles, p);
             above[plane_count++] = n;
         } else if (o.kind != Obstacle::Box) {
             ++other;
         } else if (!finite(o.a) || !finite(o.b)) {
             return sky_visible_each(obstacles, p); // (the shortcuts below reason on finite corners)
         } else if (!(signed_distance(o, p) <= 0) && std::max(o.a.y, o.b.y) > p.y) {
-            if (box_count == kMostBoxes) return sky_visible_each(obstacles, p);
+            if (box_count == kMostEach) return sky_visible_each(obstacles, p);
             boxes[box_count++] = Box{&o, glm::min(o.a, o.b), glm::max(o.a, o.b)};
         }
     }
