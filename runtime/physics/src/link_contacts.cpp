@@ -57,8 +57,15 @@ void closest_on_segments(const glm::dvec3& p1, const glm::dvec3& d1, const glm::
 // allows 10 %
 constexpr double kStretch = 1.02;
 
-// sweeps over the pairs a step at most
+// sweeps over the pairs a call at most, and the overlap they stop under (World::step runs rounds
+// of calls until a call's first sweep finds none over it)
 constexpr int kSweeps = 16;
+constexpr double kPartedWithin = 1e-4;
+
+// Over-relaxation of each push (successive over-relaxation of the Gauss-Seidel sweeps): a stem
+// pressed between a support and a heavier stem is parted a little more each sweep when the push
+// goes 30 % past contact (docs/physics.md, "Plant-plant collision")
+constexpr double kOverRelax = 1.3;
 
 // Lists each oversized link (find_link_pairs) with every other link of another plant whose bounds
 // it meets.
@@ -296,11 +303,11 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> World::link_candidates() {
     return {scratch_.link_pairs.begin(), scratch_.link_pairs.end()};
 }
 
-void World::separate_links(bool find) {
-    if (scratch_.plants < 2 || x_.size() < 4) return; // one plant: nothing of another to meet
+double World::separate_links(bool find) {
+    if (scratch_.plants < 2 || x_.size() < 4) return 0; // one plant: nothing of another to meet
     if (find) find_link_pairs();
     const auto& pairs = scratch_.link_pairs;
-    if (pairs.empty()) return;
+    if (pairs.empty()) return 0;
     // a particle's inverse mass, 0 when it does not move (weigh_particles, once a step)
     const auto& mobility = scratch_.inverse_mass;
     // and for a push along `dir`: 0 too for a particle lying on a support (within a millimetre)
@@ -338,6 +345,7 @@ void World::separate_links(bool find) {
     // Gauss-Seidel over the pairs in index order, on one thread (the same result on any thread
     // count), sweeps until no pair overlaps by 0.1 mm, at most 16: stems piled three deep
     // where several plants meet need several
+    double first = 0; // the deepest overlap the first sweep met
     for (int sweep = 0; sweep < kSweeps; ++sweep) {
         double worst = 0;
         for (const auto& [a, b] : pairs) {
@@ -365,7 +373,7 @@ void World::separate_links(bool find) {
                          w3 = weight(b, -nrm);
             const double sum = w0 * (1 - s) * (1 - s) + w1 * s * s + w2 * (1 - t) * (1 - t) + w3 * t * t;
             if (sum <= 0) continue;
-            double lambda = (want - dist) / sum;
+            double lambda = kOverRelax * (want - dist) / sum;
             // a closest point near an end that cannot move would swing the other end far: no end
             // moves more than twice the overlap in one push (as segment_contacts.cpp bounds it)
             const double most = lambda * std::max({w0 * (1 - s), w1 * s, w2 * (1 - t), w3 * t});
@@ -387,8 +395,10 @@ void World::separate_links(bool find) {
                     for (const std::uint32_t c : children_[j]) out_of_obstacles(c);
                 }
         }
-        if (worst < 1e-4) break;
+        if (sweep == 0) first = worst;
+        if (worst < kPartedWithin) break;
     }
+    return first;
 }
 
 } // namespace plant::physics
