@@ -256,7 +256,7 @@ async function climberChecks(browser) {
   await waitFor(page, () => document.getElementById('edit-list').textContent.includes('ivy.cut('), null, 20000);
   const cut = await stateOf();
   const list = await page.$eval('#edit-list', (e) => e.textContent);
-  // (at step 21, the step the cut comes before, where the branch has left the string)
+  // (at step 21, the first step after the cut: the cut branch's modules are gone from it)
   check(cut.modules[20] === before.modules[20] && cut.modules[21] < before.modules[21] && list.includes(`before step 21: ivy.cut(${picked && picked.id});`),
     'the cut button cuts the branch before the next step, and the page lists the edit', `step 21: ${before.modules[21]} -> ${cut.modules[21]} modules; ${list}`);
   await page.click('#edit-undo');

@@ -57,10 +57,8 @@ void closest_on_segments(const glm::dvec3& p1, const glm::dvec3& d1, const glm::
 // allows 10 %
 constexpr double kStretch = 1.02;
 
-// sweeps over the pairs a call at most, and the overlap they stop under (World::step runs rounds
-// of calls until a call's first sweep finds none over it)
+// sweeps over the pairs a call at most; they stop once none overlaps by kLinksParted
 constexpr int kSweeps = 16;
-constexpr double kPartedWithin = 1e-4;
 
 // Over-relaxation of each push (successive over-relaxation of the Gauss-Seidel sweeps): a stem
 // pressed between a support and a heavier stem is parted a little more each sweep when the push
@@ -358,7 +356,6 @@ double World::separate_links(bool find) {
             const double dist2 = glm::dot(d, d);
             if (dist2 >= want * want) continue; // apart
             const double dist = std::sqrt(dist2);
-            worst = std::max(worst, want - dist);
             // the way from b to a; where the axes meet (two stems crossing on one surface), across both
             glm::dvec3 nrm = dist > 1e-12 ? d / dist : glm::cross(da, db);
             if (dist <= 1e-12 && glm::dot(nrm, nrm) < 1e-24)
@@ -373,6 +370,9 @@ double World::separate_links(bool find) {
                          w3 = weight(b, -nrm);
             const double sum = w0 * (1 - s) * (1 - s) + w1 * s * s + w2 * (1 - t) * (1 - t) + w3 * t * t;
             if (sum <= 0) continue;
+            // (only the overlaps a push can part count toward more sweeps and rounds: a pair no
+            // end of which may move would keep them going to their limits every step)
+            worst = std::max(worst, want - dist);
             double lambda = kOverRelax * (want - dist) / sum;
             // a closest point near an end that cannot move would swing the other end far: no end
             // moves more than twice the overlap in one push (as segment_contacts.cpp bounds it)
@@ -396,7 +396,7 @@ double World::separate_links(bool find) {
                 }
         }
         if (sweep == 0) first = worst;
-        if (worst < kPartedWithin) break;
+        if (worst < kLinksParted) break;
     }
     return first;
 }

@@ -13,10 +13,8 @@
 namespace plant::physics {
 
 namespace {
-// rounds of link contacts and obstacles a step at most, with plant_contacts (World::step), and
-// the overlap a round's first sweep must meet for another round to follow
+// rounds of link contacts and obstacles a step at most, with plant_contacts (World::step)
 constexpr int kLinkRounds = 32;
-constexpr double kRoundsUntil = 1e-4;
 } // namespace
 
 Handle World::add_root(const glm::dvec3& position_in, const glm::dquat& orientation_in,
@@ -153,13 +151,13 @@ void World::step() {
     // the obstacles (the pairs' own pushes keep only the pushed links out of them): a stem pressed
     // between another plant's stem and a thin rail is parted from both within a few rounds, the
     // obstacles having the last word. Stems stacked on a support need more: rounds follow until
-    // the first sweep of one finds every pair within 0.1 mm (docs/physics.md, "Plant-plant
+    // the first sweep of one finds every pair within kLinksParted (docs/physics.md, "Plant-plant
     // collision")
     if (settings_.collisions && settings_.link_collisions)
         for (int round = 0; round < kLinkRounds; ++round) {
             const double met = separate_links(round == 0); // the candidate pairs are found once a step
             if (met > 0) resolve_segments(false);          // after any push
-            if (met < kRoundsUntil) break;                 // parted: no more rounds
+            if (met < kLinksParted) break;                 // parted: no more rounds
         }
     double collision_ms = ms(clock::now() - t0).count();
     t0 = clock::now();

@@ -386,8 +386,10 @@ class World {
     void find_link_pairs();
     void grid_link_pairs(double cell); // (find_link_pairs)
     // with find false, the pairs found by the last call are pushed again (a later round of a
-    // step); returns the deepest overlap its first sweep met (0: none)
+    // step); returns the deepest overlap its first sweep pushed (0: none). Its sweeps stop, and
+    // the step's rounds of it and the obstacles, once no pair overlaps by kLinksParted.
     double separate_links(bool find);
+    static constexpr double kLinksParted = 1e-4;
     void integrate(); // Eq. 17-18 with damping, and contacts with obstacles
     // energy.cpp: each particle's mechanical energy before the step and the forcing on it (open,
     // before predict); after integrate, a particle that ends the step with more than that energy
