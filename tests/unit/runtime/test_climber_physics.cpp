@@ -428,9 +428,10 @@ TEST_CASE("climber: the grammars with plant_contacts keep the links of different
 }
 
 // Not done in every grammar yet: fig10_dome leaves `plant_contacts` off, and its stems, piled on
-// one attractor, overlap by 23.6 mm (4.7 mm with the contacts on, in 300 s instead of 5). The other grammars
-// that leave it off have one plant or none touching (fig06, fig07, fig12). Before the energy budget, fig09's,
-// fig11's and fig14_left's whipping shoots overlapped too (2.2-12 mm), and with the contacts a link
+// one attractor, overlap by 23.6 mm (4.7 mm with the contacts on, in 300 s instead of 5). The
+// other grammars that leave it off have one plant or none touching (fig06, fig07, fig12). Before
+// the energy budget, fig09's, fig11's and fig14_left's whipping shoots overlapped too (2.2-12
+// mm), and with the contacts a link
 // of fig11 pinched between another plant's stem and a rail stretched past the every-grammar bound;
 // they set it now. Catch's [!shouldfail]: this passes while some grammar's plants overlap; when
 // it fails, make it a plain test.
