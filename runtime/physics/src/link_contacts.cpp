@@ -65,6 +65,10 @@ constexpr int kSweeps = 16;
 // goes 30 % past contact (docs/physics.md, "Plant-plant collision")
 constexpr double kOverRelax = 1.3;
 
+// The later sweeps of a call visit the pairs its first sweep found closer than this many times
+// their contact distance (separate_links); 1.5: half a contact distance apart at most
+constexpr double kNearSlack = 1.5;
+
 // Lists each oversized link (find_link_pairs) with every other link of another plant whose bounds
 // it meets.
 void pair_oversized(const Array<std::uint32_t>& big, const Array<std::uint32_t>& links,
@@ -342,11 +346,20 @@ double World::separate_links(bool find) {
     };
     // Gauss-Seidel over the pairs in index order, on one thread (the same result on any thread
     // count), sweeps until no pair overlaps by 0.1 mm, at most 16: stems piled three deep
-    // where several plants meet need several
+    // where several plants meet need several. The first sweep visits every pair; the later ones
+    // only those it found within kNearSlack times their contact distance (where plants pile,
+    // most candidate pairs lie farther apart: fig10_dome's sweeps visited about 12 a link). A
+    // pair the later sweeps' pushes bring together is met by the next round's first sweep, which
+    // also decides whether the rounds go on (part_plants).
     double first = 0; // the deepest overlap the first sweep met
+    auto& near = scratch_.link_near;
+    near.clear();
     for (int sweep = 0; sweep < kSweeps; ++sweep) {
         double worst = 0;
-        for (const auto& [a, b] : pairs) {
+        const std::size_t count = sweep == 0 ? pairs.size() : near.size();
+        for (std::size_t q = 0; q < count; ++q) {
+            const std::size_t pair = sweep == 0 ? q : near[q];
+            const auto [a, b] = pairs[pair];
             const std::uint32_t pa = parent_[a], pb = parent_[b];
             const glm::dvec3 da = x_[a] - x_[pa], db = x_[b] - x_[pb];
             double s = 0, t = 0;
@@ -354,6 +367,8 @@ double World::separate_links(bool find) {
             const glm::dvec3 d = (x_[pa] + da * s) - (x_[pb] + db * t);
             const double want = scratch_.thin_of(a, radii_) + scratch_.thin_of(b, radii_);
             const double dist2 = glm::dot(d, d);
+            if (sweep == 0 && dist2 < want * want * (kNearSlack * kNearSlack))
+                near.push_back(static_cast<std::uint32_t>(pair));
             if (dist2 >= want * want) continue; // apart
             const double dist = std::sqrt(dist2);
             // the way from b to a; where the axes meet (two stems crossing on one surface), across both
@@ -399,6 +414,35 @@ double World::separate_links(bool find) {
         if (worst < kLinksParted) break;
     }
     return first;
+}
+
+namespace {
+// rounds of link contacts and obstacles a step at most (part_plants)
+constexpr int kLinkRounds = 32;
+} // namespace
+
+void World::part_plants() {
+    // The rounds alternate with the obstacles (the pairs' own pushes keep only the pushed links
+    // out of them): a stem pressed between another plant's stem and a thin rail is parted from
+    // both within a few rounds, the obstacles having the last word. Stems stacked on a support
+    // need more: rounds follow until the first sweep of one finds every pair within kLinksParted
+    // (docs/physics.md, "Plant-plant collision").
+    auto& before = scratch_.anchored_before;
+    before.resize(anchors_.size());
+    for (std::size_t k = 0; k < anchors_.size(); ++k) before[k] = x_[anchors_[k].particle];
+    for (int round = 0; round < kLinkRounds; ++round) {
+        const double met = separate_links(round == 0); // the candidate pairs are found once a step
+        if (met > 0) resolve_segments(false);          // after any push
+        if (met < kLinksParted) break;                 // parted: no more rounds
+    }
+    // An anchored particle that the rounds moved holds on where they left it, to the stem that
+    // pushed it (as ivy climbs over ivy): its anchor point moves as far. Held where it was made,
+    // the anchor pulled the particle back into the other plant's stem at every step (a stem born
+    // on top of another, or pushed off its hold), the rounds pushed it out again, and where
+    // plants pile the stems jittered by centimetres and overlapped by millimetres
+    // (docs/physics.md, "Anchors give way to other plants").
+    for (std::size_t k = 0; k < anchors_.size(); ++k)
+        anchors_[k].point += x_[anchors_[k].particle] - before[k];
 }
 
 } // namespace plant::physics

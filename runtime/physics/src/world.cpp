@@ -12,11 +12,6 @@
 
 namespace plant::physics {
 
-namespace {
-// rounds of link contacts and obstacles a step at most, with plant_contacts (World::step)
-constexpr int kLinkRounds = 32;
-} // namespace
-
 Handle World::add_root(const glm::dvec3& position_in, const glm::dquat& orientation_in,
                        const glm::dvec3& radii_in, bool fixed) {
     // copies first: the arguments may refer into the arrays that grow below
@@ -113,6 +108,12 @@ void World::remove_obstacle(std::size_t k) {
         if (a.obstacle != ~std::size_t{0} && a.obstacle > k) --a.obstacle;
 }
 
+glm::dvec3 World::anchor_of(Handle h) const {
+    for (const auto& a : anchors_)
+        if (a.particle == h.index) return anchor_point(a);
+    return glm::dvec3(std::numeric_limits<double>::quiet_NaN());
+}
+
 bool World::anchored(Handle h) const {
     for (const auto& a : anchors_)
         if (a.particle == h.index) return true;
@@ -147,18 +148,8 @@ void World::step() {
     // and the links between particles, as capsules, out of the obstacles (segment_contacts.cpp)
     weigh_particles();
     resolve_segments(true);
-    // and the links of different plants, as capsules, apart (link_contacts.cpp), alternating with
-    // the obstacles (the pairs' own pushes keep only the pushed links out of them): a stem pressed
-    // between another plant's stem and a thin rail is parted from both within a few rounds, the
-    // obstacles having the last word. Stems stacked on a support need more: rounds follow until
-    // the first sweep of one finds every pair within kLinksParted (docs/physics.md, "Plant-plant
-    // collision")
-    if (settings_.collisions && settings_.link_collisions)
-        for (int round = 0; round < kLinkRounds; ++round) {
-            const double met = separate_links(round == 0); // the candidate pairs are found once a step
-            if (met > 0) resolve_segments(false);          // after any push
-            if (met < kLinksParted) break;                 // parted: no more rounds
-        }
+    // and the links of different plants, as capsules, apart (link_contacts.cpp)
+    if (settings_.collisions && settings_.link_collisions) part_plants();
     double collision_ms = ms(clock::now() - t0).count();
     t0 = clock::now();
     integrate();

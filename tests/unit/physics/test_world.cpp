@@ -467,6 +467,52 @@ TEST_CASE("plant-plant collision: stems of two plants crossing between their par
     CHECK(deepest(true) < 0.001);   // within a millimetre of apart at every step
 }
 
+TEST_CASE("plant-plant collision: an anchored stem pushed off by another plant's stem holds on where it "
+          "is pushed to",
+          "[physics]") {
+    // Two plants lying across each other on the ground, every particle anchored where it lies:
+    // b's middle particle lies on the axis of a link of a, so its anchor point is inside a's stem
+    // (as when a stem is born on top of another, or pushed off its hold). The contact rounds
+    // lift it onto a, and its anchor moves as far: it holds on to a (docs/physics.md, "Anchors
+    // give way to other plants"). Held where it was made, the anchor would pull it back into a at
+    // every step and the rounds push it out again: where plants pile, stems jittered by
+    // centimetres. Without the anchor moving, its point stays on a's axis and this fails.
+    Settings s;
+    s.fixed_stiffness = 0.5;
+    s.link_collisions = true;
+    World w(s);
+    w.add_obstacle({Obstacle::Plane, {0, 0, 0}, {0, 1, 0}});
+    const double radius = 0.003;
+    const glm::dvec3 r(radius);
+    const glm::dquat along_x = glm::rotation(glm::dvec3(0, 1, 0), glm::dvec3(1, 0, 0));
+    const glm::dquat along_z = glm::rotation(glm::dvec3(0, 1, 0), glm::dvec3(0, 0, 1));
+    std::vector<Handle> a{w.add_root({-0.2, radius, 0}, along_x, r)},
+        b{w.add_root({0.025, radius, -0.2}, along_z, r)};
+    for (int k = 1; k <= 8; ++k) {
+        a.push_back(w.add_particle(a.back(), {-0.2 + 0.05 * k, radius, 0}, along_x, r));
+        b.push_back(w.add_particle(b.back(), {0.025, radius, -0.2 + 0.05 * k}, along_z, r));
+    }
+    for (const auto& plant : {a, b})
+        for (const Handle h : plant) w.add_anchor(h, w.position(h), 0.5, 0.3);
+    const Handle on_a = b[4]; // at (0.025, r, 0): on the axis of a's link from (0, r, 0) to (0.05, r, 0)
+    auto off_axis = [&](const glm::dvec3& p) { return std::hypot(p.y - radius, p.z); }; // from a's axis
+    REQUIRE(off_axis(w.anchor_of(on_a)) < 1e-12);
+    glm::dvec3 last = w.position(on_a);
+    double moved_late = 0; // the most it moved in a step over the last ten
+    for (int step = 0; step < 40; ++step) {
+        w.step();
+        if (step >= 30) moved_late = std::max(moved_late, glm::distance(w.position(on_a), last));
+        last = w.position(on_a);
+    }
+    const glm::dvec3 hold = w.anchor_of(on_a);
+    INFO("b's particle " << off_axis(last) * 1000 << " mm off a's axis, its anchor " << off_axis(hold) * 1000
+                         << " mm; it moved up to " << moved_late * 1000 << " mm a step over the last ten");
+    CHECK(off_axis(last) > 2 * radius - 0.0001); // on a, not in it
+    CHECK(off_axis(hold) > 2 * radius - 0.001);  // and held there
+    CHECK(moved_late < 0.0005);                  // at rest
+    CHECK(w.anchored(on_a));
+}
+
 TEST_CASE("growth: a new particle's rest state continues its parent's, also when the parent sags (Eq. 9-10)",
           "[physics]") {
     Settings s;

@@ -182,6 +182,9 @@ class World {
     // fixed point.
     void add_anchor(Handle h, const glm::dvec3& point, double phi, double release);
     bool anchored(Handle h) const;
+    // Where h's first anchor holds it now (its obstacle's moves and the plant-plant contacts'
+    // pushes included); NaN when h has none.
+    glm::dvec3 anchor_of(Handle h) const;
     // Whether h is anchored to obstacle k.
     bool anchored_to(Handle h, std::size_t k) const;
     void add_obstacle(const Obstacle& o) {
@@ -390,6 +393,9 @@ class World {
     // the step's rounds of it and the obstacles, once no pair overlaps by kLinksParted.
     double separate_links(bool find);
     static constexpr double kLinksParted = 1e-4;
+    // the rounds of separate_links and the obstacles that part the plants in a step; the anchors
+    // of the particles they moved move with them
+    void part_plants();
     void integrate(); // Eq. 17-18 with damping, and contacts with obstacles
     // energy.cpp: each particle's mechanical energy before the step and the forcing on it (open,
     // before predict); after integrate, a particle that ends the step with more than that energy
@@ -493,12 +499,14 @@ class World {
         Array<glm::i64vec3> link_range_lo, link_range_hi; // (grid_link_pairs) each link's cells
         Array<LinkCell> link_cells;
         Array<std::pair<std::uint32_t, std::uint32_t>> link_pairs;
-        Array<std::uint32_t> link_big; // link contacts: boxes too large for the grid
+        Array<std::uint32_t> link_near; // (separate_links) the pairs its later sweeps visit
+        Array<std::uint32_t> link_big;  // link contacts: boxes too large for the grid
         // the energy budget (energy.cpp): the forcing on each particle this step, its energy
         // per unit mass before the step, and whether the hand holds it
         Array<glm::dvec3> forcing;
         Array<double> energy_before;
         Array<std::uint8_t> held;
+        Array<glm::dvec3> anchored_before; // (part_plants) each anchor's particle before the rounds
 
         static double thin_of(std::uint32_t i, const Array<glm::dvec3>& radii) {
             return std::min({radii[i].x, radii[i].y, radii[i].z});
