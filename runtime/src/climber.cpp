@@ -38,7 +38,7 @@ constexpr EnvMethod kClimberMethods[] = {
                "light occlusion at p, 0 to 1: 1 behind an obstacle (1 - diffuse * sky seen, with `diffuse`), "
                "else by the plant's particles"),
     env_method(M::Anchored, "anchored", {N}, N, Pure, false,
-               "1 when module id's particle is anchored to a surface"),
+               "1 when module id's particle is anchored (to a surface, or lying on another plant's stem)"),
     env_method(M::Particles, "particles", {}, N, Pure, false, "particles in the world"),
     env_method(M::Seeded, "seeded", {N}, N, Pure, false,
                "1 in the step after a hook seeded a branch at module id (ivy.seed(id))"),

@@ -1,4 +1,4 @@
-// Links of different plants against each other (docs/physics.md, "Plant-plant collision"; issue
+// Links of different plants against each other (docs/plant-contacts.md; issue
 // 18 item 4). The particles of two plants collide as spheres (collisions.cpp), but a link is
 // longer than its stem is thick, so two stems crossing between their particles went through each
 // other (up to 7 mm deep with 6 mm stems). Here every link is a capsule of its particle's
@@ -62,7 +62,7 @@ constexpr int kSweeps = 16;
 
 // Over-relaxation of each push (successive over-relaxation of the Gauss-Seidel sweeps): a stem
 // pressed between a support and a heavier stem is parted a little more each sweep when the push
-// goes 30 % past contact (docs/physics.md, "Plant-plant collision")
+// goes 30 % past contact (docs/plant-contacts.md, "Rounds until parted, over-relaxed")
 constexpr double kOverRelax = 1.3;
 
 // The later sweeps of a call visit the pairs its first sweep found closer than this many times
@@ -426,7 +426,7 @@ void World::part_plants() {
     // out of them): a stem pressed between another plant's stem and a thin rail is parted from
     // both within a few rounds, the obstacles having the last word. Stems stacked on a support
     // need more: rounds follow until the first sweep of one finds every pair within kLinksParted
-    // (docs/physics.md, "Plant-plant collision").
+    // (docs/plant-contacts.md, "Rounds until parted, over-relaxed").
     auto& before = scratch_.anchored_before;
     before.resize(anchors_.size());
     for (std::size_t k = 0; k < anchors_.size(); ++k) before[k] = x_[anchors_[k].particle];
@@ -440,9 +440,12 @@ void World::part_plants() {
     // the anchor pulled the particle back into the other plant's stem at every step (a stem born
     // on top of another, or pushed off its hold), the rounds pushed it out again, and where
     // plants pile the stems jittered by centimetres and overlapped by millimetres
-    // (docs/physics.md, "Anchors give way to other plants").
-    for (std::size_t k = 0; k < anchors_.size(); ++k)
-        anchors_[k].point += x_[anchors_[k].particle] - before[k];
+    // (docs/plant-contacts.md, "Anchors give way to other plants").
+    for (std::size_t k = 0; k < anchors_.size(); ++k) {
+        const glm::dvec3 moved = x_[anchors_[k].particle] - before[k];
+        if (std::isfinite(moved.x) && std::isfinite(moved.y) && std::isfinite(moved.z))
+            anchors_[k].point += moved;
+    }
 }
 
 } // namespace plant::physics

@@ -285,7 +285,7 @@ void World::resolve_segments(bool fresh) {
     // same positions a contact sweep does nothing to such a link: its length was brought within
     // the bounds of the contact sweeps just before (so the clamp below leaves it), and the
     // obstacles, the masses and the held particles do not change within a step. So the later
-    // calls of a step (after each round of links of different plants, World::step) test only the
+    // calls of a step (after each round of links of different plants, World::part_plants) test only the
     // links some push has moved since; the result is the same bit for bit. Fig. 14 right at 100
     // steps: of 57.9 million visits of a link, 25.5 million are passed over so, and of the
     // remaining 31.8 million contact tests 8.0 million below (the run 1.04 times as fast)

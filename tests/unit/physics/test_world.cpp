@@ -476,7 +476,10 @@ TEST_CASE("plant-plant collision: an anchored stem pushed off by another plant's
     // lift it onto a, and its anchor moves as far: it holds on to a (docs/physics.md, "Anchors
     // give way to other plants"). Held where it was made, the anchor would pull it back into a at
     // every step and the rounds push it out again: where plants pile, stems jittered by
-    // centimetres. Without the anchor moving, its point stays on a's axis and this fails.
+    // centimetres (measured on fig14_left's seeds, docs/physics.md; here, with two stems, the
+    // held anchor and the rounds settle into the same end positions every step). What tells the
+    // two apart here is where the anchor holds: without it moving, its point stays on a's axis
+    // and the second check fails.
     Settings s;
     s.fixed_stiffness = 0.5;
     s.link_collisions = true;
@@ -510,7 +513,6 @@ TEST_CASE("plant-plant collision: an anchored stem pushed off by another plant's
     CHECK(off_axis(last) > 2 * radius - 0.0001); // on a, not in it
     CHECK(off_axis(hold) > 2 * radius - 0.001);  // and held there
     CHECK(moved_late < 0.0005);                  // at rest
-    CHECK(w.anchored(on_a));
 }
 
 TEST_CASE("growth: a new particle's rest state continues its parent's, also when the parent sags (Eq. 9-10)",

@@ -389,8 +389,16 @@ std::string text_of(const std::filesystem::path& file) {
     return text.str();
 }
 
+// (in the grammar's code, not in a comment)
 bool sets_plant_contacts(const std::filesystem::path& grammar) {
-    return text_of(grammar).find("plant_contacts: 1") != std::string::npos;
+    std::istringstream text(text_of(grammar));
+    for (std::string line; std::getline(text, line);) {
+        const std::size_t code = line.find_first_not_of(" \t");
+        if (code != std::string::npos && line[code] != '#' &&
+            line.find("plant_contacts: 1") != std::string::npos)
+            return true;
+    }
+    return false;
 }
 
 // the deepest overlap of two plants' links over a climber grammar's steps within kCapsuleTolerance
@@ -409,9 +417,9 @@ void check_plant_overlap(const std::filesystem::path& grammar) {
 } // namespace
 
 // Issue 18 item 2: links of different plants collided as capsules (`plant_contacts: 1`), in
-// rounds alternating with the obstacles (World::part_plants, docs/physics.md "Plant-plant
-// collision"). Every climber grammar keeps two plants' links within kCapsuleTolerance at every
-// step. Those with more than one plant touching set `plant_contacts: 1`: fig01_car,
+// rounds alternating with the obstacles (World::part_plants, docs/plant-contacts.md). Every
+// climber grammar keeps two plants' links within kCapsuleTolerance at every step. Those with
+// more than one plant touching set `plant_contacts: 1`: fig01_car,
 // fig01_column, fig05_branching, fig08_painted_wall, fig09_boxes, fig10_dome, fig11_fence,
 // fig14_left and fig14_right; the others have one plant or none touching (fig06, fig07, fig12).
 // Measured without what made each hold: with one round a step instead of four, fig01_car's,

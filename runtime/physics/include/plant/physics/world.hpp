@@ -74,8 +74,8 @@ struct Settings {
     // Plant-plant and self collision between particles not joined to each other (section 5.2).
     bool collisions = true;
     // Links of different plants collided as capsules (link_contacts.cpp; needs `collisions`).
-    // Off by default for now: on, a push can carry a link through a thin rail
-    // (docs/physics.md, "Plant-plant collision").
+    // Off by default; a climber grammar switches it on with `plant_contacts: 1`
+    // (docs/plant-contacts.md).
     bool link_collisions = false;
     // No step gives a particle mechanical energy that gravity, the wind and the air did not give
     // it (energy.cpp; docs/physics.md, "The energy budget"). Off: the solver as it was before.
@@ -389,8 +389,9 @@ class World {
     void find_link_pairs();
     void grid_link_pairs(double cell); // (find_link_pairs)
     // with find false, the pairs found by the last call are pushed again (a later round of a
-    // step); returns the deepest overlap its first sweep pushed (0: none). Its sweeps stop, and
-    // the step's rounds of it and the obstacles, once no pair overlaps by kLinksParted.
+    // step); returns the deepest overlap its first sweep pushed (0: none). Its first sweep visits
+    // every pair, the later ones those the first found near; they stop once none of those
+    // overlaps by kLinksParted, and the step's rounds once a first sweep finds none that does.
     double separate_links(bool find);
     static constexpr double kLinksParted = 1e-4;
     // the rounds of separate_links and the obstacles that part the plants in a step; the anchors
@@ -414,13 +415,12 @@ class World {
     Array<std::uint8_t> fixed_, alive_;
     struct Anchor {
         std::uint32_t particle;
-        glm::dvec3 point; // where it was made
+        glm::dvec3 point; // where it was made, moved by the plant-plant rounds since (part_plants)
         double phi, release;
         std::size_t obstacle = ~std::size_t{0}; // none: a fixed point in the world
         glm::dvec3 origin{0.0};                 // the obstacle's `a` when it was made
     };
-    // where the anchor is now: moved as far as its obstacle has moved since (exactly where it was
-    // made while the obstacle stays put)
+    // where the anchor is now: `point` moved as far as its obstacle has moved since it was made
     glm::dvec3 anchor_point(const Anchor& a) const {
         return a.obstacle < obstacles_.size() ? a.point + (obstacles_[a.obstacle].a - a.origin) : a.point;
     }
