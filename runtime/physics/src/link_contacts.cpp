@@ -60,6 +60,9 @@ constexpr double kStretch = 1.02;
 // sweeps over the pairs a call at most; they stop once none overlaps by kLinksParted
 constexpr int kSweeps = 16;
 
+// rounds of link contacts and obstacles a step at most (part_plants)
+constexpr int kLinkRounds = 32;
+
 // Over-relaxation of each push (successive over-relaxation of the Gauss-Seidel sweeps): a stem
 // pressed between a support and a heavier stem is parted a little more each sweep when the push
 // goes 30 % past contact (docs/plant-contacts.md, "Rounds until parted, over-relaxed")
@@ -415,11 +418,6 @@ double World::separate_links(bool find) {
     }
     return first;
 }
-
-namespace {
-// rounds of link contacts and obstacles a step at most (part_plants)
-constexpr int kLinkRounds = 32;
-} // namespace
 
 void World::part_plants() {
     // The rounds alternate with the obstacles (the pairs' own pushes keep only the pushed links

@@ -108,16 +108,19 @@ void World::remove_obstacle(std::size_t k) {
         if (a.obstacle != ~std::size_t{0} && a.obstacle > k) --a.obstacle;
 }
 
-glm::dvec3 World::anchor_of(Handle h) const {
+const World::Anchor* World::anchor_for(Handle h) const {
     for (const auto& a : anchors_)
-        if (a.particle == h.index) return anchor_point(a);
-    return glm::dvec3(std::numeric_limits<double>::quiet_NaN());
+        if (a.particle == h.index) return &a;
+    return nullptr;
+}
+
+glm::dvec3 World::anchor_of(Handle h) const {
+    const Anchor* a = anchor_for(h);
+    return a ? anchor_point(*a) : glm::dvec3(std::numeric_limits<double>::quiet_NaN());
 }
 
 bool World::anchored(Handle h) const {
-    for (const auto& a : anchors_)
-        if (a.particle == h.index) return true;
-    return false;
+    return anchor_for(h) != nullptr;
 }
 
 std::size_t World::components() const {

@@ -473,10 +473,10 @@ TEST_CASE("plant-plant collision: an anchored stem pushed off by another plant's
     // Two plants lying across each other on the ground, every particle anchored where it lies:
     // b's middle particle lies on the axis of a link of a, so its anchor point is inside a's stem
     // (as when a stem is born on top of another, or pushed off its hold). The contact rounds
-    // lift it onto a, and its anchor moves as far: it holds on to a (docs/physics.md, "Anchors
-    // give way to other plants"). Held where it was made, the anchor would pull it back into a at
+    // lift it onto a, and its anchor moves as far: it holds on to a (docs/plant-contacts.md,
+    // "Anchors give way to other plants"). Held where it was made, the anchor would pull it back into a at
     // every step and the rounds push it out again: where plants pile, stems jittered by
-    // centimetres (measured on fig14_left's seeds, docs/physics.md; here, with two stems, the
+    // centimetres (measured on fig14_left's seeds, docs/plant-contacts.md; here, with two stems, the
     // held anchor and the rounds settle into the same end positions every step). What tells the
     // two apart here is where the anchor holds: without it moving, its point stays on a's axis
     // and the second check fails.

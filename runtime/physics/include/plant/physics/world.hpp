@@ -424,6 +424,7 @@ class World {
     glm::dvec3 anchor_point(const Anchor& a) const {
         return a.obstacle < obstacles_.size() ? a.point + (obstacles_[a.obstacle].a - a.origin) : a.point;
     }
+    const Anchor* anchor_for(Handle h) const; // h's first anchor, or nullptr
     std::vector<Anchor> anchors_;
     double peak_speed_ = 0, unexplained_speed_ = 0;
     Array<double> highest_; // each particle's highest potential per unit mass at a step's ends
