@@ -186,6 +186,7 @@ class Climber : public Environment {
     const Bound* bound(ModuleId id) const;
     Bound* bound(ModuleId id) { return const_cast<Bound*>(std::as_const(*this).bound(id)); }
     std::vector<physics::Handle> roots_; // the fixed roots made for plants' first segments
+    std::vector<std::uint8_t> attached_; // (advance) World::attached_all, kept for its memory
     std::vector<std::pair<std::size_t, std::vector<glm::dvec3>>> meshes_; // obstacle index, its triangles
     std::vector<BoundSegment> pending_; // bound modules without a particle yet
     // edits asked for by hooks since the last advance

@@ -77,6 +77,12 @@ bool World::attached(Handle h) const {
     return fixed_[i] != 0;
 }
 
+void World::attached_all(std::vector<std::uint8_t>& out) const {
+    out.assign(x_.size(), 0);
+    for (std::size_t i = 0; i < x_.size(); ++i)
+        if (alive_[i]) out[i] = parent_[i] == kNone ? (fixed_[i] != 0) : out[parent_[i]];
+}
+
 bool World::alive(Handle h) const {
     return h.index < x_.size() && generation_[h.index] == h.generation && alive_[h.index];
 }

@@ -147,6 +147,9 @@ class World {
     void remove(Handle h);
     // Whether h still hangs from a fixed root (false once its branch broke off or was cut).
     bool attached(Handle h) const;
+    // attached() of every slot at once, in one pass (a parent's index is below its children's):
+    // 1 where the particle is alive and hangs from a fixed root
+    void attached_all(std::vector<std::uint8_t>& out) const;
     // External acceleration a_e of Eq. 1 on every free particle (a steady wind).
     void set_wind(const glm::dvec3& a) { wind_ = a; }
     const std::vector<Obstacle>& obstacles() const { return obstacles_; }
