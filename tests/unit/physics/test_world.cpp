@@ -258,9 +258,42 @@ TEST_CASE("pulling a tip past the threshold breaks the branch and the loose part
         c.world.step();
     }
     CHECK(c.world.components() == 2);
+    // the loose part no longer hangs from the root; attached_all (one pass) says the same as
+    // attached (a walk to the root) of every slot
+    CHECK(c.world.attached(c.p.front()));
+    CHECK(!c.world.attached(c.p.back()));
+    std::vector<std::uint8_t> all;
+    c.world.attached_all(all);
+    REQUIRE(all.size() == c.world.size());
+    for (std::uint32_t i = 0; i < c.world.size(); ++i)
+        CHECK((all[i] != 0) == c.world.attached(c.world.handle(i)));
     double y0 = c.world.position(c.p.back()).y;
     c.run(1);
     CHECK(c.world.position(c.p.back()).y < y0 - 1.0); // a second of free fall
+}
+
+TEST_CASE("attached_all says of every slot what attached says, a loose part of several particles included",
+          "[physics]") {
+    Cantilever c(1.0);
+    c.world.set_break_threshold(0.2);
+    // the middle of the stem dragged down, further each step, until it breaks off with the
+    // particles beyond it
+    for (int k = 1; k <= 10 && c.world.components() == 1; ++k) {
+        c.world.pull(c.p[5], c.world.rest_position(c.p[5]) + glm::dvec3(0, -0.1 * k, 0));
+        c.world.step();
+    }
+    REQUIRE(c.world.components() >= 2);
+    std::vector<std::uint8_t> all;
+    c.world.attached_all(all);
+    REQUIRE(all.size() == c.world.size());
+    std::size_t loose_below_a_parent = 0; // loose particles that still hang from a loose parent
+    for (std::uint32_t i = 0; i < c.world.size(); ++i) {
+        const Handle h = c.world.handle(i);
+        CHECK((all[i] != 0) == c.world.attached(h));
+        if (!c.world.attached(h) && c.world.parent(h) != ~0u) ++loose_below_a_parent;
+    }
+    CHECK(loose_below_a_parent >= 1);
+    CHECK(all[c.p.front().index] == 1);
 }
 
 namespace {
