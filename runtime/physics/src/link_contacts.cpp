@@ -72,6 +72,9 @@ constexpr double kOverRelax = 1.3;
 // their contact distance (separate_links); 1.5: half a contact distance apart at most
 constexpr double kNearSlack = 1.5;
 
+// A particle within its radius and this much of a support lies on it (part_plants)
+constexpr double kOnSupport = 0.002;
+
 // Lists each oversized link (find_link_pairs) with every other link of another plant whose bounds
 // it meets.
 void pair_oversized(const Array<std::uint32_t>& big, const Array<std::uint32_t>& links,
@@ -443,6 +446,26 @@ void World::part_plants() {
         const glm::dvec3 moved = x_[anchors_[k].particle] - before[k];
         if (std::isfinite(moved.x) && std::isfinite(moved.y) && std::isfinite(moved.z))
             anchors_[k].point += moved;
+    }
+    // A particle lying on a support (within its radius and kOnSupport) whose anchor the pushes of
+    // earlier steps lifted off every support holds on to that support where it lies: the lifted
+    // anchor would pull it off the support again (docs/plant-contacts.md, "Back on a support").
+    for (Anchor& a : anchors_) {
+        const glm::dvec3 x = x_[a.particle];
+        const double r = scratch_.thin_of(a.particle, radii_);
+        std::size_t under = ~std::size_t{0};
+        double gap = 0;
+        for (std::size_t o = 0; o < obstacles_.size() && under == ~std::size_t{0}; ++o)
+            if (const double d = distance_to(o, x); std::fabs(d - r) <= kOnSupport) under = o, gap = d;
+        if (under == ~std::size_t{0}) continue;
+        const glm::dvec3 p = anchor_point(a);
+        bool on_one = false;
+        for (std::size_t o = 0; o < obstacles_.size() && !on_one; ++o)
+            on_one = std::fabs(distance_to(o, p)) <= r + kOnSupport;
+        if (on_one || !(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z))) continue;
+        a.obstacle = under;
+        a.origin = obstacles_[under].a;
+        a.point = x - surface_normal(obstacles_[under], x) * (gap - r);
     }
 }
 

@@ -501,7 +501,7 @@ TEST_CASE("plant-plant collision: stems of two plants crossing between their par
 }
 
 TEST_CASE("plant-plant collision: an anchored stem pushed off by another plant's stem holds on where it "
-          "is pushed to",
+          "is pushed to, and back on the ground holds on to the ground",
           "[physics]") {
     // Two plants lying across each other on the ground, every particle anchored where it lies:
     // b's middle particle lies on the axis of a link of a, so its anchor point is inside a's stem
@@ -546,6 +546,17 @@ TEST_CASE("plant-plant collision: an anchored stem pushed off by another plant's
     CHECK(off_axis(last) > 2 * radius - 0.0001); // on a, not in it
     CHECK(off_axis(hold) > 2 * radius - 0.001);  // and held there
     CHECK(moved_late < 0.0005);                  // at rest
+    // Then a is cut away and b's particle pressed back onto the ground (as a stem on top of it
+    // would; a pull holds it there for a step): lying on the ground, it holds on to the ground
+    // again, where it lies. With its anchor left where a had lifted it, the anchor pulls it back
+    // up off the ground (docs/plant-contacts.md, "Back on a support"): the checks below fail.
+    w.remove(a[0]);
+    w.pull(on_a, {0.025, radius, 0});
+    for (int step = 0; step < 20; ++step) w.step();
+    INFO("b's particle " << (w.position(on_a).y - radius) * 1000 << " mm off the ground, its anchor "
+                         << (w.anchor_of(on_a).y - radius) * 1000 << " mm");
+    CHECK(w.anchor_of(on_a).y < radius + 0.001);
+    CHECK(w.position(on_a).y < radius + 0.001);
 }
 
 TEST_CASE("growth: a new particle's rest state continues its parent's, also when the parent sags (Eq. 9-10)",
