@@ -4,8 +4,8 @@
 Every line of a ```sh block that starts with `build/plant` or `printf` runs, in order, with
 bash in a scratch folder that holds `build/plant` (the plant under test) and links to the
 repository's `grammars/` and `bench/`, so outputs land in the scratch folder. Each must exit 0 within
-120 s, and every `out/...` file its comment names must then exist. Two kinds of line are
-changed or left out, and said so in the output:
+120 s, and every `out/...` file its comment names must then exist. Three kinds of line are
+changed or left out, and said so in the output (and `make` lines are not `plant` commands: not run):
 - `plant test ...` is not run: ctest runs the same golden files and scripts itself (and
   `--bless` would rewrite the repository's files);
 - `plant view` and `plant repl` are not run: they serve or read a terminal until stopped (their
@@ -55,7 +55,7 @@ def main():
                 print(f"README.md:{number}: run with --seeds 1..12")
             try:
                 done = subprocess.run(["bash", "-c", command], cwd=scratch, capture_output=True,
-                                      text=True, timeout=120)
+                                      text=True, timeout=120, env=dict(os.environ, HOME=scratch))
             except subprocess.TimeoutExpired:
                 failures.append(f"README.md:{number}: over 120 s: {command.strip()}")
                 continue

@@ -447,16 +447,21 @@ void World::part_plants() {
         if (std::isfinite(moved.x) && std::isfinite(moved.y) && std::isfinite(moved.z))
             anchors_[k].point += moved;
     }
-    // A particle lying on a support (within its radius and kOnSupport) whose anchor the pushes of
-    // earlier steps lifted off every support holds on to that support where it lies: the lifted
-    // anchor would pull it off the support again (docs/plant-contacts.md, "Back on a support").
+    // A particle lying on a support (within its radius and kOnSupport of the nearest) whose
+    // anchor, made on a support, the pushes of earlier steps lifted off every support holds on to
+    // that support where it lies: the lifted anchor would pull it off the support again
+    // (docs/plant-contacts.md, "Back on a support"). The anchor goes to the particle itself (out
+    // to its radius, were it a little inside), not down onto the support: the rounds may just
+    // have lifted the particle onto a stem beside it.
     for (Anchor& a : anchors_) {
+        if (a.obstacle >= obstacles_.size()) continue; // (a fixed point in the world stays one)
         const glm::dvec3 x = x_[a.particle];
         const double r = scratch_.thin_of(a.particle, radii_);
         std::size_t under = ~std::size_t{0};
-        double gap = 0;
-        for (std::size_t o = 0; o < obstacles_.size() && under == ~std::size_t{0}; ++o)
-            if (const double d = distance_to(o, x); std::fabs(d - r) <= kOnSupport) under = o, gap = d;
+        double gap = 0, nearest = kOnSupport;
+        for (std::size_t o = 0; o < obstacles_.size(); ++o)
+            if (const double d = distance_to(o, x); std::fabs(d - r) <= nearest)
+                nearest = std::fabs(d - r), under = o, gap = d;
         if (under == ~std::size_t{0}) continue;
         const glm::dvec3 p = anchor_point(a);
         bool on_one = false;
@@ -465,7 +470,7 @@ void World::part_plants() {
         if (on_one || !(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z))) continue;
         a.obstacle = under;
         a.origin = obstacles_[under].a;
-        a.point = x - surface_normal(obstacles_[under], x) * (gap - r);
+        a.point = x - surface_normal(obstacles_[under], x) * std::min(gap - r, 0.0);
     }
 }
 

@@ -78,9 +78,12 @@ bool World::attached(Handle h) const {
 }
 
 void World::attached_all(std::vector<std::uint8_t>& out) const {
+    // whether each slot's chain of parents ends at a fixed root (dead slots too, as attached()
+    // walks through them), then only the live ones
     out.assign(x_.size(), 0);
     for (std::size_t i = 0; i < x_.size(); ++i)
-        if (alive_[i]) out[i] = parent_[i] == kNone ? (fixed_[i] != 0) : out[parent_[i]];
+        out[i] = parent_[i] == kNone ? (fixed_[i] != 0) : out[parent_[i]];
+    for (std::size_t i = 0; i < x_.size(); ++i) out[i] = out[i] && alive_[i];
 }
 
 bool World::alive(Handle h) const {

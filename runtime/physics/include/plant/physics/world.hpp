@@ -186,7 +186,8 @@ class World {
     void add_anchor(Handle h, const glm::dvec3& point, double phi, double release);
     bool anchored(Handle h) const;
     // Where h's first anchor holds it now (its obstacle's moves and the plant-plant contacts'
-    // pushes included); NaN when h has none.
+    // pushes included, remade where h lies when they had lifted it off while h is back on a
+    // support: part_plants); NaN when h has none.
     glm::dvec3 anchor_of(Handle h) const;
     // Whether h is anchored to obstacle k.
     bool anchored_to(Handle h, std::size_t k) const;
@@ -398,7 +399,7 @@ class World {
     double separate_links(bool find);
     static constexpr double kLinksParted = 1e-4;
     // the rounds of separate_links and the obstacles that part the plants in a step; the anchors
-    // of the particles they moved move with them
+    // of the particles they moved move with them, and a particle back on a support holds on to it
     void part_plants();
     void integrate(); // Eq. 17-18 with damping, and contacts with obstacles
     // energy.cpp: each particle's mechanical energy before the step and the forcing on it (open,
@@ -418,10 +419,11 @@ class World {
     Array<std::uint8_t> fixed_, alive_;
     struct Anchor {
         std::uint32_t particle;
-        glm::dvec3 point; // where it was made, moved by the plant-plant rounds since (part_plants)
+        glm::dvec3
+            point; // where it was made or last remade, moved by the plant-plant rounds since (part_plants)
         double phi, release;
         std::size_t obstacle = ~std::size_t{0}; // none: a fixed point in the world
-        glm::dvec3 origin{0.0};                 // the obstacle's `a` when it was made
+        glm::dvec3 origin{0.0};                 // the obstacle's `a` when `point` was set
     };
     // where the anchor is now: `point` moved as far as its obstacle has moved since it was made
     glm::dvec3 anchor_point(const Anchor& a) const {
