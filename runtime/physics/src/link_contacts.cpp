@@ -444,8 +444,7 @@ void World::part_plants() {
     // (docs/plant-contacts.md, "Anchors give way to other plants").
     for (std::size_t k = 0; k < anchors_.size(); ++k) {
         const glm::dvec3 moved = x_[anchors_[k].particle] - before[k];
-        if (std::isfinite(moved.x) && std::isfinite(moved.y) && std::isfinite(moved.z))
-            anchors_[k].point += moved;
+        if (finite(moved)) anchors_[k].point += moved;
     }
     // A particle lying on a support (within its radius and kOnSupport of the nearest) whose
     // anchor, made on a support, the pushes of earlier steps lifted off every support holds on to
@@ -467,7 +466,7 @@ void World::part_plants() {
         bool on_one = false;
         for (std::size_t o = 0; o < obstacles_.size() && !on_one; ++o)
             on_one = std::fabs(distance_to(o, p)) <= r + kOnSupport;
-        if (on_one || !(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z))) continue;
+        if (on_one || !finite(p)) continue;
         a.obstacle = under;
         a.origin = obstacles_[under].a;
         a.point = x - surface_normal(obstacles_[under], x) * std::min(gap - r, 0.0);

@@ -419,13 +419,13 @@ class World {
     Array<std::uint8_t> fixed_, alive_;
     struct Anchor {
         std::uint32_t particle;
-        glm::dvec3
-            point; // where it was made or last remade, moved by the plant-plant rounds since (part_plants)
+        // where it was made or last remade, moved by the plant-plant rounds since (part_plants)
+        glm::dvec3 point;
         double phi, release;
         std::size_t obstacle = ~std::size_t{0}; // none: a fixed point in the world
         glm::dvec3 origin{0.0};                 // the obstacle's `a` when `point` was set
     };
-    // where the anchor is now: `point` moved as far as its obstacle has moved since it was made
+    // where the anchor is now: `point` moved as far as its obstacle has moved since it was set
     glm::dvec3 anchor_point(const Anchor& a) const {
         return a.obstacle < obstacles_.size() ? a.point + (obstacles_[a.obstacle].a - a.origin) : a.point;
     }
