@@ -5,6 +5,7 @@
 #include "grammar.hpp"
 #include "grammar_errors.hpp"
 #include "habits.hpp"
+#include "parse_node.hpp"
 
 #include <fmt/format.h>
 #include <tao/pegtl/contrib/parse_tree.hpp>
@@ -16,7 +17,6 @@ namespace plant {
 
 namespace g = grammar;
 namespace pt = tao::pegtl::parse_tree;
-using Node = pt::node;
 
 template <typename Rule>
 using selector = pt::selector<
@@ -689,7 +689,7 @@ std::unique_ptr<ast::File> parse_file(const SourceManager& sources, std::uint32_
                                       lc.line, lc.col);
         g::ParseState state;
         try {
-            auto root = pt::parse<g::item_or_end, selector, tao::pegtl::nothing, g::control>(in, state);
+            auto root = pt::parse<g::item_or_end, Node, selector, tao::pegtl::nothing, g::control>(in, state);
             if (!root) break;
             if (root->children.empty()) break; // end of file
             for (const auto& c : root->children) lower.item(*c, *file);
@@ -714,8 +714,8 @@ ast::ExprPtr parse_one(tao::pegtl::memory_input<>& in, const SourceFile& src, st
                        Span whole, Diagnostics& diags) {
     g::ParseState state;
     try {
-        auto root = pt::parse<tao::pegtl::seq<g::ws, Rule, tao::pegtl::eof>, selector, tao::pegtl::nothing,
-                              g::control>(in, state);
+        auto root = pt::parse<tao::pegtl::seq<g::ws, Rule, tao::pegtl::eof>, Node, selector,
+                              tao::pegtl::nothing, g::control>(in, state);
         if (!root || root->children.empty()) {
             diags.error(whole, "expected an expression");
             return nullptr;
