@@ -26,7 +26,7 @@ test: build format-check
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
 # The sanitizer job (docs/testing.md): plant and the unit tests built with ASan and UBSan into
-# build-asan/, the tests, the hostile inputs and the mutation fuzzer run on them; under 30 minutes.
+# build-asan/, the tests, the hostile inputs and the mutation fuzzer run on them (docs/testing.md).
 test-sanitize: | deps
 	bash scripts/test-sanitize
 
