@@ -65,7 +65,9 @@ thread_local NodePool node_pool;
 
 } // namespace
 
-void* Node::operator new(std::size_t size) { return size == sizeof(Node) ? node_pool.take() : ::operator new(size); }
+void* Node::operator new(std::size_t size) {
+    return size == sizeof(Node) ? node_pool.take() : ::operator new(size);
+}
 
 void Node::operator delete(void* p, std::size_t size) noexcept {
     if (!p) return;
