@@ -182,9 +182,9 @@ struct Run {
     double height = 0, drawn = 0;
     std::size_t segments = 0;
     Crossings drawn_crossings, world_crossings; // of the skeleton drawn, and of the world's links
-    bool each_step = false;                     // whether to measure the world's links every step:
-    Crossings step_crossings;                   // summed over the steps
-    std::vector<double> peak_speed;             // per derivation step, its physics steps' fastest particle
+    bool each_step = false;         // whether to measure the world's links and particle centres every step:
+    Crossings step_crossings;       // summed over the steps
+    std::vector<double> peak_speed; // per derivation step, its physics steps' fastest particle
     // per derivation step, the most a particle moved faster than its fall gives (check_no_whipping)
     std::vector<double> unexplained;
     double plant_overlap = 0;           // the deepest overlap of links of different plants, any step
