@@ -2,13 +2,23 @@
 #include "commands.hpp"
 #include "version.hpp"
 
+#include "plant/big_pages.hpp"
+
 #include <fmt/format.h>
 
 #include <cstdio>
+#include <cstring>
 #include <iostream>
+#include <thread>
 
 int main(int argc, char** argv) {
     using namespace plant::cli;
+    // `plant run` and `plant derive` derive once, in a process of their own: while the options
+    // are read and the grammar is compiled, the other core clears the page the derivation's
+    // first strings will take (docs/rewriting.md, "A page cleared ahead").
+    if (argc > 1 && (std::strcmp(argv[1], "run") == 0 || std::strcmp(argv[1], "derive") == 0) &&
+        std::thread::hardware_concurrency() > 1)
+        plant::big_pages::clear_ahead();
     CLI::App app{
         "plant: an interpreter for the .plant L-system language.\n"
         "Grammars are parametric, context-sensitive and stochastic L-systems (see docs/language.md).",

@@ -17,8 +17,10 @@
 
 #include <algorithm>
 #include <bit>
+#include <condition_variable>
 #include <mutex>
 #include <sys/mman.h>
+#include <thread>
 
 namespace plant::big_pages {
 
@@ -35,6 +37,18 @@ constexpr std::size_t kKeepAtMost = std::size_t{1} << 30;
 std::mutex lock;
 std::vector<Block> kept; // guarded by lock
 std::size_t kept_total = 0;
+
+// clear_ahead's thread, as it goes (guarded by lock). A block that would take fresh pages while
+// the thread clears its page waits for that page, which is further along than a fresh one would
+// be; if the thread has not started yet, the block takes fresh pages and the thread does nothing.
+enum class Ahead { Idle, Starting, Clearing };
+Ahead ahead_state = Ahead::Idle;
+std::condition_variable ahead_cv;
+
+void await_ahead(std::unique_lock<std::mutex>& guard) {
+    if (ahead_state == Ahead::Starting) ahead_state = Ahead::Idle;
+    ahead_cv.wait(guard, [] { return ahead_state == Ahead::Idle; });
+}
 
 // The free parts of shared pages by size, kShareFrom << k for k = 0..kClasses-1 (guarded by lock).
 constexpr int kClasses = std::countr_zero(kShareTo / kShareFrom) + 1;
@@ -89,7 +103,8 @@ char* reserve(std::size_t bytes) {
 } // namespace
 
 void* map(std::size_t bytes) {
-    std::lock_guard<std::mutex> guard(lock);
+    std::unique_lock<std::mutex> guard(lock);
+    await_ahead(guard);
     return map_locked(bytes);
 }
 
@@ -99,7 +114,7 @@ void unmap(void* p, std::size_t bytes) {
 }
 
 void* map_shared(std::size_t bytes) {
-    std::lock_guard<std::mutex> guard(lock);
+    std::unique_lock<std::mutex> guard(lock);
     const int want = size_class(bytes);
     try { // room for the halves split off below: one part of each size at most
         for (auto& list : free_parts)
@@ -117,6 +132,7 @@ void* map_shared(std::size_t bytes) {
         free_parts[k].pop_back();
         free_parts_total -= kShareFrom << k;
     } else {
+        await_ahead(guard);
         p = static_cast<char*>(map_locked(kHuge)); // a kept page when there is one
         if (!p) return nullptr;
         give_free(kClasses - 1, p + kShareTo);
@@ -225,6 +241,60 @@ void trim(std::size_t keep) {
 std::size_t kept_bytes() {
     std::lock_guard<std::mutex> guard(lock);
     return kept_total;
+}
+
+namespace {
+
+#ifndef MADV_POPULATE_WRITE
+#define MADV_POPULATE_WRITE 23 // Linux 5.14
+#endif
+
+// clear_ahead's thread, joined when the process exits normally.
+struct AheadThread {
+    std::thread thread;
+    ~AheadThread() {
+        if (thread.joinable()) thread.join();
+    }
+};
+
+} // namespace
+
+void clear_ahead() {
+    static AheadThread ahead;
+    static std::once_flag once;
+    std::call_once(once, [] {
+        {
+            std::lock_guard<std::mutex> guard(lock);
+            if (kept_total > 0) return; // a kept page is waiting already
+            ahead_state = Ahead::Starting;
+        }
+        auto done = [](void* p) {
+            {
+                std::lock_guard<std::mutex> guard(lock);
+                if (p) unmap_locked(p, kHuge);
+                ahead_state = Ahead::Idle;
+            }
+            ahead_cv.notify_all();
+        };
+        try {
+            ahead.thread = std::thread([done] {
+                void* p = nullptr;
+                {
+                    std::lock_guard<std::mutex> guard(lock);
+                    if (ahead_state != Ahead::Starting) return; // a block was taken fresh meanwhile
+                    ahead_state = Ahead::Clearing;
+                    p = map_locked(kHuge);
+                }
+                // one call maps the page (a huge page when the kernel has one); where the kernel
+                // is older than MADV_POPULATE_WRITE, a write to each 4 KiB page does it
+                if (p && ::madvise(p, kHuge, MADV_POPULATE_WRITE) != 0)
+                    for (std::size_t at = 0; at < kHuge; at += 4096) static_cast<volatile char*>(p)[at] = 0;
+                done(p);
+            });
+        } catch (...) {
+            done(nullptr); // no thread to be had: the page is cleared when first needed, as before
+        }
+    });
 }
 
 } // namespace plant::big_pages

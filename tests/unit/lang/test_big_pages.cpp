@@ -4,8 +4,10 @@
 
 #include <catch2/catch.hpp>
 
+#include <chrono>
 #include <cstdint>
 #include <memory>
+#include <thread>
 
 using namespace plant;
 
@@ -138,6 +140,27 @@ TEST_CASE("a derivation's strings of a few KB take parts of the page its large o
     }
     CHECK(big_pages::shared_free_bytes() == 0);
     CHECK(big_pages::kept_bytes() == page);
+    big_pages::trim();
+}
+
+TEST_CASE("clear_ahead clears one page on another thread and keeps it for the next block", "[derive]") {
+    big_pages::trim();
+    REQUIRE(big_pages::kept_bytes() == 0);
+    big_pages::clear_ahead();
+    // the thread's page arrives in the kept blocks (a block asked for meanwhile would wait for it)
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (big_pages::kept_bytes() == 0 && std::chrono::steady_clock::now() < until)
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    REQUIRE(big_pages::kept_bytes() == big_pages::kHuge);
+    {
+        BigVector<std::uint16_t> s(50 * 1024); // 100 KiB: a part of the kept page, which reads zero
+        CHECK(big_pages::kept_bytes() == 0);
+        std::size_t nonzero = 0;
+        for (std::size_t i = 0; i < s.size(); ++i) nonzero += s[i] != 0;
+        CHECK(nonzero == 0);
+    }
+    big_pages::clear_ahead(); // once a process: nothing more is cleared
+    CHECK(big_pages::kept_bytes() == big_pages::kHuge);
     big_pages::trim();
 }
 
