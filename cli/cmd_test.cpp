@@ -26,6 +26,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <regex>
 #include <sstream>
 #include <unistd.h>
@@ -191,8 +192,31 @@ std::string timed_out(double seconds) {
                        seconds);
 }
 
-std::string run_one(const fs::path& file, bool bless, std::string& blessed,
+// Whether `path` (which may not exist yet) resolves inside `folder`: a test file, or a golden
+// file beside it, that is a symbolic link out of its folder is not read (the folder may come from
+// a stranger, and a failing test prints an excerpt of what it read).
+bool resolves_inside(const fs::path& path, const fs::path& folder) {
+    std::error_code ec;
+    const fs::path root = fs::weakly_canonical(fs::absolute(folder.empty() ? fs::path(".") : folder, ec), ec);
+    if (ec) return false;
+    const fs::path target = fs::weakly_canonical(fs::absolute(path, ec), ec);
+    if (ec) return false;
+    auto r = root.begin(), t = target.begin();
+    for (; r != root.end(); ++r, ++t)
+        if (t == target.end() || *r != *t) return false;
+    return true;
+}
+
+std::string outside_folder(const fs::path& path) {
+    return fmt::format("  {} is a symbolic link out of the test's folder: plant test does not read it "
+                       "(make it a file of its own)\n",
+                       escape_controls(path.string()));
+}
+
+// `walk_root`: the folder `file` was found in by walking it (nullptr: named on the command line).
+std::string run_one(const fs::path& file, const fs::path* walk_root, bool bless, std::string& blessed,
                     const std::vector<std::string>& allow_read, double timeout) {
+    if (walk_root && !resolves_inside(file, *walk_root)) return outside_folder(file);
     std::string text;
     if (!read_file(file.string(), text)) return "  cannot read the file\n";
     Expectations e = read_expectations(text);
@@ -224,6 +248,8 @@ std::string run_one(const fs::path& file, bool bless, std::string& blessed,
     sidecar.replace_extension(".txt");
     fs::path mesh_sidecar = file;
     mesh_sidecar.replace_extension(".mesh.txt");
+    for (const fs::path& golden : {sidecar, mesh_sidecar})
+        if (!resolves_inside(golden, file.parent_path())) return outside_folder(golden);
     if (o.exit_code != 0)
         return fmt::format("  exit code {} (a golden grammar must derive cleanly)\n{}", o.exit_code,
                            escape_controls(o.err, true));
@@ -286,8 +312,9 @@ struct TestCmd {
 };
 
 int test_main(const TestCmd& c) {
-    ChildSignalGuard guard;              // a signal stops the running child too, and then plant test
-    std::vector<fs::path> files, walked; // walked: found in a folder, not named
+    ChildSignalGuard guard;                  // a signal stops the running child too, and then plant test
+    std::vector<fs::path> files, walked;     // walked: found in a folder, not named
+    std::map<fs::path, fs::path> walk_roots; // each walked file's folder, as named
     std::vector<std::string> paths = c.paths.empty() ? std::vector<std::string>{"grammars"} : c.paths;
     for (const auto& p : paths) {
         std::error_code ec;
@@ -295,9 +322,11 @@ int test_main(const TestCmd& c) {
             fs::recursive_directory_iterator it(p, fs::directory_options::skip_permission_denied, ec), end;
             for (; !ec && it != end; it.increment(ec)) {
                 std::error_code fe;
+                // (a test file that links out of the folder is listed, and fails in run_one)
                 if (it->is_regular_file(fe) && it->path().extension() == ".plant") {
                     files.push_back(it->path());
                     walked.push_back(it->path());
+                    walk_roots[it->path()] = p;
                 }
             }
         } else if (fs::exists(p, ec)) {
@@ -319,7 +348,9 @@ int test_main(const TestCmd& c) {
             continue;
         }
         std::string blessed;
-        std::string msg = run_one(f, c.bless, blessed, c.allow_read, c.timeout);
+        const auto root = walk_roots.find(f);
+        std::string msg = run_one(f, root == walk_roots.end() ? nullptr : &root->second, c.bless, blessed,
+                                  c.allow_read, c.timeout);
         if (ChildSignalGuard::pending()) break;
         if (msg.empty()) {
             ++passed;
