@@ -104,10 +104,22 @@ int read_output_options(RunCmd& c, OutputOptions& oo) {
                                   : std::vector<std::string>{"out/" + stem + ".glb", "out/" + stem + ".png"};
     }
     for (const auto& o : c.outputs) {
-        if (!format_of(o)) {
+        const OutputFormat* f = format_of(o);
+        if (!f) {
             std::cerr << fmt::format("plant: cannot tell the format of '{}': use {}\n", escape_controls(o),
                                      known_extensions());
             return kUsage;
+        }
+        // an output (or its sidecar) that is the grammar itself would replace it
+        for (const std::string& written :
+             {o, f->sidecar_extension ? sidecar_path(o, f->sidecar_extension) : std::string{}}) {
+            std::error_code ec;
+            if (!written.empty() && fs::equivalent(written, c.g.file, ec)) {
+                std::cerr << fmt::format("plant: '{}' is the grammar being run: writing it would replace "
+                                         "the grammar; give another output name\n",
+                                         escape_controls(written));
+                return kUsage;
+            }
         }
     }
     std::optional<glm::dvec3> camera, look_at;

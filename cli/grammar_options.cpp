@@ -181,8 +181,12 @@ bool load_edits(const GrammarOptions& o, Program& program, SourceManager& source
     ReadFailure f = read_input_file(path, text, kMaxSourceBytes, o.edits.empty());
     if (f == ReadFailure::Missing && o.edits.empty()) return true; // a default not written yet
     if (f != ReadFailure::None) {
-        out +=
-            fmt::format("plant: cannot read the edits file '{}': {}\n", escape_controls(path), describe(f));
+        const std::string why =
+            fmt::format("cannot read the edits file '{}': {}", escape_controls(path), describe(f));
+        if (o.edits.empty() && program.graph.edits_span.valid()) // the grammar's `edits "FILE";`
+            out += render(Diagnostic{Severity::Error, program.graph.edits_span, why, {}}, sources, o.color);
+        else
+            out += "plant: " + why + "\n";
         exit_code = kNoInput;
         return false;
     }

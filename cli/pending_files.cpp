@@ -101,6 +101,10 @@ PendingFiles::~PendingFiles() {
     }
     for (std::size_t k = 0; k < temps_.size(); ++k)
         if (live_[k].load()) ::unlink(temps_[k].c_str());
+    // folders made for the outputs of a run that failed go too, deepest first (rmdir removes
+    // only empty ones: whatever else was put in them meanwhile stays)
+    if (!committed_)
+        for (auto d = made_dirs_.rbegin(); d != made_dirs_.rend(); ++d) ::rmdir(d->c_str());
 }
 
 namespace {
@@ -129,7 +133,17 @@ void PendingFiles::write_with(std::size_t k, const std::function<void(const Byte
     if (fs::path(target).filename().empty())
         throw ExportError("cannot write " + in_quotes(target) + ": not a file name");
     std::error_code ec;
-    if (!parent.empty()) fs::create_directories(parent, ec);
+    if (!parent.empty()) {
+        // the folders on the way that do not exist yet, outermost first, are remembered
+        std::vector<std::string> missing;
+        for (fs::path d = parent; !d.empty() && !fs::exists(fs::symlink_status(d, ec)); d = d.parent_path()) {
+            missing.push_back(d.string());
+            if (d == d.parent_path()) break;
+        }
+        fs::create_directories(parent, ec);
+        for (auto d = missing.rbegin(); d != missing.rend(); ++d)
+            if (fs::is_directory(fs::symlink_status(*d, ec))) made_dirs_.push_back(*d);
+    }
     live_[k].store(true); // before the file exists: a signal from here on removes it
     const int fd = ::open(temps_[k].c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     if (fd < 0) {
@@ -187,6 +201,7 @@ void PendingFiles::commit() {
             throw ExportError("cannot write " + in_quotes(targets_[k]) + ": " + std::strerror(e));
         live_[k].store(false);
     }
+    committed_ = true;
 }
 
 } // namespace plant::cli

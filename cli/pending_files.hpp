@@ -21,7 +21,8 @@ class PendingFiles {
     // removes or renames them. Otherwise the handler removes them and ends the process by the
     // signal, as it would have ended without us.
     explicit PendingFiles(const std::vector<std::string>& targets);
-    ~PendingFiles(); // removes what was not committed and puts the old handlers back
+    ~PendingFiles(); // removes what was not committed (and the folders made for it), puts the
+                     // old handlers back
     PendingFiles(const PendingFiles&) = delete;
     PendingFiles& operator=(const PendingFiles&) = delete;
 
@@ -45,7 +46,9 @@ class PendingFiles {
   private:
     std::vector<std::string> targets_, temps_;
     std::unique_ptr<std::atomic<bool>[]> live_; // the temporary file may exist: remove it
+    std::vector<std::string> made_dirs_;        // folders made for the targets, outermost first
     bool owns_signals_ = false;                 // this object installed the handlers
+    bool committed_ = false;                    // every file renamed into place
 };
 
 } // namespace plant::cli

@@ -75,6 +75,7 @@ void Compiler::declare_values(const LoadedFile& lf) {
             }
         }
         auto cv = eval_const(*value, v.kind == ast::DeclKind::Const ? "a const" : "the initial value");
+        if (cv && value != v.value.get()) check_override_type(v, *value, *cv);
         const bool evaluated = cv.has_value();
         if (!cv) cv = ConstVal{}; // declared all the same, so later uses are not "unknown" too
         if (v.kind == ast::DeclKind::Const) {
@@ -106,6 +107,26 @@ void Compiler::declare_values(const LoadedFile& lf) {
                     : fmt::format("the imported file has no param '{}'; did you mean '{}'?", name, near));
         }
     }
+}
+
+// A param's value from -D or an import's `with { }` is of the type of its default: a vec3 for a
+// number (or the other way round) would change every use of the param, where the error would
+// point at the grammar, or at nothing when a module parameter silently took three numbers.
+void Compiler::check_override_type(const ast::ValueDecl& v, const ast::Expr& value, const ConstVal& cv) {
+    Diagnostics quiet; // the default's own errors are not this value's
+    Diagnostics* saved = diags_;
+    diags_ = &quiet;
+    const auto dv = eval_const(*v.value, "the initial value");
+    diags_ = saved;
+    if (!dv) return;
+    auto kind = [](ValueType t) { return t == ValueType::Bool ? ValueType::Number : t; };
+    if (kind(dv->type) != kind(cv.type))
+        diags_->add(
+            {Severity::Error,
+             value.span,
+             fmt::format("'{}' is a {} by its default, found a {}: give a {}", v.name,
+                         value_type_name(dv->type), value_type_name(cv.type), value_type_name(dv->type)),
+             {{v.value->span, "the default"}}});
 }
 
 // `param r = 0.9 in 0.5 .. 1.0;`: constant numeric bounds, low below high, and the param's value
@@ -293,6 +314,12 @@ void Compiler::compile_settings(const ast::File& f) {
             if (s.key == Key::Seed && (!whole || *v < 0 || *v > 9.0e18)) // the range start() accepts
                 diags_->error(s.value->span,
                               fmt::format("the seed must be a whole number from 0 to 9e18, found {}", *v));
+            if ((s.key == Key::Angle || s.key == Key::Step) && !std::isfinite(*v))
+                diags_->error(s.value->span, fmt::format("the {} must be a finite number, found {}",
+                                                         s.key == Key::Angle ? "angle" : "step", *v));
+            if (s.key == Key::Width && !(*v >= 0 && std::isfinite(*v)))
+                diags_->error(s.value->span,
+                              fmt::format("the width must be a finite number, 0 or more, found {}", *v));
             if (s.key == Key::WidthScale && !(*v > 0 && *v <= 1e6))
                 diags_->error(
                     s.value->span,

@@ -121,6 +121,7 @@ class Compiler {
     void declare();
     void declare_modules(const ast::File& f);
     void declare_values(const LoadedFile& lf);
+    void check_override_type(const ast::ValueDecl& v, const ast::Expr& value, const ConstVal& cv);
     void check_param_range(const ast::ValueDecl& v, const ast::Expr& value, const ConstVal& cv, Global& g);
     // instances and level of detail (compile_instances.cpp)
     void declare_instances(const ast::File& f);

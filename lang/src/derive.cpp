@@ -177,6 +177,15 @@ void Derivation::evaluate_settings() {
     angle_ = setting(Key::Angle, 90);
     step_length_ = setting(Key::Step, 1);
     width_ = setting(Key::Width, 0.1); // a tenth of the default step: a slender branch
+    if (!std::isfinite(angle_))
+        throw RuntimeError{RuntimeErrorKind::Setting, where(Key::Angle),
+                           fmt::format("the angle must be a finite number, found {}", angle_)};
+    if (!std::isfinite(step_length_))
+        throw RuntimeError{RuntimeErrorKind::Setting, where(Key::Step),
+                           fmt::format("the step must be a finite number, found {}", step_length_)};
+    if (!(width_ >= 0 && std::isfinite(width_)))
+        throw RuntimeError{RuntimeErrorKind::Setting, where(Key::Width),
+                           fmt::format("the width must be a finite number, 0 or more, found {}", width_)};
     width_scale_ = setting(Key::WidthScale, 1);
     if (!(width_scale_ > 0 && width_scale_ <= 1e6))
         throw RuntimeError{

@@ -225,7 +225,7 @@ class LineReader {
     void value(GraphEdit& edit, const GraphParamDecl& p, std::uint32_t b, std::uint32_t e) {
         Diagnostics local;
         ast::ExprPtr expr = parse_expression(sm_, file_, b, e, local);
-        if (!expr) {
+        if (!expr || local.has_errors()) { // (a number out of range parses, as 0, with its error)
             const Diagnostic& d = local.all().front();
             throw Failure{d.span, d.message};
         }

@@ -102,6 +102,15 @@ check "malformed edits" 65 "$plant" run "$range" --edits "$tmp/bad.edits" -o "$t
 contains "malformed edits: file:line:col" "$tmp/stderr" "bad.edits:2:6: error: the graph has no parameter 'bent'; did you mean 'bend'?"
 contains "malformed edits: caret" "$tmp/stderr" "^~~~"
 if [ -e "$tmp/bad.txt" ]; then fail=$((fail + 1)); echo "FAIL malformed edits wrote a file"; else pass=$((pass + 1)); fi
+# a number literal out of range in an edits file is an error there, as in a grammar (it was 0)
+printf '/0.25 bend = 1e309\n' >"$tmp/huge.edits"
+check "an out-of-range literal in edits" 65 "$plant" derive "$range" --edits "$tmp/huge.edits"
+contains "the literal's place" "$tmp/stderr" "huge.edits:1:14: error: number '1e309' is out of range"
+# the grammar's own `edits "FILE";` naming a pipe: refused at that statement
+mkdir -p "$tmp/fifo" && mkfifo "$tmp/fifo/p.edits"
+printf 'graph { len = 1; }\nedits "p.edits";\nmodule Axis(n: node);\naxiom: Axis(root());\n' >"$tmp/fifo/g.plant"
+check "an edits file that is a pipe" 66 timeout 10 "$plant" derive "$tmp/fifo/g.plant"
+contains "the pipe, at the grammar's statement" "$tmp/stderr" "g.plant:2:7: error: cannot read the edits file"
 
 echo "graph CLI: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -165,6 +165,29 @@ mkdir -p "$tmp/keep" "$tmp/keep/b.skel.json" && echo old >"$tmp/keep/a.txt"
 check "second output is a folder" 73 "$plant" run "$tmp/plant.plant" -o "$tmp/keep/a.txt" -o "$tmp/keep/b.skel.json"
 contains "the target is named" "$tmp/stderr" "cannot write '$tmp/keep/b.skel.json'"
 contains "the first output keeps its old contents" "$tmp/keep/a.txt" "old"
+# a run that fails leaves no folder it made for its outputs (here the first output's name is a
+# folder the second output's path made)
+check "an output inside another output" 73 "$plant" run "$tmp/plant.plant" -o "$tmp/made/a/x.glb" \
+  -o "$tmp/made/a/x.glb/y.png"
+if [ -e "$tmp/made" ]; then bad "a failed run left the folders it made: $(find "$tmp/made" | head -3)"; else ok; fi
+mkdir -p "$tmp/mine/kept"
+check "a failed run in a folder of the user's" 73 "$plant" run "$tmp/plant.plant" -o "$tmp/mine/new/x.glb" \
+  -o "$tmp/plant.plant/x.png"
+if [ -e "$tmp/mine/new" ] || [ ! -d "$tmp/mine/kept" ]; then bad "folders: made one left, or the user's removed"; else ok; fi
+# an output (or an OBJ's .mtl) that is the grammar itself is refused before anything is written
+cp "$tmp/plant.plant" "$tmp/self.txt"
+check "the grammar as its own output" 64 "$plant" run "$tmp/self.txt" -o "$tmp/self.txt"
+contains "says why" "$tmp/stderr" "is the grammar being run"
+cp "$tmp/plant.plant" "$tmp/self.mtl"
+check "the grammar as an OBJ's .mtl" 64 "$plant" run "$tmp/self.mtl" -o "$tmp/self.obj"
+if cmp -s "$tmp/plant.plant" "$tmp/self.mtl" && [ ! -e "$tmp/self.obj" ]; then ok; else bad "the grammar was replaced"; fi
+# angle, step and width settings are finite (width 0 or more): `plant check` sees it
+printf 'axiom: F + F;\nwidth sqrt(-1);\n' >"$tmp/nanwidth.plant"
+check "a width that is not a number" 65 "$plant" check "$tmp/nanwidth.plant"
+contains "the width's error, at the setting" "$tmp/stderr" "nanwidth.plant:2:7: error: the width must be a finite number"
+printf 'param a = 0;\nparam big = 1e308;\naxiom: F + F;\nangle big * (10 + a);\n' >"$tmp/infangle.plant"
+check "an angle that overflows" 65 "$plant" check "$tmp/infangle.plant"
+contains "the angle's error, at the setting" "$tmp/stderr" "infangle.plant:4:7: error: the angle must be a finite number, found inf"
 # SIGINT while a slow output is being made removes the temporary files already written and ends
 # the process by the signal (job control, so the background run does not ignore SIGINT); SIGHUP
 # (the terminal closed) the same
