@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cfloat>
 #include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -62,10 +64,31 @@ bool count_of(std::string_view w, std::uint64_t& n) {
     return r.ec == std::errc() && r.ptr == w.data() + w.size();
 }
 
-// An element's lines must each hold its properties; a list's count must fit in its line.
-std::string vet_rows(Lines& lines, std::uint64_t rows, std::size_t scalars, const std::vector<bool>& is_list,
-                     const char* what) {
-    (void)scalars;
+// A vertex's value: a finite number that a float holds (OpenMesh keeps floats; a coordinate
+// of 1e39 or nan would reach the meshes as infinities).
+bool float_value(std::string_view w) {
+    double v = 0;
+    if (!w.empty() && w[0] == '+') w.remove_prefix(1);
+    auto r = std::from_chars(w.data(), w.data() + w.size(), v);
+    return r.ec == std::errc() && std::isfinite(v) && std::fabs(v) <= FLT_MAX;
+}
+
+std::string bad_value(const char* what, std::uint64_t row, std::string_view w) {
+    return fmt::format("{} {} has '{}', not a finite number within a float's range", what, row,
+                       w.substr(0, 40));
+}
+
+// What a face's vertex index may be: below `vertices` (0: not checked).
+std::string bad_index(const char* what, std::uint64_t row, std::string_view w, std::uint64_t vertices) {
+    return fmt::format("{} {} refers to vertex '{}', but the file has {} vertices (numbered from 0)", what,
+                       row, w.substr(0, 40), vertices);
+}
+
+// An element's lines must each hold its properties; a list's count must fit in its line. With
+// `numbers`, each scalar is a float_value; with `vertices` above 0, each list value is a vertex
+// index below it.
+std::string vet_rows(Lines& lines, std::uint64_t rows, const std::vector<bool>& is_list, const char* what,
+                     bool numbers = false, std::uint64_t vertices = 0) {
     std::string_view line;
     for (std::uint64_t r = 0; r < rows; ++r) {
         if (!lines.next(line)) return fmt::format("it ends before its {} {} (found {})", rows, what, r);
@@ -74,12 +97,16 @@ std::string vet_rows(Lines& lines, std::uint64_t rows, std::size_t scalars, cons
         for (bool list : is_list) {
             if (k >= w.size()) return fmt::format("{} {} has too few values", what, r + 1);
             if (!list) {
+                if (numbers && !float_value(w[k])) return bad_value(what, r + 1, w[k]);
                 ++k;
                 continue;
             }
             std::uint64_t n = 0;
             if (!count_of(w[k], n) || n > w.size() - k - 1)
                 return fmt::format("{} {} announces more values than it holds", what, r + 1);
+            for (std::size_t j = k + 1; vertices > 0 && j <= k + n; ++j)
+                if (std::uint64_t index = 0; !count_of(w[j], index) || index >= vertices)
+                    return bad_index(what, r + 1, w[j], vertices);
             k += 1 + static_cast<std::size_t>(n);
         }
     }
@@ -113,9 +140,12 @@ std::string vet_off(const std::string& text) {
     std::string_view v;
     for (std::uint64_t i = 0; i < nv; ++i) {
         if (!lines.next(v)) return fmt::format("it ends before its {} vertices (found {})", nv, i);
-        if (words(v).size() < 3) return fmt::format("vertex {} has fewer than 3 coordinates", i + 1);
+        const auto c = words(v);
+        if (c.size() < 3) return fmt::format("vertex {} has fewer than 3 coordinates", i + 1);
+        for (std::size_t k = 0; k < 3; ++k)
+            if (!float_value(c[k])) return bad_value("vertex", i + 1, c[k]);
     }
-    return vet_rows(lines, nf, 0, {true}, "face");
+    return vet_rows(lines, nf, {true}, "face", false, nv);
 }
 
 std::string vet_ply(const std::string& text) {
@@ -160,8 +190,16 @@ std::string vet_ply(const std::string& text) {
                                text.size());
     }
     Lines body(text, text.find('\n', end) == std::string::npos ? text.size() : text.find('\n', end) + 1);
+    std::uint64_t vertices = 0;
     for (const auto& e : elements)
-        if (std::string why = vet_rows(body, e.count, 0, e.is_list, e.name.c_str()); !why.empty()) return why;
+        if (e.name == "vertex") vertices = e.count;
+    for (const auto& e : elements) {
+        const bool vertex = e.name == "vertex", face = e.name == "face";
+        if (std::string why = vet_rows(body, e.count, e.is_list, e.name.c_str(), vertex, face ? vertices : 0);
+            !why.empty())
+            return why;
+        if (face && e.count > 0 && vertices == 0) return "it has faces but no vertex element";
+    }
     return {};
 }
 
@@ -170,7 +208,17 @@ std::string vet_stl(const std::string& text) {
     if (text.size() >= 84) {
         std::uint32_t n = 0;
         std::memcpy(&n, text.data() + 80, 4);
-        if (text.size() == 84 + std::uint64_t{50} * n) return {};
+        if (text.size() == 84 + std::uint64_t{50} * n) {
+            // each triangle: a normal and three corners, 12 little-endian floats, then 2 bytes
+            for (std::uint64_t t = 0; t < n; ++t)
+                for (std::size_t k = 3; k < 12; ++k) {
+                    float f = 0;
+                    std::memcpy(&f, text.data() + 84 + 50 * t + 4 * k, 4);
+                    if (!std::isfinite(f))
+                        return fmt::format("triangle {} has a corner that is not a finite number", t + 1);
+                }
+            return {};
+        }
     }
     return "ASCII STL is not read (and a binary STL's size must be 84 + 50 bytes a triangle): write it as "
            "OBJ";
@@ -190,10 +238,39 @@ void drop_mtllib(std::string& text) {
 
 } // namespace
 
+// An OBJ's vertices (`v x y z`) and its faces' vertex indices (`f a b c`, each `a`, `a/t` or
+// `a/t/n`): 1 up to the number of vertices given before the face, or -1 down to minus it.
+std::string vet_obj(const std::string& text) {
+    Lines lines(text, 0);
+    std::string_view line;
+    std::uint64_t v = 0, f = 0;
+    while (lines.next(line)) {
+        const auto w = words(line);
+        if (w[0] == "v") {
+            ++v;
+            if (w.size() < 4) return fmt::format("vertex {} has fewer than 3 coordinates", v);
+            for (std::size_t k = 1; k < 4; ++k)
+                if (!float_value(w[k])) return bad_value("vertex", v, w[k]);
+        } else if (w[0] == "f") {
+            ++f;
+            for (std::size_t k = 1; k < w.size(); ++k) {
+                std::string_view index = w[k].substr(0, w[k].find('/'));
+                const bool negative = !index.empty() && index[0] == '-';
+                std::uint64_t i = 0;
+                if (!count_of(negative ? index.substr(1) : index, i) || i == 0 || i > v)
+                    return fmt::format("face {} refers to vertex '{}', but {} vertices come before it "
+                                       "(numbered from 1, or from -1 backwards)",
+                                       f, w[k].substr(0, 40), v);
+            }
+        }
+    }
+    return {};
+}
+
 std::string vet_mesh_text(const std::string& ext, std::string& text) {
     if (ext == "obj") {
         drop_mtllib(text);
-        return {};
+        return vet_obj(text);
     }
     if (ext == "off") return vet_off(text);
     if (ext == "ply") return vet_ply(text);
