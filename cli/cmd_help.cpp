@@ -242,7 +242,13 @@ void setup_help(CLI::App& app, int& exit_code) {
     std::string topics = "Topics:\n";
     for (const auto& t : kTopics) topics += fmt::format("  {:<10} {}\n", t.name, t.summary);
     cmd->footer(topics);
-    cmd->callback([&app, a, &exit_code] { exit_code = help_main(app, *a); });
+    cmd->callback([&app, a, &exit_code] {
+        exit_code = help_main(app, *a);
+        if (exit_code == kOk && !(std::cout << std::flush)) { // a full disk, a closed pipe
+            std::cerr << "plant: cannot write to the standard output\n";
+            exit_code = kCantCreate;
+        }
+    });
 }
 
 } // namespace plant::cli

@@ -36,17 +36,36 @@ int main(int argc, char** argv) {
     setup_repl(app, exit_code);
     setup_view(app, exit_code);
     setup_help(app, exit_code);
+    // a first word that is no command and no option: name it (CLI11 would say only that a command
+    // is required)
+    if (argc > 1 && argv[1][0] != '-') {
+        bool known = false;
+        std::string names;
+        for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
+            known = known || sub->get_name() == argv[1];
+            names += (names.empty() ? "" : ", ") + sub->get_name();
+        }
+        if (!known) {
+            std::cerr << "plant: unknown command '" << plant::escape_controls(argv[1], true)
+                      << "' (the commands: " << names << ")\nRun 'plant --help' for usage.\n";
+            return kUsage;
+        }
+    }
+    // help and the version written where they cannot be (a full disk) fail as other outputs do
+    auto printed = [](const std::string& text) {
+        std::cout << text << std::flush;
+        if (std::cout) return kOk;
+        std::cerr << "plant: cannot write to the standard output\n";
+        return kCantCreate;
+    };
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp&) {
-        std::cout << app.help();
-        return kOk;
+        return printed(app.help());
     } catch (const CLI::CallForAllHelp&) {
-        std::cout << app.help("", CLI::AppFormatMode::All);
-        return kOk;
+        return printed(app.help("", CLI::AppFormatMode::All));
     } catch (const CLI::CallForVersion& e) {
-        std::cout << e.what() << "\n";
-        return kOk;
+        return printed(std::string(e.what()) + "\n");
     } catch (const CLI::ParseError& e) {
         // CLI11 reports --help of a subcommand as CallForHelp too, caught above; everything else
         // is a usage error.

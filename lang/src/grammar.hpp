@@ -271,6 +271,6 @@ struct item
 struct item_or_end : seq<ws, sor<eof, must<item>>> {};
 
 // A whole file in one rule, for pegtl::analyze in the tests.
-struct file : seq<ws, star<item>, must<eof>> {};
+struct file : seq<opt<utf8::bom>, ws, star<item>, must<eof>> {}; // (parse_file skips a BOM itself)
 
 } // namespace plant::grammar

@@ -681,7 +681,8 @@ std::unique_ptr<ast::File> parse_file(const SourceManager& sources, std::uint32_
     file->source = file_id;
     Lowering lower(file_id, diags);
     habits::check_cpfg_lines(src, file_id, diags);
-    std::size_t offset = 0;
+    // a UTF-8 byte-order mark at the start, which some editors write, is skipped
+    std::size_t offset = text.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;
     std::size_t errors = 0;
     while (offset <= text.size()) {
         LineCol lc = src.line_col(static_cast<std::uint32_t>(offset));
@@ -714,10 +715,18 @@ ast::ExprPtr parse_one(tao::pegtl::memory_input<>& in, const SourceFile& src, st
                        Span whole, Diagnostics& diags) {
     g::ParseState state;
     try {
-        auto root = pt::parse<tao::pegtl::seq<g::ws, Rule, tao::pegtl::eof>, Node, selector,
-                              tao::pegtl::nothing, g::control>(in, state);
+        auto root =
+            pt::parse<tao::pegtl::seq<g::ws, Rule, g::ws>, Node, selector, tao::pegtl::nothing, g::control>(
+                in, state);
         if (!root || root->children.empty()) {
             diags.error(whole, "expected an expression");
+            return nullptr;
+        }
+        if (!in.empty()) { // an expression, then more: the error is where the more starts
+            const auto at = static_cast<std::uint32_t>(in.byte());
+            diags.error({file_id, at, std::max(at + 1, whole.end)},
+                        fmt::format("expected the end of the value after the expression, found {}",
+                                    describe_found(src.text(), at)));
             return nullptr;
         }
         Lowering lower(file_id, diags);

@@ -30,6 +30,9 @@ contains "-D number for a vec3, at the -D" "$tmp/stderr" "'v' is a vec3 by its d
 check "-D number for a bool" 0 "$plant" derive "$tmp/typed.plant" -D b=0
 check "-D vec3 for a vec3" 0 "$plant" derive "$tmp/typed.plant" -D 'v=vec3(2,2,2)'
 contains "-D vec3 for a vec3 used" "$tmp/stdout" "F(2)"
+# more after a -D value's expression: the error is where the more starts
+check "-D with junk after the value" 65 "$plant" derive "$tmp/typed.plant" -D 'r=1;'
+contains "-D junk, at the junk" "$tmp/stderr" "-D r:1:2: error: expected the end of the value after the expression, found ';'"
 
 echo "defines: $pass passed, $fail failed"
 [ $fail -eq 0 ] && [ $pass -gt 0 ]

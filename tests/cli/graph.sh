@@ -106,6 +106,10 @@ if [ -e "$tmp/bad.txt" ]; then fail=$((fail + 1)); echo "FAIL malformed edits wr
 printf '/0.25 bend = 1e309\n' >"$tmp/huge.edits"
 check "an out-of-range literal in edits" 65 "$plant" derive "$range" --edits "$tmp/huge.edits"
 contains "the literal's place" "$tmp/stderr" "huge.edits:1:14: error: number '1e309' is out of range"
+# more after an edit's value: the error is at the more, not over the whole value
+printf '/0.25 bend = linear(0, 1) extra\n' >"$tmp/junk.edits"
+check "junk after an edit's value" 65 "$plant" derive "$range" --edits "$tmp/junk.edits"
+contains "the junk's place" "$tmp/stderr" "junk.edits:1:27: error: expected the end of the value after the expression, found 'extra'"
 # the grammar's own `edits "FILE";` naming a pipe: refused at that statement
 mkdir -p "$tmp/fifo" && mkfifo "$tmp/fifo/p.edits"
 printf 'graph { len = 1; }\nedits "p.edits";\nmodule Axis(n: node);\naxiom: Axis(root());\n' >"$tmp/fifo/g.plant"

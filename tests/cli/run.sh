@@ -228,5 +228,18 @@ check "repl with a missing file" 66 "$plant" repl "$tmp/none.plant"
 printf 'axiom: F ~nothing(1);\n' >"$tmp/nosurf.plant"
 check "undeclared surface" 70 "$plant" run "$tmp/nosurf.plant" -o "$tmp/n.glb"
 
+# a first word that is no command is named, with the commands
+check "an unknown command" 64 "$plant" nosuchcmd
+contains "the unknown command named" "$tmp/stderr" "plant: unknown command 'nosuchcmd' (the commands: run, derive,"
+# help and the version, written to a full disk, fail as any output does
+for words in "derive --help" "--version" "help turtle" "--help-all"; do
+  # shellcheck disable=SC2086 # the words are split on purpose
+  check "plant $words > /dev/full" 73 bash -c '"$0" "$@" >/dev/full' "$plant" $words
+done
+# a UTF-8 byte-order mark before the first line is skipped
+printf '\xef\xbb\xbfaxiom: F;\n' >"$tmp/bom.plant"
+check "a byte-order mark" 0 "$plant" derive "$tmp/bom.plant"
+contains "a byte-order mark: the string" "$tmp/stdout" "F"
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ] && [ "$pass" -gt 0 ] # running nothing is a failure too
