@@ -26,22 +26,31 @@ void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation) {
                    "Apply the decomposition graph's edits from FILE (default: the grammar's 'edits \"F\";')")
         ->type_name("FILE");
     if (derivation) {
-        cmd.add_option("-n,--steps", o.steps,
-                       "Number of derivation steps (default: the grammar's 'derive N;')")
-            ->check(CLI::Range(0, 1000000));
+        cmd.add_option_function<std::string>(
+               "-n,--steps",
+               [&o](const std::string& v) {
+                   o.steps = static_cast<int>(parse_count("--steps", v, 0, 1000000));
+               },
+               "Number of derivation steps, 0 to 1000000 (default: the grammar's 'derive N;')")
+            ->type_name("N");
         cmd.add_option_function<std::string>(
                "--seed", [&o](const std::string& v) { o.seed = parse_count("--seed", v, 0); },
                "Random seed, a whole number from 0 to 2^64 - 1 (default: the grammar's 'seed S;', "
                "else 0)")
             ->type_name("UINT");
-        cmd.add_option("--threads", o.threads,
-                       "Rewriting threads; 0 means one per core. The result never depends "
-                       "on it")
-            ->check(CLI::Range(0, 256));
-        cmd.add_option("--max-modules", o.max_modules,
-                       "Stop with an error when the string grows past this many "
-                       "modules")
-            ->check(CLI::PositiveNumber);
+        cmd.add_option_function<std::string>(
+               "--threads",
+               [&o](const std::string& v) {
+                   o.threads = static_cast<int>(parse_count("--threads", v, 0, 256));
+               },
+               "Rewriting threads, 0 to 256; 0 means one per core. The result never depends on it")
+            ->type_name("N");
+        cmd.add_option_function<std::string>(
+               "--max-modules",
+               [&o](const std::string& v) { o.max_modules = parse_count("--max-modules", v, 1); },
+               fmt::format("Stop with an error when the string grows past this many modules (default {})",
+                           o.max_modules))
+            ->type_name("N");
     }
     cmd.add_option_function<std::string>(
            "--max-steps", [&o](const std::string& v) { o.max_steps = parse_count("--max-steps", v, 1); },
@@ -102,13 +111,14 @@ void add_allow_read(CLI::App& cmd, std::vector<std::string>& dirs) {
         ->allow_extra_args(false);
 }
 
-std::uint64_t parse_count(const std::string& option, const std::string& text, std::uint64_t lowest) {
+std::uint64_t parse_count(const std::string& option, const std::string& text, std::uint64_t lowest,
+                          std::uint64_t highest) {
     std::uint64_t v = 0;
     const char* end = text.data() + text.size();
     auto r = std::from_chars(text.data(), end, v);
-    if (text.empty() || r.ec != std::errc() || r.ptr != end || v < lowest)
+    if (text.empty() || r.ec != std::errc() || r.ptr != end || v < lowest || v > highest)
         throw CLI::ValidationError(fmt::format("{} must be a whole number from {} to {}, found '{}'", option,
-                                               lowest, std::numeric_limits<std::uint64_t>::max(),
+                                               lowest, highest,
                                                text.size() > 40 ? text.substr(0, 40) + "..." : text));
     return v;
 }

@@ -195,10 +195,12 @@ void setup_repl(CLI::App& app, int& exit_code) {
                        "after this many instructions (default {})",
                        kDefaultMaxSteps))
         ->type_name("N");
-    cmd->add_option("--max-modules", *max_modules,
-                    "Stop a step with an error when the string grows past this many modules (the session "
-                    "stays at the step before)")
-        ->check(CLI::PositiveNumber);
+    cmd->add_option_function<std::string>(
+           "--max-modules",
+           [max_modules](const std::string& v) { *max_modules = parse_count("--max-modules", v, 1); },
+           "Stop a step with an error when the string grows past this many modules (the session "
+           "stays at the step before)")
+        ->type_name("N");
     add_max_work(*cmd, *max_work, "one command (a :step, a re-derivation after an edit)");
     add_max_memory(*cmd, *max_memory);
     cmd->footer("Reads commands from standard input without a prompt when it is not a terminal:\n"

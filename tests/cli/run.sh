@@ -241,5 +241,15 @@ printf '\xef\xbb\xbfaxiom: F;\n' >"$tmp/bom.plant"
 check "a byte-order mark" 0 "$plant" derive "$tmp/bom.plant"
 contains "a byte-order mark: the string" "$tmp/stdout" "F"
 
+# counts on the command line: one message naming the option, its range and what was written
+check "--steps in hex" 64 "$plant" derive "$tmp/ok.plant" -n 0x10
+contains "--steps in hex: the range" "$tmp/stderr" "plant: --steps must be a whole number from 0 to 1000000, found '0x10'"
+check "--threads past 256" 64 "$plant" derive "$tmp/ok.plant" --threads 300
+contains "--threads past 256: the range" "$tmp/stderr" "--threads must be a whole number from 0 to 256, found '300'"
+check "--max-modules 0" 64 "$plant" derive "$tmp/ok.plant" --max-modules 0
+contains "--max-modules 0: the range" "$tmp/stderr" "--max-modules must be a whole number from 1 to"
+check "repl --max-modules 0" 64 "$plant" repl "$tmp/plant.plant" --max-modules 0 <"$tmp/ok.repl"
+contains "repl --max-modules 0: the range" "$tmp/stderr" "--max-modules must be a whole number from 1 to"
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ] && [ "$pass" -gt 0 ] # running nothing is a failure too
