@@ -78,8 +78,11 @@ int view_main(ViewCmd& c) {
                      "build plant again (docs/view.md)\n";
         return kRuntime;
     }
-    if (!std::filesystem::is_regular_file(c.g.file)) {
-        std::cerr << fmt::format("plant: cannot read '{}': no such file\n", escape_controls(c.g.file));
+    if (std::error_code ec; !std::filesystem::is_regular_file(c.g.file, ec)) {
+        const char* why = std::filesystem::is_directory(c.g.file, ec) ? "it is a directory"
+                          : std::filesystem::exists(c.g.file, ec)     ? "it is not a regular file"
+                                                                      : "no such file";
+        std::cerr << fmt::format("plant: cannot read '{}': {}\n", escape_controls(c.g.file), why);
         return kNoInput;
     }
     // the HTTP server module, before any work: only `plant view` loads it (view_http.hpp)

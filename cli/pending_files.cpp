@@ -9,6 +9,7 @@
 #include <cstring>
 #include <fcntl.h>
 #include <filesystem>
+#include <iterator>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -25,6 +26,8 @@ struct Registry {
     const std::string* temps = nullptr;
     const std::atomic<bool>* live = nullptr;
     std::size_t count = 0;
+    const std::string* dirs = nullptr; // the folders made, outermost first
+    const std::atomic<std::size_t>* dir_count = nullptr;
     struct sigaction old_int {
     }, old_term{}, old_hup{}; // SIGHUP (the terminal closed) is handled as SIGTERM
 };
@@ -46,6 +49,9 @@ void on_signal(int sig, siginfo_t* info, void* context) {
     }
     for (std::size_t k = 0; k < r->count; ++k)
         if (r->live[k].load()) ::unlink(r->temps[k].c_str());
+    // rmdir removes only empty folders: one holding a file renamed into place, or anything else, stays
+    for (std::size_t k = r->dir_count->load(std::memory_order_acquire); k > 0; --k)
+        ::rmdir(r->dirs[k - 1].c_str());
     // end the process by the signal, as it would have ended without this handler
     struct sigaction dfl {};
     dfl.sa_handler = SIG_DFL;
@@ -70,9 +76,17 @@ PendingFiles::PendingFiles(const std::vector<std::string>& targets)
                                      std::to_string(::getpid()) + "-" + std::to_string(counter++)))
                 .string());
     }
+    // room for every folder on the way to every target, so that adding one never moves the others
+    std::size_t room = 0;
+    for (const auto& t : targets_) {
+        const fs::path parent = fs::path(t).parent_path();
+        room += static_cast<std::size_t>(std::distance(parent.begin(), parent.end()));
+    }
+    made_dirs_.reserve(room);
     if (g_shared_stop.load()) return; // a batch: its own handlers stop it
     owns_signals_ = true;
-    auto* r = new Registry{temps_.data(), live_.get(), temps_.size(), {}, {}, {}};
+    auto* r =
+        new Registry{temps_.data(), live_.get(), temps_.size(), made_dirs_.data(), &made_count_, {}, {}, {}};
     struct sigaction sa {};
     sa.sa_sigaction = on_signal;
     sa.sa_flags = SA_SIGINFO;
@@ -142,7 +156,10 @@ void PendingFiles::write_with(std::size_t k, const std::function<void(const Byte
         }
         fs::create_directories(parent, ec);
         for (auto d = missing.rbegin(); d != missing.rend(); ++d)
-            if (fs::is_directory(fs::symlink_status(*d, ec))) made_dirs_.push_back(*d);
+            if (fs::is_directory(fs::symlink_status(*d, ec)) && made_dirs_.size() < made_dirs_.capacity()) {
+                made_dirs_.push_back(*d);
+                made_count_.store(made_dirs_.size(), std::memory_order_release);
+            }
     }
     live_[k].store(true); // before the file exists: a signal from here on removes it
     const int fd = ::open(temps_[k].c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);

@@ -1,6 +1,7 @@
 // Output files of one command, written under temporary names beside their targets and renamed
 // into place only when every one of them has been written: a run that fails, or is stopped by
-// SIGINT or SIGTERM, leaves the earlier files as they were and no temporary file behind.
+// SIGINT or SIGTERM, leaves the earlier files as they were and no temporary file behind, nor a
+// folder it made for them that stayed empty.
 #pragma once
 
 #include "plant/export.hpp"
@@ -16,10 +17,10 @@ namespace plant::cli {
 class PendingFiles {
   public:
     // Picks a temporary name beside each target and installs SIGINT and SIGTERM handlers that
-    // remove the temporary files. When the handler found in place was a function (the REPL's
-    // Ctrl-C flag), it is called instead and the files stay: the process goes on and this object
-    // removes or renames them. Otherwise the handler removes them and ends the process by the
-    // signal, as it would have ended without us.
+    // remove the temporary files and the folders made for them that are still empty. When the handler found
+    // in place was a function (the REPL's Ctrl-C flag), it is called instead and the files stay: the process
+    // goes on and this object removes or renames them. Otherwise the handler removes them and ends the
+    // process by the signal, as it would have ended without us.
     explicit PendingFiles(const std::vector<std::string>& targets);
     ~PendingFiles(); // removes what was not committed (and the folders made for it), puts the
                      // old handlers back
@@ -46,9 +47,12 @@ class PendingFiles {
   private:
     std::vector<std::string> targets_, temps_;
     std::unique_ptr<std::atomic<bool>[]> live_; // the temporary file may exist: remove it
-    std::vector<std::string> made_dirs_;        // folders made for the targets, outermost first
-    bool owns_signals_ = false;                 // this object installed the handlers
-    bool committed_ = false;                    // every file renamed into place
+    // folders made for the targets, outermost first; reserved up front, so that the signal handler
+    // can read the first `made_count_` while a later one is added
+    std::vector<std::string> made_dirs_;
+    std::atomic<std::size_t> made_count_{0};
+    bool owns_signals_ = false; // this object installed the handlers
+    bool committed_ = false;    // every file renamed into place
 };
 
 } // namespace plant::cli

@@ -11,6 +11,11 @@
 namespace plant {
 
 SourceFile::SourceFile(std::string name, std::string text) : name_(std::move(name)), text_(std::move(text)) {
+    // A carriage return not followed by a line feed (the classic Mac OS line ending) ends a line
+    // too: read as a space, a comment would run to the end of the file and every diagnostic would
+    // be on line 1. Turned into '\n', so every offset stays where it was.
+    for (std::size_t i = 0; i < text_.size(); ++i)
+        if (text_[i] == '\r' && (i + 1 == text_.size() || text_[i + 1] != '\n')) text_[i] = '\n';
     line_starts_.push_back(0);
     for (std::uint32_t i = 0; i < text_.size(); ++i)
         if (text_[i] == '\n') line_starts_.push_back(i + 1);

@@ -188,20 +188,20 @@ contains "the width's error, at the setting" "$tmp/stderr" "nanwidth.plant:2:7: 
 printf 'param a = 0;\nparam big = 1e308;\naxiom: F + F;\nangle big * (10 + a);\n' >"$tmp/infangle.plant"
 check "an angle that overflows" 65 "$plant" check "$tmp/infangle.plant"
 contains "the angle's error, at the setting" "$tmp/stderr" "infangle.plant:4:7: error: the angle must be a finite number, found inf"
-# SIGINT while a slow output is being made removes the temporary files already written and ends
-# the process by the signal (job control, so the background run does not ignore SIGINT); SIGHUP
-# (the terminal closed) the same
+# SIGINT while a slow output is being made removes the temporary files already written and the
+# folders made for them, and ends the process by the signal (job control, so the background run
+# does not ignore SIGINT); SIGHUP (the terminal closed) the same
 printf 'axiom: A;\nderive 15;\nrules { A -> F[+A][-A]; }\n' >"$tmp/slow.plant"
 for sig in INT HUP; do
   rm -rf "$tmp/sig"
   mkdir -p "$tmp/sig"
   set -m
-  "$plant" run "$tmp/slow.plant" -o "$tmp/sig/s.txt" -o "$tmp/sig/s.png" -o "$tmp/sig/s.obj" --sides 64 --size 12000x5000 \
-    >/dev/null 2>&1 &
+  "$plant" run "$tmp/slow.plant" -o "$tmp/sig/s.txt" -o "$tmp/sig/new/deep/s.png" -o "$tmp/sig/s.obj" --sides 64 \
+    --size 12000x5000 >/dev/null 2>&1 &
   slow=$!
   set +m
   for _ in $(seq 200); do
-    ls -a "$tmp/sig" | grep -q plant-tmp && break
+    ls -a "$tmp/sig/new/deep" 2>/dev/null | grep -q plant-tmp && break
     sleep 0.05
   done
   kill -s $sig "$slow" 2>/dev/null
@@ -250,6 +250,15 @@ check "--max-modules 0" 64 "$plant" derive "$tmp/ok.plant" --max-modules 0
 contains "--max-modules 0: the range" "$tmp/stderr" "--max-modules must be a whole number from 1 to"
 check "repl --max-modules 0" 64 "$plant" repl "$tmp/plant.plant" --max-modules 0 <"$tmp/ok.repl"
 contains "repl --max-modules 0: the range" "$tmp/stderr" "--max-modules must be a whole number from 1 to"
+
+# carriage returns alone end lines (classic Mac OS files): a comment stops at one, and a
+# diagnostic names the line
+printf '# a comment\rderive 2;\raxiom: F;\rrules {\r  F -> F F;\r}\r' >"$tmp/cr.plant"
+check "CR line endings" 0 "$plant" derive "$tmp/cr.plant"
+contains "CR line endings: the string" "$tmp/stdout" "FFFF"
+printf '# a comment\rderive 2;\raxiom: F;\rrules {\r  F -> F F(;\r}\r' >"$tmp/cr_bad.plant"
+check "CR line endings, an error" 65 "$plant" derive "$tmp/cr_bad.plant"
+contains "CR line endings: the error's line" "$tmp/stderr" "cr_bad.plant:5:12: error"
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ] && [ "$pass" -gt 0 ] # running nothing is a failure too

@@ -13,6 +13,11 @@ trap 'for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done; rm -rf "$tmp"' EXIT
 holds "--help lists --port and --open" grep -q -- "--open" "$tmp/help"
 "$plant" view "$tmp/missing.plant" --port 0 > /dev/null 2> "$tmp/err"; code=$?
 holds "a missing grammar is exit 66" test "$code" = 66
+holds "a missing grammar is named missing" grep -q "missing.plant': no such file" "$tmp/err"
+mkdir -p "$tmp/adir"
+"$plant" view "$tmp/adir" --port 0 > /dev/null 2> "$tmp/err"; code=$?
+holds "a folder for the grammar is exit 66" test "$code" = 66
+holds "a folder for the grammar is named a directory" grep -q "adir': it is a directory" "$tmp/err"
 
 cp "$root/grammars/abop/fig1_24a.plant" "$tmp/g.plant"
 mkdir "$tmp/scratch"
