@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -50,6 +51,14 @@ struct GrammarOptions {
 // CLI::ValidationError naming `option` and the range otherwise (a usage error, exit 64).
 std::uint64_t parse_count(const std::string& option, const std::string& text, std::uint64_t lowest,
                           std::uint64_t highest = std::numeric_limits<std::uint64_t>::max());
+
+// The largest count an option takes when it names no bound of its own.
+inline constexpr std::uint64_t kAnyCount = std::numeric_limits<std::uint64_t>::max();
+
+// Adds an option (`flags`: "-n,--steps") taking a whole number from `lowest` to `highest`, read by
+// parse_count and handed to `set`; its value is shown as N in --help.
+CLI::Option* add_count(CLI::App& cmd, const std::string& flags, std::uint64_t lowest, std::uint64_t highest,
+                       std::function<void(std::uint64_t)> set, const std::string& help);
 
 void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation);
 

@@ -26,39 +26,27 @@ void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation) {
                    "Apply the decomposition graph's edits from FILE (default: the grammar's 'edits \"F\";')")
         ->type_name("FILE");
     if (derivation) {
-        cmd.add_option_function<std::string>(
-               "-n,--steps",
-               [&o](const std::string& v) {
-                   o.steps = static_cast<int>(parse_count("--steps", v, 0, 1000000));
-               },
-               "Number of derivation steps, 0 to 1000000 (default: the grammar's 'derive N;')")
-            ->type_name("N");
-        cmd.add_option_function<std::string>(
-               "--seed", [&o](const std::string& v) { o.seed = parse_count("--seed", v, 0); },
-               "Random seed, a whole number from 0 to 2^64 - 1 (default: the grammar's 'seed S;', "
-               "else 0)")
+        add_count(
+            cmd, "-n,--steps", 0, 1000000, [&o](std::uint64_t v) { o.steps = static_cast<int>(v); },
+            "Number of derivation steps, 0 to 1000000 (default: the grammar's 'derive N;')");
+        add_count(
+            cmd, "--seed", 0, kAnyCount, [&o](std::uint64_t v) { o.seed = v; },
+            "Random seed, a whole number from 0 to 2^64 - 1 (default: the grammar's 'seed S;', else 0)")
             ->type_name("UINT");
-        cmd.add_option_function<std::string>(
-               "--threads",
-               [&o](const std::string& v) {
-                   o.threads = static_cast<int>(parse_count("--threads", v, 0, 256));
-               },
-               "Rewriting threads, 0 to 256; 0 means one per core. The result never depends on it")
-            ->type_name("N");
-        cmd.add_option_function<std::string>(
-               "--max-modules",
-               [&o](const std::string& v) { o.max_modules = parse_count("--max-modules", v, 1); },
-               fmt::format("Stop with an error when the string grows past this many modules (default {})",
-                           o.max_modules))
-            ->type_name("N");
+        add_count(
+            cmd, "--threads", 0, 256, [&o](std::uint64_t v) { o.threads = static_cast<int>(v); },
+            "Rewriting threads, 0 to 256; 0 means one per core. The result never depends on it");
+        add_count(
+            cmd, "--max-modules", 1, kAnyCount, [&o](std::uint64_t v) { o.max_modules = v; },
+            fmt::format("Stop with an error when the string grows past this many modules (default {})",
+                        o.max_modules));
     }
-    cmd.add_option_function<std::string>(
-           "--max-steps", [&o](const std::string& v) { o.max_steps = parse_count("--max-steps", v, 1); },
-           fmt::format("Stop with an error when one evaluation (a hook call; a production's condition, "
-                       "weight or body for one module; a constant) runs more than this many "
-                       "instructions, the functions it calls included (default {})",
-                       kDefaultMaxSteps))
-        ->type_name("N");
+    add_count(
+        cmd, "--max-steps", 1, kAnyCount, [&o](std::uint64_t v) { o.max_steps = v; },
+        fmt::format("Stop with an error when one evaluation (a hook call; a production's condition, "
+                    "weight or body for one module; a constant) runs more than this many "
+                    "instructions, the functions it calls included (default {})",
+                    kDefaultMaxSteps));
     add_max_work(cmd, o.max_work, "the derivation");
     add_max_memory(cmd, o.max_memory);
     // the same param set twice on one command line is a usage error, not "the last one wins"
@@ -76,13 +64,12 @@ void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation) {
 }
 
 void add_max_work(CLI::App& cmd, std::uint64_t& max_work, const char* what) {
-    cmd.add_option_function<std::string>(
-           "--max-work", [&max_work](const std::string& v) { max_work = parse_count("--max-work", v, 1); },
-           fmt::format("Stop with an error (exit 70) when {} does more than this much work: every VM "
-                       "instruction plus every module its steps write (default {}, minutes of "
-                       "running, not days)",
-                       what, kDefaultMaxWork))
-        ->type_name("N");
+    add_count(
+        cmd, "--max-work", 1, kAnyCount, [&max_work](std::uint64_t v) { max_work = v; },
+        fmt::format("Stop with an error (exit 70) when {} does more than this much work: every VM "
+                    "instruction plus every module its steps write (default {}, minutes of "
+                    "running, not days)",
+                    what, kDefaultMaxWork));
 }
 
 void add_max_memory(CLI::App& cmd, std::uint64_t& bytes) {
@@ -109,6 +96,19 @@ void add_allow_read(CLI::App& cmd, std::vector<std::string>& dirs) {
                    "only its own folder, -I and PLANT_PATH folders and the standard library")
         ->type_name("DIR")
         ->allow_extra_args(false);
+}
+
+CLI::Option* add_count(CLI::App& cmd, const std::string& flags, std::uint64_t lowest, std::uint64_t highest,
+                       std::function<void(std::uint64_t)> set, const std::string& help) {
+    const std::string name = flags.substr(flags.rfind(',') + 1); // the long name, as messages say it
+    return cmd
+        .add_option_function<std::string>(
+            flags,
+            [name, lowest, highest, set = std::move(set)](const std::string& v) {
+                set(parse_count(name, v, lowest, highest));
+            },
+            help)
+        ->type_name("N");
 }
 
 std::uint64_t parse_count(const std::string& option, const std::string& text, std::uint64_t lowest,

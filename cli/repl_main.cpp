@@ -188,19 +188,15 @@ void setup_repl(CLI::App& app, int& exit_code) {
     cmd->add_option("FILE", *file, "A grammar to load");
     auto allow = std::make_shared<std::vector<std::string>>();
     add_allow_read(*cmd, *allow);
-    cmd->add_option_function<std::string>(
-           "--max-steps",
-           [max_steps](const std::string& v) { *max_steps = parse_count("--max-steps", v, 1); },
-           fmt::format("Stop an evaluation (a hook call, a production for one module, an expression) "
-                       "after this many instructions (default {})",
-                       kDefaultMaxSteps))
-        ->type_name("N");
-    cmd->add_option_function<std::string>(
-           "--max-modules",
-           [max_modules](const std::string& v) { *max_modules = parse_count("--max-modules", v, 1); },
-           "Stop a step with an error when the string grows past this many modules (the session "
-           "stays at the step before)")
-        ->type_name("N");
+    add_count(
+        *cmd, "--max-steps", 1, kAnyCount, [max_steps](std::uint64_t v) { *max_steps = v; },
+        fmt::format("Stop an evaluation (a hook call, a production for one module, an expression) "
+                    "after this many instructions (default {})",
+                    kDefaultMaxSteps));
+    add_count(
+        *cmd, "--max-modules", 1, kAnyCount, [max_modules](std::uint64_t v) { *max_modules = v; },
+        "Stop a step with an error when the string grows past this many modules (the session "
+        "stays at the step before)");
     add_max_work(*cmd, *max_work, "one command (a :step, a re-derivation after an edit)");
     add_max_memory(*cmd, *max_memory);
     cmd->footer("Reads commands from standard input without a prompt when it is not a terminal:\n"
