@@ -2,6 +2,7 @@
 #include "commands.hpp"
 
 #include "plant/environment_phase.hpp"
+#include "plant/mesh.hpp"
 
 #include <fmt/format.h>
 
@@ -136,6 +137,15 @@ void setup_check(CLI::App& app, int& exit_code) {
         if (program && !check_settings(*c, *program, sources)) {
             exit_code = kGrammar;
             return;
+        }
+        if (program) {
+            try { // the mesh files of `surface s = load(...)`, read as plant run would read them
+                check_surface_files(*program);
+            } catch (const RuntimeError& e) {
+                std::cerr << render(Diagnostic{Severity::Error, e.span, e.message, {}}, sources, c->color);
+                exit_code = e.kind == RuntimeErrorKind::Input ? kNoInput : kRuntime;
+                return;
+            }
         }
         exit_code = program ? report_dormant_edits(*c, *program, sources) : code;
     });

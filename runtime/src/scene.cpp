@@ -322,6 +322,17 @@ MeshPart organ_mesh(const Program& program, const OrganShape& shape) {
 
 } // namespace
 
+void check_surface_files(const Program& program) {
+    auto check = [](const Program& p) {
+        for (const SurfaceDef& s : p.surfaces)
+            if (s.kind == SurfaceKind::Load) (void)loaded_prototype(s);
+    };
+    check(program);
+    if (program.instances)
+        for (const InstanceDef& instance : *program.instances)
+            if (instance.program) check(*instance.program);
+}
+
 namespace {
 
 // Maps the whole pages of a vector's reserved storage in one call (MADV_POPULATE_WRITE, Linux

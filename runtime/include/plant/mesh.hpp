@@ -59,4 +59,10 @@ void mesh_tube(const TubePath& path, const MeshOptions& options, MeshPart& part,
 // cannot be loaded, and when instances would take more than the options allow.
 Scene build_scene(const Program& program, const Skeleton& skeleton, const MeshOptions& options);
 
+// Reads every mesh file the program's `surface s = load("...");` declarations name, its instances'
+// bodies' included, as meshing them would, and throws the RuntimeError meshing would throw (kind
+// Input for a file refused as unsafe or malformed). `plant check` runs it, so that a file `plant
+// run` would refuse is reported without growing the plant.
+void check_surface_files(const Program& program);
+
 } // namespace plant
