@@ -79,9 +79,11 @@ int view_main(ViewCmd& c) {
         return kRuntime;
     }
     if (std::error_code ec; !std::filesystem::is_regular_file(c.g.file, ec)) {
-        const char* why = std::filesystem::is_directory(c.g.file, ec) ? "it is a directory"
-                          : std::filesystem::exists(c.g.file, ec)     ? "it is not a regular file"
-                                                                      : "no such file";
+        std::error_code ec2;
+        const std::string why = ec && ec != std::errc::no_such_file_or_directory ? ec.message()
+                                : std::filesystem::is_directory(c.g.file, ec2)   ? "it is a directory"
+                                : std::filesystem::exists(c.g.file, ec2)         ? "it is not a regular file"
+                                                                                 : "no such file";
         std::cerr << fmt::format("plant: cannot read '{}': {}\n", escape_controls(c.g.file), why);
         return kNoInput;
     }

@@ -47,7 +47,7 @@ struct GrammarOptions {
     std::string appended;
 };
 
-// Reads a whole number from 0 (`lowest`) to 2^64 - 1 written in decimal digits; throws
+// Reads a whole number from `lowest` to `highest` written in decimal digits; throws
 // CLI::ValidationError naming `option` and the range otherwise (a usage error, exit 64).
 std::uint64_t parse_count(const std::string& option, const std::string& text, std::uint64_t lowest,
                           std::uint64_t highest = std::numeric_limits<std::uint64_t>::max());

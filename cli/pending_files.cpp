@@ -20,8 +20,9 @@ namespace fs = std::filesystem;
 namespace {
 
 // What the signal handler reads: published before the handlers are installed, withdrawn after
-// they are put back, never changed in between but for the `live` flags. The handler only calls
-// unlink, sigaction and raise, which are async-signal-safe (signal-safety(7)).
+// they are put back, never changed in between but for the `live` flags and the count of folders
+// made (the folders' array is reserved whole beforehand). The handler only calls unlink, rmdir,
+// sigaction and raise, which are async-signal-safe (signal-safety(7)).
 struct Registry {
     const std::string* temps = nullptr;
     const std::atomic<bool>* live = nullptr;
@@ -148,18 +149,20 @@ void PendingFiles::write_with(std::size_t k, const std::function<void(const Byte
         throw ExportError("cannot write " + in_quotes(target) + ": not a file name");
     std::error_code ec;
     if (!parent.empty()) {
-        // the folders on the way that do not exist yet, outermost first, are remembered
-        std::vector<std::string> missing;
+        // the folders on the way that do not exist yet are made here, outermost first, and only
+        // those this call made are remembered (a path through '..' names folders that exist, and
+        // one made meanwhile by another process is not ours to remove)
+        std::vector<fs::path> missing;
         for (fs::path d = parent; !d.empty() && !fs::exists(fs::symlink_status(d, ec)); d = d.parent_path()) {
-            missing.push_back(d.string());
+            missing.push_back(d);
             if (d == d.parent_path()) break;
         }
-        fs::create_directories(parent, ec);
         for (auto d = missing.rbegin(); d != missing.rend(); ++d)
-            if (fs::is_directory(fs::symlink_status(*d, ec)) && made_dirs_.size() < made_dirs_.capacity()) {
-                made_dirs_.push_back(*d);
+            if (::mkdir(d->c_str(), 0777) == 0 && made_dirs_.size() < made_dirs_.capacity()) {
+                made_dirs_.push_back(d->string());
                 made_count_.store(made_dirs_.size(), std::memory_order_release);
             }
+        fs::create_directories(parent, ec); // what is left (a '..' past a folder made above)
     }
     live_[k].store(true); // before the file exists: a signal from here on removes it
     const int fd = ::open(temps_[k].c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);

@@ -68,12 +68,13 @@ bool Session::read_default_edits() {
         default_edits_unreadable_ = true;
         return false;
     }
+    // lines as the edits' parser counts them (source.cpp): ended by '\n', "\r\n" or a lone '\r'
     std::size_t b = 0;
     while (b < text.size()) {
-        std::size_t e = text.find('\n', b);
+        std::size_t e = text.find_first_of("\r\n", b);
         if (e == std::string::npos) e = text.size();
         graph_lines_.push_back(text.substr(b, e - b));
-        b = e + 1;
+        b = e + (e + 1 < text.size() && text[e] == '\r' && text[e + 1] == '\n' ? 2 : 1);
     }
     return !graph_lines_.empty();
 }
@@ -93,7 +94,8 @@ bool Session::drop_orphaned_edits(int steps) {
             edit < edits.size() &&
             sources_->file(edits[edit].span.file).line_col(edits[edit].span.begin).line == line;
         if (is_edit && g->orphaned(edit)) {
-            out_ << fmt::format("dropped the edit '{}': its branch is gone (match single)\n", l);
+            out_ << fmt::format("dropped the edit '{}': its branch is gone (match single)\n",
+                                escape_controls(l));
             ++dropped;
         } else {
             kept.push_back(l);

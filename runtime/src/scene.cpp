@@ -16,6 +16,7 @@
 #include <map>
 #include <numbers>
 #include <optional>
+#include <set>
 #include <stdexcept>
 
 namespace plant {
@@ -323,9 +324,10 @@ MeshPart organ_mesh(const Program& program, const OrganShape& shape) {
 } // namespace
 
 void check_surface_files(const Program& program) {
-    auto check = [](const Program& p) {
+    std::set<std::string> read; // a body sees the surfaces around it: each file is read once
+    auto check = [&read](const Program& p) {
         for (const SurfaceDef& s : p.surfaces)
-            if (s.kind == SurfaceKind::Load) (void)loaded_prototype(s);
+            if (s.kind == SurfaceKind::Load && read.insert(s.path).second) (void)loaded_prototype(s);
     };
     check(program);
     if (program.instances)

@@ -194,10 +194,10 @@ contains "the angle's error, at the setting" "$tmp/stderr" "infangle.plant:4:7: 
 printf 'axiom: A;\nderive 15;\nrules { A -> F[+A][-A]; }\n' >"$tmp/slow.plant"
 for sig in INT HUP; do
   rm -rf "$tmp/sig"
-  mkdir -p "$tmp/sig"
+  mkdir -p "$tmp/sig/kept" # an empty folder that was there before stays, though named through '..'
   set -m
-  "$plant" run "$tmp/slow.plant" -o "$tmp/sig/s.txt" -o "$tmp/sig/new/deep/s.png" -o "$tmp/sig/s.obj" --sides 64 \
-    --size 12000x5000 >/dev/null 2>&1 &
+  "$plant" run "$tmp/slow.plant" -o "$tmp/sig/s.txt" -o "$tmp/sig/new/../kept/s.off" -o "$tmp/sig/new/deep/s.png" \
+    -o "$tmp/sig/s.obj" --sides 64 --size 12000x5000 >/dev/null 2>&1 &
   slow=$!
   set +m
   for _ in $(seq 200); do
@@ -209,7 +209,7 @@ for sig in INT HUP; do
   got=$?
   want=$((128 + $(kill -l $sig)))
   if [ "$got" -eq $want ]; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL SIG$sig during run: exit $got, expected $want"; fi
-  if ls -a "$tmp/sig" | grep -qv '^\.\.\?$'; then
+  if ls -a "$tmp/sig" | grep -qv '^\.\.\?$\|^kept$' || [ ! -d "$tmp/sig/kept" ] || [ -n "$(ls -A "$tmp/sig/kept")" ]; then
     fail=$((fail + 1)); echo "FAIL SIG$sig during run left files:"; ls -a "$tmp/sig"
   else pass=$((pass + 1)); fi
 done
@@ -241,6 +241,14 @@ printf '\xef\xbb\xbfaxiom: F;\n' >"$tmp/bom.plant"
 check "a byte-order mark" 0 "$plant" derive "$tmp/bom.plant"
 contains "a byte-order mark: the string" "$tmp/stdout" "F"
 
+# a failed run removes the folders it made, and only those: one named through '..' that was
+# there before stays, empty as it is
+mkdir -p "$tmp/empty_before"
+: >"$tmp/afile"
+check "a run failing after making a folder" 73 "$plant" run "$tmp/ok.plant" -o "$tmp/made/../empty_before/s.txt" -o "$tmp/made2/s.txt" -o "$tmp/afile/x.txt"
+contains "a run failing after making a folder: why" "$tmp/stderr" "cannot create a file in"
+holds "the folder that was there stays" test -d "$tmp/empty_before"
+holds "the folders the run made go" test ! -e "$tmp/made" -a ! -e "$tmp/made2"
 # counts on the command line: one message naming the option, its range and what was written
 check "--steps in hex" 64 "$plant" derive "$tmp/ok.plant" -n 0x10
 contains "--steps in hex: the range" "$tmp/stderr" "plant: --steps must be a whole number from 0 to 1000000, found '0x10'"
@@ -248,6 +256,12 @@ check "--threads past 256" 64 "$plant" derive "$tmp/ok.plant" --threads 300
 contains "--threads past 256: the range" "$tmp/stderr" "--threads must be a whole number from 0 to 256, found '300'"
 check "--max-modules 0" 64 "$plant" derive "$tmp/ok.plant" --max-modules 0
 contains "--max-modules 0: the range" "$tmp/stderr" "--max-modules must be a whole number from 1 to"
+check "--max-steps 0" 64 "$plant" derive "$tmp/ok.plant" --max-steps 0
+contains "--max-steps 0: the range" "$tmp/stderr" "--max-steps must be a whole number from 1 to"
+check "--max-work -1" 64 "$plant" derive "$tmp/ok.plant" --max-work -1
+contains "--max-work -1: the range" "$tmp/stderr" "--max-work must be a whole number from 1 to"
+check "repl --max-steps x" 64 "$plant" repl "$tmp/plant.plant" --max-steps x <"$tmp/ok.repl"
+contains "repl --max-steps x: the range" "$tmp/stderr" "--max-steps must be a whole number from 1 to"
 check "repl --max-modules 0" 64 "$plant" repl "$tmp/plant.plant" --max-modules 0 <"$tmp/ok.repl"
 contains "repl --max-modules 0: the range" "$tmp/stderr" "--max-modules must be a whole number from 1 to"
 

@@ -60,9 +60,10 @@ void mesh_tube(const TubePath& path, const MeshOptions& options, MeshPart& part,
 Scene build_scene(const Program& program, const Skeleton& skeleton, const MeshOptions& options);
 
 // Reads every mesh file the program's `surface s = load("...");` declarations name, its instances'
-// bodies' included, as meshing them would, and throws the RuntimeError meshing would throw (kind
-// Input for a file refused as unsafe or malformed). `plant check` runs it, so that a file `plant
-// run` would refuse is reported without growing the plant.
+// bodies' included, each file once, as meshing them would, and throws the RuntimeError meshing
+// would throw (kind Input for a file refused as unsafe or malformed). `plant check` runs it, so
+// that a file `plant run` would refuse is reported without growing the plant; it reads surfaces
+// the plant never places too, which `plant run` does not.
 void check_surface_files(const Program& program);
 
 } // namespace plant
