@@ -162,7 +162,6 @@ void PendingFiles::write_with(std::size_t k, const std::function<void(const Byte
                 made_dirs_.push_back(d->string());
                 made_count_.store(made_dirs_.size(), std::memory_order_release);
             }
-        fs::create_directories(parent, ec); // what is left (a '..' past a folder made above)
     }
     live_[k].store(true); // before the file exists: a signal from here on removes it
     const int fd = ::open(temps_[k].c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);

@@ -8,6 +8,7 @@
 
 #include "plant/export.hpp"
 #include "plant/graph.hpp"
+#include "plant/source.hpp"
 
 #include <fmt/format.h>
 
@@ -68,14 +69,13 @@ bool Session::read_default_edits() {
         default_edits_unreadable_ = true;
         return false;
     }
-    // lines as the edits' parser counts them (source.cpp): ended by '\n', "\r\n" or a lone '\r'
-    std::size_t b = 0;
-    while (b < text.size()) {
-        std::size_t e = text.find_first_of("\r\n", b);
-        if (e == std::string::npos) e = text.size();
-        graph_lines_.push_back(text.substr(b, e - b));
-        b = e + (e + 1 < text.size() && text[e] == '\r' && text[e + 1] == '\n' ? 2 : 1);
-    }
+    // the lines as the edits' parser numbers them (SourceFile: '\n', "\r\n" or a lone '\r' ends one),
+    // which drop_orphaned_edits matches the edits' spans against
+    const SourceFile lines(program_->graph.edits_path, std::move(text));
+    const auto size = static_cast<std::uint32_t>(lines.text().size());
+    std::uint32_t last = size == 0 ? 0 : lines.line_col(size).line;
+    if (size > 0 && lines.text().back() == '\n') --last; // nothing after the final line end
+    for (std::uint32_t line = 1; line <= last; ++line) graph_lines_.emplace_back(lines.line_text(line));
     return !graph_lines_.empty();
 }
 
