@@ -41,26 +41,49 @@ DeriveOptions Session::options() const {
     return o;
 }
 
-std::string Session::session_source(const std::string* extra_fn) const {
-    std::string s;
-    if (!file_.empty()) s += fmt::format("import \"{}\";\n", file_);
-    if (axiom_) s += "axiom: " + *axiom_ + ";\n";
+void Session::SessionText::add(std::string_view line, std::uint32_t typed_at) {
+    text.append(line);
+    text += '\n';
+    for (char c : line)
+        if (c == '\n') lines.push_back(typed_at);
+    lines.push_back(typed_at);
+}
+
+Session::SessionText Session::session_source(const std::string* extra) const {
+    // Lines the session adds around what was typed (0 below) show the number of the typed line
+    // before them, or, before any, after them: an error at a `}` the session closed is then
+    // placed near what was typed instead of at a line number that means nothing to the user.
+    SessionText s;
+    if (!file_.empty()) s.add(fmt::format("import \"{}\";", file_), 0);
+    if (axiom_) s.add("axiom: " + axiom_->text + ";", axiom_->line);
     // typed settings: the session's file comes after the import, so its settings win
-    for (const auto& [key, value] : settings_) s += fmt::format("{} {};\n", key, value);
+    for (const auto& [key, value] : settings_) s.add(fmt::format("{} {};", key, value.text), value.line);
     if (!extra_rules_.empty()) {
-        s += "rules {\n";
-        for (const auto& r : extra_rules_) s += r + "\n";
-        s += "}\n";
+        s.add("rules {", 0);
+        for (const auto& r : extra_rules_) s.add(r.text, r.line);
+        s.add("}", 0);
     }
     if (!edits_.empty()) {
         // each edit on lines of its own, so that an error points into what the user typed
-        s += fmt::format("on {} {{\n", ast::spelling(ast::HookKind::BeforeStep));
-        for (const auto& [at, statements] : edits_)
-            s += fmt::format("if step() == {} {{\n{}\n}}\n", at, statements);
-        s += "}\n";
+        s.add(fmt::format("on {} {{", ast::spelling(ast::HookKind::BeforeStep)), 0);
+        for (const auto& [at, statements] : edits_) {
+            s.add(fmt::format("if step() == {} {{", at), 0);
+            s.add(statements.text, statements.line);
+            s.add("}", 0);
+        }
+        s.add("}", 0);
     }
-    if (extra_fn) s += *extra_fn + "\n";
+    if (extra) s.add(*extra, input_line_);
+    std::uint32_t last = 0;
+    for (auto& l : s.lines) last = l = l != 0 ? l : last;
+    for (auto it = s.lines.rbegin(); it != s.lines.rend(); ++it) last = *it = *it != 0 ? *it : last;
     return s;
+}
+
+std::uint32_t Session::add_session(SourceManager& sources, const SessionText& session) const {
+    const std::uint32_t id = sources.add("<session>", session.text);
+    sources.show_lines(id, session.lines);
+    return id;
 }
 
 CompileOptions Session::compile_options() const {
@@ -95,7 +118,7 @@ bool Session::rebuild(int steps, const std::string* extra_fn) {
     auto sources = std::make_unique<SourceManager>();
     CompileOptions co = compile_options();
     Diagnostics diags;
-    std::uint32_t id = sources->add("<session>", session_source(extra_fn));
+    std::uint32_t id = add_session(*sources, session_source(extra_fn));
     auto program = compile_source(*sources, id, co, diags);
     err_ << render_all(news(diags, *sources), *sources, color_);
     last_error_input_ = diags.has_input_errors();
@@ -289,7 +312,7 @@ void Session::find(const std::string& pattern) {
     auto sources = std::make_unique<SourceManager>();
     Diagnostics diags;
     auto program =
-        compile_source(*sources, sources->add("<session>", session_source(&group)), compile_options(), diags);
+        compile_source(*sources, add_session(*sources, session_source(&group)), compile_options(), diags);
     Diagnostics errors;
     for (const auto& d : diags.all())
         if (d.severity == Severity::Error) errors.add(d);
@@ -380,8 +403,15 @@ void Session::evaluate(const std::string& expr) {
     auto sources = std::make_unique<SourceManager>();
     CompileOptions co = compile_options();
     Diagnostics diags;
-    std::string text = history_.empty() ? fn + "\naxiom: ;\n" : session_source(&fn);
-    const std::uint32_t id = sources->add("<session>", text);
+    SessionText session;
+    if (history_.empty()) {
+        session.add(fn, input_line_);
+        session.add("axiom: ;", input_line_);
+    } else {
+        session = session_source(&fn);
+    }
+    const std::string& text = session.text;
+    const std::uint32_t id = add_session(*sources, session);
     auto program = compile_source(*sources, id, co, diags);
     // An error past the typed expression (at the `;` the session added on the next line) is
     // shown at the end of what was typed, on the line the user typed.
@@ -456,7 +486,7 @@ void Session::edit(std::string statements) {
     }
     if (statements.back() != ';' && statements.back() != '}') statements += ';';
     int at = current().steps_done();
-    edits_.emplace_back(at, statements);
+    edits_.emplace_back(at, Typed{statements, input_line_});
     if (rebuild(at))
         out_ << fmt::format("before step {}: {}\n", at + 1, statements);
     else
@@ -467,7 +497,7 @@ void Session::list_edits() {
     const DecompositionGraph* g = history_.empty() ? nullptr : current().run_state().graph();
     if (edits_.empty() && (!g || !g->edits() || g->edits()->edits.empty())) out_ << "no edits\n";
     for (const auto& [at, statements] : edits_)
-        out_ << fmt::format("  before step {}: {}\n", at + 1, statements);
+        out_ << fmt::format("  before step {}: {}\n", at + 1, statements.text);
     list_graph_edits();
 }
 
@@ -533,6 +563,7 @@ std::ostream& Session::error() {
 }
 
 bool Session::execute(const std::string& raw) {
+    ++input_line_;
     std::string line = trim(raw);
     if (line.empty() || line[0] == '#') return true;
     if (line[0] == ':') {
@@ -546,7 +577,7 @@ bool Session::execute(const std::string& raw) {
         auto saved = axiom_;
         std::string a = trim(line.substr(6));
         if (!a.empty() && a.back() == ';') a.pop_back();
-        axiom_ = a;
+        axiom_ = Typed{a, input_line_};
         if (rebuild(steps))
             out_ << fmt::format("axiom set; step {}: {}\n", current().steps_done(),
                                 modules(current().string().size()));
@@ -559,7 +590,7 @@ bool Session::execute(const std::string& raw) {
         line.find("->") != std::string::npos || (line.back() == '}' && line.find('{') != std::string::npos);
     if (production) {
         if (line.back() != ';' && line.back() != '}') line += ';';
-        extra_rules_.push_back(line);
+        extra_rules_.push_back({line, input_line_});
         if (rebuild(steps))
             out_ << fmt::format("rule added; step {}: {}\n", current().steps_done(),
                                 modules(current().string().size()));

@@ -98,7 +98,16 @@ class Session {
     bool rebuild(int steps, const std::string* extra_fn = nullptr);
     CompileOptions compile_options() const;
     Diagnostics news(const Diagnostics& diags, const SourceManager& sources);
-    std::string session_source(const std::string* extra_fn) const;
+    // The session's grammar: the loaded file's import and what was typed, each typed line shown
+    // in messages by its number in the input (`lines`, as SourceFile::show_lines takes them).
+    struct SessionText {
+        std::string text;
+        std::vector<std::uint32_t> lines;
+        void add(std::string_view line, std::uint32_t typed_at); // a line (or lines) of the text
+    };
+    // `extra` (an expression's function, a pattern's rule group) is text typed on this line.
+    SessionText session_source(const std::string* extra) const;
+    std::uint32_t add_session(SourceManager& sources, const SessionText& session) const;
     bool step(int n);
     void show(const std::string& rest);
     void find(const std::string& pattern);
@@ -140,19 +149,25 @@ class Session {
     std::uint64_t max_work_ = kDefaultMaxWork;
     std::size_t max_modules_ = 0;
 
-    std::vector<std::string> allow_read_;       // --allow-read
-    std::string file_;                          // the loaded grammar's path, as given
-    std::string file_text_;                     // its text as :load or :reload read it
-    std::optional<std::string> axiom_;          // typed `axiom: ...`
-    std::vector<std::string> extra_rules_;      // typed productions
+    std::vector<std::string> allow_read_; // --allow-read
+    std::string file_;                    // the loaded grammar's path, as given
+    std::string file_text_;               // its text as :load or :reload read it
+    // Text typed at the prompt, with its line's number in the input (1 for the first line read)
+    struct Typed {
+        std::string text;
+        std::uint32_t line = 0;
+    };
+    std::uint32_t input_line_ = 0;              // the line being run
+    std::optional<Typed> axiom_;                // typed `axiom: ...`
+    std::vector<Typed> extra_rules_;            // typed productions
     std::map<std::string, std::string> params_; // :set NAME VALUE
     std::optional<std::uint64_t> seed_;
-    std::map<std::string, std::string> settings_;   // typed `angle 30;` and the like: key, value
+    std::map<std::string, Typed> settings_;         // typed `angle 30;` and the like: key, value
     std::map<std::string, std::string> consts_;     // :set NAME VALUE on a const of the loaded file
     std::vector<std::pair<int, std::string>> uses_; // :use GROUP at step N, replayed by rebuilds
     // Edits (:do, or a hook-only call such as ivy.cut(12) typed at the prompt): statements run
     // by an `on before_step` hook at step N, that is before the step that follows N.
-    std::vector<std::pair<int, std::string>> edits_;
+    std::vector<std::pair<int, Typed>> edits_;
     std::set<std::string> shown_; // warnings already shown
     bool failed_ = false;
     bool quit_ = false; // :quit was typed

@@ -270,7 +270,7 @@ bool Session::typed_setting(const std::string& line) {
         return true;
     }
     auto saved = settings_;
-    settings_[key] = value;
+    settings_[key] = Typed{value, input_line_};
     int steps = current().steps_done();
     if (key == "derive") { // the session derives that many steps from the axiom
         auto n = whole_number(value);

@@ -57,7 +57,7 @@ std::string nearest_name(std::string_view name, const std::vector<std::string>& 
 std::string Compiler::where(Span s) const {
     if (!s.valid()) return "?";
     const SourceFile& f = sm_.file(s.file);
-    LineCol lc = f.line_col(s.begin);
+    LineCol lc = f.shown_line_col(s.begin);
     if (s.file == current_file_) return fmt::format("{}:{}", lc.line, lc.col);
     return fmt::format("{}:{}:{}", f.name(), lc.line, lc.col);
 }

@@ -117,14 +117,15 @@ void render_one(std::string& out, Severity sev, Span span, const std::string& me
     }
     const SourceFile& f = sources.file(span.file);
     LineCol lc = f.line_col(span.begin);
-    out += fmt::format("{}:{}:{}: {}{}:{} {}\n", escape_controls(f.name()), lc.line, lc.col, on,
+    const std::uint32_t shown_line = f.shown(lc).line;
+    out += fmt::format("{}:{}:{}: {}{}:{} {}\n", escape_controls(f.name()), shown_line, lc.col, on,
                        severity_name(sev), off, escape_controls(message, true));
     std::vector<std::size_t> cols;
     std::string_view raw = f.line_text(lc.line);
     if (raw.size() > 200) raw = raw.substr(0, 200);
     const std::string line = printable(raw, cols);
     const std::size_t width = cols.back(); // the line's length in shown columns
-    out += fmt::format("{:5} | {}\n", lc.line, line);
+    out += fmt::format("{:5} | {}\n", shown_line, line);
     auto shown = [&](std::size_t byte_col) { return cols[std::min(byte_col, cols.size() - 1)]; };
     std::size_t col = shown(lc.col - 1);
     std::size_t len = 1;

@@ -637,7 +637,7 @@ void report(const g::GrammarError& e, const SourceFile& src, std::uint32_t file_
     if (auto p = msg.find("{at}"); p != std::string::npos) {
         std::string at = "?";
         if (e.at != std::string::npos) {
-            LineCol a = src.line_col(static_cast<std::uint32_t>(e.at));
+            LineCol a = src.shown_line_col(static_cast<std::uint32_t>(e.at));
             at = fmt::format("{}:{}", a.line, a.col);
         }
         msg.replace(p, 4, at);

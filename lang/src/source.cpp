@@ -27,6 +27,12 @@ LineCol SourceFile::line_col(std::uint32_t offset) const {
     return {line, offset - line_starts_[line - 1] + 1};
 }
 
+LineCol SourceFile::shown(LineCol at) const {
+    if (at.line >= 1 && at.line <= shown_lines_.size() && shown_lines_[at.line - 1] != 0)
+        at.line = shown_lines_[at.line - 1];
+    return at;
+}
+
 std::string_view SourceFile::line_text(std::uint32_t line) const {
     if (line == 0 || line > line_starts_.size()) return {};
     std::uint32_t b = line_starts_[line - 1];

@@ -31,11 +31,18 @@ class SourceFile {
     LineCol line_col(std::uint32_t offset) const;
     std::string_view line_text(std::uint32_t line) const; // without the newline
     std::uint32_t offset_of(std::uint32_t line, std::uint32_t col) const;
+    // The line number messages give: a line's own, unless the text was put together from lines
+    // typed elsewhere (the REPL's session), which then names each line by where it was typed.
+    // `shown[i]` is shown for line i + 1; 0 or a line past the end keeps its own number.
+    void show_lines(std::vector<std::uint32_t> shown) { shown_lines_ = std::move(shown); }
+    LineCol shown(LineCol at) const;
+    LineCol shown_line_col(std::uint32_t offset) const { return shown(line_col(offset)); }
 
   private:
     std::string name_;
     std::string text_;
     std::vector<std::uint32_t> line_starts_;
+    std::vector<std::uint32_t> shown_lines_;
 };
 
 // Owns every file read during one compilation (the main grammar and its imports).
@@ -44,6 +51,9 @@ class SourceManager {
     SourceManager();
     std::uint32_t add(std::string name, std::string text);
     const SourceFile& file(std::uint32_t id) const { return *files_.at(id); }
+    void show_lines(std::uint32_t id, std::vector<std::uint32_t> shown) {
+        files_.at(id)->show_lines(std::move(shown));
+    }
     std::size_t size() const { return files_.size(); }
 
   private:
