@@ -55,6 +55,7 @@ Session::SessionText Session::session_source(const std::string* extra) const {
     // placed near what was typed instead of at a line number that means nothing to the user.
     SessionText s;
     if (!file_.empty()) s.add(fmt::format("import \"{}\";", file_), 0);
+    for (const auto& d : declarations_) s.add(d.text, d.line);
     if (axiom_) s.add("axiom: " + axiom_->text + ";", axiom_->line);
     // typed settings: the session's file comes after the import, so its settings win
     for (const auto& [key, value] : settings_) s.add(fmt::format("{} {};", key, value.text), value.line);
@@ -174,10 +175,11 @@ int Session::load(const std::string& path) {
         return 66;
     }
     // a new grammar starts a new session; a grammar that does not build leaves the old one as it was
-    auto saved = std::tuple{file_,     file_text_, axiom_, extra_rules_, params_,     consts_,
-                            settings_, seed_,      uses_,  edits_,       graph_lines_};
+    auto saved = std::tuple{file_,   file_text_, declarations_, axiom_, extra_rules_, params_,
+                            consts_, settings_,  seed_,         uses_,  edits_,       graph_lines_};
     file_ = fs::path(path).lexically_normal().string(); // as given: messages stay short and portable
     read_file(file_, file_text_);
+    declarations_.clear();
     axiom_.reset();
     extra_rules_.clear();
     params_.clear();
@@ -190,8 +192,8 @@ int Session::load(const std::string& path) {
     graph_undo_.clear();
     default_edits_unreadable_ = false;
     if (!rebuild(0) || (read_default_edits() && !rebuild(0))) {
-        std::tie(file_, file_text_, axiom_, extra_rules_, params_, consts_, settings_, seed_, uses_, edits_,
-                 graph_lines_) = saved;
+        std::tie(file_, file_text_, declarations_, axiom_, extra_rules_, params_, consts_, settings_, seed_,
+                 uses_, edits_, graph_lines_) = saved;
         graph_undo_.clear();
         return last_error_runtime_ ? 70 : last_error_input_ ? 66 : 65;
     }
@@ -403,13 +405,8 @@ void Session::evaluate(const std::string& expr) {
     auto sources = std::make_unique<SourceManager>();
     CompileOptions co = compile_options();
     Diagnostics diags;
-    SessionText session;
-    if (history_.empty()) {
-        session.add(fn, input_line_);
-        session.add("axiom: ;", input_line_);
-    } else {
-        session = session_source(&fn);
-    }
+    SessionText session = session_source(&fn);
+    if (history_.empty()) session.add("axiom: ;", input_line_); // no grammar yet: typed declarations only
     const std::string& text = session.text;
     const std::uint32_t id = add_session(*sources, session);
     auto program = compile_source(*sources, id, co, diags);
@@ -586,6 +583,7 @@ bool Session::execute(const std::string& raw) {
         return true;
     }
     if (typed_setting(line)) return true;
+    if (typed_declaration(line)) return true;
     bool production =
         line.find("->") != std::string::npos || (line.back() == '}' && line.find('{') != std::string::npos);
     if (production) {

@@ -85,6 +85,9 @@ class Session {
     void set_param(const std::string& rest);
     void set_seed(const std::string& rest);
     // `angle 30;`, `derive 5;`, ... typed at the prompt: the session's own setting (repl_commands.cpp)
+    // `module A(x);`, `const k = 2;`, `fn f(x) = ...;`, `ignore: F;` ...: kept and compiled with
+    // the session's grammar.
+    bool typed_declaration(const std::string& line);
     bool typed_setting(const std::string& line);
     // The loaded file's consts (name: the value's byte range), which :set may replace.
     std::map<std::string, std::pair<std::uint32_t, std::uint32_t>> file_consts() const;
@@ -158,6 +161,7 @@ class Session {
         std::uint32_t line = 0;
     };
     std::uint32_t input_line_ = 0;              // the line being run
+    std::vector<Typed> declarations_;           // typed `module A(x);`, `const k = 2;` ...
     std::optional<Typed> axiom_;                // typed `axiom: ...`
     std::vector<Typed> extra_rules_;            // typed productions
     std::map<std::string, std::string> params_; // :set NAME VALUE

@@ -3,6 +3,7 @@
 #include "repl.hpp"
 #include "repl_text.hpp"
 
+#include "plant/compiler.hpp"
 #include "plant/parser.hpp"
 
 #include <fmt/format.h>
@@ -138,8 +139,10 @@ void Session::help(const std::string& topic) {
     std::string name = topic.empty() || topic[0] != ':' ? topic : topic.substr(1);
     if (name.empty()) {
         out_ << command_list();
-        out_ << "Anything else is a production (A(x) -> B(x + 1);), an axiom (axiom: A(1);) or an expression "
-                "to evaluate (2 * pi).\n";
+        out_
+            << "Anything else is a production (A(x) -> B(x + 1);), an axiom (axiom: A(1);), a setting (angle "
+               "30;), a declaration (module A(x);, const k = 2;, fn f(x) = 2 * x;, ignore: F;) or an "
+               "expression to evaluate (2 * pi).\n";
         return;
     }
     for (const auto& c : commands()) {
@@ -236,6 +239,40 @@ std::string Session::file_text_with_consts() const {
     std::string text = file_text_; // from the end, so that earlier ranges stay where they were
     for (const auto& [range, value] : edits) text.replace(range.first, range.second - range.first, value);
     return text;
+}
+
+bool Session::typed_declaration(const std::string& line) {
+    static constexpr std::string_view kWords[] = {"param ", "const ", "var ",     "module ", "fn ",
+                                                  "curve ", "ignore", "consider", "surface "};
+    const bool declaration = std::any_of(std::begin(kWords), std::end(kWords), [&](std::string_view w) {
+        if (line.rfind(w, 0) != 0) return false;
+        // `ignore:` and `consider:` take a colon; a param named `ignore_x` is an expression
+        return w.back() == ' ' || trim(line.substr(w.size())).rfind(':', 0) == 0;
+    });
+    if (!declaration) return false;
+    std::string text = line;
+    if (text.back() != ';' && text.back() != '}') text += ';';
+    declarations_.push_back({text, input_line_});
+    bool ok = false;
+    if (history_.empty()) {
+        // no grammar yet: checked with an empty axiom, kept for the axiom typed next
+        auto sources = std::make_unique<SourceManager>();
+        Diagnostics diags;
+        const std::string axiom = "axiom: ;";
+        auto program =
+            compile_source(*sources, add_session(*sources, session_source(&axiom)), compile_options(), diags);
+        err_ << render_all(news(diags, *sources), *sources, color_);
+        ok = program != nullptr;
+        if (ok) out_ << "declared; type an axiom such as 'axiom: F;' to start\n";
+    } else if ((ok = rebuild(current().steps_done()))) {
+        out_ << fmt::format("declared; step {}: {}\n", current().steps_done(),
+                            modules(current().string().size()));
+    }
+    if (!ok) {
+        failed_ = true;
+        declarations_.pop_back();
+    }
+    return true;
 }
 
 bool Session::typed_setting(const std::string& line) {
