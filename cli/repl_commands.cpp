@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <sstream>
 #include <tuple>
@@ -249,7 +250,17 @@ bool Session::typed_declaration(const std::string& line) {
         // `ignore:` and `consider:` take a colon; a param named `ignore_x` is an expression
         return w.back() == ' ' || trim(line.substr(w.size())).rfind(':', 0) == 0;
     });
-    if (!declaration) return false;
+    // a block on one line, as a grammar has it: `rules grow { A -> B; }`, `on start { ... }`
+    static constexpr std::string_view kBlocks[] = {"rules", "decompose", "interpret", "on "};
+    const bool block = line.back() == '}' && std::any_of(std::begin(kBlocks), std::end(kBlocks), [&](auto w) {
+                           const std::size_t brace = line.find('{');
+                           if (line.rfind(w, 0) != 0 || brace == std::string::npos) return false;
+                           // what comes before the '{': a group's name, `max_depth 3`, a hook's name
+                           const std::string head = line.substr(w.size(), brace - w.size());
+                           return w == "on " || head.empty() || head.front() == ' ';
+                       });
+    if (!declaration && !block) return false;
+    const char* done = block ? "added" : "declared";
     std::string text = line;
     if (text.back() != ';' && text.back() != '}') text += ';';
     declarations_.push_back({text, input_line_});
@@ -263,9 +274,9 @@ bool Session::typed_declaration(const std::string& line) {
             compile_source(*sources, add_session(*sources, session_source(&axiom)), compile_options(), diags);
         err_ << render_all(news(diags, *sources), *sources, color_);
         ok = program != nullptr;
-        if (ok) out_ << "declared; type an axiom such as 'axiom: F;' to start\n";
+        if (ok) out_ << fmt::format("{}; type an axiom such as 'axiom: F;' to start\n", done);
     } else if ((ok = rebuild(current().steps_done()))) {
-        out_ << fmt::format("declared; step {}: {}\n", current().steps_done(),
+        out_ << fmt::format("{}; step {}: {}\n", done, current().steps_done(),
                             modules(current().string().size()));
     }
     if (!ok) {
