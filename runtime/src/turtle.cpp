@@ -174,10 +174,17 @@ class Turtle {
         auto finite = [](const glm::dvec3& v) {
             return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
         };
-        if (!finite(t_.position) || !finite(t_.heading) || !finite(t_.left) || !finite(t_.up))
-            throw RuntimeError(RuntimeErrorKind::Turtle, Span{},
-                               fmt::format("the turtle left finite space at module {} ('{}') of the string",
-                                           i + 1, program_.symbols[s_.symbol(i)].name));
+        const bool at = finite(t_.position);
+        if (at && finite(t_.heading) && finite(t_.left) && finite(t_.up)) return;
+        // the module as the string has it, with its parameters: what to look for in the grammar
+        std::string text = program_.symbols[s_.symbol(i)].name;
+        for (std::uint32_t k = 0; k < s_.arity(i); ++k)
+            text += (k == 0 ? "(" : ", ") + format_double(args(i)[k]) + (k + 1 == s_.arity(i) ? ")" : "");
+        throw RuntimeError(
+            RuntimeErrorKind::Turtle, Span{},
+            fmt::format("the turtle left finite space at module {} of the string, {}: its {} is "
+                        "past the range of a double (a step or a position too large?)",
+                        i + 1, text, at ? "orientation" : "position"));
     }
 
     void tropism() {
