@@ -41,15 +41,16 @@ DeriveOptions Session::options() const {
     return o;
 }
 
-void Session::SessionText::add(std::string_view line, std::uint32_t typed_at) {
-    text.append(line);
+void Session::SessionText::add(std::string_view more, std::uint32_t typed_at) {
+    text.append(more);
     text += '\n';
-    for (char c : line)
-        if (c == '\n') lines.push_back(typed_at);
-    lines.push_back(typed_at);
+    std::uint32_t line = typed_at;
+    lines.push_back(line);
+    for (char c : more)
+        if (c == '\n') lines.push_back(typed_at == 0 ? 0 : ++line);
 }
 
-Session::SessionText Session::session_source(const std::string* extra) const {
+Session::SessionText Session::session_source(const Extra* extra) const {
     // Lines the session adds around what was typed (0 below) show the number of the typed line
     // before them, or, before any, after them: an error at a `}` the session closed is then
     // placed near what was typed instead of at a line number that means nothing to the user.
@@ -74,7 +75,11 @@ Session::SessionText Session::session_source(const std::string* extra) const {
         }
         s.add("}", 0);
     }
-    if (extra) s.add(*extra, input_line_);
+    if (extra) {
+        if (!extra->before.empty()) s.add(extra->before, 0);
+        s.add(extra->typed, item_line_);
+        if (!extra->after.empty()) s.add(extra->after, 0);
+    }
     std::uint32_t last = 0;
     for (auto& l : s.lines) last = l = l != 0 ? l : last;
     for (auto it = s.lines.rbegin(); it != s.lines.rend(); ++it) last = *it = *it != 0 ? *it : last;
@@ -115,11 +120,11 @@ Diagnostics Session::news(const Diagnostics& diags, const SourceManager& sources
     return out;
 }
 
-bool Session::rebuild(int steps, const std::string* extra_fn) {
+bool Session::rebuild(int steps) {
     auto sources = std::make_unique<SourceManager>();
     CompileOptions co = compile_options();
     Diagnostics diags;
-    std::uint32_t id = add_session(*sources, session_source(extra_fn));
+    std::uint32_t id = add_session(*sources, session_source());
     auto program = compile_source(*sources, id, co, diags);
     err_ << render_all(news(diags, *sources), *sources, color_);
     last_error_input_ = diags.has_input_errors();
@@ -153,14 +158,13 @@ bool Session::rebuild(int steps, const std::string* extra_fn) {
     } catch (const RuntimeError& e) {
         error() << render(Diagnostic{Severity::Error, e.span, e.message, {}}, *sources, color_);
         if ((e.kind == RuntimeErrorKind::ModuleLimit || e.kind == RuntimeErrorKind::WorkLimit) &&
-            !history_.empty() && !extra_fn)
+            !history_.empty())
             error() << fmt::format("not changed; still at step {}: {}\n", current().steps_done(),
                                    modules(current().string().size()));
         last_error_runtime_ = true;
         return false;
     }
     last_error_runtime_ = false;
-    if (extra_fn) return true; // an evaluation: the caller reads the program, the session stays
     sources_ = std::move(sources);
     program_ = std::move(program);
     history_ = std::move(history);
@@ -310,7 +314,7 @@ void Session::find(const std::string& pattern) {
     }
     // a pattern becomes the only production of a rule group of its own, compiled with the
     // session's grammar, then matched (context and condition included) against the string
-    std::string group = fmt::format("rules __find__ {{\n{} -> ;\n}}", pattern);
+    const Extra group{"rules __find__ {", pattern + " -> ;", "}"};
     auto sources = std::make_unique<SourceManager>();
     Diagnostics diags;
     auto program =
@@ -400,19 +404,19 @@ void Session::params() {
 void Session::evaluate(const std::string& expr) {
     static const std::string kFn = "__repl_value__";
     // the expression on a line of its own, so that errors point into what the user typed
-    std::string fn = fmt::format("fn {}() =\n{}\n;", kFn, expr);
+    const Extra fn{fmt::format("fn {}() =", kFn), expr, ";"};
     // compile the session with the expression as a function, then run it on the current globals
     auto sources = std::make_unique<SourceManager>();
     CompileOptions co = compile_options();
     Diagnostics diags;
     SessionText session = session_source(&fn);
-    if (history_.empty()) session.add("axiom: ;", input_line_); // no grammar yet: typed declarations only
+    if (history_.empty()) session.add("axiom: ;", 0); // no grammar yet: typed declarations only
     const std::string& text = session.text;
     const std::uint32_t id = add_session(*sources, session);
     auto program = compile_source(*sources, id, co, diags);
     // An error past the typed expression (at the `;` the session added on the next line) is
     // shown at the end of what was typed, on the line the user typed.
-    const std::size_t typed_end = text.find(fn) + fn.size() - 2; // before "\n;"
+    const std::size_t typed_end = text.rfind(fn.before) + fn.before.size() + 1 + fn.typed.size();
     Diagnostics placed;
     for (Diagnostic d : diags.all()) {
         if (d.span.valid() && d.span.file == id && d.span.begin > typed_end) {
@@ -483,7 +487,7 @@ void Session::edit(std::string statements) {
     }
     if (statements.back() != ';' && statements.back() != '}') statements += ';';
     int at = current().steps_done();
-    edits_.emplace_back(at, Typed{statements, input_line_});
+    edits_.emplace_back(at, Typed{statements, item_line_});
     if (rebuild(at))
         out_ << fmt::format("before step {}: {}\n", at + 1, statements);
     else
@@ -559,10 +563,73 @@ std::ostream& Session::error() {
     return err_;
 }
 
+namespace {
+
+// The depth of '{' at the end of `text`, outside strings and comments: above 0, a block is open.
+int brace_depth(std::string_view text) {
+    int depth = 0;
+    bool in_comment = false; // a /* comment */
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (in_comment) {
+            if (c == '*' && i + 1 < text.size() && text[i + 1] == '/') in_comment = false, ++i;
+        } else if (c == '#') {
+            while (i + 1 < text.size() && text[i + 1] != '\n') ++i;
+        } else if (c == '/' && i + 1 < text.size() && text[i + 1] == '*') {
+            in_comment = true;
+            ++i;
+        } else if (c == '"') { // a string ends at its closing quote or its line
+            while (++i < text.size() && text[i] != '"' && text[i] != '\n')
+                if (text[i] == '\\') ++i;
+        } else if (c == '{') {
+            ++depth;
+        } else if (c == '}') {
+            --depth;
+        }
+    }
+    return depth;
+}
+
+} // namespace
+
+void Session::finish() {
+    if (pending_.empty()) return;
+    error() << fmt::format(
+        "<session>:{}: the block begun here was not closed with '}}' before the end of the "
+        "input; it was not run\n",
+        pending_line_);
+    pending_.clear();
+}
+
 bool Session::execute(const std::string& raw) {
     ++input_line_;
+    if (!pending_.empty()) {
+        if (trim(raw).rfind(':', 0) == 0) { // a command: the block is given up
+            error() << fmt::format(
+                "the block begun at line {} was not closed with '}}'; dropped it to run {}\n", pending_line_,
+                trim(raw));
+            pending_.clear();
+        } else {
+            pending_ += "\n" + raw;
+            if (brace_depth(pending_) > 0) return true;
+            std::string item = std::move(pending_);
+            pending_.clear();
+            item_line_ = pending_line_;
+            return run_item(trim(item));
+        }
+    }
     std::string line = trim(raw);
     if (line.empty() || line[0] == '#') return true;
+    if (line[0] != ':' && brace_depth(line) > 0) {
+        pending_ = line;
+        pending_line_ = input_line_;
+        return true;
+    }
+    item_line_ = input_line_;
+    return run_item(line);
+}
+
+bool Session::run_item(std::string line) {
     if (line[0] == ':') {
         std::size_t sp = line.find_first_of(" \t");
         std::string name = line.substr(1, sp == std::string::npos ? std::string::npos : sp - 1);
@@ -574,7 +641,7 @@ bool Session::execute(const std::string& raw) {
         auto saved = axiom_;
         std::string a = trim(line.substr(6));
         if (!a.empty() && a.back() == ';') a.pop_back();
-        axiom_ = Typed{a, input_line_};
+        axiom_ = Typed{a, item_line_};
         if (rebuild(steps))
             out_ << fmt::format("axiom set; step {}: {}\n", current().steps_done(),
                                 modules(current().string().size()));
@@ -588,7 +655,7 @@ bool Session::execute(const std::string& raw) {
         line.find("->") != std::string::npos || (line.back() == '}' && line.find('{') != std::string::npos);
     if (production) {
         if (line.back() != ';' && line.back() != '}') line += ';';
-        extra_rules_.push_back({line, input_line_});
+        extra_rules_.push_back({line, item_line_});
         if (rebuild(steps))
             out_ << fmt::format("rule added; step {}: {}\n", current().steps_done(),
                                 modules(current().string().size()));

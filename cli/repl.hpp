@@ -50,6 +50,12 @@ class Session {
     // Runs one input line: a :command, `axiom: ...`, a production, or an expression.
     // Returns false when the session should end (:quit).
     bool execute(const std::string& line);
+    // Whether the last line left a block open (the prompt shows that more is awaited), and
+    // dropping it (Ctrl-C at that prompt).
+    bool continuing() const { return !pending_.empty(); }
+    void drop_pending() { pending_.clear(); }
+    // At the end of the input: a block still open is an error naming where it began.
+    void finish();
     // Names for tab completion of a word preceded on its line by `before`: after a command's
     // name, what that command takes; otherwise commands, params, modules, rule groups, ...
     std::vector<std::string> completions(const std::string& before) const;
@@ -98,7 +104,7 @@ class Session {
     const ReplCommand* find_command(const std::string& name) const;
     // Recompiles the session's grammar and replays `steps` steps. Keeps the previous state and
     // reports the error when the new grammar does not compile or derive.
-    bool rebuild(int steps, const std::string* extra_fn = nullptr);
+    bool rebuild(int steps);
     CompileOptions compile_options() const;
     Diagnostics news(const Diagnostics& diags, const SourceManager& sources);
     // The session's grammar: the loaded file's import and what was typed, each typed line shown
@@ -106,10 +112,15 @@ class Session {
     struct SessionText {
         std::string text;
         std::vector<std::uint32_t> lines;
-        void add(std::string_view line, std::uint32_t typed_at); // a line (or lines) of the text
+        // Appends `text` and a newline; its lines are numbered from `typed_at` on (0: the session's own)
+        void add(std::string_view text, std::uint32_t typed_at);
     };
-    // `extra` (an expression's function, a pattern's rule group) is text typed on this line.
-    SessionText session_source(const std::string* extra) const;
+    // Text typed on the item being run (an expression, a pattern), with the session's own
+    // wrapping around it: `before` + typed + `after` (an expression's function, a pattern's group).
+    struct Extra {
+        std::string before, typed, after;
+    };
+    SessionText session_source(const Extra* extra = nullptr) const;
     std::uint32_t add_session(SourceManager& sources, const SessionText& session) const;
     bool step(int n);
     void show(const std::string& rest);
@@ -160,7 +171,13 @@ class Session {
         std::string text;
         std::uint32_t line = 0;
     };
-    std::uint32_t input_line_ = 0;              // the line being run
+    std::uint32_t input_line_ = 0; // the last line read
+    std::uint32_t item_line_ = 0;  // the first line of the item being run
+    // An item whose '{' is not closed on its line goes on over the lines that follow, until its
+    // braces balance: the lines so far, with '\n' between them, and the first one's number.
+    std::string pending_;
+    std::uint32_t pending_line_ = 0;
+    bool run_item(std::string line);            // one whole item, its lines joined
     std::vector<Typed> declarations_;           // typed `module A(x);`, `const k = 2;` ...
     std::optional<Typed> axiom_;                // typed `axiom: ...`
     std::vector<Typed> extra_rules_;            // typed productions

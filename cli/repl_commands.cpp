@@ -263,15 +263,15 @@ bool Session::typed_declaration(const std::string& line) {
     const char* done = block ? "added" : "declared";
     std::string text = line;
     if (text.back() != ';' && text.back() != '}') text += ';';
-    declarations_.push_back({text, input_line_});
+    declarations_.push_back({text, item_line_});
     bool ok = false;
     if (history_.empty()) {
         // no grammar yet: checked with an empty axiom, kept for the axiom typed next
         auto sources = std::make_unique<SourceManager>();
         Diagnostics diags;
-        const std::string axiom = "axiom: ;";
-        auto program =
-            compile_source(*sources, add_session(*sources, session_source(&axiom)), compile_options(), diags);
+        SessionText session = session_source();
+        session.add("axiom: ;", 0);
+        auto program = compile_source(*sources, add_session(*sources, session), compile_options(), diags);
         err_ << render_all(news(diags, *sources), *sources, color_);
         ok = program != nullptr;
         if (ok) out_ << fmt::format("{}; type an axiom such as 'axiom: F;' to start\n", done);
@@ -318,7 +318,7 @@ bool Session::typed_setting(const std::string& line) {
         return true;
     }
     auto saved = settings_;
-    settings_[key] = Typed{value, input_line_};
+    settings_[key] = Typed{value, item_line_};
     int steps = current().steps_done();
     if (key == "derive") { // the session derives that many steps from the axiom
         auto n = whole_number(value);

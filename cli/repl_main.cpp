@@ -107,7 +107,7 @@ int read_script(Session& session, bool prompt) {
     std::string line;
     bool failed = false;
     for (;;) {
-        if (prompt) std::cout << "plant> " << std::flush;
+        if (prompt) std::cout << (session.continuing() ? "   ...> " : "plant> ") << std::flush;
         if (!std::getline(std::cin, line)) break;
         bool go_on = session.execute(line);
         failed = session.take_failed() || failed;
@@ -115,6 +115,8 @@ int read_script(Session& session, bool prompt) {
         std::cerr.flush();
         if (!go_on) break;
     }
+    session.finish();
+    failed = session.take_failed() || failed;
     return failed ? kFailed : kOk;
 }
 
@@ -155,13 +157,15 @@ int repl_main(const std::string& file, bool color, const std::vector<std::string
     g_edit.read_history(hist.c_str());
     for (;;) {
         g_interrupt.store(false);
-        char* raw = g_edit.readline("plant> ");
+        char* raw = g_edit.readline(session.continuing() ? "   ...> " : "plant> ");
         if (!raw && g_interrupt.load()) { // Ctrl-C at the prompt: a fresh line, not the end
             std::cout << "\n";
+            session.drop_pending(); // and a block being typed is dropped
             continue;
         }
         if (!raw) { // Ctrl-D
             std::cout << "\n";
+            session.finish();
             break;
         }
         std::string line = raw;
