@@ -595,7 +595,7 @@ int brace_depth(std::string_view text) {
 void Session::finish() {
     if (pending_.empty()) return;
     error() << fmt::format(
-        "<session>:{}: the block begun here was not closed with '}}' before the end of the "
+        "<session>:{}:1: error: the block begun here was not closed with '}}' before the end of the "
         "input; it was not run\n",
         pending_line_);
     pending_.clear();
@@ -605,9 +605,9 @@ bool Session::execute(const std::string& raw) {
     ++input_line_;
     if (!pending_.empty()) {
         if (trim(raw).rfind(':', 0) == 0) { // a command: the block is given up
-            error() << fmt::format(
-                "the block begun at line {} was not closed with '}}'; dropped it to run {}\n", pending_line_,
-                trim(raw));
+            error() << fmt::format("<session>:{}:1: error: the block begun here was not closed with '}}'; "
+                                   "dropped it to run {}\n",
+                                   pending_line_, trim(raw));
             pending_.clear();
         } else {
             pending_ += "\n" + raw;
