@@ -13,10 +13,12 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <sstream>
 #include <thread>
 #include <tuple>
+#include <utility>
 
 namespace plant::cli {
 
@@ -46,25 +48,25 @@ void Session::SessionText::add(std::string_view more, std::uint32_t typed_at) {
     text += '\n';
     std::uint32_t line = typed_at;
     lines.push_back(line);
-    for (char c : more)
-        if (c == '\n') lines.push_back(typed_at == 0 ? 0 : ++line);
+    for (std::size_t i = 0; i < more.size(); ++i) // a lone '\r' ends a line too, as SourceFile has it
+        if (more[i] == '\n' || (more[i] == '\r' && (i + 1 == more.size() || more[i + 1] != '\n')))
+            lines.push_back(typed_at == 0 ? 0 : ++line);
 }
 
 Session::SessionText Session::session_source(const Extra* extra) const {
-    // Lines the session adds around what was typed (0 below) show the number of the typed line
-    // before them, or, before any, after them: an error at a `}` the session closed is then
-    // placed near what was typed instead of at a line number that means nothing to the user.
     SessionText s;
     if (!file_.empty()) s.add(fmt::format("import \"{}\";", file_), 0);
     for (const auto& d : declarations_) s.add(d.text, d.line);
     if (axiom_) s.add("axiom: " + axiom_->text + ";", axiom_->line);
     // typed settings: the session's file comes after the import, so its settings win
     for (const auto& [key, value] : settings_) s.add(fmt::format("{} {};", key, value.text), value.line);
-    if (!extra_rules_.empty()) {
-        s.add("rules {", 0);
-        for (const auto& r : extra_rules_) s.add(r.text, r.line);
-        s.add("}", 0);
+    // productions in a rules block of the session's, blocks as typed, in the order typed
+    bool open = false;
+    for (const auto& r : extra_rules_) {
+        if (open == r.block) s.add(std::exchange(open, !r.block) ? "}" : "rules {", 0);
+        s.add(r.text, r.line);
     }
+    if (open) s.add("}", 0);
     if (!edits_.empty()) {
         // each edit on lines of its own, so that an error points into what the user typed
         s.add(fmt::format("on {} {{", ast::spelling(ast::HookKind::BeforeStep)), 0);
@@ -80,15 +82,21 @@ Session::SessionText Session::session_source(const Extra* extra) const {
         s.add(extra->typed, item_line_);
         if (!extra->after.empty()) s.add(extra->after, 0);
     }
-    std::uint32_t last = 0;
-    for (auto& l : s.lines) last = l = l != 0 ? l : last;
-    for (auto it = s.lines.rbegin(); it != s.lines.rend(); ++it) last = *it = *it != 0 ? *it : last;
     return s;
 }
 
 std::uint32_t Session::add_session(SourceManager& sources, const SessionText& session) const {
     const std::uint32_t id = sources.add("<session>", session.text);
-    sources.show_lines(id, session.lines);
+    // Lines the session adds around what was typed (0) show the number of the typed line after
+    // them (an expression's `fn ... =`, a `rules {`), or, after the last, the one before them
+    // (a closing `}`, the empty line after the text's last newline, where an unterminated
+    // comment is reported), so every message names a line of the input.
+    std::vector<std::uint32_t> lines = session.lines;
+    lines.push_back(0);
+    std::uint32_t near = 0;
+    for (auto it = lines.rbegin(); it != lines.rend(); ++it) near = *it = *it != 0 ? *it : near;
+    for (auto& l : lines) near = l = l != 0 ? l : near;
+    sources.show_lines(id, std::move(lines));
     return id;
 }
 
@@ -563,55 +571,111 @@ std::ostream& Session::error() {
     return err_;
 }
 
-namespace {
-
-// The depth of '{' at the end of `text`, outside strings and comments: above 0, a block is open.
-int brace_depth(std::string_view text) {
-    int depth = 0;
-    bool in_comment = false; // a /* comment */
+void Session::OpenScan::line(std::string_view text) {
     for (std::size_t i = 0; i < text.size(); ++i) {
         const char c = text[i];
-        if (in_comment) {
-            if (c == '*' && i + 1 < text.size() && text[i + 1] == '/') in_comment = false, ++i;
+        const char next = i + 1 < text.size() ? text[i + 1] : '\0';
+        if (comment) {
+            if (c == '*' && next == '/') comment = false, ++i;
         } else if (c == '#') {
-            while (i + 1 < text.size() && text[i + 1] != '\n') ++i;
-        } else if (c == '/' && i + 1 < text.size() && text[i + 1] == '*') {
-            in_comment = true;
+            return; // to the end of the line
+        } else if (c == '/' && next == '*') {
+            comment = true;
             ++i;
-        } else if (c == '"') { // a string ends at its closing quote or its line
-            while (++i < text.size() && text[i] != '"' && text[i] != '\n')
+        } else if (c == '"') { // a string ends at its closing quote or with its line
+            while (++i < text.size() && text[i] != '"')
                 if (text[i] == '\\') ++i;
-        } else if (c == '{') {
-            ++depth;
-        } else if (c == '}') {
-            --depth;
+        } else {
+            braces += c == '{' ? 1 : c == '}' ? -1 : 0;
+            parens += c == '(' ? 1 : c == ')' ? -1 : 0;
         }
     }
-    return depth;
+}
+
+namespace {
+
+// `text` without a # comment at its end (outside strings and /* */), and without what it would
+// then end with of blanks: a `;` the session adds must not fall into the comment.
+std::string without_trailing_comment(const std::string& text) {
+    std::size_t cut = text.size();
+    bool comment = false;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        const char next = i + 1 < text.size() ? text[i + 1] : '\0';
+        if (comment) {
+            if (c == '*' && next == '/') comment = false, ++i;
+        } else if (c == '#') {
+            const std::size_t nl = text.find('\n', i);
+            if (nl == std::string::npos) {
+                cut = i;
+                break;
+            }
+            i = nl;
+        } else if (c == '/' && next == '*') {
+            comment = true;
+            ++i;
+        } else if (c == '"') {
+            while (++i < text.size() && text[i] != '"' && text[i] != '\n')
+                if (text[i] == '\\') ++i;
+        }
+    }
+    return trim(text.substr(0, cut));
+}
+
+// Whether `text` holds nothing but comments and blanks.
+bool only_comments(std::string_view text) {
+    bool comment = false;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        const char next = i + 1 < text.size() ? text[i + 1] : '\0';
+        if (comment) {
+            if (c == '*' && next == '/') comment = false, ++i;
+        } else if (c == '#') {
+            while (i + 1 < text.size() && text[i + 1] != '\n') ++i;
+        } else if (c == '/' && next == '*') {
+            comment = true;
+            ++i;
+        } else if (c != ' ' && c != '\t' && c != '\n' && c != '\r') {
+            return false;
+        }
+    }
+    return true;
+}
+
+// A REPL command: ':' and a letter (a line of a block may start with a condition's ':').
+bool is_command(std::string_view line) {
+    return line.size() >= 2 && line[0] == ':' && std::isalpha(static_cast<unsigned char>(line[1]));
 }
 
 } // namespace
 
+std::string Session::open_thing() const {
+    if (pending_scan_.comment) return "a /* comment */";
+    return pending_scan_.braces > 0 ? "a '{'" : "a '('";
+}
+
 void Session::finish() {
     if (pending_.empty()) return;
-    error() << fmt::format(
-        "<session>:{}:1: error: the block begun here was not closed with '}}' before the end of the "
-        "input; it was not run\n",
-        pending_line_);
+    error() << fmt::format("<session>:{}:1: error: {} opened on this line is not closed at the end of the "
+                           "input; what was typed from "
+                           "here was not run\n",
+                           pending_line_, open_thing());
     pending_.clear();
 }
 
 bool Session::execute(const std::string& raw) {
     ++input_line_;
     if (!pending_.empty()) {
-        if (trim(raw).rfind(':', 0) == 0) { // a command: the block is given up
-            error() << fmt::format("<session>:{}:1: error: the block begun here was not closed with '}}'; "
-                                   "dropped it to run {}\n",
-                                   pending_line_, trim(raw));
+        if (is_command(trim(raw))) { // a command: the block is given up
+            error() << fmt::format(
+                "<session>:{}:1: error: {} opened on this line is not closed; dropped what was typed "
+                "from here to run {}\n",
+                pending_line_, open_thing(), trim(raw));
             pending_.clear();
         } else {
             pending_ += "\n" + raw;
-            if (brace_depth(pending_) > 0) return true;
+            pending_scan_.line(raw);
+            if (goes_on(pending_scan_, pending_declaration_)) return true;
             std::string item = std::move(pending_);
             pending_.clear();
             item_line_ = pending_line_;
@@ -620,16 +684,27 @@ bool Session::execute(const std::string& raw) {
     }
     std::string line = trim(raw);
     if (line.empty() || line[0] == '#') return true;
-    if (line[0] != ':' && brace_depth(line) > 0) {
-        pending_ = line;
-        pending_line_ = input_line_;
-        return true;
+    if (!is_command(line)) {
+        OpenScan scan;
+        scan.line(line);
+        const bool declaration = item_kind(line) == Item::Declaration;
+        if (goes_on(scan, declaration)) {
+            pending_ = line;
+            pending_line_ = input_line_;
+            pending_scan_ = scan;
+            pending_declaration_ = declaration;
+            return true;
+        }
     }
     item_line_ = input_line_;
     return run_item(line);
 }
 
 bool Session::run_item(std::string line) {
+    if (line[0] != ':') {
+        if (only_comments(line)) return true; // a /* comment */ over lines
+        line = without_trailing_comment(line);
+    }
     if (line[0] == ':') {
         std::size_t sp = line.find_first_of(" \t");
         std::string name = line.substr(1, sp == std::string::npos ? std::string::npos : sp - 1);

@@ -94,6 +94,12 @@ class Session {
     // `module A(x);`, `const k = 2;`, `fn f(x) = ...;`, `ignore: F;` ...: kept and compiled with
     // the session's grammar.
     bool typed_declaration(const std::string& line);
+    // What a line of grammar text starts: a declaration (`module`, `const`, `import`, ...), a
+    // block (`rules`, `on`, `graph`, ... when it ends with '}'), or neither.
+    enum class Item { Other, Declaration, Block };
+    static Item item_kind(std::string_view line);
+    // With no grammar yet, whether the typed declarations and settings compile (with an empty axiom).
+    bool compiles_alone();
     bool typed_setting(const std::string& line);
     // The loaded file's consts (name: the value's byte range), which :set may replace.
     std::map<std::string, std::pair<std::uint32_t, std::uint32_t>> file_consts() const;
@@ -170,6 +176,7 @@ class Session {
     struct Typed {
         std::string text;
         std::uint32_t line = 0;
+        bool block = false; // (extra_rules_) a top-level block, `rules grow { ... }`, not a production
     };
     std::uint32_t input_line_ = 0; // the last line read
     std::uint32_t item_line_ = 0;  // the first line of the item being run
@@ -177,10 +184,24 @@ class Session {
     // braces balance: the lines so far, with '\n' between them, and the first one's number.
     std::string pending_;
     std::uint32_t pending_line_ = 0;
+    // What is open at the end of the lines read so far: '{', '(', a /* comment */ (strings and
+    // # comments end with their line). A declaration goes on while a '(' is open too.
+    struct OpenScan {
+        int braces = 0, parens = 0;
+        bool comment = false;
+        void line(std::string_view text);
+    };
+    OpenScan pending_scan_;
+    std::string open_thing() const; // what is left open, for a message: "a '{'"
+    bool pending_declaration_ = false;
+    // Whether the lines typed for an item leave something open, so that it goes on.
+    static bool goes_on(const OpenScan& scan, bool declaration) {
+        return scan.braces > 0 || scan.comment || (declaration && scan.parens > 0);
+    }
     bool run_item(std::string line);            // one whole item, its lines joined
     std::vector<Typed> declarations_;           // typed `module A(x);`, `const k = 2;` ...
     std::optional<Typed> axiom_;                // typed `axiom: ...`
-    std::vector<Typed> extra_rules_;            // typed productions
+    std::vector<Typed> extra_rules_;            // typed productions and blocks, in the order typed
     std::map<std::string, std::string> params_; // :set NAME VALUE
     std::optional<std::uint64_t> seed_;
     std::map<std::string, Typed> settings_;         // typed `angle 30;` and the like: key, value

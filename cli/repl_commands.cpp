@@ -142,8 +142,11 @@ void Session::help(const std::string& topic) {
         out_ << command_list();
         out_
             << "Anything else is a production (A(x) -> B(x + 1);), an axiom (axiom: A(1);), a setting (angle "
-               "30;), a declaration (module A(x);, const k = 2;, fn f(x) = 2 * x;, ignore: F;) or an "
-               "expression to evaluate (2 * pi).\n";
+               "30;), a declaration (module A(x);, const k = 2;, fn f(x) = 2 * x;, ignore: F;), a block "
+               "(rules "
+               "grow { B -> C; }, on start { ... }) or an expression to evaluate (2 * pi). A line that "
+               "leaves a "
+               "'{' open (or, in a declaration, a '(') goes on over the lines after it until it is closed.\n";
         return;
     }
     for (const auto& c : commands()) {
@@ -242,46 +245,62 @@ std::string Session::file_text_with_consts() const {
     return text;
 }
 
+Session::Item Session::item_kind(std::string_view line) {
+    // a keyword, then a blank (or, for ignore and consider, a ':'; for a block, its '{')
+    auto starts = [&](std::string_view word, std::string_view then) {
+        if (line.rfind(word, 0) != 0) return false;
+        std::size_t at = word.size();
+        const bool blank = at < line.size() && (line[at] == ' ' || line[at] == '\t');
+        while (at < line.size() && (line[at] == ' ' || line[at] == '\t')) ++at;
+        return (blank && then.empty()) || (at < line.size() && then.find(line[at]) != std::string_view::npos);
+    };
+    static constexpr std::string_view kDeclarations[] = {"param", "const",   "var",     "module", "fn",
+                                                         "curve", "surface", "texture", "env",    "import"};
+    for (std::string_view w : kDeclarations)
+        if (starts(w, "")) return Item::Declaration;
+    if (starts("ignore", ":") || starts("consider", ":")) return Item::Declaration;
+    // a block as a grammar has it: `rules grow { A -> B; }`, `on start { ... }`, `graph { ... }`
+    static constexpr std::string_view kBlocks[] = {"rules", "decompose", "interpret",
+                                                   "on",    "graph",     "instance"};
+    for (std::string_view w : kBlocks)
+        if (starts(w, "") || starts(w, "{")) return Item::Block;
+    return Item::Other;
+}
+
+bool Session::compiles_alone() {
+    auto sources = std::make_unique<SourceManager>();
+    Diagnostics diags;
+    SessionText session = session_source();
+    session.add("axiom: ;", 0);
+    auto program = compile_source(*sources, add_session(*sources, session), compile_options(), diags);
+    err_ << render_all(news(diags, *sources), *sources, color_);
+    if (!program) failed_ = true;
+    return program != nullptr;
+}
+
 bool Session::typed_declaration(const std::string& line) {
-    static constexpr std::string_view kWords[] = {"param ", "const ", "var ",     "module ", "fn ",
-                                                  "curve ", "ignore", "consider", "surface "};
-    const bool declaration = std::any_of(std::begin(kWords), std::end(kWords), [&](std::string_view w) {
-        if (line.rfind(w, 0) != 0) return false;
-        // `ignore:` and `consider:` take a colon; a param named `ignore_x` is an expression
-        return w.back() == ' ' || trim(line.substr(w.size())).rfind(':', 0) == 0;
-    });
-    // a block on one line, as a grammar has it: `rules grow { A -> B; }`, `on start { ... }`
-    static constexpr std::string_view kBlocks[] = {"rules", "decompose", "interpret", "on "};
-    const bool block = line.back() == '}' && std::any_of(std::begin(kBlocks), std::end(kBlocks), [&](auto w) {
-                           const std::size_t brace = line.find('{');
-                           if (line.rfind(w, 0) != 0 || brace == std::string::npos) return false;
-                           // what comes before the '{': a group's name, `max_depth 3`, a hook's name
-                           const std::string head = line.substr(w.size(), brace - w.size());
-                           return w == "on " || head.empty() || head.front() == ' ';
-                       });
-    if (!declaration && !block) return false;
-    const char* done = block ? "added" : "declared";
+    const Item kind = item_kind(line);
+    // a block is whole once it ends with its '}' (a line that starts like one and does not,
+    // `on_x + 1` or `rules -> B`, is something else)
+    if (kind == Item::Other || (kind == Item::Block && line.back() != '}')) return false;
     std::string text = line;
     if (text.back() != ';' && text.back() != '}') text += ';';
-    declarations_.push_back({text, item_line_});
+    // blocks go with the typed productions, so that the one typed first applies first
+    auto& list = kind == Item::Block ? extra_rules_ : declarations_;
+    list.push_back({text, item_line_, kind == Item::Block});
+    const char* done = kind == Item::Block ? "added" : "declared";
     bool ok = false;
     if (history_.empty()) {
         // no grammar yet: checked with an empty axiom, kept for the axiom typed next
-        auto sources = std::make_unique<SourceManager>();
-        Diagnostics diags;
-        SessionText session = session_source();
-        session.add("axiom: ;", 0);
-        auto program = compile_source(*sources, add_session(*sources, session), compile_options(), diags);
-        err_ << render_all(news(diags, *sources), *sources, color_);
-        ok = program != nullptr;
-        if (ok) out_ << fmt::format("{}; type an axiom such as 'axiom: F;' to start\n", done);
+        if ((ok = compiles_alone()))
+            out_ << fmt::format("{}; type an axiom such as 'axiom: F;' to start\n", done);
     } else if ((ok = rebuild(current().steps_done()))) {
         out_ << fmt::format("{}; step {}: {}\n", done, current().steps_done(),
                             modules(current().string().size()));
     }
     if (!ok) {
         failed_ = true;
-        declarations_.pop_back();
+        list.pop_back();
     }
     return true;
 }
@@ -301,6 +320,16 @@ bool Session::typed_setting(const std::string& line) {
     std::string value = trim(line.substr(sp));
     if (!value.empty() && value.back() == ';') value = trim(value.substr(0, value.size() - 1));
     if (value.empty()) return false;
+    if (history_.empty() && key != "seed") {
+        // no grammar yet: kept for the axiom typed next, as a declaration is
+        auto saved = settings_;
+        settings_[key] = Typed{value, item_line_};
+        if (compiles_alone())
+            out_ << fmt::format("{} = {}; type an axiom such as 'axiom: F;' to start\n", key, value);
+        else
+            settings_ = saved;
+        return true;
+    }
     if (!need_derivation()) return true;
     if (key == "seed") { // the session's seed, as :seed sets it
         auto seed = whole_number(value);
