@@ -684,7 +684,10 @@ bool Session::execute(const std::string& raw) {
     }
     std::string line = trim(raw);
     if (line.empty() || line[0] == '#') return true;
-    if (!is_command(line)) {
+    // (of the commands, only :do takes grammar text, statements that may hold a block)
+    const bool statements =
+        line.rfind(":do", 0) == 0 && (line.size() == 3 || line[3] == ' ' || line[3] == '\t');
+    if (!is_command(line) || statements) {
         OpenScan scan;
         scan.line(line);
         const bool declaration = item_kind(line) == Item::Declaration;
