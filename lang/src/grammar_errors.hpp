@@ -5,6 +5,8 @@
 #pragma once
 
 #include "grammar.hpp"
+#include "plant/diagnostics.hpp"
+#include "plant/source.hpp"
 
 #include <string>
 #include <vector>
@@ -147,6 +149,15 @@ struct GrammarError {
     std::string message;
     std::size_t at; // byte offset of the innermost open construct, or npos
 };
+
+// (parse_errors.cpp) What is at `byte`, for a message: "'rules'", "'}'", "end of line", ...
+std::string describe_found(const std::string& text, std::size_t byte);
+// Adds `e` to `diags`: {at} replaced by where the construct began, what was found named, and
+// a ';' left off at the end of a line shown there.
+void report(const GrammarError& e, const SourceFile& src, std::uint32_t file_id, Diagnostics& diags);
+// Where to parse on after an error at `from` in an item begun at `item_start`: the first line
+// at or after the error that starts with a top-level keyword, always after `item_start`.
+std::size_t resync(const std::string& text, std::size_t from, std::size_t item_start);
 
 template <typename Rule> struct control : normal<Rule> {
     template <typename Input> static void start(const Input& in, ParseState& st) {

@@ -607,70 +607,6 @@ class Lowering {
     Diagnostics& diags_;
 };
 
-std::string describe_found(const std::string& text, std::size_t byte) {
-    if (byte >= text.size()) return "end of file";
-    unsigned char c = static_cast<unsigned char>(text[byte]);
-    if (std::isalnum(c) || c == '_') {
-        std::size_t e = byte;
-        while (e < text.size() && e - byte < 30 &&
-               (std::isalnum(static_cast<unsigned char>(text[e])) || text[e] == '_' || text[e] == '.'))
-            ++e;
-        return fmt::format("'{}'", text.substr(byte, e - byte));
-    }
-    if (c == '\n' || c == '\r') return "end of line";
-    if (std::size_t n = utf8_length(text, byte); n > 0) {
-        // a character typed from a book, shown as itself with its code point
-        std::uint32_t cp = c & (0xff >> (n + 1));
-        for (std::size_t k = 1; k < n; ++k)
-            cp = (cp << 6) | (static_cast<unsigned char>(text[byte + k]) & 0x3f);
-        return fmt::format("'{}' (U+{:04X})", text.substr(byte, n), cp);
-    }
-    if (c < 0x20 || c >= 0x7f) return fmt::format("byte 0x{:02x}", c);
-    return fmt::format("'{}'", static_cast<char>(c));
-}
-
-// A grammar error as a diagnostic: {at} becomes the line:column where the construct began, and
-// what was found at the error is named.
-void report(const g::GrammarError& e, const SourceFile& src, std::uint32_t file_id, Diagnostics& diags) {
-    std::string msg = e.message;
-    if (auto p = msg.find("{hooks}"); p != std::string::npos) msg.replace(p, 7, ast::hook_list("", " or "));
-    if (auto p = msg.find("{at}"); p != std::string::npos) {
-        std::string at = "?";
-        if (e.at != std::string::npos) {
-            LineCol a = src.shown_line_col(static_cast<std::uint32_t>(e.at));
-            at = fmt::format("{}:{}", a.line, a.col);
-        }
-        msg.replace(p, 4, at);
-    }
-    msg += ", found " + describe_found(src.text(), e.byte) + habits::hint(src.text(), e.byte, msg);
-    auto b = static_cast<std::uint32_t>(e.byte);
-    diags.error({file_id, b, b + 1}, msg);
-}
-
-// After an error, restart at the first line that starts with a top-level keyword at or after the
-// error (the error may be the keyword itself, as when a ';' is missing at the end of the line
-// before), but always after `item_start` so that parsing makes progress.
-std::size_t resync(const std::string& text, std::size_t from, std::size_t item_start) {
-    static const char* keywords[] = {"param ",   "const ",    "var ",      "module ",   "fn ",     "curve ",
-                                     "surface ", "texture ",  "env ",      "instance ", "derive ", "angle ",
-                                     "step ",    "width ",    "seed ",     "axiom",     "ignore",  "consider",
-                                     "rules",    "decompose", "interpret", "on ",       "import ", "graph",
-                                     "edits ",   "/*"};
-    std::size_t b = from;
-    while (b > 0 && text[b - 1] != '\n') --b; // start of the error's line
-    while (b < text.size()) {
-        std::size_t s = b;
-        while (s < text.size() && (text[s] == ' ' || text[s] == '\t')) ++s;
-        if (s >= from && b > item_start)
-            for (const char* kw : keywords)
-                if (text.compare(s, std::strlen(kw), kw) == 0) return b;
-        std::size_t nl = text.find('\n', b);
-        if (nl == std::string::npos) break;
-        b = nl + 1;
-    }
-    return text.size();
-}
-
 } // namespace
 
 std::unique_ptr<ast::File> parse_file(const SourceManager& sources, std::uint32_t file_id,
@@ -698,9 +634,9 @@ std::unique_ptr<ast::File> parse_file(const SourceManager& sources, std::uint32_
             if (next <= offset) break;
             offset = next;
         } catch (const g::GrammarError& e) {
-            report(e, src, file_id, diags);
+            g::report(e, src, file_id, diags);
             if (++errors >= 20) break;
-            offset = resync(text, e.byte, offset);
+            offset = g::resync(text, e.byte, offset);
             if (offset >= text.size()) break;
         }
     }
@@ -726,13 +662,13 @@ ast::ExprPtr parse_one(tao::pegtl::memory_input<>& in, const SourceFile& src, st
             const auto at = static_cast<std::uint32_t>(in.byte());
             diags.error({file_id, at, std::max(at + 1, whole.end)},
                         fmt::format("expected the end of the value after the expression, found {}",
-                                    describe_found(src.text(), at)));
+                                    g::describe_found(src.text(), at)));
             return nullptr;
         }
         Lowering lower(file_id, diags);
         return lower.expr(*root->children.at(0));
     } catch (const g::GrammarError& e) {
-        report(e, src, file_id, diags);
+        g::report(e, src, file_id, diags);
         return nullptr;
     }
 }

@@ -123,8 +123,16 @@ TEST_CASE("precedence and associativity of expressions", "[parser]") {
 }
 
 TEST_CASE("parse errors name what was expected, where the construct began and what was found", "[parser]") {
+    // a ';' left off at a line's end is shown there (after the last word, before a # comment),
+    // naming what began the next line; one missing before more text on the same line is not
     CHECK(first_error("axiom: A;\nrules {\n  A -> B C\n}\n") ==
-          "4:1: expected ';' after production (started at 3:3), found '}'");
+          "3:11: expected ';' after production (started at 3:3), found '}' on the next line");
+    CHECK(first_error("derive 2   # steps\n\naxiom: A;\n") ==
+          "1:9: expected ';' (statement started at 1:1), found 'axiom' on the next line");
+    CHECK(first_error("axiom: A\nrules { A -> B; }\n") ==
+          "1:9: expected ';' (statement started at 1:1), found 'rules' on the next line");
+    CHECK(first_error("axiom: A;\nrules {\n  A -> F [ + A ]\n     [ - A ] ) ;\n}\n") ==
+          "4:14: expected ';' after production (started at 3:3), found ')'");
     CHECK(first_error("param x = (1 + 2;\n") == "1:17: expected ')' to close '(' at 1:11, found ';'");
     CHECK(first_error("param x = 1 +;\n") == "1:14: expected an expression after the operator, found ';'");
     CHECK(first_error("rules { A B }\n") ==
