@@ -204,11 +204,23 @@ void Compiler::check_never_applying() {
             // every module of the predecessor must be produced by something (the first that is
             // not is named)
             for (const auto& m : p.strict) {
-                if (produced_.count(m.sym)) continue;
-                diags_->warning(p.span,
-                                fmt::format("this production can never apply: neither the axiom nor any "
-                                            "successor produces '{}'",
-                                            P_.symbols[m.sym].name));
+                if (!produced_.count(m.sym)) {
+                    diags_->warning(p.span,
+                                    fmt::format("this production can never apply: neither the axiom nor any "
+                                                "successor produces '{}'",
+                                                P_.symbols[m.sym].name));
+                    break;
+                }
+                // a module matches only with as many numbers as its pattern takes
+                if (emitted_.count({m.sym, m.width})) continue;
+                std::string widths;
+                for (auto it = emitted_.lower_bound({m.sym, 0}); it != emitted_.end() && it->first == m.sym;
+                     ++it)
+                    widths += fmt::format("{}{}", widths.empty() ? "" : " or ", it->second);
+                diags_->warning(
+                    m.span, fmt::format("this production can never apply: the axiom and the successors "
+                                        "write '{}' with {} number{}, and this pattern takes {}",
+                                        P_.symbols[m.sym].name, widths, widths == "1" ? "" : "s", m.width));
                 break;
             }
         }

@@ -61,6 +61,9 @@ std::string hint(const std::string& text, std::size_t byte, const std::string& m
     if (word == "maximum") return "; the depth bound is written decompose max_depth 8 { ... }";
     if (c == '^' || (c == '*' && byte > 0 && text[byte - 1] == '*'))
         return "; there is no power operator: write pow(x, 0.5)";
+    if (c == '=' && byte + 1 < text.size() && text[byte + 1] == '>' &&
+        message.find("production") != std::string::npos)
+        return "; a production's arrow is written ->";
     if (c == '\'') return "; cpfg's ' (next colour) is written ;(c) here, with the colour index, as in ;(2)";
     if ((c == '{' || c == '.') && message.find("after production") != std::string::npos)
         return "; cpfg's { . } polygons are written surface leaf = polygon(...); and drawn with ~leaf (a "

@@ -45,8 +45,8 @@ std::string describe_found(const std::string& text, std::size_t byte) {
 // Returns that place and where the next line's first word is.
 namespace {
 
-std::optional<std::pair<std::uint32_t, std::size_t>> missing_semicolon_at(const std::string& text, std::size_t at,
-                                                                          std::size_t byte) {
+std::optional<std::pair<std::uint32_t, std::size_t>> missing_semicolon_at(const std::string& text,
+                                                                          std::size_t at, std::size_t byte) {
     if (at == std::string::npos || byte > text.size()) return std::nullopt;
     std::size_t line = byte;
     while (line > 0 && text[line - 1] != '\n' && text[line - 1] != '\r') --line;
@@ -56,7 +56,9 @@ std::optional<std::pair<std::uint32_t, std::size_t>> missing_semicolon_at(const 
     std::size_t word = first;
     while (word < byte && (std::isalnum(static_cast<unsigned char>(text[word])) || text[word] == '_')) ++word;
     while (word < byte && (text[word] == ' ' || text[word] == '\t')) ++word;
-    if (word != byte) return std::nullopt; // more than one word before the error
+    // more than one word before the error, unless the error is at the line's '->' (`A(x) : x > 1
+    // -> B;`, its predecessor and condition read as more of the production before)
+    if (word != byte && text.compare(byte, 2, "->") != 0) return std::nullopt;
     // the last line before this one with something on it other than a comment
     std::size_t end = line;
     while (end > at) {
@@ -92,7 +94,8 @@ void report(const GrammarError& e, const SourceFile& src, std::uint32_t file_id,
     if (msg.rfind("expected ';'", 0) == 0) {
         if (auto end = missing_semicolon_at(src.text(), e.at, e.byte)) {
             // the ';' left off at the end of a line: shown there, naming what began the next line
-            msg += ", found " + describe_found(src.text(), end->second) + " on the next line" + hint;
+            const std::string found = describe_found(src.text(), end->second);
+            msg += ", found " + found + (found == "end of file" ? "" : " on the next line") + hint;
             diags.error({file_id, end->first, end->first + 1}, msg);
             return;
         }

@@ -133,6 +133,9 @@ TEST_CASE("parse errors name what was expected, where the construct began and wh
           "1:9: expected ';' (statement started at 1:1), found 'rules' on the next line");
     CHECK(first_error("axiom: A;\nrules {\n  A -> F [ + A ]\n     [ - A ] ) ;\n}\n") ==
           "4:14: expected ';' after production (started at 3:3), found ')'");
+    CHECK(first_error("axiom: A(1);\nrules {\n  A(x) : x < 3 -> A(x+1)\n  A(x) : x >= 3 -> B;\n}\n") ==
+          "3:25: expected ';' after production (started at 3:3), found 'A' on the next line");
+    CHECK(first_error("axiom: A(1)\n") == "1:12: expected ';' (statement started at 1:1), found end of file");
     CHECK(first_error("param x = (1 + 2;\n") == "1:17: expected ')' to close '(' at 1:11, found ';'");
     CHECK(first_error("param x = 1 +;\n") == "1:14: expected an expression after the operator, found ';'");
     CHECK(first_error("rules { A B }\n") ==
