@@ -100,6 +100,9 @@ class Session {
     static Item item_kind(std::string_view line);
     // With no grammar yet, whether the typed declarations and settings compile (with an empty axiom).
     bool compiles_alone();
+    // With no grammar yet, whether the typed declarations compile as they are: an import has
+    // brought an axiom.
+    bool brings_axiom() const;
     bool typed_setting(const std::string& line);
     // The loaded file's consts (name: the value's byte range), which :set may replace.
     std::map<std::string, std::pair<std::uint32_t, std::uint32_t>> file_consts() const;

@@ -267,6 +267,14 @@ Session::Item Session::item_kind(std::string_view line) {
     return Item::Other;
 }
 
+bool Session::brings_axiom() const {
+    auto sources = std::make_unique<SourceManager>();
+    Diagnostics quiet; // what is wrong is told by the compile that follows
+    auto program =
+        compile_source(*sources, add_session(*sources, session_source()), compile_options(), quiet);
+    return program != nullptr;
+}
+
 bool Session::compiles_alone() {
     auto sources = std::make_unique<SourceManager>();
     Diagnostics diags;
@@ -290,7 +298,11 @@ bool Session::typed_declaration(const std::string& line) {
     list.push_back({text, item_line_, kind == Item::Block});
     const char* done = kind == Item::Block ? "added" : "declared";
     bool ok = false;
-    if (history_.empty()) {
+    if (history_.empty() && brings_axiom()) {
+        // an import of a grammar with an axiom: the session starts as after :load
+        if ((ok = rebuild(0)))
+            out_ << fmt::format("{}; step 0: {}\n", done, modules(current().string().size()));
+    } else if (history_.empty()) {
         // no grammar yet: checked with an empty axiom, kept for the axiom typed next
         if ((ok = compiles_alone()))
             out_ << fmt::format("{}; type an axiom such as 'axiom: F;' to start\n", done);
