@@ -571,75 +571,57 @@ std::ostream& Session::error() {
     return err_;
 }
 
-void Session::OpenScan::line(std::string_view text) {
+namespace {
+
+// What lex() reports of a character: code, the opening quote of a string, the '#' of a comment
+// that runs to the end of its line.
+enum class Lexed { Code, String, LineComment };
+
+// Walks `text` as the grammar's lexer does (docs/language.md, lexical rules), calling
+// `on(i, what)` for every character outside comments and strings and for the start of each
+// string and # comment; `comment` says whether a /* comment */ is open, before and after.
+template <typename On> void lex(std::string_view text, bool& comment, On&& on) {
     for (std::size_t i = 0; i < text.size(); ++i) {
         const char c = text[i];
         const char next = i + 1 < text.size() ? text[i + 1] : '\0';
         if (comment) {
             if (c == '*' && next == '/') comment = false, ++i;
         } else if (c == '#') {
-            return; // to the end of the line
+            on(i, Lexed::LineComment);
+            while (i + 1 < text.size() && text[i + 1] != '\n') ++i;
         } else if (c == '/' && next == '*') {
             comment = true;
             ++i;
         } else if (c == '"') { // a string ends at its closing quote or with its line
-            while (++i < text.size() && text[i] != '"')
+            on(i, Lexed::String);
+            while (++i < text.size() && text[i] != '"' && text[i] != '\n')
                 if (text[i] == '\\') ++i;
         } else {
-            braces += c == '{' ? 1 : c == '}' ? -1 : 0;
-            parens += c == '(' ? 1 : c == ')' ? -1 : 0;
+            on(i, Lexed::Code);
         }
     }
 }
-
-namespace {
 
 // `text` without a # comment at its end (outside strings and /* */), and without what it would
 // then end with of blanks: a `;` the session adds must not fall into the comment.
 std::string without_trailing_comment(const std::string& text) {
     std::size_t cut = text.size();
     bool comment = false;
-    for (std::size_t i = 0; i < text.size(); ++i) {
-        const char c = text[i];
-        const char next = i + 1 < text.size() ? text[i + 1] : '\0';
-        if (comment) {
-            if (c == '*' && next == '/') comment = false, ++i;
-        } else if (c == '#') {
-            const std::size_t nl = text.find('\n', i);
-            if (nl == std::string::npos) {
-                cut = i;
-                break;
-            }
-            i = nl;
-        } else if (c == '/' && next == '*') {
-            comment = true;
-            ++i;
-        } else if (c == '"') {
-            while (++i < text.size() && text[i] != '"' && text[i] != '\n')
-                if (text[i] == '\\') ++i;
-        }
-    }
+    lex(text, comment, [&](std::size_t i, Lexed what) {
+        if (what == Lexed::LineComment && text.find('\n', i) == std::string::npos) cut = i;
+    });
     return trim(text.substr(0, cut));
 }
 
 // Whether `text` holds nothing but comments and blanks.
 bool only_comments(std::string_view text) {
-    bool comment = false;
-    for (std::size_t i = 0; i < text.size(); ++i) {
+    bool comment = false, code = false;
+    lex(text, comment, [&](std::size_t i, Lexed what) {
         const char c = text[i];
-        const char next = i + 1 < text.size() ? text[i + 1] : '\0';
-        if (comment) {
-            if (c == '*' && next == '/') comment = false, ++i;
-        } else if (c == '#') {
-            while (i + 1 < text.size() && text[i + 1] != '\n') ++i;
-        } else if (c == '/' && next == '*') {
-            comment = true;
-            ++i;
-        } else if (c != ' ' && c != '\t' && c != '\n' && c != '\r') {
-            return false;
-        }
-    }
-    return true;
+        code = code || what == Lexed::String ||
+               (what == Lexed::Code && c != ' ' && c != '\t' && c != '\n' && c != '\r');
+    });
+    return !code;
 }
 
 // A REPL command: ':' and a letter (a line of a block may start with a condition's ':').
@@ -648,6 +630,14 @@ bool is_command(std::string_view line) {
 }
 
 } // namespace
+
+void Session::OpenScan::line(std::string_view text) {
+    lex(text, comment, [&](std::size_t i, Lexed what) {
+        if (what != Lexed::Code) return;
+        braces += text[i] == '{' ? 1 : text[i] == '}' ? -1 : 0;
+        parens += text[i] == '(' ? 1 : text[i] == ')' ? -1 : 0;
+    });
+}
 
 std::string Session::open_thing() const {
     if (pending_scan_.comment) return "a /* comment */";
