@@ -13,8 +13,10 @@ namespace plant::habits {
 
 bool looks_like_a_name(std::string_view run) {
     if (run.size() < 3) return false;
+    // a capital may begin a name (L-Py's Leaf, Apex) when three or more small letters follow
+    const std::size_t first = std::isupper(static_cast<unsigned char>(run[0])) && run.size() >= 4 ? 1 : 0;
     bool vowel = false, consonant = false;
-    for (std::size_t i = 0; i < run.size(); ++i) {
+    for (std::size_t i = first; i < run.size(); ++i) {
         const auto c = static_cast<unsigned char>(run[i]);
         if (!std::islower(c)) return false; // Xab, FbFb: capitals are modules of their own
         (std::string_view("aeiouy").find(static_cast<char>(std::tolower(c))) != std::string_view::npos
@@ -110,6 +112,23 @@ void check_cpfg_lines(const SourceFile& src, std::uint32_t file_id, Diagnostics&
         } else if (line.rfind("#include ", 0) == 0) {
             diags.error(at(8), fmt::format("cpfg's #include is a comment in plant; write import \"{}\";",
                                            after("#include")));
+        }
+        // `// text` where a statement may begin (a line's start, after a ';', '{' or '}'): a C or
+        // L-Py comment, which plant would read as two roll modules and the text as modules
+        bool quoted = false;
+        for (std::size_t i = 0; i + 2 < line.size() && line[i] != '#'; ++i) {
+            if (line[i] == '"') quoted = !quoted;
+            if (quoted || line.compare(i, 3, "// ") != 0) continue;
+            std::size_t before = i;
+            while (before > 0 && (line[before - 1] == ' ' || line[before - 1] == '\t')) --before;
+            if (before == 0 || line[before - 1] == ';' || line[before - 1] == '{' ||
+                line[before - 1] == '}') {
+                diags.error(
+                    {file_id, static_cast<std::uint32_t>(b + i), static_cast<std::uint32_t>(b + i + 2)},
+                    "'//' is not a comment in plant: it is two '/' (roll) modules, and what follows "
+                    "is read as more of the grammar; write # for a comment");
+                break;
+            }
         }
         if (nl == std::string::npos) break;
         b = nl + 1;

@@ -16,8 +16,8 @@ namespace plant::habits {
 std::string hint(const std::string& text, std::size_t byte, const std::string& message);
 
 // A letter run that reads like a word meant as one module (`leaf`, `plant`): three or more
-// lower-case letters, with a vowel and a consonant (docs/language.md, coming
-// from ABOP, cpfg or L-Py). FbFb, Xab, ff and ab do not.
+// lower-case letters, with a vowel and a consonant, or a capital and three or more such letters
+// (`Leaf`; docs/language.md, coming from ABOP, cpfg or L-Py). FbFb, Xab, Bud, ff and ab do not.
 bool looks_like_a_name(std::string_view run);
 
 // cpfg's preprocessor lines (#define, #ignore:, #consider:, #include) are comments in plant: each
