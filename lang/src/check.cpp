@@ -201,18 +201,17 @@ void Compiler::check_raw_runs() {
 void Compiler::check_never_applying() {
     auto check = [&](const RuleSet& rs) {
         for (const auto& p : rs.productions) {
-            // every module of the predecessor must be produced by something (the first that is
-            // not is named)
-            for (const auto& m : p.strict) {
+            // every module of the predecessor and of its context must be produced by something,
+            // with as many numbers as its pattern takes (the first that is not is named)
+            auto never = [&](const PatternModule& m, const char* role) {
                 if (!produced_.count(m.sym)) {
-                    diags_->warning(p.span,
+                    diags_->warning(role[0] ? m.span : p.span,
                                     fmt::format("this production can never apply: neither the axiom nor any "
-                                                "successor produces '{}'",
-                                                P_.symbols[m.sym].name));
-                    break;
+                                                "successor produces '{}'{}",
+                                                P_.symbols[m.sym].name, role));
+                    return true;
                 }
-                // a module matches only with as many numbers as its pattern takes
-                if (emitted_.count({m.sym, m.width})) continue;
+                if (emitted_.count({m.sym, m.width})) return false;
                 std::string widths;
                 for (auto it = emitted_.lower_bound({m.sym, 0}); it != emitted_.end() && it->first == m.sym;
                      ++it)
@@ -221,8 +220,14 @@ void Compiler::check_never_applying() {
                     m.span, fmt::format("this production can never apply: the axiom and the successors "
                                         "write '{}' with {} number{}, and this pattern takes {}",
                                         P_.symbols[m.sym].name, widths, widths == "1" ? "" : "s", m.width));
-                break;
-            }
+                return true;
+            };
+            bool told = false;
+            for (const auto& m : p.strict)
+                if (!told) told = never(m, "");
+            for (const auto* context : {&p.left, &p.right, &p.left_new, &p.right_new})
+                for (const auto& m : *context)
+                    if (!told) told = never(m, ", which its context needs");
         }
     };
     check(P_.rules);

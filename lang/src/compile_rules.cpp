@@ -3,6 +3,7 @@
 // the engine apply an arrow-form production without running its code module by module.
 #include "compiler_internal.hpp"
 #include "habits.hpp"
+#include "plant/derive.hpp"
 #include "plant/vm.hpp"
 
 #include <fmt/format.h>
@@ -76,6 +77,19 @@ void Compiler::compile_production(const ast::Production& p, RuleSet& set) {
             diags_->error(p.condition->span, fmt::format("a condition must be a bool or number, found a {}",
                                                          value_type_name(t)));
         emit(c, Op::Halt, 0, 1, p.condition->span);
+        if (auto v = fold_number(*p.condition)) {
+            // `a : 0.2 -> X`: a probability written where the condition goes
+            if (t == ValueType::Number && *v != 0 && *v != 1)
+                diags_->error(
+                    p.condition->span,
+                    fmt::format("a condition of {} is always true: a condition is a bool (x > 1); a "
+                                "probability is the production's weight, after its successor: {} -> "
+                                "... : {};",
+                                format_double(*v), p.strict.empty() ? "A" : p.strict[0].name,
+                                format_double(*v)));
+            // always true: the production is unconditional, and shadows those after it as one
+            if (*v != 0) cp.condition = Code{};
+        }
     }
     if (p.weight) {
         c.code = &cp.weight;
