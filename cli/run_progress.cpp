@@ -21,8 +21,10 @@ std::string human_bytes(double bytes) {
     return fmt::format("{:.0f} kB", std::ceil(bytes / 1e3));
 }
 
-double remaining_ms(double last_ms, double prev_ms, int done, int target) {
-    const double growth = prev_ms > 0 ? std::clamp(last_ms / prev_ms, 1.0, 16.0) : 1.0;
+double remaining_ms(double last_ms, std::size_t last_modules, std::size_t prev_modules, int done,
+                    int target) {
+    const double growth =
+        prev_modules > 0 ? std::clamp(double(last_modules) / double(prev_modules), 1.0, 16.0) : 1.0;
     double total = 0, t = last_ms;
     for (int k = done + 1; k <= target && total < 1e12; ++k) total += (t *= growth);
     return total;
@@ -33,15 +35,17 @@ void RunProgress::show(const std::string& line) {
 }
 
 void RunProgress::step(const StepStats& s, int target) {
-    prev_ms_ = last_ms_;
-    last_ms_ = s.ms;
+    prev_modules_ = last_modules_;
+    last_modules_ = s.modules;
     if (!terminal_) return;
     const double rate = s.ms > 0 ? double(s.modules) / (s.ms / 1000.0) : 0.0;
     std::string line = fmt::format("step {}/{}: {} modules, {} modules/s", s.step, target,
                                    human_count(double(s.modules)), human_count(rate));
-    if (s.step < target && s.step >= 2)
-        line +=
-            fmt::format(", about {:.0f} s left", remaining_ms(last_ms_, prev_ms_, s.step, target) / 1000.0);
+    // once a step's time follows its string: a step of a few thousand modules takes what the
+    // step itself costs, and the estimate from it was minutes for a run of a second
+    if (s.step < target && s.step >= 2 && s.modules >= 100000)
+        line += fmt::format(", about {:.0f} s left",
+                            remaining_ms(s.ms, last_modules_, prev_modules_, s.step, target) / 1000.0);
     show(line);
 }
 

@@ -23,15 +23,17 @@ class RunProgress {
   private:
     void show(const std::string& line);
     bool terminal_;
-    double last_ms_ = 0, prev_ms_ = 0;
+    std::size_t last_modules_ = 0, prev_modules_ = 0; // the strings of the last two steps
 };
 
 // "1.2 million", "340 thousand", "812": counts for people.
 std::string human_count(double n);
 // "1.2 GB", "96 MB", "12 kB".
 std::string human_bytes(double bytes);
-// The time the steps from `done` + 1 to `target` are expected to take, in ms: each step's time
-// grows by the ratio of the last two (between 1 and 16 times), as an L-system's string does.
-double remaining_ms(double last_ms, double prev_ms, int done, int target);
+// The time the steps from `done` + 1 to `target` are expected to take, in ms: a step's time
+// follows its string, and the string grows each step by the ratio of the last two strings
+// (between 1 and 16 times), as an L-system's does. (From the strings, not the steps' times: the
+// time of a step of a few thousand modules is noise, and its ratio made estimates of years.)
+double remaining_ms(double last_ms, std::size_t last_modules, std::size_t prev_modules, int done, int target);
 
 } // namespace plant::cli

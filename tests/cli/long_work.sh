@@ -12,11 +12,17 @@ g=$src/grammars/abop/fig1_24a.plant
 if command -v script >/dev/null 2>&1; then
   script -qec "'$plant' run '$g' -n 6 -o '$tmp/t.glb'" /dev/null | tr '\r' '\n' >"$tmp/tty"
   contains "step with a rate" "$tmp/tty" "step 6/6: 39 thousand modules, "
-  contains "an estimate of the time left" "$tmp/tty" "s left"
+  lacks "no estimate while the string is small" "$tmp/tty" "s left"
   contains "interpreting" "$tmp/tty" "interpreting the string"
   contains "meshing with its estimate" "$tmp/tty" "meshing about "
   contains "writing" "$tmp/tty" "writing $tmp/t.glb (1 of 1)"
   contains "summary" "$tmp/tty" "39061 modules, "
+  # an estimate once the string is large enough for its steps' times to follow it (195 thousand
+  # modules at step 7), from the strings' growth: under a minute for a run of a second
+  script -qec "'$plant' run '$g' -n 8 -o '$tmp/t.txt'" /dev/null | tr '\r' '\n' >"$tmp/tty"
+  contains "an estimate of the time left" "$tmp/tty" "step 7/8: 195 thousand modules, "
+  left=$(grep -ao 'about [0-9]* s left' "$tmp/tty" | head -1 | tr -dc 0-9)
+  if [ -n "$left" ] && [ "$left" -lt 60 ]; then ok; else bad "the estimate: '$left' s left"; fi
 else
   echo "long_work: script(1) not installed: the terminal part skipped"
 fi
