@@ -25,22 +25,30 @@ void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation) {
     cmd.add_option("--edits", o.edits,
                    "Apply the decomposition graph's edits from FILE (default: the grammar's 'edits \"F\";')")
         ->type_name("FILE");
-    if (derivation) {
-        add_count(
-            cmd, "-n,--steps", 0, 1000000, [&o](std::uint64_t v) { o.steps = static_cast<int>(v); },
-            "Number of derivation steps, 0 to 1000000 (default: the grammar's 'derive N;')");
-        add_count(
-            cmd, "--seed", 0, kAnyCount, [&o](std::uint64_t v) { o.seed = v; },
-            "Random seed, a whole number from 0 to 2^64 - 1 (default: the grammar's 'seed S;', else 0)")
-            ->type_name("UINT");
-        add_count(
-            cmd, "--threads", 0, 256, [&o](std::uint64_t v) { o.threads = static_cast<int>(v); },
-            "Rewriting threads, 0 to 256; 0 means one per core. The result never depends on it");
-        add_count(
-            cmd, "--max-modules", 1, kAnyCount, [&o](std::uint64_t v) { o.max_modules = v; },
-            fmt::format("Stop with an error when the string grows past this many modules (default {})",
-                        o.max_modules));
-    }
+    // plant check takes them too, so that a run's command line checks as it is; it derives
+    // nothing, and -n only tells it that the steps are given
+    const std::string unused = "Taken as plant run takes it, so that a run's command line checks as it is; "
+                               "check derives nothing";
+    add_count(
+        cmd, "-n,--steps", 0, 1000000, [&o](std::uint64_t v) { o.steps = static_cast<int>(v); },
+        derivation ? "Number of derivation steps, 0 to 1000000 (default: the grammar's 'derive N;')"
+                   : "The steps a run would derive: given, no note that the grammar has no 'derive N;'");
+    add_count(
+        cmd, "--seed", 0, kAnyCount, [&o](std::uint64_t v) { o.seed = v; },
+        derivation
+            ? "Random seed, a whole number from 0 to 2^64 - 1 (default: the grammar's 'seed S;', else 0)"
+            : unused)
+        ->type_name("UINT");
+    add_count(
+        cmd, "--threads", 0, 256, [&o](std::uint64_t v) { o.threads = static_cast<int>(v); },
+        derivation ? "Rewriting threads, 0 to 256; 0 means one per core. The result never depends on it"
+                   : unused);
+    add_count(
+        cmd, "--max-modules", 1, kAnyCount, [&o](std::uint64_t v) { o.max_modules = v; },
+        derivation
+            ? fmt::format("Stop with an error when the string grows past this many modules (default {})",
+                          o.max_modules)
+            : unused);
     add_count(
         cmd, "--max-steps", 1, kAnyCount, [&o](std::uint64_t v) { o.max_steps = v; },
         fmt::format("Stop with an error when one evaluation (a hook call; a production's condition, "
@@ -148,6 +156,7 @@ std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& so
     co.allow_read = o.allow_read;
     co.environments = runtime_environments();
     co.max_steps = o.max_steps;
+    co.steps_given = o.steps.has_value();
     for (const auto& d : o.defines) {
         auto eq = d.find('=');
         if (eq == std::string::npos || eq == 0) {

@@ -236,7 +236,7 @@ void Compiler::check_never_applying() {
     check(P_.interpret);
     // rules with no `derive N;` derive 0 steps unless the command line says how many
     // (only for rules of the main file: the REPL's session imports the grammar and steps itself)
-    if (P_.setting(ast::SettingKey::Derive).empty() && !P_.rules.productions.empty() &&
+    if (P_.setting(ast::SettingKey::Derive).empty() && !opts_.steps_given && !P_.rules.productions.empty() &&
         P_.rules.productions[0].span.file == current_file_ && sm_.file(current_file_).name() != "<session>")
         // a note, not a warning: grammars meant for `-n` (and their tests) stay warning-free
         diags_->add({Severity::Note,

@@ -24,6 +24,7 @@ struct CompileOptions {
     std::vector<std::string> allow_read;        // --allow-read DIR
     EnvironmentFactory environments;            // the runtime's kinds; none: `env` cannot be used
     std::uint64_t max_steps = kDefaultMaxSteps; // the VM's budget for constants evaluated now
+    bool steps_given = false; // the command line says how many steps (-n): no note that derive N is missing
 };
 
 // Reads, parses and compiles `path` and everything it imports. Returns null when there were
