@@ -2,6 +2,7 @@
 #include "batch.hpp"
 #include "commands.hpp"
 #include "outputs.hpp"
+#include "pending_files.hpp"
 #include "run_progress.hpp"
 
 #include "plant/environment_phase.hpp"
@@ -12,6 +13,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <filesystem>
 #include <iostream>
@@ -110,6 +112,28 @@ int read_output_options(RunCmd& c, OutputOptions& oo) {
                                      known_extensions());
             return kUsage;
         }
+        // a placeholder is filled in by a batch only: a single run would write '{seed}' as it is
+        if (!c.batch.any())
+            for (std::size_t at = o.find('{'); at != std::string::npos; at = o.find('{', at + 1)) {
+                const std::size_t close = o.find('}', at);
+                if (close == std::string::npos || close == at + 1 ||
+                    !std::all_of(o.begin() + static_cast<std::ptrdiff_t>(at) + 1,
+                                 o.begin() + static_cast<std::ptrdiff_t>(close), [](char ch) {
+                                     return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_';
+                                 }))
+                    continue;
+                std::cerr << fmt::format(
+                    "plant: the output '{}' holds the placeholder {}, which only a batch "
+                    "fills in: give --seeds S..S for one variant, or write the name out\n",
+                    escape_controls(o), escape_controls(o.substr(at, close - at + 1)));
+                return kUsage;
+            }
+        // a folder it cannot go into stops the run now, not after deriving and meshing
+        if (o.find('{') == std::string::npos)
+            if (const std::string problem = output_problem(o); !problem.empty()) {
+                std::cerr << "plant: " << escape_controls(problem) << "\n";
+                return kCantCreate;
+            }
         // an output (or its sidecar) that is the grammar itself would replace it
         for (const std::string& written :
              {o, f->sidecar_extension ? sidecar_path(o, f->sidecar_extension) : std::string{}}) {

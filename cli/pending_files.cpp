@@ -138,6 +138,32 @@ int write_all(int fd, const char* data, std::size_t size) {
 
 } // namespace
 
+std::string output_problem(const std::string& target) {
+    const fs::path path(target);
+    if (path.filename().empty()) return "cannot write " + in_quotes(target) + ": not a file name";
+    std::error_code ec;
+    if (fs::is_directory(path, ec)) return "cannot write " + in_quotes(target) + ": it is a folder";
+    fs::path dir = path.parent_path();
+    while (!dir.empty() && !fs::exists(fs::symlink_status(dir, ec)) && dir != dir.parent_path())
+        dir = dir.parent_path();
+    const std::string shown = dir.empty() ? std::string(".") : dir.string();
+    auto problem = [&](int err) {
+        return fmt::format("cannot write {}: cannot create a file in {}: {}", in_quotes(target),
+                           in_quotes(shown), std::strerror(err));
+    };
+    if (!fs::is_directory(shown, ec)) return problem(ENOTDIR);
+#ifdef O_TMPFILE
+    const int fd = ::open(shown.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0600);
+    if (fd >= 0) {
+        ::close(fd);
+        return {};
+    }
+    // a file system without unnamed files says so; the permissions then tell
+    if (errno != EOPNOTSUPP && errno != EISDIR && errno != EINVAL) return problem(errno);
+#endif
+    return ::access(shown.c_str(), W_OK | X_OK) == 0 ? std::string() : problem(errno);
+}
+
 void PendingFiles::write(std::size_t k, const std::string& bytes) {
     write_with(k, [&](const ByteSink& sink) { sink(bytes.data(), bytes.size()); });
 }

@@ -55,4 +55,10 @@ class PendingFiles {
     bool committed_ = false;    // every file renamed into place
 };
 
+// Before any work: why a file could not be written at `target`, or "" when nothing is seen to stop
+// it. The folders a run makes for it do not exist yet, so it is the nearest folder that does that
+// must be one, and one a file can be made in (tried with an unnamed file, which leaves nothing).
+// A name that is a folder is refused too. The message is the one writing the file would give.
+std::string output_problem(const std::string& target);
+
 } // namespace plant::cli

@@ -153,6 +153,15 @@ if [ -e "$tmp/pop.glb" ] || [ -e "$tmp/pop.png" ]; then fail=$((fail + 1)); echo
 check "one unwritable output of two" 73 "$plant" run "$tmp/plant.plant" -o "$tmp/both.glb" -o /proc/nope/x.png
 if [ -e "$tmp/both.glb" ]; then fail=$((fail + 1)); echo "FAIL both.glb left behind"; else pass=$((pass + 1)); fi
 if ls -a "$tmp" | grep -q plant-tmp; then fail=$((fail + 1)); echo "FAIL temporary files left behind"; else pass=$((pass + 1)); fi
+# an output whose folder cannot be: refused before any work (the grammar's start hook never prints)
+printf 'derive 2;\naxiom: F;\nrules { F -> FF; }\non start { print("started"); }\n' >"$tmp/hook.plant"
+: >"$tmp/afile"
+check "an output under a file" 73 "$plant" run "$tmp/hook.plant" -o "$tmp/x.glb" -o "$tmp/afile/x.png"
+contains "an output under a file: why" "$tmp/stderr" "cannot write '$tmp/afile/x.png': cannot create a file in '$tmp/afile': Not a directory"
+lacks "an output under a file: before any work" "$tmp/stderr" "started"
+# a placeholder is a batch's: a single run refuses it rather than writing '{seed}' into a name
+check "a placeholder in a single run" 64 "$plant" run "$tmp/hook.plant" --seed 5 -o "$tmp/x-{seed}.glb"
+contains "a placeholder in a single run: what to do" "$tmp/stderr" "holds the placeholder {seed}, which only a batch fills in: give --seeds S..S"
 # a .glb goes to its file piece by piece: a write refused part way (here the file-size limit, 64 kB
 # of a 640 kB file) is an error that leaves neither the file nor a temporary one
 mkdir -p "$tmp/full"
