@@ -239,6 +239,24 @@ SymbolId Compiler::module_symbol(const std::string& name) {
     return P_.symbols.intern(name);
 }
 
+// `~name` places the surface `name`: one not declared (here, in a library imported, or in the
+// program an instance body belongs to) is an error at the module, with the nearest name.
+void Compiler::check_surface_named(const std::string& module, Span at) {
+    if (module.size() < 2 || module[0] != '~') return;
+    const std::string_view name = std::string_view(module).substr(1);
+    std::vector<std::string> names; // compiled (an instance body's inherited among them) or declared
+    for (const auto& s : P_.surfaces) names.push_back(s.name);
+    for (const ast::ShapeDecl* s : surface_decls_) names.push_back(s->name); // one that failed: told already
+    if (std::find(names.begin(), names.end(), name) != names.end()) return;
+    const std::string near = nearest_name(name, names);
+    diags_->error(at, near.empty()
+                          ? fmt::format("'{}' places a surface that is not declared: add 'surface {} = "
+                                        "polygon(...);' or load(\"file.obj\")",
+                                        module, name)
+                          : fmt::format("'{}' places a surface that is not declared; did you mean '~{}'?",
+                                        module, near));
+}
+
 void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list) {
     for (const auto& m : list) {
         if (m.name == "*") {
@@ -249,6 +267,7 @@ void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list) {
         for (std::size_t k = 0; k < parts.size(); ++k) {
             SymbolId sym = module_symbol(parts[k].first);
             produced_.insert(sym);
+            check_surface_named(parts[k].first, k + 1 == parts.size() ? m.span : Span{parts[k].second});
             const bool last = k + 1 == parts.size();
             const SymbolInfo& info = P_.symbols[sym];
             int width = 0;
