@@ -341,16 +341,29 @@ int test_main(const TestCmd& c) {
     // files imported by others, with no expectations of their own, are libraries, not tests
     std::vector<fs::path> libraries = library_files(walked);
     int passed = 0, failed = 0, written = 0;
+    // on a terminal, a line on standard error says which test runs (the results go to standard
+    // output): a folder of slow grammars otherwise runs a minute without a word
+    const bool progress = isatty(2) != 0;
+    auto clear_progress = [&] {
+        if (progress) std::cerr << "\r\x1b[K" << std::flush;
+    };
+    std::size_t index = 0;
     for (const auto& f : files) {
+        ++index;
         if (std::find(libraries.begin(), libraries.end(), f) != libraries.end()) {
             if (c.verbose)
                 std::cout << "library " << escape_controls(f.string()) << " (imported, not a test)\n";
             continue;
         }
+        if (progress)
+            std::cerr << fmt::format("\r\x1b[Ktest {}/{}: {}", index, files.size(),
+                                     escape_controls(f.string()))
+                      << std::flush;
         std::string blessed;
         const auto root = walk_roots.find(f);
         std::string msg = run_one(f, root == walk_roots.end() ? nullptr : &root->second, c.bless, blessed,
                                   c.allow_read, c.timeout);
+        clear_progress();
         if (ChildSignalGuard::pending()) break;
         if (msg.empty()) {
             ++passed;

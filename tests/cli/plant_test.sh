@@ -52,5 +52,14 @@ for f in no_position no_suggestion no_suggestion_placed contains; do contains "$
 for f in wrong_name wrong_column cut_mid_message wrong_contains; do contains "$f fails" "$tmp/out" "FAIL ./$f.plant"; done
 contains "a contains expectation is shown as one" "$tmp/out" "expected: containing: 'sprod'"
 
+# on a terminal a progress line on standard error names the test that runs; on a pipe, nothing
+mkdir -p "$tmp/progress" && printf 'derive 1;\naxiom: F;\n# expect: F\n' >"$tmp/progress/one.plant"
+if command -v script >/dev/null 2>&1; then
+  (cd "$tmp/progress" && script -qec "'$plant' test ." /dev/null) | tr '\r' '\n' >"$tmp/tty"
+  contains "the progress line on a terminal" "$tmp/tty" "test 1/1: ./one.plant"
+fi
+(cd "$tmp/progress" && "$plant" test . 2>"$tmp/err" >/dev/null)
+if [ ! -s "$tmp/err" ]; then ok; else bad "progress on a pipe: $(head -c 200 "$tmp/err")"; fi
+
 echo "plant_test: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
