@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cctype>
 #include <set>
 #include <string_view>
@@ -23,6 +24,16 @@ void Compiler::check_defines_used() {
                               fmt::format("-D {}: '{}' is a const, which -D cannot set; declare it as "
                                           "'param {} = ...;' to set it from the command line",
                                           name, name, name));
+                continue;
+            }
+            const auto var = std::find_if(P_.globals.begin(), P_.globals.end(), [&](const Global& g) {
+                return g.name == name && g.kind != GlobalKind::Param;
+            });
+            if (var != P_.globals.end()) {
+                diags_->error(var->span, fmt::format("-D {}: '{}' is a var, which hooks change and -D cannot "
+                                                     "set; declare it as 'param {} = ...;' to set its start "
+                                                     "from the command line",
+                                                     name, name, name));
                 continue;
             }
             std::vector<std::string> params;
