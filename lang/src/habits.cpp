@@ -61,11 +61,41 @@ std::string hint(const std::string& text, std::size_t byte, const std::string& m
     for (const auto& [w, fix] : kSectionWords)
         if (word == w) return fmt::format("; {}", fix);
     if (word == "maximum") return "; the depth bound is written decompose max_depth 8 { ... }";
-    if (c == '^' || (c == '*' && byte > 0 && text[byte - 1] == '*'))
+    if (c == '^' || (c == '*' && byte > 0 && text[byte - 1] == '*')) {
+        // the operands as written, when they are a name or a number: x^2 is pow(x, 2)
+        auto is_word = [](char ch) {
+            return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '.';
+        };
+        std::size_t b = c == '^' ? byte : byte - 1;
+        while (b > 0 && text[b - 1] == ' ') --b;
+        std::size_t a = b;
+        while (a > 0 && is_word(text[a - 1])) --a;
+        std::size_t e = byte + 1;
+        while (e < text.size() && text[e] == ' ') ++e;
+        std::size_t f = e;
+        while (f < text.size() && is_word(text[f])) ++f;
+        if (a < b && e < f)
+            return fmt::format("; there is no power operator: write pow({}, {})", text.substr(a, b - a),
+                               text.substr(e, f - e));
         return "; there is no power operator: write pow(x, 0.5)";
-    if (c == '=' && byte + 1 < text.size() && text[byte + 1] == '>' &&
-        message.find("production") != std::string::npos)
+    }
+    if (c == '=' && ((byte + 1 < text.size() && text[byte + 1] == '>' &&
+                      message.find("production") != std::string::npos) ||
+                     message.find("after the predecessor") != std::string::npos))
         return "; a production's arrow is written ->";
+    if (c == '+' && byte > 0 && text[byte - 1] == '+') return "; there is no ++: write n += 1";
+    if (c == '-' && byte > 0 && text[byte - 1] == '-' &&
+        message.find("after the operator") != std::string::npos)
+        return "; there is no --: write n -= 1";
+    if (c == '{') { // `elif (...) {`, read as a call of elif
+        std::size_t line = text.rfind('\n', byte);
+        line = line == std::string::npos ? 0 : line + 1;
+        for (std::size_t at = text.find("elif", line); at != std::string::npos && at < byte;
+             at = text.find("elif", at + 4))
+            if ((at == 0 || !std::isalnum(static_cast<unsigned char>(text[at - 1]))) &&
+                at + 4 < text.size() && !std::isalnum(static_cast<unsigned char>(text[at + 4])))
+                return "; there is no elif: write else if (...) { ... }";
+    }
     if (c == '\'') return "; cpfg's ' (next colour) is written ;(c) here, with the colour index, as in ;(2)";
     if ((c == '{' || c == '.') && message.find("after production") != std::string::npos)
         return "; cpfg's { . } polygons are written surface leaf = polygon(...); and drawn with ~leaf (a "
