@@ -6,10 +6,13 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <iostream>
+#include <string_view>
 #include <thread>
+#include <vector>
 
 int main(int argc, char** argv) {
     using namespace plant::cli;
@@ -46,8 +49,13 @@ int main(int argc, char** argv) {
             names += (names.empty() ? "" : ", ") + sub->get_name();
         }
         if (!known) {
-            std::cerr << "plant: unknown command '" << plant::escape_controls(argv[1], true)
-                      << "' (the commands: " << names << ")\nRun 'plant --help' for usage.\n";
+            std::vector<std::string> commands;
+            for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
+                commands.push_back(sub->get_name());
+            const std::string near = plant::nearest_name(argv[1], commands);
+            std::cerr << "plant: unknown command '" << plant::escape_controls(argv[1], true) << "'"
+                      << (near.empty() ? "" : "; did you mean '" + near + "'?") << " (the commands: " << names
+                      << ")\nRun 'plant --help' for usage.\n";
             return kUsage;
         }
     }
@@ -70,9 +78,25 @@ int main(int argc, char** argv) {
         // CLI11 reports --help of a subcommand as CallForHelp too, caught above; everything else
         // is a usage error.
         std::string which;
-        for (const CLI::App* sub : app.get_subcommands()) which = sub->get_name();
-        std::cerr << "plant: " << plant::escape_controls(e.what(), true) << "\n"
-                  << "Run 'plant " << (which.empty() ? "" : which + " ") << "--help' for usage.\n";
+        const CLI::App* command = nullptr;
+        for (const CLI::App* sub : app.get_subcommands()) which = sub->get_name(), command = sub;
+        std::cerr << "plant: " << plant::escape_controls(e.what(), true) << "\n";
+        // an option the command does not have: the nearest one it has
+        if (command) {
+            std::vector<std::string> options;
+            for (const CLI::Option* o : command->get_options())
+                for (const std::string& name : o->get_lnames()) options.push_back("--" + name);
+            for (int k = 2; k < argc && std::string_view(argv[k]) != "--"; ++k) {
+                const std::string word = std::string(argv[k]).substr(0, std::string_view(argv[k]).find('='));
+                if (word.rfind("--", 0) != 0 ||
+                    std::find(options.begin(), options.end(), word) != options.end())
+                    continue;
+                if (const std::string near = plant::nearest_name(word, options); !near.empty())
+                    std::cerr << "plant: " << which << " has no option " << plant::escape_controls(word, true)
+                              << "; did you mean " << near << "?\n";
+            }
+        }
+        std::cerr << "Run 'plant " << (which.empty() ? "" : which + " ") << "--help' for usage.\n";
         return kUsage;
     } catch (const plant::RuntimeError& e) { // one no command caught (a memory budget refused)
         std::cerr << "plant: error: " << plant::escape_controls(e.message, true) << "\n";

@@ -129,7 +129,12 @@ const ReplCommand* Session::find_command(const std::string& name) const {
 bool Session::command(const std::string& name, const std::string& rest) {
     const ReplCommand* c = find_command(name);
     if (!c) {
-        error() << fmt::format("unknown command ':{}'; :help lists the commands\n", name);
+        std::vector<std::string> names;
+        for (const auto& known : commands()) names.emplace_back(known.name);
+        const std::string near = nearest_name(name, names);
+        error() << fmt::format("unknown command ':{}'; {}\n", escape_controls(name),
+                               near.empty() ? ":help lists the commands"
+                                            : fmt::format("did you mean ':{}'?", near));
         return true;
     }
     c->run(*this, name, rest);

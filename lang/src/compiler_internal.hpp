@@ -67,7 +67,6 @@ inline bool numeric(ValueType t) {
 }
 
 std::size_t edit_distance(std::string_view a, std::string_view b);
-std::string nearest_name(std::string_view name, const std::vector<std::string>& candidates);
 
 class Compiler {
   public:

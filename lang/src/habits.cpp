@@ -5,9 +5,11 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 #include <cctype>
 #include <utility>
+#include <vector>
 
 namespace plant::habits {
 
@@ -61,6 +63,19 @@ std::string hint(const std::string& text, std::size_t byte, const std::string& m
     for (const auto& [w, fix] : kSectionWords)
         if (word == w) return fmt::format("; {}", fix);
     if (word == "maximum") return "; the depth bound is written decompose max_depth 8 { ... }";
+    if (!word.empty() && message.rfind("expected a top-level item", 0) == 0) {
+        static const std::vector<std::string> kItems = {
+            "param",       "const", "var",      "module", "fn",       "curve", "surface",
+            "texture",     "env",   "instance", "derive", "angle",    "step",  "width",
+            "width_scale", "seed",  "axiom",    "ignore", "consider", "rules", "decompose",
+            "interpret",   "on",    "import",   "graph",  "edits"};
+        std::string lower(word);
+        for (char& ch : lower) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+        if (lower != word && std::find(kItems.begin(), kItems.end(), lower) != kItems.end())
+            return fmt::format("; keywords are lower case: write {}", lower);
+        if (const std::string near = nearest_name(word, kItems); !near.empty())
+            return fmt::format("; did you mean '{}'?", near);
+    }
     if (c == '^' || (c == '*' && byte > 0 && text[byte - 1] == '*')) {
         // the operands as written, when they are a name or a number: x^2 is pow(x, 2)
         auto is_word = [](char ch) {

@@ -235,11 +235,18 @@ check "repl script" 0 "$plant" repl "$tmp/plant.plant" <"$tmp/ok.repl"
 check "repl script with a failing line" 1 "$plant" repl "$tmp/plant.plant" <"$tmp/bad.repl"
 check "repl with a missing file" 66 "$plant" repl "$tmp/none.plant"
 printf 'axiom: F ~nothing(1);\n' >"$tmp/nosurf.plant"
-check "undeclared surface" 70 "$plant" run "$tmp/nosurf.plant" -o "$tmp/n.glb"
+check "undeclared surface" 65 "$plant" run "$tmp/nosurf.plant" -o "$tmp/n.glb"
+contains "undeclared surface: at the module" "$tmp/stderr" "nosurf.plant:1:10: error: '~nothing' places a surface that is not declared"
 
 # a first word that is no command is named, with the commands
 check "an unknown command" 64 "$plant" nosuchcmd
 contains "the unknown command named" "$tmp/stderr" "plant: unknown command 'nosuchcmd' (the commands: run, derive,"
+check "a misspelt command" 64 "$plant" drive "$tmp/plant.plant"
+contains "a misspelt command: the nearest" "$tmp/stderr" "plant: unknown command 'drive'; did you mean 'derive'?"
+check "a misspelt option" 64 "$plant" derive "$tmp/plant.plant" --step 3
+contains "a misspelt option: the nearest" "$tmp/stderr" "plant: derive has no option --step; did you mean --steps?"
+check "a misspelt option with its value" 64 "$plant" run "$tmp/plant.plant" --sed=3
+contains "a misspelt option with its value: the nearest" "$tmp/stderr" "plant: run has no option --sed; did you mean --seed?"
 # help and the version, written to a full disk, fail as any output does
 for words in "derive --help" "--version" "help turtle" "--help-all"; do
   # shellcheck disable=SC2086 # the words are split on purpose

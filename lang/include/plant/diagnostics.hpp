@@ -19,6 +19,9 @@ const char* severity_name(Severity s);
 
 // The length of the UTF-8 sequence at s[i], or 0 when it is not one (RFC 3629: no overlong
 // forms, no surrogates, nothing past U+10FFFF).
+// The candidate nearest to `name` by edit distance (a swap of two letters counts one), when it is
+// near enough for a "did you mean" (short names only get close ones); "" otherwise.
+std::string nearest_name(std::string_view name, const std::vector<std::string>& candidates);
 std::size_t utf8_length(std::string_view s, std::size_t i);
 
 struct Diagnostic {
