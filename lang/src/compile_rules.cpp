@@ -292,6 +292,14 @@ void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list) {
             if (info.instance >= 0 && self_index_ >= 0) // what this body places (check_instance_graph)
                 graph_->places[static_cast<std::size_t>(self_index_)].emplace_back(
                     info.instance, last ? m.span : Span{parts[k].second});
+            // ABOP's and cpfg's bare '!' narrows the width a step; here it sets it, and alone
+            // changes nothing (said once a program)
+            if (info.turtle_op == TurtleOp::Width && last && !m.has_args && !bare_width_told_) {
+                bare_width_told_ = true;
+                diags_->warning(m.span,
+                                "'!' without a width changes nothing here; ABOP's and cpfg's '!' (a "
+                                "step narrower) is written with the width it should take, as !(w * 0.7)");
+            }
             if (info.turtle_op == TurtleOp::Push || info.turtle_op == TurtleOp::Pop) {
                 // the turtle table's only count it enforces: brackets take none
                 if (nargs > turtle_symbol(info.turtle_op)->max_params)

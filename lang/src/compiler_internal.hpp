@@ -225,6 +225,7 @@ class Compiler {
     std::set<SymbolId> produced_;
     // (symbol, count of numbers) of every Emit compiled: each gets a plain kind (assign_kinds)
     std::set<std::pair<SymbolId, std::uint32_t>> emitted_;
+    bool bare_width_told_ = false; // the warning for a bare '!' was given
     std::vector<RawRun> raw_runs_;
     std::size_t max_declared_len_ = 1;
     std::map<std::string, std::pair<ast::ExprPtr, std::uint32_t>> defines_; // -D name -> expr, source
