@@ -69,10 +69,11 @@ void Compiler::load(std::uint32_t file_id, std::map<std::string, std::pair<const
         std::vector<std::string> searched;
         std::string path = resolve_import(im, file_id, searched);
         if (path.empty()) {
-            diags_->error(im.span, im.is_path ? fmt::format("cannot find imported file '{}' (looked for {})",
-                                                            im.target, searched.empty() ? "?" : searched[0])
-                                              : fmt::format("cannot find library '{}' (searched {})",
-                                                            im.target, fmt::join(searched, ", ")));
+            diags_->input_error(im.span, im.is_path
+                                             ? fmt::format("cannot find imported file '{}' (looked for {})",
+                                                           im.target, searched.empty() ? "?" : searched[0])
+                                             : fmt::format("cannot find library '{}' (searched {})",
+                                                           im.target, fmt::join(searched, ", ")));
             continue;
         }
         const auto given = opts_.file_texts.find(path);

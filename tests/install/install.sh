@@ -73,7 +73,7 @@ contains "a linked plant searches its install's stdlib" "$tmp/stderr" "$p/share/
 # an install without rose.plant cannot import rose: it does not fall back on the source tree
 cp -r "$p" "$tmp/bare"
 rm "$tmp/bare/share/plant/stdlib/rose.plant"
-check "install without rose.plant" 65 "$tmp/bare/bin/plant" check fig12c.plant
+check "install without rose.plant" 66 "$tmp/bare/bin/plant" check fig12c.plant
 contains "names the missing library" "$tmp/stderr" "cannot find library 'rose'"
 lacks "and searched no source tree" "$tmp/stderr" "$src"
 
