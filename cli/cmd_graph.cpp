@@ -178,7 +178,9 @@ int graph_main(const GraphCmd& c) {
         out += edits_text(g, sources, false);
     }
     std::cout << out << std::flush;
-    return std::cout ? kOk : kCantCreate;
+    if (std::cout) return kOk;
+    std::cerr << "plant: cannot write the graph to standard output\n";
+    return kCantCreate;
 }
 
 } // namespace

@@ -252,6 +252,8 @@ for words in "derive --help" "--version" "help turtle" "--help-all"; do
   # shellcheck disable=SC2086 # the words are split on purpose
   check "plant $words > /dev/full" 73 bash -c '"$0" "$@" >/dev/full' "$plant" $words
 done
+check "plant graph > /dev/full" 73 bash -c '"$0" graph "$1" >/dev/full' "$plant" "$(dirname "$0")/../../grammars/bonsai/bunjingi.plant"
+contains "plant graph > /dev/full: why" "$tmp/stderr" "plant: cannot write the graph to standard output"
 # a UTF-8 byte-order mark before the first line is skipped
 printf '\xef\xbb\xbfaxiom: F;\n' >"$tmp/bom.plant"
 check "a byte-order mark" 0 "$plant" derive "$tmp/bom.plant"
