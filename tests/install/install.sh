@@ -60,14 +60,14 @@ wait "$view_pid"
 # the search for a library: -I, then PLANT_PATH, then the install's stdlib, never the source tree
 printf 'import nosuchlib;\naxiom: F;\n' >missing.plant
 mkdir -p inc pp
-check "import nosuchlib fails" 65 env PLANT_PATH="$tmp/work/pp" "$p/bin/plant" check missing.plant -I "$tmp/work/inc"
+check "import nosuchlib fails" 66 env PLANT_PATH="$tmp/work/pp" "$p/bin/plant" check missing.plant -I "$tmp/work/inc"
 contains "import names the paths searched, in order" "$tmp/stderr" \
   "(searched $tmp/work/inc/nosuchlib.plant, $tmp/work/pp/nosuchlib.plant, $p/share/plant/stdlib/nosuchlib.plant)"
 lacks "a moved install never searches the source tree" "$tmp/stderr" "$src"
 
 # through a symbolic link (/usr/local/bin/plant -> /opt/plant/bin/plant) it is still the install
 ln -s "$p/bin/plant" "$tmp/plant-link"
-check "plant through a symbolic link" 65 "$tmp/plant-link" check missing.plant
+check "plant through a symbolic link" 66 "$tmp/plant-link" check missing.plant
 contains "a linked plant searches its install's stdlib" "$tmp/stderr" "$p/share/plant/stdlib/nosuchlib.plant"
 
 # an install without rose.plant cannot import rose: it does not fall back on the source tree
@@ -80,11 +80,11 @@ lacks "and searched no source tree" "$tmp/stderr" "$src"
 # a program copied out of its build tree reads no source tree either (the old behaviour did)
 mkdir -p "$tmp/lonely/bin"
 cp "$build/plant" "$tmp/lonely/bin/"
-check "copied build-tree program" 65 "$tmp/lonely/bin/plant" check missing.plant
+check "copied build-tree program" 66 "$tmp/lonely/bin/plant" check missing.plant
 contains "names where an install's stdlib would be" "$tmp/stderr" "$tmp/lonely/share/plant/stdlib/nosuchlib.plant"
 lacks "copied build-tree program ignores the source tree" "$tmp/stderr" "$src"
 # while the build tree's own program reads the source tree's stdlib
-check "build-tree program" 65 "$build/plant" check missing.plant
+check "build-tree program" 66 "$build/plant" check missing.plant
 contains "the build tree's program searches the source stdlib" "$tmp/stderr" "$src/stdlib/nosuchlib.plant"
 
 # the C++ API: examples/cpp against the moved install's CMake package
@@ -125,7 +125,7 @@ if can_hide; then
   check "moved install, source tree hidden" 0 hidden "$src" "$p/bin/plant" run fig12c.plant -o hidden.mesh.txt
   same "rose with the source tree hidden" hidden.mesh.txt "$golden"
   check "example, source tree hidden" 0 hidden "$src" "$tmp/example/grow" fig12c.plant hidden.glb
-  check "copied program, source tree hidden, finds no rose" 65 hidden "$src" "$tmp/lonely/bin/plant" check fig12c.plant
+  check "copied program, source tree hidden, finds no rose" 66 hidden "$src" "$tmp/lonely/bin/plant" check fig12c.plant
   if [ -n "$python" ]; then
     check "the Python tests against the install, source tree hidden" 0 hidden "$src" "${pytest[@]}"
     tail -3 "$tmp/stdout"

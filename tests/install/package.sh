@@ -62,7 +62,7 @@ fi
 check "the unpacked plant grows a rose" 0 "${run[@]}" "$root/usr/bin/plant" run fig12c.plant -o rose.mesh.txt
 same "the unpacked plant's rose matches the golden" rose.mesh.txt "$golden"
 printf 'import nosuchlib;\naxiom: F;\n' >missing.plant
-check "the unpacked plant: a missing library" 65 "${run[@]}" "$root/usr/bin/plant" check missing.plant
+check "the unpacked plant: a missing library" 66 "${run[@]}" "$root/usr/bin/plant" check missing.plant
 contains "it searched the unpacked stdlib" "$tmp/stderr" "$root/usr/share/plant/stdlib/nosuchlib.plant"
 lacks "and not the source tree" "$tmp/stderr" "$src"
 if [ -n "$python" ]; then
