@@ -67,7 +67,13 @@ ReadFailure read_input_file(const std::string& path, std::string& out, std::size
         return errno == EACCES                       ? ReadFailure::Denied
                : errno == ENOENT || errno == ENOTDIR ? ReadFailure::Missing
                                                      : ReadFailure::Failed;
-    if (S_ISDIR(st.st_mode) || (regular_only && !S_ISREG(st.st_mode))) return ReadFailure::NotRegular;
+    // a device is refused even where a pipe is read (the grammar named on the command line):
+    // /dev/zero never ends, a terminal waits for typing
+    auto refused = [&](const struct stat& s) {
+        return S_ISDIR(s.st_mode) || S_ISCHR(s.st_mode) || S_ISBLK(s.st_mode) ||
+               (regular_only && !S_ISREG(s.st_mode));
+    };
+    if (refused(st)) return ReadFailure::NotRegular;
     if (S_ISREG(st.st_mode) && static_cast<std::uint64_t>(st.st_size) > max_bytes)
         return ReadFailure::TooLarge;
     const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOCTTY | (regular_only ? O_NONBLOCK : 0));
@@ -75,7 +81,7 @@ ReadFailure read_input_file(const std::string& path, std::string& out, std::size
     ReadFailure result = ReadFailure::None;
     if (::fstat(fd, &st) != 0) {
         result = ReadFailure::Failed;
-    } else if (S_ISDIR(st.st_mode) || (regular_only && !S_ISREG(st.st_mode))) {
+    } else if (refused(st)) {
         result = ReadFailure::NotRegular;
     } else {
         std::string text;

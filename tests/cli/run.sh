@@ -254,6 +254,11 @@ for words in "derive --help" "--version" "help turtle" "--help-all"; do
 done
 check "plant graph > /dev/full" 73 bash -c '"$0" graph "$1" >/dev/full' "$plant" "$(dirname "$0")/../../grammars/bonsai/bunjingi.plant"
 contains "plant graph > /dev/full: why" "$tmp/stderr" "plant: cannot write the graph to standard output"
+# the grammar named on the command line may be a pipe, but not a device (/dev/zero never ends)
+check "a device as the grammar" 66 "$plant" check /dev/zero
+contains "a device as the grammar: why" "$tmp/stderr" "plant: cannot read '/dev/zero': it is not a regular file"
+check "a pipe as the grammar" 0 bash -c '"$0" derive <(printf "axiom: F;\n")' "$plant"
+contains "a pipe as the grammar: derived" "$tmp/stdout" "F"
 # a UTF-8 byte-order mark before the first line is skipped
 printf '\xef\xbb\xbfaxiom: F;\n' >"$tmp/bom.plant"
 check "a byte-order mark" 0 "$plant" derive "$tmp/bom.plant"
