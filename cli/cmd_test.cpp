@@ -44,6 +44,7 @@ struct Expectations : TestCommandLine {
     std::vector<std::string> out;
     std::vector<ExpectedDiagnostic> errors, warnings;
     std::optional<int> exit_code;
+    std::vector<std::string> misspelt; // "line N: ..." for a comment that looks like a directive mistyped
 };
 
 // The words of `rest` with the 1-based column each begins at, `rest` starting at column `col`.
@@ -114,6 +115,27 @@ Expectations read_expectations(const std::string& text) {
         } else if (take("expect:", rest)) {
             e.out.push_back(rest);
             e.script = true;
+        } else {
+            // `# expcet: F`, `# Expect:`: a directive mistyped would otherwise be a comment, and the
+            // test would run without what it meant to check
+            std::size_t a = 0;
+            while (a < c.size() && c[a] == ' ') ++a;
+            std::size_t b = a;
+            while (b < c.size() && std::isalpha(static_cast<unsigned char>(c[b]))) ++b;
+            const std::string word = c.substr(a, b - a);
+            const std::size_t colon = c.find(':', b);
+            const bool directive_like =
+                b > a && colon != std::string::npos &&
+                std::all_of(c.begin() + static_cast<std::ptrdiff_t>(b),
+                            c.begin() + static_cast<std::ptrdiff_t>(colon), [](char ch) {
+                                return std::isalpha(static_cast<unsigned char>(ch)) || ch == ' ';
+                            });
+            if (directive_like)
+                if (const std::string near = nearest_name(word, {"expect", "args", "command"});
+                    !near.empty() && near != word)
+                    e.misspelt.push_back(
+                        fmt::format("line {}: '#{}' is not a directive; did you mean '# {}:'?", line_no,
+                                    escape_controls(c.substr(0, colon + 1)), near));
         }
     }
     return e;
@@ -220,6 +242,11 @@ std::string run_one(const fs::path& file, const fs::path* walk_root, bool bless,
     std::string text;
     if (!read_file(file.string(), text)) return "  cannot read the file\n";
     Expectations e = read_expectations(text);
+    if (!e.misspelt.empty()) {
+        std::string msg;
+        for (const std::string& m : e.misspelt) msg += "  " + m + "\n";
+        return msg;
+    }
     OutputFolder outdir;
     if (std::string refused = confine_test_command(file, e, outdir.path); !refused.empty()) return refused;
     std::vector<std::string> args{e.command, file.filename().string()};

@@ -52,6 +52,13 @@ for f in no_position no_suggestion no_suggestion_placed contains; do contains "$
 for f in wrong_name wrong_column cut_mid_message wrong_contains; do contains "$f fails" "$tmp/out" "FAIL ./$f.plant"; done
 contains "a contains expectation is shown as one" "$tmp/out" "expected: containing: 'sprod'"
 
+# a directive mistyped (`# expcet:`) fails the test, naming the directive, instead of being a comment
+mkdir -p "$tmp/typo" && printf 'derive 1;\naxiom: F;\n# expcet: F\n# Note: a comment\n' >"$tmp/typo/one.plant"
+(cd "$tmp/typo" && "$plant" test . >"$tmp/out" 2>&1)
+if [ $? -eq 1 ]; then ok; else bad "a mistyped directive: not a failure"; fi
+contains "a mistyped directive: named" "$tmp/out" "line 3: '# expcet:' is not a directive; did you mean '# expect:'?"
+lacks "a comment with a colon is no directive" "$tmp/out" "line 4"
+
 # on a terminal a progress line on standard error names the test that runs; on a pipe, nothing
 mkdir -p "$tmp/progress" && printf 'derive 1;\naxiom: F;\n# expect: F\n' >"$tmp/progress/one.plant"
 if command -v script >/dev/null 2>&1; then
