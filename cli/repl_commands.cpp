@@ -145,13 +145,11 @@ void Session::help(const std::string& topic) {
     std::string name = topic.empty() || topic[0] != ':' ? topic : topic.substr(1);
     if (name.empty()) {
         out_ << command_list();
-        out_
-            << "Anything else is a production (A(x) -> B(x + 1);), an axiom (axiom: A(1);), a setting (angle "
-               "30;), a declaration (module A(x);, const k = 2;, fn f(x) = 2 * x;, ignore: F;), a block "
-               "(rules "
-               "grow { B -> C; }, on start { ... }) or an expression to evaluate (2 * pi). A line that "
-               "leaves a "
-               "'{' open (or, in a declaration, a '(') goes on over the lines after it until it is closed.\n";
+        out_ << "Anything else is a production (A(x) -> B(x + 1);), an axiom (axiom: A(1);), a setting "
+                "(angle 30;), a declaration (module A(x);, const k = 2;, fn f(x) = 2 * x;, ignore: F;), a "
+                "block (rules grow { B -> C; }, on start { ... }) or an expression to evaluate (2 * pi). A "
+                "line that leaves a '{' open (or, in a declaration, a '(') goes on over the lines after it "
+                "until it is closed.\n";
         return;
     }
     for (const auto& c : commands()) {

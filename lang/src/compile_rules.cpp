@@ -267,8 +267,8 @@ void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list) {
         for (std::size_t k = 0; k < parts.size(); ++k) {
             SymbolId sym = module_symbol(parts[k].first);
             produced_.insert(sym);
-            check_surface_named(parts[k].first, k + 1 == parts.size() ? m.span : Span{parts[k].second});
             const bool last = k + 1 == parts.size();
+            check_surface_named(parts[k].first, last ? m.span : Span{parts[k].second});
             const SymbolInfo& info = P_.symbols[sym];
             int width = 0;
             std::size_t nargs = last ? m.args.size() : 0;
