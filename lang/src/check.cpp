@@ -26,8 +26,10 @@ void Compiler::check_defines_used() {
                                           name, name, name));
                 continue;
             }
+            // clang 14 cannot capture a structured binding, so the lambda gets a plain reference
+            const std::string& wanted = name;
             const auto var = std::find_if(P_.globals.begin(), P_.globals.end(), [&](const Global& g) {
-                return g.name == name && g.kind != GlobalKind::Param;
+                return g.name == wanted && g.kind != GlobalKind::Param;
             });
             if (var != P_.globals.end()) {
                 diags_->error(var->span, fmt::format("-D {}: '{}' is a var, which hooks change and -D cannot "
