@@ -100,6 +100,11 @@ int read_output_options(RunCmd& c, OutputOptions& oo) {
             escape_controls(c.size));
         return kUsage;
     }
+    if (c.outputs.empty() && reads_standard_input(c.g)) {
+        std::cerr << "plant: a grammar from standard input has no name to call its outputs by: give "
+                     "them with -o (-o out/plant.glb)\n";
+        return kUsage;
+    }
     if (c.outputs.empty()) {
         std::string stem = fs::path(c.g.file).stem().string();
         c.outputs = c.batch.any() ? std::vector<std::string>{"out/" + stem + "-{n}.glb"}

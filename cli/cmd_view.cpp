@@ -78,6 +78,11 @@ int view_main(ViewCmd& c) {
                      "build plant again (docs/view.md)\n";
         return kRuntime;
     }
+    if (reads_standard_input(c.g)) {
+        std::cerr << "plant: plant view watches its grammar's file and grows it again when it is saved, so "
+                     "it needs a file: save the grammar and name it\n";
+        return kUsage;
+    }
     if (std::error_code ec; !std::filesystem::is_regular_file(c.g.file, ec)) {
         std::error_code ec2;
         const std::string why = ec && ec != std::errc::no_such_file_or_directory ? ec.message()

@@ -76,6 +76,9 @@ void set_memory_budget(std::uint64_t bytes);
 // --allow-read DIR (repeatable), on every command that compiles a grammar.
 void add_allow_read(CLI::App& cmd, std::vector<std::string>& dirs);
 
+// FILE '-': the grammar comes from standard input (read once, named '<stdin>' in messages).
+bool reads_standard_input(const GrammarOptions& o);
+
 // Compiles the grammar, printing diagnostics to stderr (or appending them to `*messages`, when
 // given, in the same words). On failure sets `exit_code`.
 std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& sources, int& exit_code,

@@ -6,17 +6,20 @@
 
 #include <fmt/format.h>
 
+#include <cerrno>
 #include <charconv>
 #include <filesystem>
 #include <iostream>
 #include <limits>
+#include <mutex>
+#include <optional>
 #include <thread>
 #include <unistd.h>
 
 namespace plant::cli {
 
 void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation) {
-    cmd.add_option("FILE", o.file, "The .plant grammar")->required();
+    cmd.add_option("FILE", o.file, "The .plant grammar; '-' reads it from standard input")->required();
     cmd.add_option("-D,--define", o.defines, "Override a param: -D name=value (value is an expression)")
         ->type_name("NAME=VALUE");
     cmd.add_option("-I,--include", o.include_dirs, "Add a directory to the library search path")
@@ -131,6 +134,45 @@ std::uint64_t parse_count(const std::string& option, const std::string& text, st
     return v;
 }
 
+namespace {
+
+// The grammar piped in for FILE '-', read once: a batch compiles the grammar again for each grid
+// tuple, and standard input can be read only once. Its messages name it '<stdin>'; it may read
+// files of the current folder, as a grammar of that folder may.
+ReadFailure read_standard_input(std::string& out) {
+    static std::mutex mutex;
+    static std::optional<std::pair<ReadFailure, std::string>> read;
+    std::lock_guard lock(mutex);
+    if (!read) {
+        std::string text;
+        ReadFailure f = ReadFailure::None;
+        char buf[1 << 16];
+        for (;;) {
+            const ssize_t n = ::read(STDIN_FILENO, buf, sizeof buf);
+            if (n < 0 && errno == EINTR) continue;
+            if (n < 0) {
+                f = ReadFailure::Failed;
+                break;
+            }
+            if (n == 0) break;
+            if (text.size() + static_cast<std::size_t>(n) > kMaxSourceBytes) {
+                f = ReadFailure::TooLarge;
+                break;
+            }
+            text.append(buf, static_cast<std::size_t>(n));
+        }
+        read.emplace(f, f == ReadFailure::None ? std::move(text) : std::string());
+    }
+    out = read->second;
+    return read->first;
+}
+
+} // namespace
+
+bool reads_standard_input(const GrammarOptions& o) {
+    return o.file == "-";
+}
+
 std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& sources, int& exit_code,
                                       std::string* messages) {
     std::string printed;
@@ -143,7 +185,21 @@ std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& so
         }
     } flush{out, messages == nullptr};
     std::string text;
-    if (ReadFailure f = read_input_file(o.file, text, kMaxSourceBytes, false); f != ReadFailure::None) {
+    if (reads_standard_input(o)) {
+        // a terminal would wait for typing that nobody knows is wanted
+        if (::isatty(STDIN_FILENO)) {
+            out += "plant: '-' reads the grammar from standard input, which is a terminal here: pipe a "
+                   "grammar in ('cat tree.plant | plant derive -') or type one in 'plant repl'\n";
+            exit_code = kUsage;
+            return nullptr;
+        }
+        if (ReadFailure f = read_standard_input(text); f != ReadFailure::None) {
+            out += fmt::format("plant: cannot read the grammar from standard input: {}\n", describe(f));
+            exit_code = kNoInput;
+            return nullptr;
+        }
+    } else if (ReadFailure f = read_input_file(o.file, text, kMaxSourceBytes, false);
+               f != ReadFailure::None) {
         std::error_code ec;
         out += fmt::format("plant: cannot read '{}': {}\n", escape_controls(o.file),
                            std::filesystem::is_directory(o.file, ec) ? "it is a directory" : describe(f));
@@ -168,7 +224,7 @@ std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& so
     }
     if (!o.appended.empty()) text += "\n" + o.appended;
     Diagnostics diags;
-    std::uint32_t id = sources.add(o.file, std::move(text));
+    std::uint32_t id = sources.add(reads_standard_input(o) ? "<stdin>" : o.file, std::move(text));
     std::unique_ptr<Program> program;
     try {
         program = compile_source(sources, id, co, diags);

@@ -257,6 +257,32 @@ contains "plant graph > /dev/full: why" "$tmp/stderr" "plant: cannot write the g
 # the grammar named on the command line may be a pipe, but not a device (/dev/zero never ends)
 check "a device as the grammar" 66 "$plant" check /dev/zero
 contains "a device as the grammar: why" "$tmp/stderr" "plant: cannot read '/dev/zero': it is not a regular file"
+
+# FILE '-': the grammar from standard input, named <stdin> in messages, read once for a batch
+from() { local input=$1; shift; "$@" <"$input"; } # from FILE COMMAND...: COMMAND reading FILE
+printf 'axiom: F;\nrules { F -> FF; }\n' >"$tmp/piped.plant"
+check "derive -" 0 from "$tmp/piped.plant" "$plant" derive - -n 2
+contains "derive -: the string" "$tmp/stdout" "FFFF"
+cat "$tmp/piped.plant" | "$plant" derive - -n 3 >"$tmp/stdout" 2>&1
+contains "derive - from a pipe" "$tmp/stdout" "FFFFFFFF"
+printf 'axiom: F;\nrules { F -> F(1 +; }\n' >"$tmp/piped_bad.plant"
+check "check - with an error" 65 from "$tmp/piped_bad.plant" "$plant" check -
+contains "check -: the error names <stdin>" "$tmp/stderr" "<stdin>:2:19: error"
+check "run - without -o" 64 from "$tmp/piped.plant" "$plant" run - -n 1
+contains "run - without -o: why" "$tmp/stderr" "give them with -o"
+check "run - -o" 0 from "$tmp/piped.plant" "$plant" run - -n 1 -o "$tmp/piped.txt"
+contains "run - -o: the string" "$tmp/piped.txt" "FF"
+printf 'axiom: F;\nderive 2;\nrules { F -> F[+F] : 0.5; F -> F[-F] : 0.5; }\n' >"$tmp/piped_batch.plant"
+check "a batch of -" 0 from "$tmp/piped_batch.plant" "$plant" run - --seeds 1..4 --jobs 2 -o "$tmp/pb-{seed}.txt"
+holds "a batch of -: every variant" test -s "$tmp/pb-1.txt" -a -s "$tmp/pb-4.txt"
+check "view -" 64 from "$tmp/piped.plant" "$plant" view -
+contains "view -: why" "$tmp/stderr" "needs a file"
+if command -v script >/dev/null; then # a terminal as standard input would wait for typing
+  script -qec "$plant check -" /dev/null </dev/null >"$tmp/stdout" 2>&1
+  got=$?
+  if [ "$got" -eq 64 ]; then ok; else bad "check - on a terminal: exit $got, expected 64"; fi
+  contains "check - on a terminal: why" "$tmp/stdout" "which is a terminal here"
+fi
 check "a pipe as the grammar" 0 bash -c '"$0" derive <(printf "axiom: F;\n")' "$plant"
 contains "a pipe as the grammar: derived" "$tmp/stdout" "F"
 # a UTF-8 byte-order mark before the first line is skipped
