@@ -98,6 +98,12 @@ void Compiler::compile_production(const ast::Production& p, RuleSet& set) {
             diags_->error(p.weight->span,
                           fmt::format("a weight must be a number, found a {}", value_type_name(t)));
         emit(c, Op::Halt, 0, 1, p.weight->span);
+        // a constant weight is checked now, as a derivation would at its first choice
+        if (auto v = fold_number(*p.weight); v && t == ValueType::Number && (!std::isfinite(*v) || *v < 0))
+            diags_->error(p.weight->span,
+                          fmt::format("a production weight must be a finite number >= 0, found {}: weights "
+                                      "are relative chances (1 and 3 give a quarter and three quarters)",
+                                      format_double(*v)));
     }
     c.code = &cp.body;
     cp.body_form = p.body_form;
