@@ -263,6 +263,19 @@ void Compiler::check_surface_named(const std::string& module, Span at) {
                                         module, near));
 }
 
+// A width or radius known now to be below 0 (the turtle stops at the others): '!', '@O', and F's
+// second number.
+void Compiler::check_size_argument(const SymbolInfo& info, const ast::ModuleRef& m) {
+    const std::size_t at = info.turtle_op == TurtleOp::Forward ? 1 : 0;
+    const char* what = info.turtle_op == TurtleOp::Sphere                                         ? "radius"
+                       : info.turtle_op == TurtleOp::Width || info.turtle_op == TurtleOp::Forward ? "width"
+                                                                                                  : nullptr;
+    if (!what || m.args.size() <= at) return;
+    if (auto v = fold_number(*m.args[at]); v && *v < 0)
+        diags_->error(m.args[at]->span, fmt::format("'{}' gives a {} of {}: a {} is at least 0", info.name,
+                                                    what, format_double(*v), what));
+}
+
 void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list) {
     for (const auto& m : list) {
         if (m.name == "*") {
@@ -306,6 +319,7 @@ void Compiler::compile_successor(Ctx& c, const ast::ModuleList& list) {
                                 "'!' without a width changes nothing here; ABOP's and cpfg's '!' (a "
                                 "step narrower) is written with the width it should take, as !(w * 0.7)");
             }
+            if (last && info.instance < 0) check_size_argument(info, m);
             if (info.turtle_op == TurtleOp::Push || info.turtle_op == TurtleOp::Pop) {
                 // the turtle table's only count it enforces: brackets take none
                 if (nargs > turtle_symbol(info.turtle_op)->max_params)

@@ -91,6 +91,7 @@ class Compiler {
     void compile_return(Ctx& c, const ast::Stmt& s);
     void compile_print(Ctx& c, const ast::Expr& e);
     void check_surface_named(const std::string& module, Span at);
+    void check_size_argument(const SymbolInfo& info, const ast::ModuleRef& m);
     void compile_successor(Ctx& c, const ast::ModuleList& list);
     std::vector<PatternModule> compile_pattern(Ctx& c, const ast::ModuleList& list, PatternRole role);
     std::vector<std::pair<std::string, Span>> split_run(const ast::ModuleRef& m);

@@ -176,15 +176,29 @@ class Turtle {
         };
         const bool at = finite(t_.position);
         if (at && finite(t_.heading) && finite(t_.left) && finite(t_.up)) return;
-        // the module as the string has it, with its parameters: what to look for in the grammar
-        std::string text = program_.symbols[s_.symbol(i)].name;
-        for (std::uint32_t k = 0; k < s_.arity(i); ++k)
-            text += (k == 0 ? "(" : ", ") + format_double(args(i)[k]) + (k + 1 == s_.arity(i) ? ")" : "");
         throw RuntimeError(
             RuntimeErrorKind::Turtle, Span{},
             fmt::format("the turtle left finite space at module {} of the string, {}: its {} is "
                         "past the range of a double (a step or a position too large?)",
-                        i + 1, text, at ? "orientation" : "position"));
+                        i + 1, module_text(i), at ? "orientation" : "position"));
+    }
+
+    // the module as the string has it, with its parameters: what to look for in the grammar
+    std::string module_text(std::size_t i) const {
+        std::string text = program_.symbols[s_.symbol(i)].name;
+        for (std::uint32_t k = 0; k < s_.arity(i); ++k)
+            text += (k == 0 ? "(" : ", ") + format_double(args(i)[k]) + (k + 1 == s_.arity(i) ? ")" : "");
+        return text;
+    }
+
+    // a width or radius below 0 would turn a tube or a sphere inside out
+    double size_arg(std::size_t i, std::uint32_t k, double fallback, const char* what) const {
+        const double v = arg(i, k, fallback);
+        if (v >= 0) return v;
+        throw RuntimeError(RuntimeErrorKind::Turtle, Span{},
+                           fmt::format("module {} of the string, {}, gives a {} below 0; a {} is at least 0 "
+                                       "(max(w, 0) keeps a computed one there)",
+                                       i + 1, module_text(i), what, what));
     }
 
     void tropism() {
@@ -234,7 +248,7 @@ class Turtle {
 
     void forward(std::size_t i) {
         double len = arg(i, 0, t_.step);
-        if (s_.arity(i) > 1) t_.width = args(i)[1];
+        if (s_.arity(i) > 1) t_.width = size_arg(i, 1, t_.width, "width");
         start_axis();
         glm::dvec3 from = t_.position;
         t_.position += t_.heading * len;
@@ -377,7 +391,7 @@ void Turtle::apply(TurtleOp op, std::size_t i) {
         pop(i);
         break;
     case TurtleOp::Width:
-        t_.width = arg(i, 0, t_.width);
+        t_.width = size_arg(i, 0, t_.width, "width");
         break;
     case TurtleOp::PaletteColor:
         t_.color_index = static_cast<int>(std::clamp(arg(i, 0, t_.color_index + 1), -1e6, 1e6));
@@ -391,7 +405,7 @@ void Turtle::apply(TurtleOp op, std::size_t i) {
     }
     case TurtleOp::Sphere:
         sink_.organ(TurtleOrgan{{OrganKind::Sphere, {}, -1, {}},
-                                frame_matrix(t_, arg(i, 0, t_.width / 2)),
+                                frame_matrix(t_, size_arg(i, 0, t_.width / 2, "radius")),
                                 t_.color,
                                 i,
                                 s_.id(i),
