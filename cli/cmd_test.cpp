@@ -424,7 +424,7 @@ void setup_test(CLI::App& app, int& exit_code) {
                     fmt::format("Seconds each process a test starts may run before it is stopped and "
                                 "the test fails (default {})",
                                 kDefaultTestTimeout))
-        ->check(CLI::Range(0.1, 86400.0))
+        ->check(number_in(0.1, 86400, Bound::From))
         ->type_name("SECONDS");
     add_allow_read(*cmd, c->allow_read);
     cmd->callback([c, &exit_code] { exit_code = test_main(*c); });

@@ -60,6 +60,12 @@ inline constexpr std::uint64_t kAnyCount = std::numeric_limits<std::uint64_t>::m
 CLI::Option* add_count(CLI::App& cmd, const std::string& flags, std::uint64_t lowest, std::uint64_t highest,
                        std::function<void(std::uint64_t)> set, const std::string& help);
 
+// The check of a number option, whose message says what to give in the words parse_count uses:
+// "--sides: must be a whole number from 3 to 64, found '2'". Whole: an integer from lowest to
+// highest; From: any number from lowest to highest; Above: above lowest, at most highest.
+enum class Bound { Whole, From, Above };
+CLI::Validator number_in(double lowest, double highest, Bound bound);
+
 void add_grammar_options(CLI::App& cmd, GrammarOptions& o, bool derivation);
 
 // --max-work N: the whole derivation's work budget (DeriveOptions::max_work); `what` says what

@@ -8,6 +8,7 @@
 
 #include <cerrno>
 #include <charconv>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <limits>
@@ -132,6 +133,33 @@ std::uint64_t parse_count(const std::string& option, const std::string& text, st
                                                lowest, highest,
                                                text.size() > 40 ? text.substr(0, 40) + "..." : text));
     return v;
+}
+
+CLI::Validator number_in(double lowest, double highest, Bound bound) {
+    auto shown = [](double v) { // 1000000, not 1e6
+        return v == std::floor(v) && std::fabs(v) < 1e15 ? fmt::format("{}", static_cast<long long>(v))
+                                                         : format_double(v);
+    };
+    const std::string want =
+        bound == Bound::Whole ? fmt::format("a whole number from {} to {}", shown(lowest), shown(highest))
+        : bound == Bound::From
+            ? fmt::format("a number from {} to {}", shown(lowest), shown(highest))
+            : fmt::format("a number above {} and at most {}", shown(lowest), shown(highest));
+    return CLI::Validator(
+        [=](std::string& text) -> std::string {
+            double v = 0;
+            const char* end = text.data() + text.size();
+            auto r = std::from_chars(text.data(), end, v);
+            const bool read = !text.empty() && r.ec == std::errc() && r.ptr == end;
+            const bool fits = read && v <= highest && (bound == Bound::Above ? v > lowest : v >= lowest) &&
+                              (bound != Bound::Whole || v == std::floor(v));
+            if (fits) return {};
+            return fmt::format("must be {}, found '{}'", want,
+                               text.size() > 40 ? text.substr(0, 40) + "..." : text);
+        },
+        bound == Bound::Above ? fmt::format("above {}, at most {}", shown(lowest), shown(highest))
+                              : fmt::format("{} to {}", shown(lowest), shown(highest)),
+        "number_in");
 }
 
 namespace {

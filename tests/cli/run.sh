@@ -258,6 +258,17 @@ contains "plant graph > /dev/full: why" "$tmp/stderr" "plant: cannot write the g
 check "a device as the grammar" 66 "$plant" check /dev/zero
 contains "a device as the grammar: why" "$tmp/stderr" "plant: cannot read '/dev/zero': it is not a regular file"
 
+# a number option out of its range says what to give, in the option's own terms
+check "--width-scale 0" 64 "$plant" run "$tmp/ok.plant" --width-scale 0 -o "$tmp/w.glb"
+contains "--width-scale 0: what to give" "$tmp/stderr" "plant: --width-scale: must be a number above 0 and at most 1000000, found '0'"
+check "--sides 3.5" 64 "$plant" run "$tmp/ok.plant" --sides 3.5 -o "$tmp/w.glb"
+contains "--sides 3.5: what to give" "$tmp/stderr" "plant: --sides: must be a whole number from 3 to 64, found '3.5'"
+check "--timeout 0" 64 "$plant" test "$tmp/ok.plant" --timeout 0
+contains "--timeout 0: what to give" "$tmp/stderr" "plant: --timeout: must be a number from 0.1 to 86400, found '0'"
+check "--port 70000" 64 "$plant" view "$tmp/ok.plant" --port 70000
+contains "--port 70000: what to give" "$tmp/stderr" "plant: --port: must be a whole number from 0 to 65535, found '70000'"
+check "in range" 0 "$plant" run "$tmp/ok.plant" --width-scale 1000000 --sides 64 --min-line-width 0 -o "$tmp/w.glb"
+
 # FILE '-': the grammar from standard input, named <stdin> in messages, read once for a batch
 from() { local input=$1; shift; "$@" <"$input"; } # from FILE COMMAND...: COMMAND reading FILE
 printf 'axiom: F;\nrules { F -> FF; }\n' >"$tmp/piped.plant"
