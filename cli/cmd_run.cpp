@@ -86,6 +86,30 @@ void warn_unused_options(const RunCmd& c) {
     if (c.sides_given && svg && !meshed)
         std::cerr << "plant: warning: --sides shapes meshed tubes; an .svg is a line drawing of the "
                      "skeleton and does not use it\n";
+    bool image = false;
+    for (const auto& o : c.outputs)
+        if (const OutputFormat* f = format_of(o))
+            image =
+                image || std::string_view(f->extension) == ".png" || std::string_view(f->extension) == ".svg";
+    if (c.size_given && !image)
+        std::cerr << "plant: warning: --size sets the size of .png and .svg outputs, and none is written\n";
+}
+
+// The same file named twice by -o would be written twice, the second over the first.
+bool outputs_distinct(const RunCmd& c) {
+    std::vector<fs::path> seen;
+    for (const auto& o : c.outputs) {
+        std::error_code ec;
+        fs::path p = fs::weakly_canonical(fs::absolute(o, ec), ec);
+        if (ec) p = fs::path(o).lexically_normal();
+        if (std::find(seen.begin(), seen.end(), p) != seen.end()) {
+            std::cerr << fmt::format("plant: '{}' is given twice as an output: name each file once\n",
+                                     escape_controls(o));
+            return false;
+        }
+        seen.push_back(std::move(p));
+    }
+    return true;
 }
 
 // Reads --size, --max-memory, the view and the layout into `oo`, and checks the outputs' formats
@@ -179,6 +203,7 @@ int read_output_options(RunCmd& c, OutputOptions& oo) {
     oo.width_scale = c.width_scale;
     oo.max_triangles = c.max_triangles;
     oo.size_given = c.size_given;
+    if (!outputs_distinct(c)) return kUsage;
     warn_unused_options(c);
     return kOk;
 }
@@ -231,6 +256,16 @@ int run_main(RunCmd& c) {
     try {
         OutputSummary summary = write_outputs(*program, d, c.outputs, oo);
         progress.clear();
+        const bool meshed = std::any_of(c.outputs.begin(), c.outputs.end(), [](const std::string& o) {
+            const OutputFormat* f = format_of(o);
+            return f && f->needs == OutputNeeds::Scene;
+        });
+        if (meshed && summary.triangles == 0 && summary.organs == 0)
+            std::cerr << fmt::format(
+                "plant: warning: the plant draws nothing: its string ({} modules after {} "
+                "steps) holds no F, organ or instance the turtle draws, so the files "
+                "show an empty scene\n",
+                d.string().size(), d.steps_done());
         if (progress.enabled())
             std::cerr << fmt::format("{} modules, {} triangles, {} organs in {:.0f} ms\n", d.string().size(),
                                      summary.triangles, summary.organs, ms_since(t0));

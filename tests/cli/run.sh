@@ -269,6 +269,21 @@ check "--port 70000" 64 "$plant" view "$tmp/ok.plant" --port 70000
 contains "--port 70000: what to give" "$tmp/stderr" "plant: --port: must be a whole number from 0 to 65535, found '70000'"
 check "in range" 0 "$plant" run "$tmp/ok.plant" --width-scale 1000000 --sides 64 --min-line-width 0 -o "$tmp/w.glb"
 
+# the same output named twice is refused before any work; --size with no image, and a plant that
+# draws nothing, are warned about
+check "an output named twice" 64 "$plant" run "$tmp/ok.plant" -o "$tmp/twice.png" -o "$tmp/./twice.png"
+contains "an output named twice: why" "$tmp/stderr" "is given twice as an output: name each file once"
+holds "an output named twice: nothing written" test ! -e "$tmp/twice.png"
+check "--size with no image" 0 "$plant" run "$tmp/ok.plant" --size 64x64 -o "$tmp/size.glb"
+contains "--size with no image: warned" "$tmp/stderr" "plant: warning: --size sets the size of .png and .svg outputs, and none is written"
+check "--size with an image" 0 "$plant" run "$tmp/ok.plant" --size 64x64 -o "$tmp/size.png"
+lacks "--size with an image: no warning" "$tmp/stderr" "warning"
+printf 'axiom: A;\nderive 2;\nrules { A -> A B; }\n' >"$tmp/draws_nothing.plant"
+check "a plant that draws nothing" 0 "$plant" run "$tmp/draws_nothing.plant" -o "$tmp/nothing.glb"
+contains "a plant that draws nothing: warned" "$tmp/stderr" "plant: warning: the plant draws nothing: its string (3 modules after 2 steps)"
+check "a string of nothing drawn, as text" 0 "$plant" run "$tmp/draws_nothing.plant" -o "$tmp/nothing.txt"
+lacks "a string of nothing drawn, as text: no warning" "$tmp/stderr" "warning"
+
 # FILE '-': the grammar from standard input, named <stdin> in messages, read once for a batch
 from() { local input=$1; shift; "$@" <"$input"; } # from FILE COMMAND...: COMMAND reading FILE
 printf 'axiom: F;\nrules { F -> FF; }\n' >"$tmp/piped.plant"
