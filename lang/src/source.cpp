@@ -84,26 +84,25 @@ ReadFailure read_input_file(const std::string& path, std::string& out, std::size
     } else if (refused(st)) {
         result = ReadFailure::NotRegular;
     } else {
-        std::string text;
-        char buf[1 << 16];
-        while (true) {
-            const ssize_t n = ::read(fd, buf, sizeof buf);
-            if (n < 0 && errno == EINTR) continue;
-            if (n < 0) {
-                result = ReadFailure::Failed;
-                break;
-            }
-            if (n == 0) break;
-            if (text.size() + static_cast<std::size_t>(n) > max_bytes) { // grew, or not a regular file
-                result = ReadFailure::TooLarge;
-                break;
-            }
-            text.append(buf, static_cast<std::size_t>(n));
-        }
-        if (result == ReadFailure::None) out = std::move(text);
+        result = read_descriptor(fd, out, max_bytes); // (a file that grew is caught there too)
     }
     ::close(fd);
     return result;
+}
+
+ReadFailure read_descriptor(int fd, std::string& out, std::size_t max_bytes) {
+    std::string text;
+    char buf[1 << 16];
+    while (true) {
+        const ssize_t n = ::read(fd, buf, sizeof buf);
+        if (n < 0 && errno == EINTR) continue;
+        if (n < 0) return ReadFailure::Failed;
+        if (n == 0) break;
+        if (text.size() + static_cast<std::size_t>(n) > max_bytes) return ReadFailure::TooLarge;
+        text.append(buf, static_cast<std::size_t>(n));
+    }
+    out = std::move(text);
+    return ReadFailure::None;
 }
 
 std::string describe(ReadFailure f, std::size_t max_bytes) {

@@ -72,6 +72,10 @@ inline constexpr std::size_t kMaxSourceBytes = std::size_t{64} << 20; // sources
 ReadFailure read_input_file(const std::string& path, std::string& out,
                             std::size_t max_bytes = kMaxSourceBytes, bool regular_only = true);
 
+// Reads an open descriptor to its end into `out` (standard input for the grammar '-'), up to
+// `max_bytes`; `out` is left as it was on a failure.
+ReadFailure read_descriptor(int fd, std::string& out, std::size_t max_bytes = kMaxSourceBytes);
+
 // Why it failed, for a message: "no such file", "it is not a regular file", ...
 std::string describe(ReadFailure f, std::size_t max_bytes = kMaxSourceBytes);
 
