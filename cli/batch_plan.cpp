@@ -8,6 +8,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
+#include <map>
 #include <set>
 
 namespace plant::cli {
@@ -213,14 +214,40 @@ std::optional<BatchPlan> make_plan(const BatchOptions& o, const std::vector<std:
     return plan;
 }
 
+namespace {
+
+// A path with every placeholder replaced by one mark: two outputs with the same shape differ only
+// in which placeholders they hold ('a-{seed}.txt', 'a-{n}.txt'), so one variant's {seed} and
+// another's {n} can name the same file, and the later one overwrites the earlier.
+std::string shape_of(const std::string& path) {
+    std::string out;
+    std::size_t from = 0;
+    for (std::size_t open = path.find('{'); open != std::string::npos; open = path.find('{', open + 1)) {
+        const auto close = path.find('}', open);
+        if (close == std::string::npos) break;
+        out += path.substr(from, open - from) + '\x01';
+        from = close + 1;
+        open = close;
+    }
+    return out + path.substr(from);
+}
+
+} // namespace
+
 std::string check_templates(const BatchPlan& plan, const std::vector<std::string>& outputs) {
     std::string error;
     std::set<std::string> seen;
+    std::map<std::string, std::string> shapes; // shape -> the first output with it
     for (const auto& path : outputs) {
         const auto names = placeholders(path, plan, error);
         if (!error.empty()) return error;
         if (!seen.insert(path).second) return fmt::format("the output {} is given twice", shown(path));
         if (plan.total() < 2) continue;
+        if (const auto [it, first] = shapes.emplace(shape_of(path), path); !first)
+            return fmt::format("the outputs {} and {} differ only in their placeholders, so one variant's "
+                               "file can be another's and be written over: make the rest of their names "
+                               "differ too",
+                               shown(it->second), shown(path));
         auto has = [&](const std::string& n) {
             return std::find(names.begin(), names.end(), n) != names.end();
         };

@@ -16,6 +16,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <csignal>
+#include <filesystem>
 #include <iostream>
 #include <malloc.h>
 #include <map>
@@ -236,6 +237,15 @@ int run_batch(BatchJob& job) {
     }
     if (!job.batch.manifest.empty() && !manifest_format(job.batch.manifest)) {
         std::cerr << fmt::format("plant: --manifest '{}': name a .jsonl (JSON lines) or .csv file\n",
+                                 escape_controls(job.batch.manifest));
+        return kUsage;
+    }
+    // the manifest is written over whatever has its name: not over the grammar (no output can
+    // have its name, .csv and .jsonl being no output's format)
+    if (std::error_code ec; !job.batch.manifest.empty() && !reads_standard_input(job.grammar) &&
+                            std::filesystem::equivalent(job.batch.manifest, job.grammar.file, ec)) {
+        std::cerr << fmt::format("plant: --manifest '{}' is the grammar being run: writing it would replace "
+                                 "the grammar; give the manifest a name of its own\n",
                                  escape_controls(job.batch.manifest));
         return kUsage;
     }

@@ -142,6 +142,11 @@ usage "seed placeholder, grid" "put {n} (the variant's number) or {spread}" --se
 usage "unknown placeholder" "unknown placeholder {sede}" --seeds 1..3 -o 'x/{sede}.glb'
 usage "output twice" "given twice" --seeds 1..3 -o 'x/{n}.glb' -o 'x/{n}.glb'
 usage "seed and seeds" "--seed and --seeds" --seed 4 --seeds 1..3 -o 'x/{n}.glb'
+usage "outputs differing only in placeholders" "differ only in their placeholders" --seeds 1..3 -o 'x/a-{seed}.txt' -o 'x/a-{n}.txt'
+cp "$bush" bush_copy.csv
+check "manifest over the grammar" 64 "$plant" run bush_copy.csv --seeds 1..2 -o 'x/{n}.txt' --manifest bush_copy.csv
+contains "manifest over the grammar: why" stderr "is the grammar being run"
+same "manifest over the grammar: the grammar kept" "$bush" bush_copy.csv
 usage "manifest extension" "name a .jsonl" --seeds 1..3 -o 'x/{n}.glb' --manifest x/m.txt
 usage "jobs alone" "give --seeds or --grid" --jobs 2 -o x/a.glb
 usage "jobs 0" "--jobs" --seeds 1..3 --jobs 0 -o 'x/{n}.glb'
