@@ -207,7 +207,13 @@ class InstanceBuilder {
         // what the derivation took, while it lives: its string, then the skeleton
         used_ += double(d.string().size()) * 16.0;
         if (used_ > budget_) memory_error("deriving the instances", used_);
-        const Skeleton skeleton = build_skeleton(*def.program, d.interpreted(d.string()), turtle_options(d));
+        Skeleton skeleton;
+        try {
+            skeleton = build_skeleton(*def.program, d.interpreted(d.string()), turtle_options(d));
+        } catch (RuntimeError& e) { // the module count is of the instance's own string
+            e.message = fmt::format("instance {}: {}", made.name, e.message);
+            throw;
+        }
         std::uint64_t points = 0;
         for (const auto& a : skeleton.axes) points += a.points.size();
         used_ += double(points) * double(std::max(opt_.sides, 3) + 1) * 44.0 +

@@ -176,11 +176,18 @@ class Turtle {
         };
         const bool at = finite(t_.position);
         if (at && finite(t_.heading) && finite(t_.left) && finite(t_.up)) return;
-        throw RuntimeError(
-            RuntimeErrorKind::Turtle, Span{},
-            fmt::format("the turtle left finite space at module {} of the string, {}: its {} is "
-                        "past the range of a double (a step or a position too large?)",
-                        i + 1, module_text(i), at ? "orientation" : "position"));
+        throw RuntimeError(RuntimeErrorKind::Turtle, Span{},
+                           fmt::format("the turtle left finite space at module {} of {}, {}: its {} is "
+                                       "past the range of a double (a step or a position too large?)",
+                                       i + 1, which_string(), module_text(i),
+                                       at ? "orientation" : "position"));
+    }
+
+    // the string the turtle reads, as its messages name it: a grammar with interpretation rules
+    // has the turtle read what they make of the derived string, whose modules count differently
+    const char* which_string() const {
+        return program_.interpret.empty() ? "the string"
+                                          : "the interpreted string (after the interpret rules)";
     }
 
     // the module as the string has it, with its parameters: what to look for in the grammar
@@ -196,9 +203,9 @@ class Turtle {
         const double v = arg(i, k, fallback);
         if (v >= 0) return v;
         throw RuntimeError(RuntimeErrorKind::Turtle, Span{},
-                           fmt::format("module {} of the string, {}, gives a {} below 0; a {} is at least 0 "
+                           fmt::format("module {} of {}, {}, gives a {} below 0; a {} is at least 0 "
                                        "(max(w, 0) keeps a computed one there)",
-                                       i + 1, module_text(i), what, what));
+                                       i + 1, which_string(), module_text(i), what, what));
     }
 
     void tropism() {
@@ -275,9 +282,9 @@ class Turtle {
     void pop(std::size_t i) {
         if (stack_.empty())
             throw RuntimeError(RuntimeErrorKind::Turtle, Span{},
-                               fmt::format("']' at module {} of the string closes no '[' (the turtle's "
+                               fmt::format("']' at module {} of {} closes no '[' (the turtle's "
                                            "stack is empty)",
-                                           i + 1));
+                                           i + 1, which_string()));
         t_ = stack_.back();
         stack_.pop_back();
         parent_axis_ = parent_stack_.back();
@@ -298,10 +305,10 @@ class Turtle {
         if (!(t >= 0) || t != std::floor(t) || t >= static_cast<double>(n))
             throw RuntimeError(
                 RuntimeErrorKind::Turtle, Span{},
-                fmt::format("module {} ('{}') of the string sets texture {}, but the grammar declares {}: "
+                fmt::format("module {} ('{}') of {} sets texture {}, but the grammar declares {}: "
                             "declare one with 'texture bark = image(\"bark.png\");' and write "
                             "SetTexture(bark), or SetTexture(-1) for none",
-                            i + 1, program_.symbols[s_.symbol(i)].name, format_double(t),
+                            i + 1, program_.symbols[s_.symbol(i)].name, which_string(), format_double(t),
                             n == 0   ? std::string("no textures")
                             : n == 1 ? std::string("only texture 0")
                                      : fmt::format("textures 0 to {}", n - 1)));
@@ -318,11 +325,11 @@ class Turtle {
         for (std::size_t k = 0; k < std::min<std::size_t>(n, width); ++k) args[k] = a[k];
         const double scale = n > width ? a[width] : 1.0;
         if (!std::isfinite(scale) || scale <= 0)
-            throw RuntimeError(
-                RuntimeErrorKind::Turtle, Span{},
-                fmt::format("module {} ('{}') of the string places an instance at scale {}: the "
-                            "scale must be a positive number",
-                            i + 1, program_.symbols[s_.symbol(i)].name, scale));
+            throw RuntimeError(RuntimeErrorKind::Turtle, Span{},
+                               fmt::format("module {} ('{}') of {} places an instance at scale {}: the "
+                                           "scale must be a positive number",
+                                           i + 1, program_.symbols[s_.symbol(i)].name, which_string(),
+                                           scale));
         sink_.organ(
             TurtleOrgan{{OrganKind::Instance, program_.symbols[s_.symbol(i)].name, index, std::move(args)},
                         frame_matrix(t_, scale),
