@@ -124,7 +124,8 @@ int read_output_options(RunCmd& c, OutputOptions& oo) {
             escape_controls(c.size));
         return kUsage;
     }
-    if (c.outputs.empty() && reads_standard_input(c.g)) {
+    if (c.outputs.empty() && reads_standard_input(c.g) &&
+        !isatty(STDIN_FILENO)) { // (a terminal: refused later)
         std::cerr << "plant: a grammar from standard input has no name to call its outputs by: give "
                      "them with -o (-o out/plant.glb)\n";
         return kUsage;
@@ -262,10 +263,11 @@ int run_main(RunCmd& c) {
         });
         if (meshed && summary.triangles == 0 && summary.organs == 0)
             std::cerr << fmt::format(
-                "plant: warning: the plant draws nothing: its string ({} modules after {} "
-                "steps) holds no F, organ or instance the turtle draws, so the files "
-                "show an empty scene\n",
-                d.string().size(), d.steps_done());
+                "plant: warning: the plant draws nothing: no tube, organ or instance came "
+                "of its string ({} module{} after {} step{}), so the files show an "
+                "empty scene\n",
+                d.string().size(), d.string().size() == 1 ? "" : "s", d.steps_done(),
+                d.steps_done() == 1 ? "" : "s");
         if (progress.enabled())
             std::cerr << fmt::format("{} modules, {} triangles, {} organs in {:.0f} ms\n", d.string().size(),
                                      summary.triangles, summary.organs, ms_since(t0));
@@ -294,7 +296,7 @@ void add_batch_options(CLI::App& cmd, BatchOptions& b) {
         ->type_name("NAME=FROM:TO:STEP")
         ->group(group);
     cmd.add_option("--jobs", b.jobs, "Variants grown at once (default: one per core)")
-        ->check(number_in(1, 256, Bound::Whole))
+        ->transform(number_in(1, 256, Bound::Whole))
         ->group(group);
     cmd.add_option("--shard", b.shard,
                    "Grow only the K-th of N slices of the variants (those whose number n has n mod N = "
@@ -320,7 +322,7 @@ void setup_run(CLI::App& app, int& exit_code) {
                     "(default: out/NAME.glb and out/NAME.png; for many variants out/NAME-{n}.glb)")
         ->type_name("FILE");
     cmd->add_option("--sides", c->sides, "Vertices around each ring of a branch (meshes only; not .svg)")
-        ->check(number_in(3, 64, Bound::Whole))
+        ->transform(number_in(3, 64, Bound::Whole))
         ->each([c](const std::string&) { c->sides_given = true; });
     cmd->add_option("--size", c->size, "Size of PNG previews, and of SVG drawings (the figure fitted inside)")
         ->type_name("WxH")
@@ -328,7 +330,7 @@ void setup_run(CLI::App& app, int& exit_code) {
     cmd->add_option("--width-scale", c->width_scale,
                     "Multiply every drawn width by this (replaces the grammar's `width_scale`; ABOP's "
                     "!(w) is in pixels: try 0.02)")
-        ->check(number_in(0, 1e6, Bound::Above))
+        ->transform(number_in(0, 1e6, Bound::Above))
         ->type_name("X");
     cmd->add_option("--view", c->view,
                     "PNG preview from the front (looking along -z, y up), top, side (from +x) or iso (3/4 "
@@ -340,12 +342,12 @@ void setup_run(CLI::App& app, int& exit_code) {
     cmd->add_flag("--tubes", c->tubes, "PNG: draw the meshed tubes only, however thin")->excludes(lines);
     cmd->add_option("--min-line-width", c->min_line_width,
                     "PNG: the narrowest branch drawn, in pixels (default 1; 0 lets thin tubes vanish)")
-        ->check(number_in(0, 100, Bound::From))
+        ->transform(number_in(0, 100, Bound::From))
         ->type_name("PX");
     cmd->add_option("--max-triangles", c->max_triangles,
                     "Stop before meshing when the mesh is estimated to have more triangles than this "
                     "(default 20 million, about 3 GB while meshing and a 600 MB .glb)")
-        ->check(number_in(1, 1e12, Bound::Whole))
+        ->transform(number_in(1, 1e12, Bound::Whole))
         ->type_name("N");
     auto* nodes = cmd->add_flag("--no-gpu-instancing", c->no_gpu_instancing,
                                 "glTF: place each organ and instance by a plain node sharing its mesh, for "

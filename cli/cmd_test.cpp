@@ -229,6 +229,13 @@ bool resolves_inside(const fs::path& path, const fs::path& folder) {
     return true;
 }
 
+// The test file as its child process is given it, run in the file's folder: by its name, with
+// './' before a name that would read as an option ('-x.plant') or as standard input ('-').
+std::string child_name(const fs::path& file) {
+    const std::string name = file.filename().string();
+    return name.empty() || name[0] != '-' ? name : "./" + name;
+}
+
 std::string outside_folder(const fs::path& path) {
     return fmt::format("  {} is a symbolic link out of the test's folder: plant test does not read it "
                        "(make it a file of its own)\n",
@@ -249,7 +256,7 @@ std::string run_one(const fs::path& file, const fs::path* walk_root, bool bless,
     }
     OutputFolder outdir;
     if (std::string refused = confine_test_command(file, e, outdir.path); !refused.empty()) return refused;
-    std::vector<std::string> args{e.command, file.filename().string()};
+    std::vector<std::string> args{e.command, child_name(file)};
     args.insert(args.end(), e.args.begin(), e.args.end());
     for (const auto& d : allow_read) args.insert(args.end(), {"--allow-read", fs::absolute(d).string()});
     ChildOutcome o = run_child(args, file.parent_path(), timeout);
@@ -287,7 +294,7 @@ std::string run_one(const fs::path& file, const fs::path* walk_root, bool bless,
         int fd = mkstemps(tmp_name, 9);
         if (fd < 0) return "  cannot create a temporary file\n";
         close(fd);
-        std::vector<std::string> run_args{"run", file.filename().string()};
+        std::vector<std::string> run_args{"run", child_name(file)};
         run_args.insert(run_args.end(), e.args.begin(), e.args.end());
         run_args.insert(run_args.end(), {"-o", tmp_name});
         for (const auto& d : allow_read)
@@ -359,8 +366,11 @@ int test_main(const TestCmd& c) {
         } else if (fs::exists(p, ec)) {
             files.emplace_back(p);
         } else {
-            std::cerr << fmt::format("plant: cannot read '{}': no such file or directory\n",
-                                     escape_controls(p));
+            std::cerr << fmt::format(
+                "plant: cannot read '{}': no such file or directory{}\n", escape_controls(p),
+                p == "-" ? " (plant test runs files with their golden files beside them, "
+                           "so it does not read standard input)"
+                         : "");
             return kNoInput;
         }
     }
@@ -424,7 +434,7 @@ void setup_test(CLI::App& app, int& exit_code) {
                     fmt::format("Seconds each process a test starts may run before it is stopped and "
                                 "the test fails (default {})",
                                 kDefaultTestTimeout))
-        ->check(number_in(0.1, 86400, Bound::From))
+        ->transform(number_in(0.1, 86400, Bound::From))
         ->type_name("SECONDS");
     add_allow_read(*cmd, c->allow_read);
     cmd->callback([c, &exit_code] { exit_code = test_main(*c); });

@@ -160,11 +160,11 @@ void setup_view(CLI::App& app, int& exit_code) {
                 "as controls (docs/view.md)");
     add_grammar_options(*cmd, c->g, true);
     cmd->add_option("--port", c->port, "The port on 127.0.0.1 to serve on (0: any free port)")
-        ->check(number_in(0, 65535, Bound::Whole))
+        ->transform(number_in(0, 65535, Bound::Whole))
         ->capture_default_str();
     cmd->add_flag("--open", c->open, "Open the page in the desktop's browser (xdg-open)");
     cmd->add_option("--sides", c->sides, "Sides of each tube's cross-section")
-        ->check(number_in(3, 64, Bound::Whole))
+        ->transform(number_in(3, 64, Bound::Whole))
         ->capture_default_str();
     cmd->add_flag("--no-obstacles", c->no_obstacles, "Leave the environments' walls and boxes out");
     cmd->callback([c, &exit_code] {

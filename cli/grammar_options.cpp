@@ -6,7 +6,6 @@
 
 #include <fmt/format.h>
 
-#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
@@ -110,6 +109,18 @@ void add_allow_read(CLI::App& cmd, std::vector<std::string>& dirs) {
         ->allow_extra_args(false);
 }
 
+namespace {
+
+// An option's value as a message shows it: at most 40 bytes, not cut inside a UTF-8 character.
+std::string cut_for_message(const std::string& text) {
+    if (text.size() <= 40) return text;
+    std::size_t end = 40;
+    while (end > 0 && (static_cast<unsigned char>(text[end]) & 0xC0) == 0x80) --end;
+    return text.substr(0, end) + "...";
+}
+
+} // namespace
+
 CLI::Option* add_count(CLI::App& cmd, const std::string& flags, std::uint64_t lowest, std::uint64_t highest,
                        std::function<void(std::uint64_t)> set, const std::string& help) {
     const std::string name = flags.substr(flags.rfind(',') + 1); // the long name, as messages say it
@@ -130,8 +141,7 @@ std::uint64_t parse_count(const std::string& option, const std::string& text, st
     auto r = std::from_chars(text.data(), end, v);
     if (text.empty() || r.ec != std::errc() || r.ptr != end || v < lowest || v > highest)
         throw CLI::ValidationError(fmt::format("{} must be a whole number from {} to {}, found '{}'", option,
-                                               lowest, highest,
-                                               text.size() > 40 ? text.substr(0, 40) + "..." : text));
+                                               lowest, highest, cut_for_message(text)));
     return v;
 }
 
@@ -153,12 +163,15 @@ CLI::Validator number_in(double lowest, double highest, Bound bound) {
             const bool read = !text.empty() && r.ec == std::errc() && r.ptr == end;
             const bool fits = read && v <= highest && (bound == Bound::Above ? v > lowest : v >= lowest) &&
                               (bound != Bound::Whole || v == std::floor(v));
-            if (fits) return {};
-            return fmt::format("must be {}, found '{}'", want,
-                               text.size() > 40 ? text.substr(0, 40) + "..." : text);
+            if (fits) {
+                // in decimal for CLI11, which would read '010' as octal 8 and not take '5.0' or '1e1'
+                if (bound == Bound::Whole) text = fmt::format("{}", static_cast<long long>(v));
+                return {};
+            }
+            return fmt::format("must be {}, found '{}'", want, cut_for_message(text));
         },
-        bound == Bound::Above ? fmt::format("above {}, at most {}", shown(lowest), shown(highest))
-                              : fmt::format("{} to {}", shown(lowest), shown(highest)),
+        bound == Bound::Above ? fmt::format("(above {}, at most {})", shown(lowest), shown(highest))
+                              : fmt::format("({} to {})", shown(lowest), shown(highest)),
         "number_in");
 }
 
@@ -173,23 +186,8 @@ ReadFailure read_standard_input(std::string& out) {
     std::lock_guard lock(mutex);
     if (!read) {
         std::string text;
-        ReadFailure f = ReadFailure::None;
-        char buf[1 << 16];
-        for (;;) {
-            const ssize_t n = ::read(STDIN_FILENO, buf, sizeof buf);
-            if (n < 0 && errno == EINTR) continue;
-            if (n < 0) {
-                f = ReadFailure::Failed;
-                break;
-            }
-            if (n == 0) break;
-            if (text.size() + static_cast<std::size_t>(n) > kMaxSourceBytes) {
-                f = ReadFailure::TooLarge;
-                break;
-            }
-            text.append(buf, static_cast<std::size_t>(n));
-        }
-        read.emplace(f, f == ReadFailure::None ? std::move(text) : std::string());
+        const ReadFailure f = read_descriptor(STDIN_FILENO, text);
+        read.emplace(f, std::move(text));
     }
     out = read->second;
     return read->first;

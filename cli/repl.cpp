@@ -183,7 +183,10 @@ int Session::load(const std::string& path) {
     std::error_code ec;
     if (!fs::is_regular_file(path, ec)) {
         error() << fmt::format("plant: cannot read '{}': {}\n", escape_controls(path),
-                               fs::is_directory(path, ec) ? "it is a directory" : "no such file");
+                               fs::is_directory(path, ec) ? "it is a directory"
+                               : path == "-" ? "no such file (the REPL reads its commands from standard "
+                                               "input; pipe a grammar in as typed lines, or name its file)"
+                                             : "no such file");
         return 66;
     }
     // a new grammar starts a new session; a grammar that does not build leaves the old one as it was

@@ -268,6 +268,14 @@ contains "--timeout 0: what to give" "$tmp/stderr" "plant: --timeout: must be a 
 check "--port 70000" 64 "$plant" view "$tmp/ok.plant" --port 70000
 contains "--port 70000: what to give" "$tmp/stderr" "plant: --port: must be a whole number from 0 to 65535, found '70000'"
 check "in range" 0 "$plant" run "$tmp/ok.plant" --width-scale 1000000 --sides 64 --min-line-width 0 -o "$tmp/w.glb"
+# a whole number is read in decimal, whatever its spelling: 010 is ten sides (CLI11 alone read eight)
+check "--sides 010" 0 "$plant" run "$tmp/ok.plant" --sides 010 -o "$tmp/s010.mesh.txt"
+check "--sides 10" 0 "$plant" run "$tmp/ok.plant" --sides 10 -o "$tmp/s10.mesh.txt"
+check "--sides 8" 0 "$plant" run "$tmp/ok.plant" --sides 8 -o "$tmp/s8.mesh.txt"
+holds "--sides 010 is ten" cmp -s "$tmp/s010.mesh.txt" "$tmp/s10.mesh.txt"
+differ "--sides 010 is not eight" "$tmp/s010.mesh.txt" "$tmp/s8.mesh.txt"
+check "--sides 1e1" 0 "$plant" run "$tmp/ok.plant" --sides 1e1 -o "$tmp/s1e1.mesh.txt"
+holds "--sides 1e1 is ten" cmp -s "$tmp/s1e1.mesh.txt" "$tmp/s10.mesh.txt"
 
 # the same output named twice is refused before any work; --size with no image, and a plant that
 # draws nothing, are warned about
@@ -280,9 +288,25 @@ check "--size with an image" 0 "$plant" run "$tmp/ok.plant" --size 64x64 -o "$tm
 lacks "--size with an image: no warning" "$tmp/stderr" "warning"
 printf 'axiom: A;\nderive 2;\nrules { A -> A B; }\n' >"$tmp/draws_nothing.plant"
 check "a plant that draws nothing" 0 "$plant" run "$tmp/draws_nothing.plant" -o "$tmp/nothing.glb"
-contains "a plant that draws nothing: warned" "$tmp/stderr" "plant: warning: the plant draws nothing: its string (3 modules after 2 steps)"
+contains "a plant that draws nothing: warned" "$tmp/stderr" "plant: warning: the plant draws nothing: no tube, organ or instance came of its string (3 modules after 2 steps)"
 check "a string of nothing drawn, as text" 0 "$plant" run "$tmp/draws_nothing.plant" -o "$tmp/nothing.txt"
 lacks "a string of nothing drawn, as text: no warning" "$tmp/stderr" "warning"
+
+# the turtle's runtime errors name the string they count modules in: an instance's own, or the
+# string the interpret rules make
+printf 'instance B(w) { axiom: F F F !(w) F; }\nderive 1;\naxiom: A(-1);\nrules { A(w) -> F [ B(w) ]; }\n' >"$tmp/inst_width.plant"
+check "a width below 0 in an instance" 70 "$plant" run "$tmp/inst_width.plant" -o "$tmp/inst_width.glb"
+contains "a width below 0 in an instance: which string" "$tmp/stderr" "instance B(-1): module 4 of the string, !(-1), gives a width below 0"
+printf 'derive 1;\naxiom: A(-1);\nrules { A(x) -> A(x); }\ninterpret { A(x) -> F F !(x) F; }\n' >"$tmp/interp_width.plant"
+check "a width below 0 from interpret rules" 70 "$plant" run "$tmp/interp_width.plant" -o "$tmp/interp_width.glb"
+contains "a width below 0 from interpret rules: which string" "$tmp/stderr" "module 3 of the interpreted string (after the interpret rules), !(-1)"
+
+# plant test hands its child a file named like an option as a file
+mkdir -p "$tmp/dashes"
+printf '# expect: FF\nderive 1;\naxiom: F;\nrules { F -> FF; }\n' >"$tmp/dashes/-x.plant"
+check "plant test of -x.plant" 0 "$plant" test "$tmp/dashes"
+check "plant test -" 66 "$plant" test -
+contains "plant test -: why" "$tmp/stderr" "does not read standard input"
 
 # FILE '-': the grammar from standard input, named <stdin> in messages, read once for a batch
 from() { local input=$1; shift; "$@" <"$input"; } # from FILE COMMAND...: COMMAND reading FILE
