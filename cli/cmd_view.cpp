@@ -159,6 +159,7 @@ void setup_view(CLI::App& app, int& exit_code) {
         "view", "Show the plant live in a web browser: redrawn on every save, with params, seed and steps "
                 "as controls (docs/view.md)");
     add_grammar_options(*cmd, c->g, true);
+    cmd->get_option("FILE")->description("The .plant grammar, a file (watched: saving it redraws the plant)");
     cmd->add_option("--port", c->port, "The port on 127.0.0.1 to serve on (0: any free port)")
         ->transform(number_in(0, 65535, Bound::Whole))
         ->capture_default_str();

@@ -224,6 +224,12 @@ std::unique_ptr<Program> load_program(const GrammarOptions& o, SourceManager& so
             exit_code = kNoInput;
             return nullptr;
         }
+        if (text.empty()) { // (an empty file is a grammar without an axiom; empty input is more likely a
+                            // slip)
+            out += "plant: standard input was empty: '-' reads the grammar from it, so pipe one in\n";
+            exit_code = kNoInput;
+            return nullptr;
+        }
     } else if (ReadFailure f = read_input_file(o.file, text, kMaxSourceBytes, false);
                f != ReadFailure::None) {
         std::error_code ec;

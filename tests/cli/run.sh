@@ -325,6 +325,8 @@ contains "run - -o: the string" "$tmp/piped.txt" "FF"
 printf 'axiom: F;\nderive 2;\nrules { F -> F[+F] : 0.5; F -> F[-F] : 0.5; }\n' >"$tmp/piped_batch.plant"
 check "a batch of -" 0 from "$tmp/piped_batch.plant" "$plant" run - --seeds 1..4 --jobs 2 -o "$tmp/pb-{seed}.txt"
 holds "a batch of -: every variant" test -s "$tmp/pb-1.txt" -a -s "$tmp/pb-4.txt"
+check "derive - of empty input" 66 from /dev/null "$plant" derive -
+contains "derive - of empty input: why" "$tmp/stderr" "standard input was empty"
 check "view -" 64 from "$tmp/piped.plant" "$plant" view -
 contains "view -: why" "$tmp/stderr" "needs a file"
 if command -v script >/dev/null; then # a terminal as standard input would wait for typing
