@@ -75,23 +75,26 @@ bool read_view(const RunCmd& c, std::optional<glm::dvec3>& camera, std::optional
     return true;
 }
 
+// Whether an output is meshed (it needs the scene).
+bool meshes(const std::vector<std::string>& outputs) {
+    return std::any_of(outputs.begin(), outputs.end(), [](const std::string& o) {
+        const OutputFormat* f = format_of(o);
+        return f && f->needs == OutputNeeds::Scene;
+    });
+}
+
 // Options no requested output reads are said to be ignored, rather than silently dropped.
 void warn_unused_options(const RunCmd& c) {
-    bool meshed = false, svg = false;
-    for (const auto& o : c.outputs) {
-        const OutputFormat* f = format_of(o);
-        meshed = meshed || (f && f->needs == OutputNeeds::Scene);
-        svg = svg || (f && std::string_view(f->extension) == ".svg");
-    }
-    if (c.sides_given && svg && !meshed)
+    bool svg = false, png = false;
+    for (const auto& o : c.outputs)
+        if (const OutputFormat* f = format_of(o)) {
+            svg = svg || std::string_view(f->extension) == ".svg";
+            png = png || std::string_view(f->extension) == ".png";
+        }
+    if (c.sides_given && svg && !meshes(c.outputs))
         std::cerr << "plant: warning: --sides shapes meshed tubes; an .svg is a line drawing of the "
                      "skeleton and does not use it\n";
-    bool image = false;
-    for (const auto& o : c.outputs)
-        if (const OutputFormat* f = format_of(o))
-            image =
-                image || std::string_view(f->extension) == ".png" || std::string_view(f->extension) == ".svg";
-    if (c.size_given && !image)
+    if (c.size_given && !svg && !png)
         std::cerr << "plant: warning: --size sets the size of .png and .svg outputs, and none is written\n";
 }
 
@@ -257,11 +260,7 @@ int run_main(RunCmd& c) {
     try {
         OutputSummary summary = write_outputs(*program, d, c.outputs, oo);
         progress.clear();
-        const bool meshed = std::any_of(c.outputs.begin(), c.outputs.end(), [](const std::string& o) {
-            const OutputFormat* f = format_of(o);
-            return f && f->needs == OutputNeeds::Scene;
-        });
-        if (meshed && summary.triangles == 0 && summary.organs == 0)
+        if (meshes(c.outputs) && summary.triangles == 0 && summary.organs == 0)
             std::cerr << fmt::format(
                 "plant: warning: the plant draws nothing: no tube, organ or instance came "
                 "of its string ({} module{} after {} step{}), so the files show an "
