@@ -104,6 +104,10 @@ void Compiler::compile_production(const ast::Production& p, RuleSet& set) {
                           fmt::format("a production weight must be a finite number >= 0, found {}: weights "
                                       "are relative chances (1 and 3 give a quarter and three quarters)",
                                       format_double(*v)));
+        else if (v && *v == 0)
+            diags_->warning(p.weight->span, "this production is never chosen: its weight is always 0 (a "
+                                            "module whose applicable productions all weigh 0 is copied "
+                                            "unchanged)");
     }
     c.code = &cp.body;
     cp.body_form = p.body_form;
@@ -263,13 +267,22 @@ void Compiler::check_surface_named(const std::string& module, Span at) {
                                         module, near));
 }
 
-// A width or radius known now to be below 0 (the turtle stops at the others): '!', '@O', and F's
-// second number.
+// A size known now to be below 0 (the turtle stops at the others): the width of '!' and of F's
+// second number, the radius of '@O' and of a bound segment's second number (`Seg(len, r) bound
+// ivy`), a surface's scale ('~leaf(s)').
 void Compiler::check_size_argument(const SymbolInfo& info, const ast::ModuleRef& m) {
-    const std::size_t at = info.turtle_op == TurtleOp::Forward ? 1 : 0;
-    const char* what = info.turtle_op == TurtleOp::Sphere                                         ? "radius"
-                       : info.turtle_op == TurtleOp::Width || info.turtle_op == TurtleOp::Forward ? "width"
-                                                                                                  : nullptr;
+    std::size_t at = 0;
+    const char* what = nullptr;
+    if (!info.bound_to.empty())
+        at = 1, what = "radius";
+    else if (info.turtle_op == TurtleOp::Forward)
+        at = 1, what = "width";
+    else if (info.turtle_op == TurtleOp::Width)
+        what = "width";
+    else if (info.turtle_op == TurtleOp::Sphere)
+        what = "radius";
+    else if (info.turtle_op == TurtleOp::Surface)
+        what = "scale";
     if (!what || m.args.size() <= at) return;
     if (auto v = fold_number(*m.args[at]); v && *v < 0)
         diags_->error(m.args[at]->span, fmt::format("'{}' gives a {} of {}: a {} is at least 0", info.name,

@@ -198,7 +198,7 @@ class Turtle {
         return text;
     }
 
-    // a width or radius below 0 would turn a tube or a sphere inside out
+    // a width, radius or scale below 0 would turn a tube, a sphere or a surface inside out
     double size_arg(std::size_t i, std::uint32_t k, double fallback, const char* what) const {
         const double v = arg(i, k, fallback);
         if (v >= 0) return v;
@@ -229,7 +229,7 @@ class Turtle {
     // its position and the turtle takes its frame
     void bound_segment(std::size_t i) {
         double len = arg(i, 0, t_.step);
-        if (s_.arity(i) > 1) t_.width = 2 * args(i)[1];
+        if (s_.arity(i) > 1) t_.width = 2 * size_arg(i, 1, t_.width / 2, "radius");
         start_axis();
         glm::dvec3 from = t_.position;
         glm::dvec3 p;
@@ -425,7 +425,7 @@ void Turtle::apply(TurtleOp op, std::size_t i) {
              program_.symbols[s_.symbol(i)].name.substr(turtle_symbol(TurtleOp::Surface)->name.size()),
              -1,
              {}},
-            frame_matrix(t_, arg(i, 0, 1.0)),
+            frame_matrix(t_, size_arg(i, 0, 1.0, "scale")),
             t_.color,
             i,
             s_.id(i),
