@@ -174,6 +174,15 @@ double plant_overlap(const physics::World& w) {
     return deepest;
 }
 
+// How a plant holds on to its supports after a derivation's last step (clinging()).
+struct Clinging {
+    std::size_t live = 0;        // particles with a parent
+    std::size_t on_support = 0;  // of them, within 1 cm of a support's surface
+    std::size_t held_there = 0;  // of those, anchored (to anything)
+    std::size_t to_support = 0;  // particles anchored to a support
+    std::size_t anchors_off = 0; // anchors more than 2 cm from every obstacle's surface, and not on a stem
+};
+
 struct Run {
     std::unique_ptr<test::Compiled> compiled;
     TurtleEnvironmentPhase phase;
@@ -189,10 +198,49 @@ struct Run {
     std::vector<double> unexplained;
     double plant_overlap = 0;           // the deepest overlap of links of different plants, any step
     std::size_t plant_overlap_step = 0; // the step where it was
+    Clinging clinging;                  // after the last step
     double deepest_centre = 0;          // (each_step) metres a particle's centre went into an obstacle
     std::string deepest_centre_at;      // which step and obstacle
     std::unique_ptr<Derivation> d;
 };
+
+// How a plant holds on to its supports (the obstacles other than planes: the wall, boxes, dome,
+// fence, tank, building or car of a figure; the ground is not one) after a derivation's last step.
+Clinging clinging(const physics::World& w) {
+    Clinging c;
+    const auto& obstacles = w.obstacles();
+    for (std::uint32_t i = 0; i < w.size(); ++i) {
+        const physics::Handle h = w.handle(i);
+        if (!w.alive(h) || w.parent(h) == ~0u) continue;
+        ++c.live;
+        double gap = HUGE_VAL, anchor_gap = HUGE_VAL;
+        bool to_support = false;
+        for (std::size_t k = 0; k < obstacles.size(); ++k) {
+            if (w.anchored(h))
+                anchor_gap = std::min(anchor_gap, std::fabs(obstacles[k].distance(w.anchor_of(h))));
+            if (obstacles[k].kind == physics::Obstacle::Plane) continue;
+            gap = std::min(gap, obstacles[k].distance(w.position(h)) - w.radii(h).x);
+            to_support = to_support || w.anchored_to(h, k);
+        }
+        if (gap < 0.01) {
+            ++c.on_support;
+            if (w.anchored(h)) ++c.held_there;
+        }
+        if (to_support) ++c.to_support;
+        if (w.anchored(h) && anchor_gap > 0.02) {
+            // on another stem, where the plant-plant rounds put it (docs/plant-contacts.md)?
+            const glm::dvec3 a = w.anchor_of(h);
+            bool on_stem = false;
+            for (std::uint32_t j = 0; j < w.size() && !on_stem; ++j) {
+                const physics::Handle g = w.handle(j);
+                on_stem = j != i && w.alive(g) &&
+                          glm::distance(w.position(g), a) < w.radii(g).x + w.radii(h).x + 0.01;
+            }
+            if (!on_stem) ++c.anchors_off;
+        }
+    }
+    return c;
+}
 
 // derives `text` (or, when `text` is empty, the grammar file `path`, so that it finds the files
 // it loads beside it) step by step, checking the links after each step, then measures the skeleton
@@ -244,6 +292,7 @@ std::unique_ptr<Run> derive(const std::string& text, const std::filesystem::path
             }
         }
     }
+    r->clinging = clinging(climber_in(d).world());
     Skeleton s = build_skeleton(*r->compiled->program, d.interpreted(d.string()), turtle_options(d));
     r->drawn_crossings = crossings(s, climber_in(d).world().obstacles());
     r->world_crossings = crossings(climber_in(d).world());
@@ -278,11 +327,14 @@ seed 1;
 // where a figure moves the plant on purpose: fig06_break drags a particle (3 and 5 cm further each
 // derivation step, a 5.8 cm jump in one 25 ms physics step: 2.3 m/s, and what its neighbours take
 // from it), fig07_editing's hand pulls a stem (steps 16-19, let go in step 20) and its emitter
-// blows the air at 4 m/s from step 26 (the gust lingers in the closed box after it stops).
+// blows the air at 4 m/s from step 44 (the gust lingers in the closed box after it stops). Its
+// air lies over the wall's top, and from step 35 its shoots grow into it: the air moves them before
+// the gust too (up to 1.3 m/s over their fall at step 41; with air_coupling: 0, 0 at every step),
+// and a fall does not account for the air's work.
 double whip_bound(const std::string& grammar, std::size_t k) {
     if (grammar == "fig06_break" && k >= 28 && k < 36) return 2.5;
     if (grammar == "fig07_editing" && k >= 16 && k < 21) return 2.5; // the hand's pull, as fig06's
-    if (grammar == "fig07_editing" && k >= 26) return 4.0;
+    if (grammar == "fig07_editing" && k >= 34) return 4.0;           // (k counts from 0: step 35 on)
     return 1.0;
 }
 
@@ -380,6 +432,34 @@ void check_plant_overlap(const std::string& name, const Run& r) {
     CHECK(r.plant_overlap < kCapsuleTolerance);
 }
 
+// Issue 18: every figure's plants cling where the figure says, to its supports (the obstacles
+// other than planes: the wall, boxes, dome, fence, tank, building or car), by Eq. 5's anchors.
+// At the last step, of the particles lying on a support (within 1 cm) at least 80 % hold on,
+// at least 20 (a metre of stem) are anchored to a support, and few anchors float: more than 2 cm
+// from every surface and not on a stem. Where stems pile the plant-plant rounds carry anchors
+// off their supports (docs/plant-contacts.md, "What it costs"): fig10_dome, whose stems pile on
+// the dome's top, keeps 5.7 % such anchors and is allowed an eighth; every other grammar under
+// 2 % (fig14_left 1.9 %), allowed a twentieth. fig12_free_shoot has no support: nothing is
+// anchored to one. Shares measured: docs/climber-figures.md.
+void check_clinging(const std::string& name, const Run& r) {
+    const Clinging& c = r.clinging;
+    INFO(name << ": " << c.live << " particles, " << c.on_support << " within 1 cm of a support, "
+              << c.held_there << " of those anchored; " << c.to_support << " anchored to a support; "
+              << c.anchors_off << " anchors over 2 cm from every surface and off every stem");
+    if (std::getenv("PLANT_CLING_REPORT"))
+        fmt::print("{}: {} particles, {} on a support, {} of those anchored, {} anchored to a support, {} "
+                   "anchors floating\n",
+                   name, c.live, c.on_support, c.held_there, c.to_support, c.anchors_off);
+    if (name == "fig12_free_shoot") {
+        CHECK(c.to_support == 0);
+        return;
+    }
+    REQUIRE(c.on_support > 0);
+    CHECK(c.held_there >= 0.8 * static_cast<double>(c.on_support));
+    CHECK(c.to_support >= std::min<std::size_t>(20, c.live));
+    CHECK(c.anchors_off * (name == "fig10_dome" ? 8 : 20) <= c.live);
+}
+
 } // namespace
 
 // Every climber grammar derived once, step by step, and checked after every step (each check
@@ -437,6 +517,7 @@ TEST_CASE("climber: every climber grammar, at every step, keeps its stems' lengt
                                         << r->deepest_centre_at);
         CHECK(r->deepest_centre < 0.001);
         check_plant_overlap(name, *r);
+        check_clinging(name, *r);
         ++grammars;
         if (sets_plant_contacts(entry.path())) ++with_contacts;
     }
