@@ -360,3 +360,30 @@ TEST_CASE("climber figures: Fig. 1's plants are cut away from the car's windows 
     CHECK(over_glass(*pruned) == 0);
     CHECK(pruned->count("Seg") > 300); // and cover the rest of the car
 }
+
+TEST_CASE("climber figures: Fig. 12's free shoot stands when stiff and droops when soft, keeping its length",
+          "[climber]") {
+    // fig12_free_shoot.plant as shipped, at three stiffnesses (-D stiff): its one shoot's highest
+    // point against the length of stem it grew (test_climber_physics.cpp checks the same on a shoot
+    // of its own, with a cap on its length)
+    double last = HUGE_VAL;
+    for (const char* stiff : {"1", "0.5", "0.2"}) {
+        auto f = grow("fig12_free_shoot.plant", {{"stiff", stiff}});
+        double height = 0, length = 0;
+        std::size_t count = 0;
+        for (const Segment& s : segments(f->skeleton())) {
+            height = std::max({height, s.a.y, s.b.y});
+            length += s.length();
+            ++count;
+        }
+        const double rest = 0.05 * static_cast<double>(count); // the library's segment length
+        INFO("stiffness " << stiff << ": " << count << " segments, " << length << " m of stem for " << rest
+                          << " m of rest length, highest point " << height << " m");
+        REQUIRE(count >= 30);
+        CHECK(std::fabs(length / rest - 1) < 0.1);
+        if (std::string(stiff) == "1") CHECK(height > 0.8 * rest);   // stands within 20 % of its length
+        if (std::string(stiff) == "0.2") CHECK(height < 0.2 * rest); // droops to the ground
+        CHECK(height < last);                                        // lower as it gets softer
+        last = height;
+    }
+}
