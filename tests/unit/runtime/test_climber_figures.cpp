@@ -16,8 +16,11 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <memory>
 #include <optional>
+#include <regex>
 #include <string>
 #include <utility>
 #include <vector>
@@ -386,4 +389,52 @@ TEST_CASE("climber figures: Fig. 12's free shoot stands when stiff and droops wh
         CHECK(height < last);                                        // lower as it gets softer
         last = height;
     }
+}
+
+TEST_CASE("climber figures: Fig. 8's shoots spread over the painted band", "[climber]") {
+    // fig08_painted_wall.plant paints a band of samples across the wall; -D paint=0 grows the same
+    // plants on an unpainted wall. A sample is covered when a stem passes within 15 cm of it.
+    std::vector<glm::dvec3> painted;
+    {
+        std::ifstream in(kFigures / "fig08_painted_wall.plant");
+        const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        const std::regex sample(R"(attractor: vec3\(([-0-9.]+), ([-0-9.]+), ([-0-9.]+)\))");
+        for (auto it = std::sregex_iterator(text.begin(), text.end(), sample); it != std::sregex_iterator();
+             ++it)
+            painted.emplace_back(std::stod((*it)[1]), std::stod((*it)[2]), std::stod((*it)[3]));
+    }
+    REQUIRE(painted.size() >= 20);
+    auto covered = [&](const Figure& f) {
+        const std::vector<Segment> stems = segments(f.skeleton());
+        return std::count_if(painted.begin(), painted.end(), [&](const glm::dvec3& p) {
+            return std::any_of(stems.begin(), stems.end(),
+                               [&](const Segment& s) { return distance_to(p, s) < 0.15; });
+        });
+    };
+    auto with_paint = grow("fig08_painted_wall.plant");
+    auto without = grow("fig08_painted_wall.plant", {{"paint", "0"}});
+    const auto on = covered(*with_paint), off = covered(*without);
+    INFO(painted.size() << " painted samples; covered " << on << " with the paint, " << off << " without");
+    CHECK(on >= 0.8 * static_cast<double>(painted.size()));
+    CHECK(on >= 2 * off);
+}
+
+TEST_CASE("climber figures: Fig. 11's plants grow toward the light from the upper left", "[climber]") {
+    // fig11_fence.plant lights its fence from the upper left (light_x -1); -D light_x=1 mirrors the
+    // light. The fence and the seeds are symmetric about x = 0: the share of stem length at x < 0.
+    auto left_share = [](const Figure& f) {
+        double left = 0, all = 0;
+        for (const Segment& s : segments(f.skeleton())) {
+            all += s.length();
+            if (s.mid().x < 0) left += s.length();
+        }
+        return all > 0 ? left / all : 0.0;
+    };
+    auto from_left = grow("fig11_fence.plant");
+    auto from_right = grow("fig11_fence.plant", {{"light_x", "1"}});
+    const double l = left_share(*from_left), r = left_share(*from_right);
+    INFO("stem length left of the middle: " << l << " lit from the upper left, " << r
+                                            << " from the upper right");
+    CHECK(l > 0.7);
+    CHECK(r < 0.3);
 }
