@@ -169,9 +169,33 @@ TEST_CASE("climber figures: Fig. 7's gust of wind bends the plant more than 5 cm
     REQUIRE(moves.size() > 30);
     CHECK(moves.back() > 0.05);
     CHECK(bent >= 5); // a stretch of stem, not one tip
-    // and the cut at step 52 took the seeded branch away
+    // and the cut at step 52 took the seeded branch away: #85 hangs from #28, where step 10
+    // seeded the branch, on a stem of its own (the main shoot's #68 is not on its path), and
+    // after the cut #85 and what grew from it are gone while #28 and #68 remain
     auto before_cut = grow("fig07_editing.plant", {}, 51);
     auto after_cut = grow("fig07_editing.plant", {}, 53);
+    {
+        const physics::World& w = before_cut->world();
+        const physics::Handle cut = before_cut->climber().particle(85);
+        const physics::Handle seeded = before_cut->climber().particle(28);
+        const physics::Handle shoot = before_cut->climber().particle(68);
+        REQUIRE(cut.valid());
+        REQUIRE(seeded.valid());
+        REQUIRE(shoot.valid());
+        bool from_seeded = false, through_shoot = false;
+        for (std::uint32_t at = cut.index; at != ~0u; at = w.parent(w.handle(at))) {
+            from_seeded = from_seeded || at == seeded.index;
+            through_shoot = through_shoot || at == shoot.index;
+        }
+        CHECK(from_seeded);
+        CHECK(!through_shoot);
+    }
+    const physics::Handle gone = after_cut->climber().particle(85);
+    CHECK((!gone.valid() || !after_cut->world().alive(gone)));
+    for (const ModuleId kept : {ModuleId{28}, ModuleId{68}}) {
+        const physics::Handle h = after_cut->climber().particle(kept);
+        CHECK((h.valid() && after_cut->world().alive(h)));
+    }
     CHECK(after_cut->count("Seg") + 10 < before_cut->count("Seg"));
 }
 
@@ -320,11 +344,17 @@ TEST_CASE("climber figures: Fig. 5's branching probability and variance show", "
         if (laterals > 0) s.lean /= static_cast<double>(laterals);
         return s;
     };
-    const Shoots a = shoots("1"), b = shoots("2"), c = shoots("3");
-    INFO("(a) " << a.count << " shoots; (b) " << b.count << " shoots leaning " << b.lean << " deg; (c) "
-                << c.count << " leaning " << c.lean << " deg");
+    const Shoots a = shoots("1"), b = shoots("2"), c = shoots("3"), d = shoots("4");
+    INFO("(a) " << a.count << " shoots leaning " << a.lean << " deg; (b) " << b.count << " leaning " << b.lean
+                << " deg; (c) " << c.count << " leaning " << c.lean << " deg; (d) " << d.count << " leaning "
+                << d.lean << " deg");
     CHECK(b.count > 2.5 * static_cast<double>(a.count)); // branching probability
     CHECK(b.lean > c.lean + 10);                         // branching variance
+    // (d), low probability and medium variance: far fewer shoots than (b), and laterals leaning
+    // further than (a)'s (low variance) but less than (b)'s (high)
+    CHECK(2 * d.count < b.count);
+    CHECK(d.lean > 2 * a.lean);
+    CHECK(d.lean < b.lean);
 }
 
 TEST_CASE("climber figures: Fig. 6's dragged branch breaks off and leaves the plant", "[climber]") {
