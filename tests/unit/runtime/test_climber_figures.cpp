@@ -136,6 +136,17 @@ void check_thickening(const std::string& name, const Figure& f) {
     CHECK(worst < 1e-9);
 }
 
+// The points of a figure grammar's `attractor: vec3(x, y, z)` arguments, as written.
+std::vector<glm::dvec3> attractors_of(const std::string& name) {
+    std::ifstream in(kFigures / name);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::regex sample(R"(attractor: vec3\(([-0-9.]+), ([-0-9.]+), ([-0-9.]+)\))");
+    std::vector<glm::dvec3> points;
+    for (auto it = std::sregex_iterator(text.begin(), text.end(), sample); it != std::sregex_iterator(); ++it)
+        points.emplace_back(std::stod((*it)[1]), std::stod((*it)[2]), std::stod((*it)[3]));
+    return points;
+}
+
 } // namespace
 
 TEST_CASE("climber figures: Fig. 7's gust of wind bends the plant more than 5 cm", "[climber]") {
@@ -380,18 +391,42 @@ TEST_CASE("climber figures: Fig. 1's plants are cut away from the car's windows 
         {{-1.15, 0.4, 0.18}, {-0.98, 0.62, 0.4}}, {{-1.15, 0.4, -0.4}, {-0.98, 0.62, -0.18}}};
     auto over_glass = [&](const Figure& f) {
         std::size_t n = 0;
-        for (const Segment& s : segments(f.skeleton()))
-            for (const auto& [lo, hi] : glass)
-                if (glm::all(glm::greaterThanEqual(s.b, lo)) && glm::all(glm::lessThanEqual(s.b, hi))) ++n;
+        // a segment is over glass where its end, its start or any point between (sampled every
+        // tenth of it) is in one of the boxes
+        for (const Segment& s : segments(f.skeleton())) {
+            bool over = false;
+            for (int k = 0; k <= 10 && !over; ++k) {
+                const glm::dvec3 p = s.a + (s.b - s.a) * (k / 10.0);
+                for (const auto& [lo, hi] : glass)
+                    over = over ||
+                           (glm::all(glm::greaterThanEqual(p, lo)) && glm::all(glm::lessThanEqual(p, hi)));
+            }
+            n += over ? 1 : 0;
+        }
         return n;
     };
     auto pruned = grow("fig01_car.plant");
     check_thickening("fig01_car", *pruned);
     auto wild = grow("fig01_car.plant", {{"prune_from", "1000"}});
-    INFO(over_glass(*pruned) << " stem points over glass pruned, " << over_glass(*wild) << " unpruned");
+    INFO(over_glass(*pruned) << " segments over glass pruned, " << over_glass(*wild) << " unpruned");
     CHECK(over_glass(*wild) > 20); // the plants do grow over the glass
     CHECK(over_glass(*pruned) == 0);
     CHECK(pruned->count("Seg") > 300); // and cover the rest of the car
+    // the sketched attractors draw stems to them: stem length with its midpoint within 25 cm of a
+    // sketched point, against the same plants grown without them (-D sketch=0)
+    const std::vector<glm::dvec3> sketched = attractors_of("fig01_car.plant");
+    REQUIRE(sketched.size() >= 5);
+    auto near_sketch = [&](const Figure& f) {
+        double l = 0;
+        for (const Segment& s : segments(f.skeleton()))
+            for (const glm::dvec3& p : sketched)
+                if (glm::distance(s.mid(), p) < 0.25) l += s.length();
+        return l;
+    };
+    auto unsketched = grow("fig01_car.plant", {{"sketch", "0"}});
+    const double with = near_sketch(*pruned), without = near_sketch(*unsketched);
+    INFO(with << " m of stem within 25 cm of the sketched points, " << without << " m without them");
+    CHECK(with > 1.5 * without);
 }
 
 TEST_CASE("climber figures: Fig. 12's free shoot stands when stiff and droops when soft, keeping its length",
@@ -424,15 +459,7 @@ TEST_CASE("climber figures: Fig. 12's free shoot stands when stiff and droops wh
 TEST_CASE("climber figures: Fig. 8's shoots spread over the painted band", "[climber]") {
     // fig08_painted_wall.plant paints a band of samples across the wall; -D paint=0 grows the same
     // plants on an unpainted wall. A sample is covered when a stem passes within 15 cm of it.
-    std::vector<glm::dvec3> painted;
-    {
-        std::ifstream in(kFigures / "fig08_painted_wall.plant");
-        const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-        const std::regex sample(R"(attractor: vec3\(([-0-9.]+), ([-0-9.]+), ([-0-9.]+)\))");
-        for (auto it = std::sregex_iterator(text.begin(), text.end(), sample); it != std::sregex_iterator();
-             ++it)
-            painted.emplace_back(std::stod((*it)[1]), std::stod((*it)[2]), std::stod((*it)[3]));
-    }
+    const std::vector<glm::dvec3> painted = attractors_of("fig08_painted_wall.plant");
     REQUIRE(painted.size() >= 20);
     auto covered = [&](const Figure& f) {
         const std::vector<Segment> stems = segments(f.skeleton());
