@@ -44,7 +44,8 @@ constexpr EnvMethod kClimberMethods[] = {
                "1 in the step after a hook seeded a branch at module id (ivy.seed(id))"),
     env_method(M::Pull, "pull", {N, V}, N, Edit, false,
                "hold module id's particle at a point through the next step's physics"),
-    env_method(M::Cut, "cut", {N}, N, Edit, false, "cut the branch at module id: it leaves the string"),
+    env_method(M::Cut, "cut", {N}, N, Edit, false,
+               "cut the branch at module id: it falls for fall_time, then leaves the string"),
     env_method(M::Wind, "wind", {V}, N, Edit, false, "set the wind (vec3(0, 0, 0): off)"),
     env_method(M::Move, "move", {N, V}, N, Edit, false,
                "move obstacle k (in the order declared: spheres, boxes, planes, meshes) by a vector"),
@@ -231,6 +232,13 @@ bool Climber::pose(ModuleId id, glm::dvec3& position, glm::dmat3& frame) const {
     return true;
 }
 
+bool Climber::starts_loose(ModuleId id) const {
+    // a bound module's particle hangs from its plant's fixed root or from another bound one's,
+    // so one with no parent is where a break or a cut let go
+    const physics::Handle h = particle(id);
+    return h.valid() && world_.alive(h) && world_.parent(h) == ~0u;
+}
+
 const physics::Obstacle* Climber::nearest_obstacle(const glm::dvec3& p, double within,
                                                    double& distance) const {
     const physics::Obstacle* nearest = nullptr;
@@ -283,9 +291,16 @@ void Climber::charge_particles(std::size_t air) {
     memory_.resize((world_.size() + 2 * pending_.size()) * kBytesPerParticle + air * kBytesPerAirParticle);
 }
 
-void Climber::place_pending() {
-    // new bound modules become particles where the turtle drew them
+void Climber::place_pending(std::set<ModuleId>& left) {
+    // new bound modules become particles where the turtle drew them; a part that is falling
+    // (broken off or cut) does not grow: what it grew leaves the string, and with it the rest of
+    // its branch (the apex that grew it)
     for (const BoundSegment& p : pending_) {
+        if (const physics::Handle from = particle(p.parent);
+            from.valid() && world_.alive(from) && !world_.attached(from)) {
+            left.insert(p.id);
+            continue;
+        }
         const double r = std::isfinite(p.radius) ? std::clamp(p.radius, 1e-4, 1e6) : 1e-4;
         const double length = std::isfinite(p.length) ? std::clamp(p.length, 0.0, 1e6) : 0.0;
         const glm::dvec3 radii(r, std::max(length / 2, r), r);
@@ -325,7 +340,7 @@ void Climber::advance(std::set<ModuleId>& left) {
         world_.remove(b.particle);
         return true;
     });
-    place_pending();
+    place_pending(left);
     // painted samples a new particle reached are used up, so shoots move on across the region
     // instead of circling a sample (as a space-colonization attractor is removed once reached)
     if (!attractors_.empty()) {
@@ -345,9 +360,9 @@ void Climber::advance(std::set<ModuleId>& left) {
     }
     rethickened_.clear();
     thicken(); // secondary growth, before the physics, so the step collides the stems as thick as drawn
-    for (ModuleId id : cuts_) { // edits from hooks
+    for (ModuleId id : cuts_) { // edits from hooks: the part cut off falls (fall_time)
         physics::Handle h = particle(id);
-        if (h.valid() && world_.alive(h)) world_.remove(h);
+        if (h.valid() && world_.alive(h)) world_.cut_loose(h);
     }
     cuts_.clear();
     // seeds asked for since the last step are visible to this step's productions
@@ -405,16 +420,7 @@ void Climber::advance(std::set<ModuleId>& left) {
             throw RuntimeError(RuntimeErrorKind::Physics, Span{},
                                "the air left finite space (a particle's position is infinite or not a "
                                "number): lower the wind or the emitters' velocities");
-    // broken-off and cut parts leave the string (and the world); whether each particle hangs
-    // from a fixed root, found in one pass (asked of each particle, a walk to its root: a sum of
-    // depths over 25,000 particles every step)
-    world_.attached_all(attached_);
-    drop_in_order(particle_of_, [&](const Bound& b) {
-        if (world_.alive(b.particle) && attached_[b.particle.index]) return false;
-        left.insert(b.id);
-        world_.remove(b.particle); // a broken-off part is no longer drawn, so no longer simulated
-        return true;
-    });
+    drop_fallen(left);
     // a fixed root whose plant is gone would only be in the way of the next one planted there
     for (auto it = roots_.begin(); it != roots_.end();) {
         if (world_.has_children(*it)) {
@@ -426,6 +432,31 @@ void Climber::advance(std::set<ModuleId>& left) {
     }
     rebuild_occupancy();
     index_bounds();
+}
+
+// Broken-off and cut parts fall for fall_time (Hädrich et al., section 6.1: the pieces fall under
+// gravity), then leave the string (and the world). Whether each particle hangs from a fixed root
+// is found in one pass (asked of each particle, a walk to its root: a sum of depths over 25,000
+// particles every step).
+void Climber::drop_fallen(std::set<ModuleId>& left) {
+    world_.attached_all(attached_);
+    const double step_time = config_.substeps * world_.settings().dt;
+    const auto fall_steps =
+        static_cast<std::uint32_t>(std::ceil(std::min(config_.fall_time / step_time - 1e-9, 1e9)));
+    bool came_loose = false;
+    drop_in_order(particle_of_, [&](Bound& b) {
+        if (world_.alive(b.particle) && attached_[b.particle.index]) {
+            b.loose = 0;
+            return false;
+        }
+        came_loose = came_loose || b.loose == 0;
+        if (world_.alive(b.particle) && ++b.loose <= fall_steps) return false; // still falling
+        left.insert(b.id);
+        world_.remove(b.particle); // no longer drawn, so no longer simulated
+        return true;
+    });
+    if (came_loose)
+        world_.release_loose(attached_); // a part that has just come loose lets go of its supports
 }
 
 void Climber::count_beyond() {

@@ -79,7 +79,8 @@ bool ClimberArgs::read(const EnvArg& a, std::string& error) {
         "elasticity",     "attractor_radius", "attractor_strength", "threads",         "light_cell",
         "opacity",        "air_spacing",      "air_density",        "air_viscosity",   "air_stiffness",
         "air_coupling",   "mesh_cell",        "attractor_reach",    "emitter_radius",  "strand",
-        "obstacle_shade", "grab_speed",       "plant_contacts",     "energy_budget",   "diffuse"};
+        "obstacle_shade", "grab_speed",       "fall_time",          "plant_contacts",  "energy_budget",
+        "diffuse"};
     static const char* vectors[] = {"gravity", "light",   "wind",    "attractor",
                                     "air_min", "air_max", "emitter", "emitter_velocity"};
     if (a.key == "mesh") {
@@ -193,6 +194,8 @@ void ClimberArgs::set(const std::string& key, double x, const glm::dvec3& v) {
         c.strand = std::clamp(x, 0.0, 1.0); // a strand wider than 1 m is no stem
     else if (key == "grab_speed")
         c.grab_speed = std::clamp(x, 0.0, 1e3); // a hand faster than 1 km/s is no hand
+    else if (key == "fall_time")
+        c.fall_time = std::clamp(x, 0.0, 1e6);
     else if (key == "obstacle_shade")
         c.obstacle_shade = x != 0;
     else if (key == "diffuse")

@@ -230,16 +230,26 @@ class Turtle {
     void bound_segment(std::size_t i) {
         double len = arg(i, 0, t_.step);
         if (s_.arity(i) > 1) t_.width = 2 * size_arg(i, 1, t_.width / 2, "radius");
-        start_axis();
-        glm::dvec3 from = t_.position;
         glm::dvec3 p;
         glm::dmat3 frame;
-        bool placed = false;
+        const BoundPoses* placed_by = nullptr;
         for (const BoundPoses* bp : options_.poses)
             if (bp && bp->pose(s_.id(i), p, frame)) {
-                placed = true;
+                placed_by = bp;
                 break;
             }
+        const bool placed = placed_by != nullptr;
+        if (placed && placed_by->starts_loose(s_.id(i))) {
+            // the first segment of a part that broke off or was cut and is falling: a tube of its
+            // own, from its particle's length back along its heading
+            t_.axis = -1;
+            t_.heading = frame[1];
+            t_.left = -frame[0];
+            t_.up = frame[2];
+            t_.position = p - t_.heading * len;
+        }
+        start_axis();
+        glm::dvec3 from = t_.position;
         if (placed) {
             t_.position = p;
             t_.heading = frame[1];

@@ -104,6 +104,9 @@ class BoundPoses {
     virtual ~BoundPoses() = default;
     // The particle of module `id`: its position and its frame (+y heading, -x left, +z up).
     virtual bool pose(ModuleId id, glm::dvec3& position, glm::dmat3& frame) const = 0;
+    // Whether module `id`'s particle is the first of a part that hangs from nothing (broken off
+    // or cut, falling): the turtle draws its segment from its own start, not from where it stands.
+    virtual bool starts_loose(ModuleId /*id*/) const { return false; }
 };
 
 // A segment the turtle drew for a module bound to an environment, shown to it in the

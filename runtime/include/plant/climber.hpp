@@ -99,7 +99,8 @@ class Climber : public Environment {
         double attractor_reach = 0.1; // a painted sample a particle comes this near is used up
         double strand = 0;            // secondary growth: a pipe's radius per segment beyond (0: none)
         double grab_speed = 1;        // m/s: how fast grab(id, target) pulls a particle toward its target
-        bool air = false;             // SPH air fills [air_min, air_max] (section 5.3)
+        double fall_time = 1; // s a broken-off or cut part falls before it leaves the string (0: at once)
+        bool air = false;     // SPH air fills [air_min, air_max] (section 5.3)
         physics::FluidSettings fluid;
     };
 
@@ -127,6 +128,7 @@ class Climber : public Environment {
     void query(std::size_t method, const double* args, double* result) const override;
     void edit(std::size_t method, const double* args) override;
     bool pose(ModuleId id, glm::dvec3& position, glm::dmat3& frame) const override;
+    bool starts_loose(ModuleId id) const override;
 
     // The environment phase: begin, be shown every bound module the turtle drew (in string
     // order), advance; `left` receives the modules whose particles broke off or were cut.
@@ -155,7 +157,8 @@ class Climber : public Environment {
     // Secondary growth (docs/climber-growth.md, "Growth rate and secondary growth"): with a `strand`,
     // thicken() counts the segments beyond every particle before each step's physics and widens
     // each segment from the radius it was born with.
-    void place_pending(); // the new bound modules become particles
+    void place_pending(std::set<ModuleId>& left); // the new bound modules become particles
+    void drop_fallen(std::set<ModuleId>& left);   // loose parts: fall, then leave the string
     void count_beyond();
     void thicken();
     double thickness(ModuleId id) const;
@@ -173,6 +176,7 @@ class Climber : public Environment {
         ModuleId id;
         physics::Handle particle;
         bool seen = false;
+        std::uint32_t loose = 0; // derivation steps its part has hung from no fixed root
     };
     std::vector<Bound> particle_of_;
     // particle_of_ hashed by identity (1 + the entry's index, 0 for an empty slot; open

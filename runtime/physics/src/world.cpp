@@ -70,6 +70,11 @@ void World::remove(Handle h) {
     std::erase_if(anchors_, [&](const Anchor& a) { return !alive_[a.particle]; });
 }
 
+void World::release_loose(const std::vector<std::uint8_t>& attached) {
+    std::erase_if(anchors_,
+                  [&](const Anchor& a) { return a.particle >= attached.size() || !attached[a.particle]; });
+}
+
 bool World::attached(Handle h) const {
     if (!alive(h)) return false;
     std::uint32_t i = h.index;

@@ -86,19 +86,43 @@ TEST_CASE("climber: bound segments sag under gravity and the turtle draws them w
 
 TEST_CASE("climber: a pulled tip past the break threshold leaves the string, and so does a cut branch",
           "[climber]") {
-    // ids in the axiom: -(90) is 1, the segments 2 to 5
-    Grown pulled = grow(cantilever("stiffness: 1, substeps: 4, break_threshold: 0.3",
+    // ids in the axiom: -(90) is 1, the segments 2 to 5; fall_time: 0, so a loose part leaves
+    // the string in the step it came loose (the next test lets it fall first)
+    Grown pulled = grow(cantilever("stiffness: 1, substeps: 4, break_threshold: 0.3, fall_time: 0",
                                    "on before_step { if step() == 2 { ivy.pull(5, vec3(1, 1, 0)); } }\n"));
     CHECK(count(pulled.string, "Seg(") < 4);
     CHECK(count(pulled.string, "Seg(") >= 1);
     CHECK(pulled.string.find("?P") == std::string::npos); // it followed the broken tip out
-    Grown whole = grow(cantilever("stiffness: 1, substeps: 4, break_threshold: 0.3"));
+    Grown whole = grow(cantilever("stiffness: 1, substeps: 4, break_threshold: 0.3, fall_time: 0"));
     CHECK(count(whole.string, "Seg(") == 4);
 
-    Grown cut =
-        grow(cantilever("stiffness: 1, substeps: 4", "on before_step { if step() == 3 { ivy.cut(4); } }\n"));
+    Grown cut = grow(cantilever("stiffness: 1, substeps: 4, fall_time: 0",
+                                "on before_step { if step() == 3 { ivy.cut(4); } }\n"));
     CHECK(cut.string == "-(90)Seg(0.1,0.01)Seg(0.1,0.01)");
     CHECK(cut.particles == 5); // the world keeps its slots; the cut ones are dead
+}
+
+TEST_CASE("climber: a cut part falls for fall_time, drawn as a tube of its own, then leaves the string",
+          "[climber]") {
+    // Hädrich et al., section 6.1 and Fig. 7 (e): "separated branches fall on the ground and
+    // disappear". Cut at segment 4 in step 3 of 6 (0.4 s a step); the default fall_time, 1 s,
+    // keeps it falling to the end
+    const std::string cut_at_3 = "on before_step { if step() == 3 { ivy.cut(4); } }\n";
+    Grown falling = grow(cantilever("stiffness: 1, substeps: 4", cut_at_3));
+    CHECK(count(falling.string, "Seg(") == 4);
+    REQUIRE(falling.skeleton.axes.size() == 2); // the part that hangs on, and the falling one
+    const auto& kept = falling.skeleton.axes[0].points;
+    const auto& loose = falling.skeleton.axes[1].points;
+    REQUIRE(loose.size() == 3); // its own start, then segments 4 and 5
+    INFO("kept tip at y = " << kept.back().position.y << ", falling part's lowest at y = "
+                            << std::min(loose[1].position.y, loose[2].position.y));
+    CHECK(kept.back().position.y > -0.02);                            // stiff: it holds its shape
+    CHECK(std::max(loose[1].position.y, loose[2].position.y) < -0.1); // fallen over 10 cm in 1.2 s
+    // its own start: the first segment is as long as the others, not stretched back to the plant
+    CHECK(glm::distance(loose[0].position, loose[1].position) == Approx(0.1).margin(1e-9));
+    // with a fall time of two steps it has left by the end
+    Grown gone = grow(cantilever("stiffness: 1, substeps: 4, fall_time: 0.2", cut_at_3));
+    CHECK(gone.string == "-(90)Seg(0.1,0.01)Seg(0.1,0.01)");
 }
 
 TEST_CASE("climber: a plant beside a wall climbs it without entering, parallel to its face", "[climber]") {

@@ -149,6 +149,21 @@ std::vector<glm::dvec3> attractors_of(const std::string& name) {
 
 } // namespace
 
+// The live particles of a figure's world that hang from no fixed root (broken off or cut,
+// falling), and their mean height.
+std::pair<std::size_t, double> loose(const Figure& f) {
+    const physics::World& w = f.world();
+    std::size_t n = 0;
+    double y = 0;
+    for (std::uint32_t i = 0; i < w.size(); ++i) {
+        const physics::Handle h = w.handle(i);
+        if (!w.alive(h) || w.attached(h)) continue;
+        ++n;
+        y += w.position(h).y;
+    }
+    return {n, n > 0 ? y / static_cast<double>(n) : 0.0};
+}
+
 TEST_CASE("climber figures: Fig. 7's gust of wind bends the plant more than 5 cm", "[climber]") {
     // fig07_editing.plant blows from step 44 to 51. The segments grown before the gust (step 43,
     // where the runs with and without it are still the same) are compared at step 51, in the
@@ -181,10 +196,14 @@ TEST_CASE("climber figures: Fig. 7's gust of wind bends the plant more than 5 cm
     CHECK(moves.back() > 0.05);
     CHECK(bent >= 5); // a stretch of stem, not one tip
     // and the cut at step 52 took the seeded branch away: #85 hangs from #28, where step 10
-    // seeded the branch, on a stem of its own (the main shoot's #68 is not on its path), and
-    // after the cut #85 and what grew from it are gone while #28 and #68 remain
+    // seeded the branch, on a stem of its own (the main shoot's #68 is not on its path); the cut
+    // part lets go and falls for the grammar's fall_time (0.6 s, six steps) while #28 and #68
+    // hang on, then leaves the string (Fig. 7 (e): "separated branches fall on the ground and
+    // disappear")
     auto before_cut = grow("fig07_editing.plant", {}, 51);
-    auto after_cut = grow("fig07_editing.plant", {}, 53);
+    auto just_cut = grow("fig07_editing.plant", {}, 53);
+    auto fallen = grow("fig07_editing.plant", {}, 56);
+    auto after_cut = grow("fig07_editing.plant", {}, 60);
     {
         const physics::World& w = before_cut->world();
         const physics::Handle cut = before_cut->climber().particle(85);
@@ -200,14 +219,26 @@ TEST_CASE("climber figures: Fig. 7's gust of wind bends the plant more than 5 cm
         }
         CHECK(from_seeded);
         CHECK(!through_shoot);
+        CHECK(loose(*before_cut).first == 0);
     }
+    const physics::Handle falling = just_cut->climber().particle(85);
+    REQUIRE(falling.valid());
+    CHECK(just_cut->world().alive(falling));
+    CHECK(!just_cut->world().attached(falling));
+    const auto [n53, y53] = loose(*just_cut);
+    const auto [n56, y56] = loose(*fallen);
+    INFO("cut part: " << n53 << " particles at mean height " << y53 << " m at step 53, " << n56 << " at "
+                      << y56 << " m at step 56");
+    CHECK(n53 > 10);
+    CHECK(y56 < y53 - 0.05);
     const physics::Handle gone = after_cut->climber().particle(85);
     CHECK((!gone.valid() || !after_cut->world().alive(gone)));
+    CHECK(loose(*after_cut).first == 0);
     for (const ModuleId kept : {ModuleId{28}, ModuleId{68}}) {
         const physics::Handle h = after_cut->climber().particle(kept);
-        CHECK((h.valid() && after_cut->world().alive(h)));
+        CHECK((h.valid() && after_cut->world().alive(h) && after_cut->world().attached(h)));
     }
-    CHECK(after_cut->count("Seg") + 10 < before_cut->count("Seg"));
+    CHECK(after_cut->count("Seg") + 10 < fallen->count("Seg")); // its segments left the string
 }
 
 // The largest |length / rest length - 1| of any link of the world.
@@ -368,15 +399,30 @@ TEST_CASE("climber figures: Fig. 5's branching probability and variance show", "
     CHECK(d.lean < b.lean);
 }
 
-TEST_CASE("climber figures: Fig. 6's dragged branch breaks off and leaves the plant", "[climber]") {
-    // fig06_break.plant drags segment #67 from step 28 on
+TEST_CASE("climber figures: Fig. 6's dragged branch breaks off, falls and leaves the plant", "[climber]") {
+    // fig06_break.plant drags segment #67 from step 28 on; the part above the break lets go of the
+    // wall and falls (section 6.1: "the pieces fall down due to gravity") for the climber's
+    // fall_time (1 s, ten steps), then leaves the string
     auto before = grow("fig06_break.plant", {}, 28);
     auto broken = grow("fig06_break.plant", {}, 31);
-    auto undisturbed = grow("fig06_break.plant", {{"drag", "0"}}, 31);
-    INFO("segments: " << before->count("Seg") << " before the drag, " << broken->count("Seg") << " after, "
-                      << undisturbed->count("Seg") << " undisturbed");
-    CHECK(broken->count("Seg") + 5 < before->count("Seg")); // the part above the break is gone
-    CHECK(broken->alive() + 5 < undisturbed->alive());      // and its particles
+    auto falling = grow("fig06_break.plant", {}, 38);
+    auto gone = grow("fig06_break.plant", {}, 40);
+    auto undisturbed = grow("fig06_break.plant", {{"drag", "0"}}, 40);
+    const auto [n31, y31] = loose(*broken);
+    const auto [n38, y38] = loose(*falling);
+    INFO("segments: " << before->count("Seg") << " before the drag, " << broken->count("Seg")
+                      << " at step 31, " << gone->count("Seg") << " at step 40, " << undisturbed->count("Seg")
+                      << " undisturbed; loose particles " << n31 << " at mean height " << y31
+                      << " m at step 31, " << n38 << " at " << y38 << " m at step 38, " << loose(*gone).first
+                      << " at step 40");
+    CHECK(n31 > 20);                                        // most of the plant broke off
+    CHECK(broken->count("Seg") + 5 > before->count("Seg")); // still drawn while it falls
+    CHECK(n38 == n31);
+    CHECK(y38 < y31 - 0.3);                               // fallen
+    CHECK(y38 < 0.1);                                     // to the foot of the wall
+    CHECK(loose(*gone).first == 0);                       // then gone, from the world
+    CHECK(gone->count("Seg") + 5 < before->count("Seg")); // and the string
+    CHECK(gone->alive() + 5 < undisturbed->alive());
     CHECK(undisturbed->count("Seg") > before->count("Seg"));
 }
 

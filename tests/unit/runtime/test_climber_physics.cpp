@@ -110,7 +110,9 @@ Crossings crossings(const physics::World& w) {
 // The deepest overlap between links of different plants (0 when none), each link a capsule of its
 // particle's thinnest radius: every pair of links of different plants whose midpoints are near
 // enough to touch, from a grid of midpoints (not the physics' own broad phase), its closest points
-// found by sampling both segments every 0.5 mm.
+// found by sampling both segments every 0.5 mm. A part that broke off or was cut and is falling
+// (it hangs from no fixed root) is not a plant: it collides as particles, and as capsules where
+// `plant_contacts` is on, but is not counted here.
 double plant_overlap(const physics::World& w) {
     struct Link {
         glm::dvec3 a, b;
@@ -120,9 +122,11 @@ double plant_overlap(const physics::World& w) {
     std::vector<Link> links;
     std::vector<std::uint32_t> plant(w.size(), ~0u);
     double reach = 0; // the farthest two touching links' midpoints can be apart, halved
+    std::vector<std::uint8_t> attached;
+    w.attached_all(attached);
     for (std::uint32_t i = 0; i < w.size(); ++i) {
         const physics::Handle h = w.handle(i);
-        if (!w.alive(h)) continue;
+        if (!w.alive(h) || !attached[i]) continue;
         const std::uint32_t p = w.parent(h);
         plant[i] = p == ~0u ? i : plant[p];
         if (p == ~0u) continue;
@@ -176,7 +180,7 @@ double plant_overlap(const physics::World& w) {
 
 // How a plant holds on to its supports after a derivation's last step (clinging()).
 struct Clinging {
-    std::size_t live = 0;        // particles with a parent
+    std::size_t live = 0;        // particles with a parent, hanging from a fixed root
     std::size_t on_support = 0;  // of them, within 1 cm of a support's surface
     std::size_t held_there = 0;  // of those, anchored (to anything)
     std::size_t to_support = 0;  // particles anchored to a support
@@ -211,7 +215,8 @@ Clinging clinging(const physics::World& w) {
     const auto& obstacles = w.obstacles();
     for (std::uint32_t i = 0; i < w.size(); ++i) {
         const physics::Handle h = w.handle(i);
-        if (!w.alive(h) || w.parent(h) == ~0u) continue;
+        // (a part that broke off or was cut lets go of its supports and falls: not counted)
+        if (!w.alive(h) || w.parent(h) == ~0u || !w.attached(h)) continue;
         ++c.live;
         double gap = HUGE_VAL, anchor_gap = HUGE_VAL;
         bool to_support = false;

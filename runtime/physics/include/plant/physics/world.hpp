@@ -199,6 +199,14 @@ class World {
     // outside every obstacle, at the segment's length from `from` (a new segment's end, before it
     // is drawn: segment_contacts.cpp). Where `from` itself is too near an obstacle, as far as it can.
     glm::dvec3 clear_segment_end(const glm::dvec3& from, const glm::dvec3& to, double r) const;
+    // Unlinks h from its parent: h and what hangs from it become a loose part, which falls (a cut
+    // that keeps the part; remove() takes it away).
+    void cut_loose(Handle h) {
+        if (alive(h)) detach(h.index);
+    }
+    // The anchors of particles whose `attached` entry (attached_all) is 0 let go: a loose part
+    // falls, its pieces "fall down due to gravity" (Hädrich et al., section 6.1).
+    void release_loose(const std::vector<std::uint8_t>& attached);
     // Removes obstacle k (later ones move down one); its anchors let go, so what it held falls.
     void remove_obstacle(std::size_t k);
     // Moves obstacle k by `delta` (section 5.2: the user moves objects and the plants adapt).
