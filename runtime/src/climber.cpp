@@ -62,8 +62,10 @@ constexpr EnvMethod kClimberMethods[] = {
     env_method(M::Grab, "grab", {N, V}, N, Edit, false,
                "pull module id's particle toward a point at grab_speed through the next step, its stem "
                "following within its length and coming off its supports"),
+    env_method(M::Remove, "remove", {N}, N, Edit, false,
+               "take obstacle k away (numbered as for move): the particles anchored to it let go"),
 };
-static_assert(method_table(kClimberMethods, M::Grab));
+static_assert(method_table(kClimberMethods, M::Remove));
 
 } // namespace
 
@@ -208,6 +210,10 @@ void Climber::edit(std::size_t method, const double* a) {
     case M::Seed:
         seed_requests_.push_back(id_of(a[0]));
         return;
+    case M::Remove:
+        if (std::isfinite(a[0]) && a[0] >= 0 && a[0] < 1e9)
+            removals_.push_back(static_cast<std::size_t>(a[0]));
+        return;
     case M::Emit:
         // the bound of `emitter_velocity` (docs/language.md "Limits") holds for emit too; the VM
         // places the error on the call
@@ -258,6 +264,23 @@ void Climber::geometry(std::vector<glm::dvec3>& triangles, const glm::dvec3& lo,
             k < obstacles.size() ? obstacles[k].a : glm::dvec3(0.0); // moved since loaded
         for (const auto& v : mesh) triangles.push_back(v + offset);
     }
+}
+
+void Climber::remove_obstacles() {
+    for (const std::size_t declared : removals_) {
+        const std::size_t now = obstacle_now(declared);
+        if (now == ~std::size_t{0} || now >= world_.obstacles().size()) continue; // gone, or never there
+        if (obstacle_at_.empty())
+            for (std::size_t k = 0; k < world_.obstacles().size(); ++k) obstacle_at_.push_back(k);
+        world_.remove_obstacle(now); // its anchors let go
+        for (std::size_t& k : obstacle_at_)
+            if (k != ~std::size_t{0} && k > now) --k;
+        obstacle_at_[declared] = ~std::size_t{0};
+        std::erase_if(meshes_, [&](const auto& m) { return m.first == now; });
+        for (auto& m : meshes_)
+            if (m.first > now) --m.first;
+    }
+    removals_.clear();
 }
 
 void Climber::begin_segments() {
@@ -369,8 +392,10 @@ void Climber::advance(std::set<ModuleId>& left) {
     seeded_.clear();
     seeded_.insert(seed_requests_.begin(), seed_requests_.end());
     seed_requests_.clear();
-    for (const auto& [k, delta] : moves_) world_.move_obstacle(k, delta);
+    for (const auto& [k, delta] : moves_)
+        if (const std::size_t now = obstacle_now(k); now != ~std::size_t{0}) world_.move_obstacle(now, delta);
     moves_.clear();
+    remove_obstacles();
     auto& emitters = fluid_.settings().emitters;
     for (const auto& [k, velocity] : emits_)
         if (k < emitters.size()) emitters[k].velocity = velocity;

@@ -70,7 +70,8 @@ enum class ClimberMethod : std::uint8_t {
     // queries, after the edits so that their numbers stay
     ClearDir,
     Thickness,
-    Grab, // an edit, after the queries so that their numbers stay
+    Grab,   // an edit, after the queries so that their numbers stay
+    Remove, // an edit too
 };
 
 const EnvironmentKind& climber_kind();
@@ -197,6 +198,16 @@ class Climber : public Environment {
     std::vector<std::pair<ModuleId, glm::dvec3>> pulls_, grabs_;
     std::vector<ModuleId> cuts_;
     std::vector<std::pair<std::size_t, glm::dvec3>> moves_;
+    std::vector<std::size_t> removals_; // obstacles, numbered as declared
+    // Each declared obstacle's index in the world now (~0: removed); empty until one is removed,
+    // so that move(k, delta) and remove(k) keep the declared numbers after a removal.
+    std::vector<std::size_t> obstacle_at_;
+    std::size_t obstacle_now(std::size_t declared) const {
+        return obstacle_at_.empty()
+                   ? declared
+                   : (declared < obstacle_at_.size() ? obstacle_at_[declared] : ~std::size_t{0});
+    }
+    void remove_obstacles(); // removals_, in the order asked
     std::vector<ModuleId> seed_requests_;
     std::vector<std::pair<std::size_t, glm::dvec3>> emits_; // emitter, its new velocity
     std::set<ModuleId> seeded_;

@@ -442,3 +442,30 @@ axiom: Seg(0.1, 0.02) Seg(0.1, 0.02) Seg(0.1, 0.02) Seg(0.1, 0.02) Seg(0.1, 0.02
     CHECK(off == calm);          // switched off before any air step: as if it had never blown
     CHECK(on == blown);          // and switched on: as if declared blowing
 }
+
+TEST_CASE("climber: ivy.remove(k) takes a support away and the plant anchored to it falls", "[climber]") {
+    // a soft shoot of ten segments anchored along the face of a box (obstacle 0), 1 m up, beside a
+    // second box (obstacle 1) it never touches; removing the second changes nothing, removing the
+    // first from a hook lets the shoot go, and it sags (issue 18, item 3)
+    const std::string shoot = R"(
+env ivy = climber(box_min: vec3(-1, 0, -0.2), box_max: vec3(1, 2, 0), box_min: vec3(3, 0, 0), box_max: vec3(4, 1, 1),
+                  anchor: 0.5, anchor_range: 0.03, stiffness: 0.2);
+module Seg(len, r) bound ivy;
+derive 10;
+axiom: @M(0, 1, 0.015) SetHead(1, 0, 0, 0, 0, 1) Seg(0.1, 0.01) Seg(0.1, 0.01) Seg(0.1, 0.01) Seg(0.1, 0.01)
+       Seg(0.1, 0.01) Seg(0.1, 0.01) Seg(0.1, 0.01) Seg(0.1, 0.01) Seg(0.1, 0.01) Seg(0.1, 0.01) ?P(0, 0, 0);
+)";
+    auto tip = [](const Grown& g) { return g.skeleton.axes.at(0).points.back().position; };
+    const Grown held = grow(shoot);
+    const Grown other = grow(shoot + "on before_step { if step() == 3 { ivy.remove(1); } }\n");
+    const Grown removed = grow(shoot + "on before_step { if step() == 3 { ivy.remove(0); } }\n");
+    // numbered as declared: the wall is still 0 after the other box went
+    const Grown both = grow(shoot + "on before_step { if step() == 3 { ivy.remove(1); } if step() == 4 { "
+                                    "ivy.remove(0); } }\n");
+    INFO("tip held at y = " << tip(held).y << ", with the other box removed " << tip(other).y
+                            << ", with its wall removed " << tip(removed).y << ", with both " << tip(both).y);
+    CHECK(tip(held).y > 0.9); // anchored, it holds its line along the wall
+    CHECK(tip(other) == tip(held));
+    CHECK(tip(removed).y < tip(held).y - 0.2); // let go, it sags
+    CHECK(tip(both).y < tip(held).y - 0.2);
+}
